@@ -1,0 +1,39 @@
+#pragma once
+// Geometry shared by every domain. Coordinates are left-image (epipolar) pixels unless a type
+// says otherwise: x to the right, y down, pixel (i, j) covers [i, i+1) x [j, j+1), so the centre
+// of pixel (i, j) is (i + 0.5, j + 0.5).
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace delineo::core {
+
+using Ring = std::vector<cv::Point2d>;  // closed implicitly: last vertex connects to the first
+
+struct Polygon {
+  Ring outer;               // counter-clockwise or clockwise; helpers normalise when needed
+  std::vector<Ring> holes;  // inner courtyards
+};
+
+using AttributeValue = std::variant<std::monostate, long long, double, std::string>;
+
+struct Feature {
+  Polygon polygon;
+  std::map<std::string, AttributeValue> attributes;
+};
+
+// Signed area (shoelace): positive for counter-clockwise in a y-up frame, i.e. clockwise on
+// screen with y down.
+double signedArea(const Ring& ring);
+double area(const Polygon& polygon);  // outer minus holes, always >= 0
+cv::Rect2d boundingBox(const Ring& ring);
+// True when no two non-adjacent edges of the ring intersect and it has >= 3 vertices.
+bool isSimple(const Ring& ring);
+// Rasterises a polygon (with holes) into a CV_8U mask of the given size: 255 where the pixel
+// centre is inside.
+cv::Mat rasterize(const Polygon& polygon, cv::Size size);
+
+}  // namespace delineo::core

@@ -1,0 +1,109 @@
+#include "delineo/core/geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+
+namespace delineo::core {
+
+double signedArea(const Ring& ring) {
+  double a = 0.0;
+  const size_t n = ring.size();
+  for (size_t i = 0; i < n; ++i) {
+    const auto& p = ring[i];
+    const auto& q = ring[(i + 1) % n];
+    a += p.x * q.y - q.x * p.y;
+  }
+  return 0.5 * a;
+}
+
+double area(const Polygon& polygon) {
+  double a = std::abs(signedArea(polygon.outer));
+  for (const auto& h : polygon.holes) a -= std::abs(signedArea(h));
+  return std::max(0.0, a);
+}
+
+cv::Rect2d boundingBox(const Ring& ring) {
+  if (ring.empty()) return {};
+  double x0 = std::numeric_limits<double>::max(), y0 = x0;
+  double x1 = std::numeric_limits<double>::lowest(), y1 = x1;
+  for (const auto& p : ring) {
+    x0 = std::min(x0, p.x);
+    y0 = std::min(y0, p.y);
+    x1 = std::max(x1, p.x);
+    y1 = std::max(y1, p.y);
+  }
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+namespace {
+double cross(const cv::Point2d& o, const cv::Point2d& a, const cv::Point2d& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+bool onSegment(const cv::Point2d& p, const cv::Point2d& q, const cv::Point2d& r) {
+  return std::min(p.x, r.x) <= q.x && q.x <= std::max(p.x, r.x) && std::min(p.y, r.y) <= q.y &&
+         q.y <= std::max(p.y, r.y);
+}
+int sign(double v) { return (v > 1e-12) - (v < -1e-12); }
+bool segmentsIntersect(const cv::Point2d& p1, const cv::Point2d& p2, const cv::Point2d& p3,
+                       const cv::Point2d& p4) {
+  const int d1 = sign(cross(p3, p4, p1)), d2 = sign(cross(p3, p4, p2));
+  const int d3 = sign(cross(p1, p2, p3)), d4 = sign(cross(p1, p2, p4));
+  if (d1 * d2 < 0 && d3 * d4 < 0) return true;
+  if (d1 == 0 && onSegment(p3, p1, p4)) return true;
+  if (d2 == 0 && onSegment(p3, p2, p4)) return true;
+  if (d3 == 0 && onSegment(p1, p3, p2)) return true;
+  if (d4 == 0 && onSegment(p1, p4, p2)) return true;
+  return false;
+}
+}  // namespace
+
+bool isSimple(const Ring& ring) {
+  const size_t n = ring.size();
+  if (n < 3) return false;
+  if (std::abs(signedArea(ring)) < 1e-12) return false;
+  for (size_t i = 0; i < n; ++i) {
+    const auto& a = ring[i];
+    const auto& b = ring[(i + 1) % n];
+    if (a == b) return false;
+    for (size_t j = i + 1; j < n; ++j) {
+      if (j == i || (j + 1) % n == i || (i + 1) % n == j) continue;  // adjacent edges
+      if (segmentsIntersect(a, b, ring[j], ring[(j + 1) % n])) return false;
+    }
+  }
+  return true;
+}
+
+cv::Mat rasterize(const Polygon& polygon, cv::Size size) {
+  // Exact even-odd scanline fill at pixel centres: a pixel is inside when its centre is, with
+  // half-open edge rules so that adjacent polygons never share a pixel.
+  cv::Mat mask(size, CV_8U, cv::Scalar(0));
+  std::vector<const Ring*> rings{&polygon.outer};
+  for (const auto& h : polygon.holes) rings.push_back(&h);
+  std::vector<double> xs;
+  for (int y = 0; y < size.height; ++y) {
+    const double yc = y + 0.5;
+    xs.clear();
+    for (const Ring* ring : rings) {
+      const size_t n = ring->size();
+      for (size_t i = 0; i < n; ++i) {
+        const auto& a = (*ring)[i];
+        const auto& b = (*ring)[(i + 1) % n];
+        if ((a.y <= yc) == (b.y <= yc)) continue;  // edge does not cross this scanline
+        xs.push_back(a.x + (yc - a.y) * (b.x - a.x) / (b.y - a.y));
+      }
+    }
+    std::sort(xs.begin(), xs.end());
+    auto* row = mask.ptr<uchar>(y);
+    for (size_t k = 0; k + 1 < xs.size(); k += 2) {
+      // pixels whose centre x + 0.5 lies in [xs[k], xs[k+1])
+      const int x0 = std::max(0, static_cast<int>(std::ceil(xs[k] - 0.5)));
+      const int x1 = std::min(size.width, static_cast<int>(std::ceil(xs[k + 1] - 0.5)));
+      for (int x = x0; x < x1; ++x) row[x] = 255;
+    }
+  }
+  return mask;
+}
+
+}  // namespace delineo::core
