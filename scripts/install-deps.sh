@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git jq
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev libqt6concurrent6 qt6-tools-dev
   qt6-tools-dev-tools qt6-l10n-tools linguist-qt6 libqt6svg6 qt6-translations-l10n
   libopencv-dev libopencv-contrib-dev
