@@ -1,0 +1,487 @@
+#include "delineo/widgets/polygon_overlay.hpp"
+
+#include <QContextMenuEvent>
+#include <QKeyEvent>
+#include <QMenu>
+#include <QMouseEvent>
+#include <QPainter>
+#include <QPainterPath>
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/widgets/image_view.hpp"
+
+namespace delineo::widgets {
+namespace {
+
+constexpr double kVertexHitPx = 7.0;  // widget pixels
+constexpr double kEdgeHitPx = 5.0;
+
+double dot(QPointF a, QPointF b) { return a.x() * b.x() + a.y() * b.y(); }
+double length(QPointF a) { return std::hypot(a.x(), a.y()); }
+
+// Distance from p to segment [a, b] and the parameter t of the closest point.
+double segmentDistance(QPointF p, QPointF a, QPointF b, double* t) {
+  const QPointF ab = b - a;
+  const double len2 = dot(ab, ab);
+  double s = len2 > 0 ? dot(p - a, ab) / len2 : 0.0;
+  s = std::clamp(s, 0.0, 1.0);
+  if (t != nullptr) *t = s;
+  return length(p - (a + ab * s));
+}
+
+// Angle between two vectors in degrees, in [0, 180].
+double angleBetween(QPointF u, QPointF w) {
+  const double lu = length(u);
+  const double lw = length(w);
+  if (lu < 1e-12 || lw < 1e-12) return 0.0;
+  return std::acos(std::clamp(dot(u, w) / (lu * lw), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// Projection of p onto the line through `origin` with direction `dir`.
+QPointF projectOntoLine(QPointF p, QPointF origin, QPointF dir) {
+  const double d2 = dot(dir, dir);
+  if (d2 < 1e-24) return p;
+  return origin + dir * (dot(p - origin, dir) / d2);
+}
+
+bool intersectLines(QPointF p, QPointF d, QPointF q, QPointF e, QPointF* out) {
+  const double cross = d.x() * e.y() - d.y() * e.x();
+  if (std::abs(cross) < 1e-9 * length(d) * length(e)) return false;
+  const QPointF w = q - p;
+  const double s = (w.x() * e.y() - w.y() * e.x()) / cross;
+  *out = p + d * s;
+  return true;
+}
+
+QPointF perpendicular(QPointF v) { return {-v.y(), v.x()}; }
+
+}  // namespace
+
+QPolygonF toQPolygon(const core::Ring& ring) {
+  QPolygonF out;
+  out.reserve(static_cast<qsizetype>(ring.size()));
+  for (const cv::Point2d& p : ring) out << QPointF(p.x, p.y);
+  return out;
+}
+
+core::Ring toRing(const QPolygonF& polygon) {
+  core::Ring out;
+  out.reserve(static_cast<size_t>(polygon.size()));
+  for (const QPointF& p : polygon) out.emplace_back(p.x(), p.y());
+  // QPolygonF may repeat the first point to close itself; core rings are implicitly closed.
+  if (out.size() > 1 && out.front() == out.back()) out.pop_back();
+  return out;
+}
+
+QColor statusColour(PolygonStatus status) {
+  switch (status) {
+    case PolygonStatus::Candidate: return QColor(0, 200, 255);    // cyan
+    case PolygonStatus::Accepted: return QColor(40, 220, 90);     // green
+    case PolygonStatus::Rejected: return QColor(150, 150, 150);   // grey
+    case PolygonStatus::Edited: return QColor(255, 170, 0);       // orange
+    case PolygonStatus::Failed: return QColor(235, 60, 60);       // red
+  }
+  return QColor(0, 200, 255);
+}
+
+PolygonOverlay::PolygonOverlay(ImageView* view) : QObject(view), view_(view) {}
+
+void PolygonOverlay::setPolygons(std::vector<OverlayPolygon> polygons) {
+  polygons_ = std::move(polygons);
+  drag_.reset();
+  hover_.reset();
+  if (selectedId_ >= 0 && selectedPolygon() == nullptr) {
+    selectedId_ = -1;
+    emit selectionChanged(-1);
+  }
+  emit changed();
+}
+
+void PolygonOverlay::clearPolygons() { setPolygons({}); }
+
+void PolygonOverlay::setSelectedId(int id) {
+  if (id == selectedId_) return;
+  selectedId_ = id;
+  drag_.reset();
+  hover_.reset();
+  emit selectionChanged(id);
+  emit changed();
+}
+
+const OverlayPolygon* PolygonOverlay::selectedPolygon() const {
+  for (const OverlayPolygon& p : polygons_) {
+    if (p.id == selectedId_) return &p;
+  }
+  return nullptr;
+}
+
+void PolygonOverlay::setEvolvingContour(const QPolygonF& contour) {
+  evolving_ = contour;
+  emit changed();
+}
+
+void PolygonOverlay::clearEvolvingContour() { setEvolvingContour({}); }
+
+void PolygonOverlay::setRoi(const QRectF& roi) {
+  roi_ = roi;
+  emit changed();
+}
+
+void PolygonOverlay::setEdgeMap(const cv::Mat& edgeStrength, double threshold) {
+  CV_Assert(edgeStrength.empty() || edgeStrength.channels() == 1);
+  if (edgeStrength.empty() || edgeStrength.depth() == CV_32F) {
+    edgeMap_ = edgeStrength;
+  } else {
+    edgeStrength.convertTo(edgeMap_, CV_32F);
+  }
+  edgeThreshold_ = threshold;
+}
+
+QPolygonF PolygonOverlay::ringOf(const OverlayPolygon& polygon, int ringIndex) const {
+  if (drag_ && polygon.id == selectedId_ && drag_->ring == ringIndex) return drag_->preview;
+  if (ringIndex == 0) return toQPolygon(polygon.polygon.outer);
+  const size_t hole = static_cast<size_t>(ringIndex - 1);
+  return hole < polygon.polygon.holes.size() ? toQPolygon(polygon.polygon.holes[hole]) : QPolygonF();
+}
+
+// --- snapping --------------------------------------------------------------------------------
+
+QPointF PolygonOverlay::snapToEdge(QPointF pos, bool* snapped) const {
+  *snapped = false;
+  if (edgeMap_.empty()) return pos;
+  const int r = static_cast<int>(std::ceil(edgeSnapRadius_));
+  const int cx = static_cast<int>(std::floor(pos.x()));
+  const int cy = static_cast<int>(std::floor(pos.y()));
+  double best = edgeSnapRadius_ * edgeSnapRadius_ + 1e-9;
+  QPointF bestPos = pos;
+  for (int y = std::max(cy - r, 0); y <= std::min(cy + r, edgeMap_.rows - 1); ++y) {
+    const float* row = edgeMap_.ptr<float>(y);
+    for (int x = std::max(cx - r, 0); x <= std::min(cx + r, edgeMap_.cols - 1); ++x) {
+      if (!(row[x] >= edgeThreshold_)) continue;
+      const QPointF centre(x + 0.5, y + 0.5);
+      const QPointF d = centre - pos;
+      const double d2 = dot(d, d);
+      if (d2 < best) {
+        best = d2;
+        bestPos = centre;
+        *snapped = true;
+      }
+    }
+  }
+  return bestPos;
+}
+
+QPointF PolygonOverlay::snapVertex(const QPolygonF& ring, int vertex, QPointF pos) const {
+  const int n = static_cast<int>(ring.size());
+  if (snapEdges_) {
+    bool snapped = false;
+    const QPointF onEdge = snapToEdge(pos, &snapped);
+    if (snapped) return onEdge;
+  }
+  if (!snapRightAngles_ || n < 3) return pos;
+  auto at = [&](int i) { return ring[((i % n) + n) % n]; };
+  const QPointF prev = at(vertex - 1);
+  const QPointF next = at(vertex + 1);
+  const double tol = rightAngleToleranceDeg_;
+
+  // Right angle at the previous vertex: pos on the line through prev perpendicular to the edge
+  // arriving there. Likewise at the next vertex. Both → their intersection (a rectangle corner).
+  bool havePrevLine = false;
+  bool haveNextLine = false;
+  QPointF prevDir;
+  QPointF nextDir;
+  if (n >= 4) {
+    const QPointF prevEdge = prev - at(vertex - 2);
+    if (std::abs(angleBetween(at(vertex - 2) - prev, pos - prev) - 90.0) <= tol) {
+      havePrevLine = true;
+      prevDir = perpendicular(prevEdge);
+    }
+    const QPointF nextEdge = at(vertex + 2) - next;
+    if (std::abs(angleBetween(at(vertex + 2) - next, pos - next) - 90.0) <= tol) {
+      haveNextLine = true;
+      nextDir = perpendicular(nextEdge);
+    }
+  }
+  if (havePrevLine && haveNextLine) {
+    QPointF corner;
+    if (intersectLines(prev, prevDir, next, nextDir, &corner)) return corner;
+  }
+  if (havePrevLine) return projectOntoLine(pos, prev, prevDir);
+  if (haveNextLine) return projectOntoLine(pos, next, nextDir);
+
+  // Right angle at the vertex itself: pos on the circle whose diameter is prev-next (Thales).
+  if (std::abs(angleBetween(prev - pos, next - pos) - 90.0) <= tol) {
+    const QPointF centre = (prev + next) / 2.0;
+    const double radius = length(next - prev) / 2.0;
+    const QPointF d = pos - centre;
+    const double dl = length(d);
+    if (dl > 1e-12) return centre + d * (radius / dl);
+  }
+  return pos;
+}
+
+// --- hit testing -----------------------------------------------------------------------------
+
+std::optional<PolygonOverlay::Hit> PolygonOverlay::hitTest(QPointF widgetPos) const {
+  const OverlayPolygon* selected = selectedPolygon();
+  if (selected == nullptr) return std::nullopt;
+  const int rings = 1 + static_cast<int>(selected->polygon.holes.size());
+  std::optional<Hit> best;
+  double bestVertex = kVertexHitPx;
+  for (int r = 0; r < rings; ++r) {
+    const QPolygonF ring = ringOf(*selected, r);
+    for (int i = 0; i < ring.size(); ++i) {
+      const double d = length(view_->imageToWidget(ring[i]) - widgetPos);
+      if (d <= bestVertex) {
+        bestVertex = d;
+        best = Hit{r, i, -1, view_->widgetToImage(widgetPos)};
+      }
+    }
+  }
+  if (best) return best;
+  double bestEdge = kEdgeHitPx;
+  for (int r = 0; r < rings; ++r) {
+    const QPolygonF ring = ringOf(*selected, r);
+    const int n = static_cast<int>(ring.size());
+    for (int i = 0; i < n; ++i) {
+      double t = 0;
+      const double d = segmentDistance(widgetPos, view_->imageToWidget(ring[i]),
+                                       view_->imageToWidget(ring[(i + 1) % n]), &t);
+      if (d <= bestEdge) {
+        bestEdge = d;
+        best = Hit{r, -1, i, view_->widgetToImage(widgetPos)};
+      }
+    }
+  }
+  return best;
+}
+
+int PolygonOverlay::polygonAt(QPointF widgetPos) const {
+  const QPointF p = view_->widgetToImage(widgetPos);
+  for (auto it = polygons_.rbegin(); it != polygons_.rend(); ++it) {
+    if (!toQPolygon(it->polygon.outer).containsPoint(p, Qt::OddEvenFill)) continue;
+    const bool inHole = std::any_of(it->polygon.holes.begin(), it->polygon.holes.end(), [&](const core::Ring& h) {
+      return toQPolygon(h).containsPoint(p, Qt::OddEvenFill);
+    });
+    if (!inHole) return it->id;
+  }
+  return -1;
+}
+
+// --- gestures --------------------------------------------------------------------------------
+
+bool PolygonOverlay::mousePress(QMouseEvent* event) {
+  if (event->button() != Qt::LeftButton) return false;
+  const OverlayPolygon* selected = selectedPolygon();
+  const std::optional<Hit> hit = hitTest(event->position());
+  if (selected == nullptr || !hit) return false;
+  if (hit->vertex >= 0) {
+    const QPolygonF ring = ringOf(*selected, hit->ring);
+    drag_ = Drag{Drag::Kind::Vertex, hit->ring, hit->vertex, hit->imagePos, ring, ring};
+    hover_ = hit;
+    emit changed();
+    return true;
+  }
+  if (hit->edge >= 0 && (event->modifiers() & Qt::ShiftModifier)) {
+    const QPolygonF ring = ringOf(*selected, hit->ring);
+    drag_ = Drag{Drag::Kind::Edge, hit->ring, hit->edge, hit->imagePos, ring, ring};
+    hover_ = hit;
+    emit changed();
+    return true;
+  }
+  return false;
+}
+
+bool PolygonOverlay::mouseMove(QMouseEvent* event) {
+  const QPointF imagePos = view_->widgetToImage(event->position());
+  if (!drag_) {
+    const std::optional<Hit> hit = hitTest(event->position());
+    const bool hoverChanged = hit.has_value() != hover_.has_value() ||
+                              (hit && (hit->vertex != hover_->vertex || hit->edge != hover_->edge ||
+                                       hit->ring != hover_->ring));
+    if (hit || !drag_) hover_ = hit;
+    if (hoverChanged) emit changed();
+    return false;
+  }
+  Drag& d = *drag_;
+  const int n = static_cast<int>(d.original.size());
+  d.preview = d.original;
+  if (d.kind == Drag::Kind::Vertex) {
+    d.preview[d.index] = snapVertex(d.original, d.index, imagePos);
+  } else {
+    const int j = (d.index + 1) % n;
+    QPointF delta = imagePos - d.pressImagePos;
+    const QPointF along = d.original[j] - d.original[d.index];
+    const QPointF normal = perpendicular(along);
+    if (snapRightAngles_) {
+      // Moving along the normal keeps the edge parallel to itself and its neighbours' angles.
+      delta = projectOntoLine(delta, QPointF(0, 0), normal);
+    }
+    if (snapEdges_) {
+      bool snapped = false;
+      const QPointF mid = (d.original[d.index] + d.original[j]) / 2.0 + delta;
+      const QPointF onEdge = snapToEdge(mid, &snapped);
+      if (snapped) delta += projectOntoLine(onEdge - mid, QPointF(0, 0), normal);
+    }
+    d.preview[d.index] = d.original[d.index] + delta;
+    d.preview[j] = d.original[j] + delta;
+  }
+  emit changed();
+  return true;
+}
+
+bool PolygonOverlay::mouseRelease(QMouseEvent* event) {
+  if (!drag_ || event->button() != Qt::LeftButton) return false;
+  mouseMove(event);  // the release position is the final one
+  const Drag d = *drag_;
+  drag_.reset();
+  emit changed();
+  if (d.preview != d.original) {
+    emit editRequested(selectedId_, d.ring, d.preview,
+                       d.kind == Drag::Kind::Vertex ? tr("Move vertex") : tr("Move edge"));
+  }
+  return true;
+}
+
+bool PolygonOverlay::mouseDoubleClick(QMouseEvent* event) {
+  if (event->button() != Qt::LeftButton) return false;
+  const OverlayPolygon* selected = selectedPolygon();
+  const std::optional<Hit> hit = hitTest(event->position());
+  if (selected == nullptr || !hit || hit->edge < 0) return false;
+  drag_.reset();
+  QPolygonF ring = ringOf(*selected, hit->ring);
+  const int n = static_cast<int>(ring.size());
+  double t = 0.5;
+  segmentDistance(hit->imagePos, ring[hit->edge], ring[(hit->edge + 1) % n], &t);
+  const QPointF inserted = ring[hit->edge] + (ring[(hit->edge + 1) % n] - ring[hit->edge]) * t;
+  ring.insert(hit->edge + 1, inserted);
+  emit editRequested(selectedId_, hit->ring, ring, tr("Insert vertex"));
+  return true;
+}
+
+void PolygonOverlay::deleteVertex(int ringIndex, int vertex) {
+  const OverlayPolygon* selected = selectedPolygon();
+  if (selected == nullptr) return;
+  QPolygonF ring = ringOf(*selected, ringIndex);
+  if (ring.size() <= 3 || vertex < 0 || vertex >= ring.size()) return;  // keep a valid polygon
+  ring.remove(vertex);
+  hover_.reset();
+  emit editRequested(selectedId_, ringIndex, ring, tr("Delete vertex"));
+}
+
+bool PolygonOverlay::keyPress(QKeyEvent* event) {
+  if (event->key() == Qt::Key_Escape && drag_) {
+    drag_.reset();
+    emit changed();
+    return true;
+  }
+  if ((event->key() == Qt::Key_Delete || event->key() == Qt::Key_Backspace) && !drag_ && hover_ &&
+      hover_->vertex >= 0) {
+    deleteVertex(hover_->ring, hover_->vertex);
+    return true;
+  }
+  return false;
+}
+
+bool PolygonOverlay::contextMenu(QContextMenuEvent* event) {
+  const OverlayPolygon* selected = selectedPolygon();
+  const std::optional<Hit> hit = hitTest(event->pos());
+  if (selected == nullptr || !hit) return false;
+  QMenu menu(view_);
+  if (hit->vertex >= 0) {
+    QAction* del = menu.addAction(tr("Delete vertex"));
+    del->setEnabled(ringOf(*selected, hit->ring).size() > 3);
+    if (menu.exec(event->globalPos()) == del) deleteVertex(hit->ring, hit->vertex);
+  } else {
+    QAction* insert = menu.addAction(tr("Insert vertex here"));
+    if (menu.exec(event->globalPos()) == insert) {
+      QPolygonF ring = ringOf(*selected, hit->ring);
+      const int n = static_cast<int>(ring.size());
+      double t = 0.5;
+      segmentDistance(hit->imagePos, ring[hit->edge], ring[(hit->edge + 1) % n], &t);
+      ring.insert(hit->edge + 1, ring[hit->edge] + (ring[(hit->edge + 1) % n] - ring[hit->edge]) * t);
+      emit editRequested(selectedId_, hit->ring, ring, tr("Insert vertex"));
+    }
+  }
+  return true;
+}
+
+// --- painting --------------------------------------------------------------------------------
+
+void PolygonOverlay::paint(QPainter& painter) const {
+  auto toWidget = [&](const QPolygonF& ring) {
+    QPolygonF out;
+    out.reserve(ring.size());
+    for (const QPointF& p : ring) out << view_->imageToWidget(p);
+    return out;
+  };
+
+  if (!roi_.isNull()) {
+    painter.setBrush(Qt::NoBrush);
+    painter.setPen(QPen(QColor(255, 255, 255), 1.0, Qt::SolidLine));
+    const QRectF r(view_->imageToWidget(roi_.topLeft()), view_->imageToWidget(roi_.bottomRight()));
+    painter.drawRect(r);
+    painter.setPen(QPen(QColor(255, 200, 0), 1.0, Qt::DashLine));
+    painter.drawRect(r);
+  }
+
+  for (const OverlayPolygon& polygon : polygons_) {
+    const bool selected = polygon.id == selectedId_;
+    QColor colour = polygon.colour.isValid() ? polygon.colour : statusColour(polygon.status);
+    QPainterPath path;
+    path.setFillRule(Qt::OddEvenFill);
+    const int rings = 1 + static_cast<int>(polygon.polygon.holes.size());
+    for (int r = 0; r < rings; ++r) {
+      const QPolygonF ring = toWidget(ringOf(polygon, r));
+      if (ring.size() < 2) continue;
+      path.addPolygon(ring);
+      path.closeSubpath();
+    }
+    QColor fill = colour;
+    fill.setAlpha(selected ? 60 : 35);
+    QPen pen(colour, selected ? 2.5 : 1.5);
+    if (polygon.status == PolygonStatus::Rejected) pen.setStyle(Qt::DashLine);
+    painter.setPen(pen);
+    painter.setBrush(fill);
+    painter.drawPath(path);
+    if (!polygon.label.isEmpty() && !polygon.polygon.outer.empty()) {
+      painter.setPen(colour);
+      const QPointF at = view_->imageToWidget(QPointF(polygon.polygon.outer[0].x, polygon.polygon.outer[0].y));
+      painter.drawText(at + QPointF(4, -4), polygon.label);
+    }
+    if (selected && view_->interactionMode() == InteractionMode::EditPolygon) {
+      for (int r = 0; r < rings; ++r) {
+        const QPolygonF ring = toWidget(ringOf(polygon, r));
+        for (int i = 0; i < ring.size(); ++i) {
+          const bool hot = (hover_ && hover_->ring == r && hover_->vertex == i) ||
+                           (drag_ && drag_->kind == Drag::Kind::Vertex && drag_->ring == r && drag_->index == i);
+          painter.setPen(QPen(Qt::black, 1.0));
+          painter.setBrush(hot ? QColor(255, 255, 0) : QColor(255, 255, 255));
+          const double s = hot ? 4.5 : 3.5;
+          painter.drawRect(QRectF(ring[i] - QPointF(s, s), ring[i] + QPointF(s, s)));
+        }
+        const bool edgeHot = (hover_ && hover_->ring == r && hover_->edge >= 0) ||
+                             (drag_ && drag_->kind == Drag::Kind::Edge && drag_->ring == r);
+        if (edgeHot && ring.size() >= 2) {
+          const int e = drag_ ? drag_->index : hover_->edge;
+          painter.setPen(QPen(QColor(255, 255, 0), 3.0));
+          painter.drawLine(ring[e], ring[(e + 1) % ring.size()]);
+        }
+      }
+    }
+  }
+
+  if (evolving_.size() >= 2) {
+    const QPolygonF ring = toWidget(evolving_);
+    painter.setBrush(Qt::NoBrush);
+    painter.setPen(QPen(QColor(0, 0, 0), 2.5));
+    painter.drawPolygon(ring);
+    painter.setPen(QPen(QColor(255, 60, 200), 2.0, Qt::DashLine));
+    painter.drawPolygon(ring);
+  }
+}
+
+}  // namespace delineo::widgets
