@@ -1,0 +1,130 @@
+#pragma once
+// The six-term energy of the statistical active polygon, in ROI pixel coordinates.
+//
+//   F(C) = Σ_Ω c_roof + Σ_E c_ground + Σ_O NoMatchCost
+//          - λ Σ_C |∇I1·n| - λ Σ_C |∇I2(x - d_xy, y)·n| + β Σ_s R(θ_s)
+//
+// Inputs are plain images so that tests can feed hand-made costs. Polygons have integer
+// vertices in [0, W] x [0, H] (pixel corners); a pixel belongs to the polygon when its centre
+// does (same rule as core::rasterize).
+#include <array>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/core/geometry.hpp"
+
+namespace delineo::delineation {
+
+using IntRing = std::vector<cv::Point>;
+struct IntPolygon {
+  IntRing outer;
+  std::vector<IntRing> holes;
+  size_t ringCount() const { return 1 + holes.size(); }
+  const IntRing& ring(size_t r) const { return r == 0 ? outer : holes[r - 1]; }
+  IntRing& ring(size_t r) { return r == 0 ? outer : holes[r - 1]; }
+  int vertexCount() const;
+};
+core::Polygon toPolygon(const IntPolygon& p, cv::Point2d offset = {0, 0});
+// Every ring simple with >= 3 vertices, no two rings touching, holes inside the outer ring and
+// outside each other.
+bool isValidPolygon(const IntPolygon& p);
+
+struct EnergyImages {
+  cv::Mat roofCost;       // CV_32F, c_roof = min over the roof interval of Crit
+  cv::Mat groundCost;     // CV_32F, c_ground, same size
+  float noMatchCost = 1;  // cost of each pixel of the wall/occlusion band
+  // CV_32S, same size, >= 0: width in px of the occlusion band next to a roof run whose edge is
+  // at this pixel (|roof disparity - ground disparity| there). Empty = no band.
+  cv::Mat occlusionWidth;
+  // -1: the band lies on the -x side of roof runs (roof disparity > ground disparity with
+  // x_right = x_left - d); +1: on the +x side.
+  int occlusionSide = -1;
+  // Normalised image gradients (CV_32F, same size); empty pairs disable the term. The right
+  // gradients are already resampled at (x - d_xy, y).
+  cv::Mat leftGradX, leftGradY, rightGradX, rightGradY;
+};
+
+struct EnergyWeights {
+  double edgeWeight = 5.0;  // λ
+  double rigidity = 15.0;   // β
+};
+
+// Contour length unit of the edge terms: a full-contrast edge (normalised gradient 1) across the
+// contour is worth edgeUnit * λ per pixel of contour, i.e. 0.25 with λ = 5, a quarter of the
+// largest cost difference a pixel can make. docs/delineation.md explains the choice.
+inline constexpr double kEdgeUnit = 0.05;
+
+struct EnergyTerms {
+  std::array<double, 6> term{};  // (1) roof, (2) ground, (3) occlusion, (4) left edges,
+                                 // (5) right edges, (6) shape prior; already weighted and signed
+  double total() const {
+    double t = 0;
+    for (double v : term) t += v;
+    return t;
+  }
+};
+
+// R(θ), θ in radians: 2 - |sin 2θ| when cos θ >= |sin θ|, else |sin 2θ|.
+double anglePrior(double theta);
+// Angle at vertex v between the edges to `prev` and `next`, in [0, π].
+double vertexAngle(cv::Point prev, cv::Point v, cv::Point next);
+
+// Energy by rasterising the polygon and summing pixels: slow, simple, the reference.
+EnergyTerms referenceEnergy(const EnergyImages& images, const EnergyWeights& weights,
+                            const IntPolygon& polygon);
+
+// Incremental energy: per-row prefix sums of the costs turn area sums into sums over boundary
+// crossings; a local change re-evaluates only the rows its edges cross and its edges' samples.
+class PolygonEnergy {
+ public:
+  // A local change: in ring `ring`, the `removeCount` vertices starting at `first` (cyclic) are
+  // replaced by `inserted` (moves: 1 → 1, edge moves: 2 → 2, deletion: 1 → 0).
+  struct Change {
+    int ring = 0;
+    int first = 0;
+    int removeCount = 1;
+    std::vector<cv::Point> inserted;
+  };
+
+  PolygonEnergy(const EnergyImages& images, const EnergyWeights& weights);
+  void setPolygon(const IntPolygon& polygon);
+  const IntPolygon& polygon() const { return polygon_; }
+  EnergyTerms terms() const;
+  double total() const { return terms().total(); }
+  // F(after change) - F(now), without applying it.
+  double delta(const Change& change) const;
+  // True when the changed polygon stays simple: no crossing edges within or between rings,
+  // no fold-back, every ring keeps >= 3 vertices, its orientation and a non-zero area, and
+  // every vertex stays within [0, W] x [0, H].
+  bool valid(const Change& change) const;
+  void apply(const Change& change);
+  IntPolygon changed(const Change& change) const;
+  cv::Size size() const { return size_; }
+
+ private:
+  struct RowTerms {
+    double roof = 0, ground = 0, band = 0;  // Σ c_roof, Σ c_ground over E, NoMatch * |O|
+  };
+  struct Crossing {
+    double x;
+    int edge;  // edge id: ringOffset[ring] + index of the edge's first vertex
+  };
+  RowTerms rowTerms(int y, const std::vector<double>& xs) const;
+  double edgeTerm(cv::Point a, cv::Point b, int which) const;  // which: 0 left, 1 right
+  double vertexPrior(const IntRing& ring, int i) const;
+  void rebuild();
+
+  EnergyImages images_;
+  EnergyWeights weights_;
+  cv::Size size_;
+  std::vector<double> roofPrefix_, groundPrefix_;  // (W + 1) per row
+  IntPolygon polygon_;
+  std::vector<int> ringOffset_;
+  std::vector<std::vector<Crossing>> rowCrossings_;
+  std::vector<RowTerms> rowTerms_;
+  std::vector<std::array<double, 2>> edgeTerms_;  // by edge id
+  std::vector<double> vertexPriors_;              // by vertex id (same ids as edges)
+};
+
+}  // namespace delineo::delineation

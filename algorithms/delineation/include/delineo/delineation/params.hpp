@@ -1,0 +1,80 @@
+#pragma once
+// Parameters of the statistical active polygon (docs/delineation.md explains each choice).
+#include "delineo/core/params.hpp"
+
+namespace delineo::delineation {
+
+struct DelineationParams {
+  double occlusionPercent = 10.0;  // %, p: share of ROI pixels assumed unmatched (paper: 10)
+  double edgeWeight = 5.0;         // λ of the edge terms (4) and (5) (paper: 5)
+  double rigidity = 15.0;          // β of the angle prior (6) (paper: 15)
+  int initialSpacing = 16;         // px between vertices when polygonising the init (paper: 16)
+  int refinedSpacing = 8;          // px between vertices after the insertion step (paper: 8)
+  int moveRadius = 2;              // px, half side of the square of candidate vertex positions
+  int maxIterations = 400;         // sweeps (moves, edge moves, deletions) over all rounds
+  int roiMargin = 24;              // px added around the initial polygon to make the ROI
+  int costWindow = 5;              // px, side of the correlation window of Crit
+  int groundTolerance = 1;         // px, half width of the ground interval estimated from the ring
+  int groundSearch = 64;           // px searched below the roof interval when ground is unknown
+  int ringWidth = 8;               // px, width of the band outside the init used to estimate ground
+  bool edgeMoves = true;           // also translate whole edges (two vertices at once)
+  bool courtyards = true;          // look for inner courtyards after convergence (holes)
+  double minCourtyardArea = 120.0; // px², smallest courtyard tried
+  template <class V>
+  void visit(V&& v) {
+    v(core::ParamInfo{"occlusion", "Occlusion", "%",
+                      "Percentage p of ROI pixels taken as unmatched; NoMatchCost is the (100-p)% "
+                      "quantile of the best costs (paper: 10)",
+                      0, 99},
+      occlusionPercent);
+    v(core::ParamInfo{"edge-weight", "Edge weight", "",
+                      "Weight lambda of the left and right image edge terms (paper: 5)", 0, 1000},
+      edgeWeight);
+    v(core::ParamInfo{"rigidity", "Rigidity", "",
+                      "Weight beta of the vertex angle prior R (paper: 15)", 0, 10000},
+      rigidity);
+    v(core::ParamInfo{"initial-spacing", "Initial spacing", "px",
+                      "Vertex spacing when polygonising the initial contour (paper: 16)", 2, 256},
+      initialSpacing);
+    v(core::ParamInfo{"refined-spacing", "Refined spacing", "px",
+                      "Vertex spacing after the insertion step (paper: 8)", 2, 256},
+      refinedSpacing);
+    v(core::ParamInfo{"move-radius", "Move radius", "px",
+                      "Half side of the square of candidate positions of a vertex move", 1, 8},
+      moveRadius);
+    v(core::ParamInfo{"max-iterations", "Max iterations", "",
+                      "Maximum number of optimisation sweeps", 1, 100000},
+      maxIterations);
+    v(core::ParamInfo{"roi-margin", "ROI margin", "px",
+                      "Margin added around the initial polygon to make the region of interest", 0,
+                      1000},
+      roiMargin);
+    v(core::ParamInfo{"cost-window", "Cost window", "px",
+                      "Side of the correlation window of the per-pixel cost", 3, 31},
+      costWindow);
+    v(core::ParamInfo{"ground-tolerance", "Ground tolerance", "px",
+                      "Half width of the ground disparity interval estimated around the init", 0,
+                      32},
+      groundTolerance);
+    v(core::ParamInfo{"ground-search", "Ground search", "px",
+                      "Disparities searched below the roof interval when ground is not given", 1,
+                      1024},
+      groundSearch);
+    v(core::ParamInfo{"ring-width", "Ring width", "px",
+                      "Width of the band outside the init where ground disparity is estimated", 2,
+                      200},
+      ringWidth);
+    v(core::ParamInfo{"edge-moves", "Edge moves", "",
+                      "Also try translating whole edges (two vertices together)"},
+      edgeMoves);
+    v(core::ParamInfo{"courtyards", "Courtyards", "",
+                      "Search for inner courtyards (holes) after convergence"},
+      courtyards);
+    v(core::ParamInfo{"min-courtyard-area", "Min courtyard area", "px²",
+                      "Smallest interior ground region tried as a courtyard", 16, 1e9},
+      minCourtyardArea);
+  }
+  void validate() const;
+};
+
+}  // namespace delineo::delineation

@@ -1,0 +1,501 @@
+#include "delineo/delineation/energy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace delineo::delineation {
+
+int IntPolygon::vertexCount() const {
+  int n = static_cast<int>(outer.size());
+  for (const auto& h : holes) n += static_cast<int>(h.size());
+  return n;
+}
+
+core::Polygon toPolygon(const IntPolygon& p, cv::Point2d offset) {
+  auto convert = [&](const IntRing& ring) {
+    core::Ring out;
+    out.reserve(ring.size());
+    for (const auto& v : ring) out.emplace_back(v.x + offset.x, v.y + offset.y);
+    return out;
+  };
+  core::Polygon out;
+  out.outer = convert(p.outer);
+  for (const auto& h : p.holes) out.holes.push_back(convert(h));
+  return out;
+}
+
+double anglePrior(double theta) {
+  const double c = std::cos(theta), s = std::sin(theta);
+  const double s2 = std::abs(std::sin(2.0 * theta));
+  // Rounding: cos and |sin| are equal at 45°, where both branches give 1.
+  return c >= std::abs(s) ? 2.0 - s2 : s2;
+}
+
+double vertexAngle(cv::Point prev, cv::Point v, cv::Point next) {
+  const double ax = prev.x - v.x, ay = prev.y - v.y;
+  const double bx = next.x - v.x, by = next.y - v.y;
+  // R is symmetric under θ → 2π - θ, so the unsigned angle in [0, π] is enough.
+  return std::atan2(std::abs(ax * by - ay * bx), ax * bx + ay * by);
+}
+
+namespace {
+
+float bilinear(const cv::Mat& img, double x, double y) {
+  const int w = img.cols, h = img.rows;
+  x = std::clamp(x, 0.0, static_cast<double>(w - 1));
+  y = std::clamp(y, 0.0, static_cast<double>(h - 1));
+  const int x0 = std::min(static_cast<int>(x), w - 1), y0 = std::min(static_cast<int>(y), h - 1);
+  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+  const double fx = x - x0, fy = y - y0;
+  const float* r0 = img.ptr<float>(y0);
+  const float* r1 = img.ptr<float>(y1);
+  return static_cast<float>((1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x1]) +
+                            fy * ((1 - fx) * r1[x0] + fx * r1[x1]));
+}
+
+// Σ along the segment of min(1, |∇I·n|), sampled once per pixel of length.
+double edgeIntegral(const cv::Mat& gx, const cv::Mat& gy, cv::Point a, cv::Point b) {
+  if (gx.empty() || gy.empty()) return 0.0;
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double len = std::hypot(dx, dy);
+  if (len <= 0) return 0.0;
+  const double nx = -dy / len, ny = dx / len;
+  const int samples = std::max(1, static_cast<int>(std::ceil(len)));
+  double sum = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const double t = (i + 0.5) / samples;
+    // Pixel centres are at +0.5: sample the gradient images in their index frame.
+    const double px = a.x + t * dx - 0.5, py = a.y + t * dy - 0.5;
+    const double g = bilinear(gx, px, py) * nx + bilinear(gy, px, py) * ny;
+    sum += std::min(1.0, std::abs(g));
+  }
+  return sum * len / samples;
+}
+
+double edgeTermOf(const EnergyImages& im, const EnergyWeights& w, cv::Point a, cv::Point b,
+                  int which) {
+  const double integral = which == 0 ? edgeIntegral(im.leftGradX, im.leftGradY, a, b)
+                                     : edgeIntegral(im.rightGradX, im.rightGradY, a, b);
+  return -w.edgeWeight * kEdgeUnit * integral;
+}
+
+int occlusionAt(const EnergyImages& im, int y, int x) {
+  if (im.occlusionWidth.empty()) return 0;
+  x = std::clamp(x, 0, im.occlusionWidth.cols - 1);
+  return std::max(0, im.occlusionWidth.at<int>(y, x));
+}
+
+int pixelIndex(double x, int w) {
+  return std::clamp(static_cast<int>(std::ceil(x - 0.5)), 0, w);
+}
+
+// Appends the crossings of edge a→b with the pixel-centre lines y + 0.5, rows in [0, h).
+template <class Fn>
+void forEachCrossing(cv::Point a, cv::Point b, int h, Fn&& fn) {
+  if (a.y == b.y) return;
+  const cv::Point lo = a.y < b.y ? a : b, hi = a.y < b.y ? b : a;
+  const int y0 = std::max(lo.y, 0), y1 = std::min(hi.y, h);
+  const double slope = static_cast<double>(hi.x - lo.x) / (hi.y - lo.y);
+  for (int y = y0; y < y1; ++y) fn(y, lo.x + (y + 0.5 - lo.y) * slope);
+}
+
+double cross(cv::Point o, cv::Point a, cv::Point b) {
+  return static_cast<double>(a.x - o.x) * (b.y - o.y) - static_cast<double>(a.y - o.y) * (b.x - o.x);
+}
+bool onSegment(cv::Point p, cv::Point q, cv::Point r) {
+  return std::min(p.x, r.x) <= q.x && q.x <= std::max(p.x, r.x) && std::min(p.y, r.y) <= q.y &&
+         q.y <= std::max(p.y, r.y);
+}
+int sgn(double v) { return (v > 0) - (v < 0); }
+bool segmentsTouch(cv::Point p1, cv::Point p2, cv::Point p3, cv::Point p4) {
+  const int d1 = sgn(cross(p3, p4, p1)), d2 = sgn(cross(p3, p4, p2));
+  const int d3 = sgn(cross(p1, p2, p3)), d4 = sgn(cross(p1, p2, p4));
+  if (d1 * d2 < 0 && d3 * d4 < 0) return true;
+  if (d1 == 0 && onSegment(p3, p1, p4)) return true;
+  if (d2 == 0 && onSegment(p3, p2, p4)) return true;
+  if (d3 == 0 && onSegment(p1, p3, p2)) return true;
+  if (d4 == 0 && onSegment(p1, p4, p2)) return true;
+  return false;
+}
+// Edges s→a and s→b share s: they may only meet there (no fold-back along a common line).
+bool adjacentOverlap(cv::Point s, cv::Point a, cv::Point b) {
+  if (cross(s, a, b) != 0) return false;
+  return static_cast<double>(a.x - s.x) * (b.x - s.x) + static_cast<double>(a.y - s.y) * (b.y - s.y) > 0;
+}
+double ringArea2(const IntRing& r) {
+  double a = 0;
+  for (size_t i = 0; i < r.size(); ++i) {
+    const auto& p = r[i];
+    const auto& q = r[(i + 1) % r.size()];
+    a += static_cast<double>(p.x) * q.y - static_cast<double>(q.x) * p.y;
+  }
+  return a;
+}
+bool insideRing(const IntRing& ring, cv::Point2d p) {
+  bool in = false;
+  for (size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+    const auto& a = ring[i];
+    const auto& b = ring[j];
+    if ((a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / double(b.y - a.y) + a.x)
+      in = !in;
+  }
+  return in;
+}
+
+}  // namespace
+
+bool isValidPolygon(const IntPolygon& p) {
+  const core::Polygon d = toPolygon(p);
+  if (!core::isSimple(d.outer)) return false;
+  for (size_t h = 0; h < p.holes.size(); ++h) {
+    if (!core::isSimple(d.holes[h])) return false;
+    if (!insideRing(p.outer, cv::Point2d(p.holes[h][0]))) return false;
+    for (size_t k = 0; k < p.holes.size(); ++k) {
+      if (k != h && insideRing(p.holes[k], cv::Point2d(p.holes[h][0]))) return false;
+    }
+  }
+  for (size_t r = 0; r < p.ringCount(); ++r) {
+    for (size_t s = r + 1; s < p.ringCount(); ++s) {
+      const IntRing& a = p.ring(r);
+      const IntRing& b = p.ring(s);
+      for (size_t i = 0; i < a.size(); ++i) {
+        for (size_t j = 0; j < b.size(); ++j) {
+          if (segmentsTouch(a[i], a[(i + 1) % a.size()], b[j], b[(j + 1) % b.size()])) return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+EnergyTerms referenceEnergy(const EnergyImages& im, const EnergyWeights& w,
+                            const IntPolygon& polygon) {
+  EnergyTerms t;
+  const cv::Size size = im.roofCost.size();
+  const cv::Mat mask = core::rasterize(toPolygon(polygon), size);
+  cv::Mat band(size, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* m = mask.ptr<uchar>(y);
+    uchar* b = band.ptr<uchar>(y);
+    // Runs of roof pixels on this row, in order.
+    std::vector<std::pair<int, int>> runs;
+    for (int x = 0; x < size.width;) {
+      if (!m[x]) { ++x; continue; }
+      int e = x;
+      while (e < size.width && m[e]) ++e;
+      runs.emplace_back(x, e);
+      x = e;
+    }
+    for (size_t k = 0; k < runs.size(); ++k) {
+      if (im.occlusionSide < 0) {
+        const int start = runs[k].first;
+        const int stop = k == 0 ? 0 : runs[k - 1].second;
+        for (int x = std::max(start - occlusionAt(im, y, start), stop); x < start; ++x) b[x] = 255;
+      } else {
+        const int end = runs[k].second;
+        const int stop = k + 1 == runs.size() ? size.width : runs[k + 1].first;
+        for (int x = end; x < std::min(end + occlusionAt(im, y, end - 1), stop); ++x) b[x] = 255;
+      }
+    }
+  }
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* m = mask.ptr<uchar>(y);
+    const uchar* b = band.ptr<uchar>(y);
+    const float* cr = im.roofCost.ptr<float>(y);
+    const float* cg = im.groundCost.ptr<float>(y);
+    for (int x = 0; x < size.width; ++x) {
+      if (m[x]) t.term[0] += cr[x];
+      else if (b[x]) t.term[2] += im.noMatchCost;
+      else t.term[1] += cg[x];
+    }
+  }
+  for (size_t r = 0; r < polygon.ringCount(); ++r) {
+    const IntRing& ring = polygon.ring(r);
+    const size_t n = ring.size();
+    for (size_t i = 0; i < n; ++i) {
+      const cv::Point a = ring[i], b = ring[(i + 1) % n];
+      t.term[3] += edgeTermOf(im, w, a, b, 0);
+      t.term[4] += edgeTermOf(im, w, a, b, 1);
+      t.term[5] += w.rigidity * anglePrior(vertexAngle(ring[(i + n - 1) % n], a, b));
+    }
+  }
+  return t;
+}
+
+PolygonEnergy::PolygonEnergy(const EnergyImages& images, const EnergyWeights& weights)
+    : images_(images), weights_(weights), size_(images.roofCost.size()) {
+  CV_Assert(images.roofCost.type() == CV_32F && images.groundCost.type() == CV_32F &&
+            images.groundCost.size() == size_);
+  const int w = size_.width;
+  roofPrefix_.assign(static_cast<size_t>(size_.height) * (w + 1), 0.0);
+  groundPrefix_.assign(roofPrefix_.size(), 0.0);
+  for (int y = 0; y < size_.height; ++y) {
+    const float* cr = images.roofCost.ptr<float>(y);
+    const float* cg = images.groundCost.ptr<float>(y);
+    double* pr = &roofPrefix_[static_cast<size_t>(y) * (w + 1)];
+    double* pg = &groundPrefix_[static_cast<size_t>(y) * (w + 1)];
+    for (int x = 0; x < w; ++x) {
+      pr[x + 1] = pr[x] + cr[x];
+      pg[x + 1] = pg[x] + cg[x];
+    }
+  }
+}
+
+PolygonEnergy::RowTerms PolygonEnergy::rowTerms(int y, const std::vector<double>& xs) const {
+  const int w = size_.width;
+  const double* pr = &roofPrefix_[static_cast<size_t>(y) * (w + 1)];
+  const double* pg = &groundPrefix_[static_cast<size_t>(y) * (w + 1)];
+  // Even-odd pairing of the sorted crossings gives the roof runs [l, r) of the row.
+  int runs[2 * 64];
+  std::vector<int> bigRuns;
+  int* run = runs;
+  const size_t pairs = xs.size() / 2;
+  if (pairs > 64) {
+    bigRuns.resize(2 * pairs);
+    run = bigRuns.data();
+  }
+  int count = 0;
+  for (size_t k = 0; k < pairs; ++k) {
+    const int l = pixelIndex(xs[2 * k], w), r = pixelIndex(xs[2 * k + 1], w);
+    if (l >= r) continue;
+    run[2 * count] = l;
+    run[2 * count + 1] = r;
+    ++count;
+  }
+  RowTerms t;
+  double groundOut = 0.0;
+  int bandPixels = 0;
+  for (int k = 0; k < count; ++k) {
+    const int l = run[2 * k], r = run[2 * k + 1];
+    t.roof += pr[r] - pr[l];
+    groundOut += pg[r] - pg[l];
+    int b0, b1;
+    if (images_.occlusionSide < 0) {
+      b1 = l;
+      b0 = std::max(l - occlusionAt(images_, y, l), k == 0 ? 0 : run[2 * k - 1]);
+    } else {
+      b0 = r;
+      b1 = std::min(r + occlusionAt(images_, y, r - 1), k + 1 == count ? w : run[2 * k + 2]);
+    }
+    if (b1 > b0) {
+      groundOut += pg[b1] - pg[b0];
+      bandPixels += b1 - b0;
+    }
+  }
+  t.ground = pg[w] - groundOut;
+  t.band = static_cast<double>(images_.noMatchCost) * bandPixels;
+  return t;
+}
+
+double PolygonEnergy::edgeTerm(cv::Point a, cv::Point b, int which) const {
+  return edgeTermOf(images_, weights_, a, b, which);
+}
+
+double PolygonEnergy::vertexPrior(const IntRing& ring, int i) const {
+  const int n = static_cast<int>(ring.size());
+  return weights_.rigidity *
+         anglePrior(vertexAngle(ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]));
+}
+
+void PolygonEnergy::setPolygon(const IntPolygon& polygon) {
+  polygon_ = polygon;
+  rebuild();
+}
+
+void PolygonEnergy::rebuild() {
+  ringOffset_.clear();
+  int total = 0;
+  for (size_t r = 0; r < polygon_.ringCount(); ++r) {
+    ringOffset_.push_back(total);
+    total += static_cast<int>(polygon_.ring(r).size());
+  }
+  edgeTerms_.assign(total, {0.0, 0.0});
+  vertexPriors_.assign(total, 0.0);
+  rowCrossings_.assign(size_.height, {});
+  for (size_t r = 0; r < polygon_.ringCount(); ++r) {
+    const IntRing& ring = polygon_.ring(r);
+    const int n = static_cast<int>(ring.size());
+    for (int i = 0; i < n; ++i) {
+      const int id = ringOffset_[r] + i;
+      const cv::Point a = ring[i], b = ring[(i + 1) % n];
+      edgeTerms_[id] = {edgeTerm(a, b, 0), edgeTerm(a, b, 1)};
+      vertexPriors_[id] = vertexPrior(ring, i);
+      forEachCrossing(a, b, size_.height,
+                      [&](int y, double x) { rowCrossings_[y].push_back({x, id}); });
+    }
+  }
+  rowTerms_.assign(size_.height, {});
+  std::vector<double> xs;
+  for (int y = 0; y < size_.height; ++y) {
+    auto& c = rowCrossings_[y];
+    std::sort(c.begin(), c.end(), [](const Crossing& p, const Crossing& q) { return p.x < q.x; });
+    xs.clear();
+    for (const auto& k : c) xs.push_back(k.x);
+    rowTerms_[y] = rowTerms(y, xs);
+  }
+}
+
+EnergyTerms PolygonEnergy::terms() const {
+  EnergyTerms t;
+  for (const auto& r : rowTerms_) {
+    t.term[0] += r.roof;
+    t.term[1] += r.ground;
+    t.term[2] += r.band;
+  }
+  for (const auto& e : edgeTerms_) {
+    t.term[3] += e[0];
+    t.term[4] += e[1];
+  }
+  for (double p : vertexPriors_) t.term[5] += p;
+  return t;
+}
+
+IntPolygon PolygonEnergy::changed(const Change& c) const {
+  IntPolygon out = polygon_;
+  const IntRing& ring = polygon_.ring(c.ring);
+  const int n = static_cast<int>(ring.size());
+  IntRing next;
+  next.reserve(n - c.removeCount + c.inserted.size());
+  if (c.first + c.removeCount <= n) {  // keeps vertex order so that sweeps stay in place
+    next.insert(next.end(), ring.begin(), ring.begin() + c.first);
+    next.insert(next.end(), c.inserted.begin(), c.inserted.end());
+    next.insert(next.end(), ring.begin() + c.first + c.removeCount, ring.end());
+  } else {  // the replaced run wraps past the end: the inserted vertices start the ring
+    next.insert(next.end(), c.inserted.begin(), c.inserted.end());
+    next.insert(next.end(), ring.begin() + (c.first + c.removeCount - n), ring.begin() + c.first);
+  }
+  out.ring(c.ring) = std::move(next);
+  return out;
+}
+
+double PolygonEnergy::delta(const Change& c) const {
+  const IntRing& ring = polygon_.ring(c.ring);
+  const int n = static_cast<int>(ring.size());
+  const int m = static_cast<int>(c.inserted.size());
+  if (n - c.removeCount + m < 3) return std::numeric_limits<double>::infinity();
+  auto at = [&](int i) { return ring[((c.first + i) % n + n) % n]; };
+  const int offset = ringOffset_[c.ring];
+  auto idOf = [&](int i) { return offset + ((c.first + i) % n + n) % n; };
+
+  // New local chain: prev2, prev, inserted..., next, next2.
+  std::vector<cv::Point> chain;
+  chain.reserve(m + 4);
+  chain.push_back(at(-2));
+  chain.push_back(at(-1));
+  for (const auto& v : c.inserted) chain.push_back(v);
+  chain.push_back(at(c.removeCount));
+  chain.push_back(at(c.removeCount + 1));
+
+  double d = 0.0;
+  // Old edges: first vertex at -1 .. removeCount-1; old priors at -1 .. removeCount.
+  std::vector<int> oldEdges;
+  for (int i = -1; i < c.removeCount; ++i) oldEdges.push_back(idOf(i));
+  std::sort(oldEdges.begin(), oldEdges.end());
+  oldEdges.erase(std::unique(oldEdges.begin(), oldEdges.end()), oldEdges.end());
+  std::vector<int> oldVertices;
+  for (int i = -1; i <= c.removeCount; ++i) oldVertices.push_back(idOf(i));
+  std::sort(oldVertices.begin(), oldVertices.end());
+  oldVertices.erase(std::unique(oldVertices.begin(), oldVertices.end()), oldVertices.end());
+  for (int e : oldEdges) d -= edgeTerms_[e][0] + edgeTerms_[e][1];
+  for (int v : oldVertices) d -= vertexPriors_[v];
+  // New edges chain[1]→chain[2] ... chain[m+1]→chain[m+2]; new priors at chain[1..m+2].
+  for (int i = 1; i <= m + 1; ++i) d += edgeTerm(chain[i], chain[i + 1], 0) + edgeTerm(chain[i], chain[i + 1], 1);
+  for (int i = 1; i <= m + 2; ++i) {
+    d += weights_.rigidity * anglePrior(vertexAngle(chain[i - 1], chain[i], chain[i + 1]));
+  }
+
+  // Area terms: rows crossed by an old or a new edge.
+  std::vector<int> rows;
+  std::vector<std::pair<int, double>> added;
+  for (int i = -1; i < c.removeCount; ++i) {
+    forEachCrossing(at(i), at(i + 1), size_.height, [&](int y, double) { rows.push_back(y); });
+  }
+  for (int i = 1; i <= m + 1; ++i) {
+    forEachCrossing(chain[i], chain[i + 1], size_.height, [&](int y, double x) {
+      rows.push_back(y);
+      added.emplace_back(y, x);
+    });
+  }
+  std::sort(rows.begin(), rows.end());
+  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  std::sort(added.begin(), added.end());
+  std::vector<double> xs;
+  size_t a = 0;
+  for (int y : rows) {
+    xs.clear();
+    for (const auto& k : rowCrossings_[y]) {
+      if (!std::binary_search(oldEdges.begin(), oldEdges.end(), k.edge)) xs.push_back(k.x);
+    }
+    while (a < added.size() && added[a].first < y) ++a;
+    for (size_t j = a; j < added.size() && added[j].first == y; ++j) xs.push_back(added[j].second);
+    std::sort(xs.begin(), xs.end());
+    const RowTerms now = rowTerms(y, xs);
+    const RowTerms& before = rowTerms_[y];
+    d += (now.roof - before.roof) + (now.ground - before.ground) + (now.band - before.band);
+  }
+  return d;
+}
+
+bool PolygonEnergy::valid(const Change& c) const {
+  const IntRing& ring = polygon_.ring(c.ring);
+  const int n = static_cast<int>(ring.size());
+  const int m = static_cast<int>(c.inserted.size());
+  const int newN = n - c.removeCount + m;
+  if (newN < 3) return false;
+  for (const auto& v : c.inserted) {
+    if (v.x < 0 || v.y < 0 || v.x > size_.width || v.y > size_.height) return false;
+  }
+  const IntPolygon after = changed(c);
+  const IntRing& nr = after.ring(c.ring);
+  // In `nr` the inserted run starts at `start`; the changed edges start at start-1 .. start+m-1.
+  const int start = c.first + c.removeCount <= n ? c.first : 0;
+  std::vector<int> changedEdges;
+  for (int i = -1; i < m; ++i) changedEdges.push_back(((start + i) % newN + newN) % newN);
+  for (int e : changedEdges) {
+    const cv::Point a = nr[e], b = nr[(e + 1) % newN];
+    if (a == b) return false;
+    for (int j = 0; j < newN; ++j) {
+      if (j == e) continue;
+      const cv::Point p = nr[j], q = nr[(j + 1) % newN];
+      if (j == (e + 1) % newN) {  // shares b
+        if (adjacentOverlap(b, a, q)) return false;
+      } else if ((j + 1) % newN == e) {  // shares a
+        if (adjacentOverlap(a, b, p)) return false;
+      } else if (segmentsTouch(a, b, p, q)) {
+        return false;
+      }
+    }
+    for (size_t r = 0; r < after.ringCount(); ++r) {
+      if (static_cast<int>(r) == c.ring) continue;
+      const IntRing& other = after.ring(r);
+      for (size_t j = 0; j < other.size(); ++j) {
+        if (segmentsTouch(a, b, other[j], other[(j + 1) % other.size()])) return false;
+      }
+    }
+  }
+  const double before = ringArea2(ring), now = ringArea2(nr);
+  if (now == 0 || (before > 0) != (now > 0)) return false;
+  // A ring may jump over a whole small ring without crossing it: keep holes inside the outer
+  // ring and outside each other.
+  if (c.ring == 0) {
+    for (const auto& h : after.holes) {
+      if (!insideRing(nr, cv::Point2d(h[0]))) return false;
+    }
+  } else {
+    if (!insideRing(after.outer, cv::Point2d(nr[0]))) return false;
+    for (size_t r = 1; r < after.ringCount(); ++r) {
+      if (static_cast<int>(r) == c.ring) continue;
+      if (insideRing(nr, cv::Point2d(after.ring(r)[0]))) return false;
+      if (insideRing(after.ring(r), cv::Point2d(nr[0]))) return false;
+    }
+  }
+  return true;
+}
+
+void PolygonEnergy::apply(const Change& c) {
+  polygon_ = changed(c);
+  rebuild();
+}
+
+}  // namespace delineo::delineation

@@ -1,0 +1,21 @@
+#include "delineo/delineation/params.hpp"
+
+#include "delineo/core/error.hpp"
+
+namespace delineo::delineation {
+
+void DelineationParams::validate() const {
+  core::checkDeclaredRanges(*this);
+  if (refinedSpacing > initialSpacing) {
+    throw core::Error(core::ErrorCode::InvalidParameter,
+                      "refined-spacing (" + std::to_string(refinedSpacing) +
+                          " px) must not exceed initial-spacing (" +
+                          std::to_string(initialSpacing) + " px)");
+  }
+  if (costWindow % 2 == 0) {
+    throw core::Error(core::ErrorCode::InvalidParameter,
+                      "cost-window must be odd, got " + std::to_string(costWindow));
+  }
+}
+
+}  // namespace delineo::delineation
