@@ -1,0 +1,315 @@
+#include "delineo/io/raster.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include <cpl_conv.h>
+#include <cpl_string.h>
+#include <cpl_vsi.h>
+#include <gdal.h>
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+#include "gdal_support.hpp"
+
+namespace delineo::io {
+
+using core::Error;
+using core::ErrorCode;
+
+cv::Point2d GeoReference::pixelToMap(const cv::Point2d& pixel) const {
+  const auto& gt = geoTransform;
+  return {gt[0] + pixel.x * gt[1] + pixel.y * gt[2], gt[3] + pixel.x * gt[4] + pixel.y * gt[5]};
+}
+
+cv::Point2d GeoReference::mapToPixel(const cv::Point2d& map) const {
+  const auto& gt = geoTransform;
+  const double det = gt[1] * gt[5] - gt[2] * gt[4];
+  if (det == 0.0 || !std::isfinite(det)) {
+    throw Error(ErrorCode::InvalidParameter, "geotransform is not invertible (zero pixel size)");
+  }
+  const double dx = map.x - gt[0];
+  const double dy = map.y - gt[3];
+  return {(gt[5] * dx - gt[2] * dy) / det, (-gt[4] * dx + gt[1] * dy) / det};
+}
+
+namespace {
+
+using DatasetPtr = std::unique_ptr<void, detail::DatasetCloser>;
+
+struct ReadLayout {
+  GDALDataType gdalType;
+  int depth;  // OpenCV depth of the decoded pixels
+};
+
+// Maps the file's pixel type to what Raster holds. Signed and 32-bit integer rasters (e.g. Int16
+// DEMs) are decoded as float32, which is exact for 16-bit values.
+ReadLayout layoutFor(GDALDataType type, const std::string& path) {
+  switch (type) {
+    case GDT_Byte: return {GDT_Byte, CV_8U};
+    case GDT_UInt16: return {GDT_UInt16, CV_16U};
+    case GDT_Float32:
+    case GDT_Int16:
+    case GDT_Int32:
+    case GDT_UInt32: return {GDT_Float32, CV_32F};
+    default:
+      throw Error(ErrorCode::UnsupportedInput,
+                  std::string("pixel type ") + GDALGetDataTypeName(type) +
+                      " is not supported (8/16-bit unsigned, 16/32-bit integer or float32 only)",
+                  path);
+  }
+}
+
+// Expands a palette band (e.g. an indexed PNG) into three R, G, B channels of the same depth.
+cv::Mat expandPalette(const cv::Mat& indices, GDALColorTableH table) {
+  const int entries = GDALGetColorEntryCount(table);
+  cv::Mat lut(1, 256, CV_8UC3, cv::Scalar::all(0));
+  for (int i = 0; i < std::min(entries, 256); ++i) {
+    const GDALColorEntry* entry = GDALGetColorEntry(table, i);
+    lut.at<cv::Vec3b>(0, i) = cv::Vec3b(static_cast<uchar>(entry->c1), static_cast<uchar>(entry->c2),
+                                        static_cast<uchar>(entry->c3));
+  }
+  cv::Mat rgbSource;
+  cv::cvtColor(indices, rgbSource, cv::COLOR_GRAY2BGR);  // three copies of the index
+  cv::Mat rgb;
+  cv::LUT(rgbSource, lut, rgb);
+  return rgb;
+}
+
+// Float copy of `data` where each band's nodata value becomes NaN.
+cv::Mat toFloatWithNaN(const cv::Mat& data, const std::vector<std::optional<double>>& bandNodata) {
+  cv::Mat asFloat;
+  data.convertTo(asFloat, CV_32F);
+  const int channels = asFloat.channels();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  bool anyNodata = false;
+  for (const auto& value : bandNodata) anyNodata = anyNodata || (value && !std::isnan(*value));
+  if (!anyNodata) return asFloat;
+  for (int row = 0; row < asFloat.rows; ++row) {
+    float* pixel = asFloat.ptr<float>(row);
+    for (int col = 0; col < asFloat.cols; ++col) {
+      for (int c = 0; c < channels; ++c, ++pixel) {
+        const auto& nodata = bandNodata[static_cast<size_t>(c)];
+        // Compare in float: the nodata value went through the same conversion as the pixels.
+        if (nodata && *pixel == static_cast<float>(*nodata)) *pixel = nan;
+      }
+    }
+  }
+  return asFloat;
+}
+
+// Single-channel float grey: 1 channel as is, 3+ channels 0.299 R + 0.587 G + 0.114 B.
+cv::Mat greyFromFloat(const cv::Mat& asFloat) {
+  if (asFloat.channels() == 1) return asFloat;
+  std::vector<cv::Mat> planes;
+  cv::split(asFloat, planes);
+  cv::Mat grey = 0.299 * planes[0] + 0.587 * planes[1] + 0.114 * planes[2];
+  return grey;
+}
+
+}  // namespace
+
+Raster readRaster(const std::string& path, const ReadOptions& options) {
+  detail::ensureGdalRegistered();
+  if (!detail::isVirtualPath(path)) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw Error(ErrorCode::FileNotFound, "no such file", path);
+    if (std::filesystem::is_directory(path, ec)) {
+      throw Error(ErrorCode::UnreadableFile, "is a directory, not a raster file", path);
+    }
+  }
+  detail::ScopedGdalErrors errors;
+  DatasetPtr dataset(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr, nullptr, nullptr));
+  if (!dataset) throw Error(ErrorCode::UnreadableFile, errors.describe("not a readable raster"), path);
+  GDALDatasetH ds = dataset.get();
+
+  const int width = GDALGetRasterXSize(ds);
+  const int height = GDALGetRasterYSize(ds);
+  const int bands = GDALGetRasterCount(ds);
+  if (bands == 0 || width <= 0 || height <= 0) {
+    throw Error(ErrorCode::UnreadableFile, "the file holds no raster band", path);
+  }
+  if (bands == 2) {
+    throw Error(ErrorCode::UnsupportedInput,
+                "2-band rasters are not supported (expected 1 grey band or 3+ colour bands)", path);
+  }
+  if (bands > CV_CN_MAX) {
+    throw Error(ErrorCode::UnsupportedInput, "too many bands (" + std::to_string(bands) + ")", path);
+  }
+  GDALRasterBandH first = GDALGetRasterBand(ds, 1);
+  const ReadLayout layout = layoutFor(GDALGetRasterDataType(first), path);
+  for (int b = 2; b <= bands; ++b) {
+    const GDALDataType type = GDALGetRasterDataType(GDALGetRasterBand(ds, b));
+    if (GDALDataTypeIsComplex(type) || GDALGetDataTypeSizeBytes(type) > 4) layoutFor(type, path);
+  }
+
+  Raster raster;
+  raster.path = path;
+  cv::Mat data(height, width, CV_MAKETYPE(layout.depth, bands));
+  const auto elementBytes = static_cast<GSpacing>(data.elemSize1());
+  errors.reset();
+  const CPLErr readStatus = GDALDatasetRasterIOEx(
+      ds, GF_Read, 0, 0, width, height, data.data, width, height, layout.gdalType, bands, nullptr,
+      elementBytes * bands, static_cast<GSpacing>(data.step[0]), elementBytes, nullptr);
+  // A truncated TIFF often opens fine (the header is intact) and only fails here.
+  if (readStatus != CE_None || errors.failed()) {
+    throw Error(ErrorCode::UnreadableFile, errors.describe("pixel data cannot be read (truncated or corrupt)"),
+                path);
+  }
+
+  std::vector<std::optional<double>> bandNodata(static_cast<size_t>(bands));
+  for (int b = 1; b <= bands; ++b) {
+    int hasNodata = 0;
+    const double value = GDALGetRasterNoDataValue(GDALGetRasterBand(ds, b), &hasNodata);
+    if (hasNodata) bandNodata[static_cast<size_t>(b - 1)] = value;
+  }
+  raster.nodata = bandNodata[0];
+
+  double geoTransform[6];
+  if (GDALGetGeoTransform(ds, geoTransform) == CE_None) {
+    std::copy(geoTransform, geoTransform + 6, raster.geo.geoTransform.begin());
+    raster.geo.hasTransform = true;
+  }
+  if (const char* wkt = GDALGetProjectionRef(ds); wkt != nullptr) raster.geo.crsWkt = wkt;
+
+  // An indexed-colour band only means something as colours when converting to grey; kept as
+  // indices otherwise (label images and masks are often paletted).
+  if (options.toGrey && bands == 1 && layout.depth == CV_8U &&
+      GDALGetRasterColorInterpretation(first) == GCI_PaletteIndex) {
+    if (GDALColorTableH table = GDALGetRasterColorTable(first); table != nullptr) {
+      data = expandPalette(data, table);
+      bandNodata.assign(3, std::nullopt);
+    }
+  }
+
+  const bool wantFloat = options.type == PixelType::Float32;
+  const bool needsGrey = options.toGrey && data.channels() > 1;
+  if (!wantFloat && !needsGrey) {
+    raster.data = data;
+    return raster;
+  }
+  cv::Mat asFloat = toFloatWithNaN(data, bandNodata);
+  if (needsGrey) asFloat = greyFromFloat(asFloat);
+  if (wantFloat) {
+    raster.data = asFloat;
+    return raster;
+  }
+  // Keep the source depth for grey output: nodata pixels get the nodata value back.
+  if (raster.nodata && !std::isnan(*raster.nodata)) {
+    cv::Mat nanMask = asFloat != asFloat;
+    asFloat.setTo(*raster.nodata, nanMask);
+  }
+  asFloat.convertTo(raster.data, layout.depth);
+  return raster;
+}
+
+cv::Mat readGreyFloat(const std::string& path, GeoReference* geo) {
+  ReadOptions options;
+  options.type = PixelType::Float32;
+  options.toGrey = true;
+  Raster raster = readRaster(path, options);
+  if (geo != nullptr) *geo = raster.geo;
+  return raster.data;
+}
+
+void writeGeoTiff(const std::string& path, const cv::Mat& image, const GeoReference& geo,
+                  const WriteOptions& options) {
+  detail::ensureGdalRegistered();
+  if (image.empty()) throw Error(ErrorCode::WriteFailed, "the image to write is empty", path);
+  GDALDataType gdalType = GDT_Unknown;
+  switch (image.depth()) {
+    case CV_8U: gdalType = GDT_Byte; break;
+    case CV_16U: gdalType = GDT_UInt16; break;
+    case CV_32F: gdalType = GDT_Float32; break;
+    default:
+      throw Error(ErrorCode::WriteFailed, "only 8-bit, 16-bit unsigned and float32 images can be written",
+                  path);
+  }
+  const int bands = image.channels();
+  if (bands < 1 || bands > 4) {
+    throw Error(ErrorCode::WriteFailed, "only 1 to 4 channels can be written (got " + std::to_string(bands) + ")",
+                path);
+  }
+
+  cv::Mat pixels = image;
+  if (image.depth() == CV_32F && options.nodata && !std::isnan(*options.nodata)) {
+    pixels = image.clone();
+    cv::patchNaNs(pixels, *options.nodata);
+  }
+
+  detail::ScopedGdalErrors errors;
+  GDALDriverH driver = GDALGetDriverByName("GTiff");
+  if (driver == nullptr) throw Error(ErrorCode::WriteFailed, "GDAL has no GTiff driver", path);
+  CPLStringList createOptions;
+  createOptions.SetNameValue("BIGTIFF", "IF_SAFER");
+  if (options.compress) {
+    createOptions.SetNameValue("COMPRESS", "DEFLATE");
+    createOptions.SetNameValue("PREDICTOR", gdalType == GDT_Float32 ? "3" : "2");
+  }
+  if (bands == 3) createOptions.SetNameValue("PHOTOMETRIC", "RGB");
+
+  DatasetPtr dataset(GDALCreate(driver, path.c_str(), pixels.cols, pixels.rows, bands, gdalType,
+                                createOptions.List()));
+  if (!dataset) throw Error(ErrorCode::WriteFailed, errors.describe("cannot create the GeoTIFF"), path);
+  GDALDatasetH ds = dataset.get();
+
+  auto failAndRemove = [&](const std::string& what) {
+    const std::string message = errors.describe(what);
+    dataset.reset();
+    VSIUnlink(path.c_str());
+    throw Error(ErrorCode::WriteFailed, message, path);
+  };
+
+  if (geo.valid()) {
+    double geoTransform[6];
+    std::copy(geo.geoTransform.begin(), geo.geoTransform.end(), geoTransform);
+    if (GDALSetGeoTransform(ds, geoTransform) != CE_None) failAndRemove("cannot write the geotransform");
+    if (!geo.crsWkt.empty() && GDALSetProjection(ds, geo.crsWkt.c_str()) != CE_None) {
+      failAndRemove("cannot write the CRS");
+    }
+  }
+  if (options.nodata) {
+    for (int b = 1; b <= bands; ++b) {
+      if (GDALSetRasterNoDataValue(GDALGetRasterBand(ds, b), *options.nodata) != CE_None) {
+        failAndRemove("cannot write the nodata value");
+      }
+    }
+  }
+  const auto elementBytes = static_cast<GSpacing>(pixels.elemSize1());
+  if (GDALDatasetRasterIOEx(ds, GF_Write, 0, 0, pixels.cols, pixels.rows, pixels.data, pixels.cols,
+                            pixels.rows, gdalType, bands, nullptr, elementBytes * bands,
+                            static_cast<GSpacing>(pixels.step[0]), elementBytes, nullptr) != CE_None) {
+    failAndRemove("cannot write the pixels");
+  }
+  GDALFlushCache(ds);
+  if (errors.failed()) failAndRemove("cannot write the pixels");
+  // Closing writes the TIFF directory; GDALClose reports failures only through CPLError.
+  dataset.reset();
+  if (errors.failed()) {
+    const std::string message = errors.describe("cannot finish the GeoTIFF");
+    VSIUnlink(path.c_str());
+    throw Error(ErrorCode::WriteFailed, message, path);
+  }
+}
+
+void writeFloatGeoTiff(const std::string& path, const cv::Mat& image, const GeoReference& geo) {
+  cv::Mat asFloat = image;
+  if (!image.empty() && image.depth() != CV_32F) image.convertTo(asFloat, CV_32F);
+  WriteOptions options;
+  options.nodata = std::numeric_limits<double>::quiet_NaN();
+  writeGeoTiff(path, asFloat, geo, options);
+}
+
+void requireSameSize(const Raster& a, const Raster& b) {
+  if (a.data.size() == b.data.size()) return;
+  auto describe = [](const Raster& r) {
+    return (r.path.empty() ? std::string("<in memory>") : r.path) + " is " + std::to_string(r.data.cols) + "x" +
+           std::to_string(r.data.rows);
+  };
+  throw Error(ErrorCode::MismatchedInputs, "sizes differ: " + describe(a) + ", " + describe(b), a.path);
+}
+
+}  // namespace delineo::io
