@@ -155,6 +155,51 @@ double boundaryContribution(const std::vector<Ring>& rings, const std::vector<Ri
   return sum;
 }
 
+Polygon translated(const Polygon& polygon, const cv::Point2d& shift) {
+  Polygon out = polygon;
+  for (auto& p : out.outer) p += shift;
+  for (auto& hole : out.holes) {
+    for (auto& p : hole) p += shift;
+  }
+  return out;
+}
+
+bool isSimplePolygon(const Polygon& polygon) {
+  if (!core::isSimple(withoutRepeats(polygon.outer))) return false;
+  for (const auto& hole : polygon.holes) {
+    if (!core::isSimple(withoutRepeats(hole))) return false;
+  }
+  return true;
+}
+
+// Even-odd areas measured on a common supersampled raster (see overlapAreas).
+OverlapAreas rasterOverlap(const Polygon& a, const Polygon& b) {
+  constexpr double kMaxSamplesPerUnit = 16.0;
+  constexpr double kMaxSamplesAcross = 2048.0;
+  cv::Rect2d box = core::boundingBox(a.outer) | core::boundingBox(b.outer);
+  const double extent = std::max({box.width, box.height, 1e-12});
+  const double scale = std::min(kMaxSamplesPerUnit, kMaxSamplesAcross / extent);
+  auto toRaster = [&](const Polygon& p) {
+    Polygon out = translated(p, -box.tl());
+    for (auto& v : out.outer) v *= scale;
+    for (auto& hole : out.holes) {
+      for (auto& v : hole) v *= scale;
+    }
+    return out;
+  };
+  const cv::Size size(static_cast<int>(std::ceil(box.width * scale)) + 1,
+                      static_cast<int>(std::ceil(box.height * scale)) + 1);
+  const cv::Mat maskA = core::rasterize(toRaster(a), size);
+  const cv::Mat maskB = core::rasterize(toRaster(b), size);
+  const double pixelArea = 1.0 / (scale * scale);
+  OverlapAreas result;
+  result.exact = false;
+  result.a = cv::countNonZero(maskA) * pixelArea;
+  result.b = cv::countNonZero(maskB) * pixelArea;
+  result.intersection = cv::countNonZero(maskA & maskB) * pixelArea;
+  return result;
+}
+
 std::vector<cv::Point2d> verticesOf(const std::vector<Ring>& rings) {
   std::vector<cv::Point2d> v;
   for (const auto& r : rings) v.insert(v.end(), r.begin(), r.end());
@@ -178,15 +223,26 @@ double directedHausdorff(const std::vector<Segment>& from, const std::vector<Seg
 
 }  // namespace
 
-double intersectionArea(const core::Polygon& a, const core::Polygon& b) {
-  const auto ringsA = orientedRings(a);
-  const auto ringsB = orientedRings(b);
-  if (ringsA.empty() || ringsB.empty()) return 0.0;
+OverlapAreas overlapAreas(const core::Polygon& a, const core::Polygon& b) {
+  // Work around a local origin: map coordinates (UTM metres ~1e6) would otherwise lose
+  // significant digits in the shoelace products.
+  const cv::Point2d origin = a.outer.empty() ? cv::Point2d() : a.outer.front();
+  const Polygon localA = translated(a, -origin);
+  const Polygon localB = translated(b, -origin);
+  if (!isSimplePolygon(localA) || !isSimplePolygon(localB)) {
+    return rasterOverlap(localA, localB);
+  }
+  OverlapAreas result;
+  result.a = core::area(localA);
+  result.b = core::area(localB);
+  const auto ringsA = orientedRings(localA);
+  const auto ringsB = orientedRings(localB);
+  if (ringsA.empty() || ringsB.empty()) return result;
   const cv::Rect2d boxA = core::boundingBox(ringsA.front());
   const cv::Rect2d boxB = core::boundingBox(ringsB.front());
   if (boxA.x > boxB.x + boxB.width || boxB.x > boxA.x + boxA.width ||
       boxA.y > boxB.y + boxB.height || boxB.y > boxA.y + boxA.height) {
-    return 0.0;
+    return result;
   }
   const double tolerance = 1e-9 * extentOf(ringsA, ringsB);
   const auto edgesA = edgesOf(ringsA);
@@ -194,21 +250,25 @@ double intersectionArea(const core::Polygon& a, const core::Polygon& b) {
   // Shared pieces are taken from a's pass only, so they count once.
   const double s = boundaryContribution(ringsA, ringsB, edgesB, true, tolerance) +
                    boundaryContribution(ringsB, ringsA, edgesA, false, tolerance);
-  return std::clamp(s, 0.0, std::min(core::area(a), core::area(b)));
+  result.intersection = std::clamp(s, 0.0, std::min(result.a, result.b));
+  return result;
+}
+
+double intersectionArea(const core::Polygon& a, const core::Polygon& b) {
+  return overlapAreas(a, b).intersection;
 }
 
 double intersectionOverUnion(const core::Polygon& a, const core::Polygon& b) {
-  const double inter = intersectionArea(a, b);
-  const double uni = core::area(a) + core::area(b) - inter;
-  return uni > 0 ? inter / uni : 0.0;
+  const OverlapAreas areas = overlapAreas(a, b);
+  const double uni = areas.a + areas.b - areas.intersection;
+  return uni > 0 ? areas.intersection / uni : 0.0;
 }
 
 double shapeErrorP1(const core::Polygon& predicted, const core::Polygon& truth) {
-  const double truthArea = core::area(truth);
-  if (truthArea <= 0) return std::numeric_limits<double>::quiet_NaN();
-  const double inter = intersectionArea(predicted, truth);
-  const double symmetricDifference = core::area(predicted) + truthArea - 2.0 * inter;
-  return 100.0 * std::max(0.0, symmetricDifference) / truthArea;
+  const OverlapAreas areas = overlapAreas(predicted, truth);
+  if (areas.b <= 0) return std::numeric_limits<double>::quiet_NaN();
+  const double symmetricDifference = areas.a + areas.b - 2.0 * areas.intersection;
+  return 100.0 * std::max(0.0, symmetricDifference) / areas.b;
 }
 
 double distanceToBoundary(const cv::Point2d& point, const core::Polygon& polygon) {

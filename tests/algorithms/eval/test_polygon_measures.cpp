@@ -110,6 +110,29 @@ TEST(PolygonMeasures, ExactAreaAgreesWithFineRasterisation) {
   }
 }
 
+TEST(PolygonMeasures, MapCoordinatesKeepFullPrecision) {
+  // UTM-like coordinates: the shoelace products would lose digits without a local origin.
+  const double x0 = 733900.25, y0 = 3725100.75;
+  const auto areas = eval::overlapAreas(square(x0, y0, 10), square(x0 + 5, y0, 10));
+  EXPECT_TRUE(areas.exact);
+  EXPECT_NEAR(areas.intersection, 50.0, 1e-6);
+  EXPECT_NEAR(eval::intersectionOverUnion(square(x0, y0, 10), square(x0 + 5, y0, 10)), 1.0 / 3.0,
+              1e-9);
+}
+
+TEST(PolygonMeasures, SelfIntersectingOutlinesUseTheEvenOddRaster) {
+  // Bow tie: two triangles of area 25 under the even-odd rule, both inside the square.
+  const Polygon bowTie{{{0, 0}, {10, 10}, {10, 0}, {0, 10}}, {}};
+  const auto areas = eval::overlapAreas(bowTie, square(0, 0, 10));
+  EXPECT_FALSE(areas.exact);
+  EXPECT_NEAR(areas.a, 50.0, 0.5);
+  EXPECT_NEAR(areas.b, 100.0, 0.5);
+  EXPECT_NEAR(areas.intersection, 50.0, 0.5);
+  EXPECT_NEAR(eval::intersectionOverUnion(bowTie, square(0, 0, 10)), 0.5, 0.01);
+  EXPECT_NEAR(eval::intersectionOverUnion(bowTie, bowTie), 1.0, 1e-12);
+  EXPECT_NEAR(eval::shapeErrorP1(bowTie, square(0, 0, 10)), 50.0, 1.0);
+}
+
 TEST(PolygonMeasures, ShapeErrorP1MatchesTheMaskFormula) {
   const Polygon truth = square(10, 10, 20);
   const Polygon predicted{box(12, 10, 30, 34), {}};  // misses 2 x 20, adds 18 x 4

@@ -10,11 +10,25 @@
 
 namespace delineo::eval {
 
-// Exact area of a ∩ b (no rasterisation). The boundary of a ∩ b is made of the pieces of ∂a
-// inside b and the pieces of ∂b inside a; with every ring oriented interior-on-the-left, the
-// shoelace integral over those pieces is the area (Green's theorem). Boundary pieces shared by
-// both outlines count once when the interiors lie on the same side, not at all otherwise.
-// Polygons must be simple (holes inside the outer ring, rings not crossing each other).
+// Areas of two outlines and of their intersection.
+struct OverlapAreas {
+  double a = 0.0;
+  double b = 0.0;
+  double intersection = 0.0;
+  bool exact = true;  // false when the rasterised fallback was used
+};
+
+// For simple polygons (every ring simple, holes inside the outer ring) the areas are exact, with
+// no rasterisation: the boundary of a ∩ b is made of the pieces of ∂a inside b and the pieces of
+// ∂b inside a; with every ring oriented interior-on-the-left, the shoelace integral over those
+// pieces is the area (Green's theorem). Boundary pieces shared by both outlines count once when
+// the interiors lie on the same side, not at all otherwise.
+// A self-intersecting ring has no such orientation: the polygons are then read under the
+// even-odd rule (as core::rasterize does) and all three areas are measured on a common raster
+// of up to 16 samples per unit and at most 2048 samples across the pair (exact = false).
+OverlapAreas overlapAreas(const core::Polygon& a, const core::Polygon& b);
+
+// overlapAreas(a, b).intersection.
 double intersectionArea(const core::Polygon& a, const core::Polygon& b);
 
 // Intersection over union of the areas, in [0, 1]; 0 when both areas are zero.
