@@ -1,0 +1,105 @@
+#pragma once
+// Dense disparity for an epipolar pair (Cord, Paparoditis & Jordan): normalised cross-correlation
+// on contour-adaptive template shapes, ±1 line shift, sub-pixel peak, symmetric left/right
+// validation and coarse-to-fine search intervals. OpenCV's StereoSGBM is the alternative
+// backend with the same conventions.
+//
+// Conventions: left = reference image, x_right = x_left - d, disparity ranges are any integers
+// (negative allowed). Output disparity is float32 with NaN for rejected/unmatched pixels.
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/core/params.hpp"
+#include "delineo/core/progress.hpp"
+
+namespace delineo::stereo {
+
+struct MatchParams {
+  std::string method = "adaptive";  // adaptive | sgbm
+  int dmin = 0;                      // px, smallest disparity searched (x_right = x_left - d)
+  int dmax = 64;                     // px, largest disparity searched
+  int levels = 0;                    // pyramid levels, 0 = auto: ceil(1 + log2(range / 20))
+  int window = 15;                   // px, odd side of the (maximal) template window
+  double tolerance = 1.0;            // px, τ of the symmetric left/right validation
+  double edgeLow = 40.0;             // Canny low threshold on the 0..255-normalised image
+  double edgeHigh = 100.0;           // Canny high threshold
+  double edgeSigma = 1.0;            // px, Gaussian smoothing before Canny (same at each level)
+  int minShape = 25;                 // px, adaptive shapes smaller than this use the square window
+  int margin = 2;                    // px, half-width added around the coarser level's disparity
+  int lineShift = 1;                 // px, search ±lineShift lines (0 or 1) across the epipolar direction
+  double minScore = 0.3;             // NCC below this is rejected (flat or unmatched windows)
+  bool subpixel = true;              // sub-pixel peak from the 3x3 correlation neighbourhood
+  bool adaptive = true;              // contour-adaptive shapes (false: plain square windows)
+  int threads = 0;                   // worker threads, 0 = all cores
+
+  template <class V>
+  void visit(V&& v) {
+    v(core::ParamInfo{"method", "Method", "", "Matcher: adaptive (Cord et al.) or sgbm (OpenCV)",
+                      0, 0, "adaptive|sgbm"},
+      method);
+    v(core::ParamInfo{"dmin", "Minimum disparity", "px",
+                      "Smallest disparity searched, x_right = x_left - d", -100000, 100000},
+      dmin);
+    v(core::ParamInfo{"dmax", "Maximum disparity", "px", "Largest disparity searched", -100000,
+                      100000},
+      dmax);
+    v(core::ParamInfo{"levels", "Pyramid levels", "",
+                      "Resolution levels, 0 = automatic from the range (coarsest range ~20 px)",
+                      0, 10},
+      levels);
+    v(core::ParamInfo{"window", "Template size", "px",
+                      "Odd side of the maximal template window (paper: 15)", 3, 31},
+      window);
+    v(core::ParamInfo{"tolerance", "Validation tolerance", "px",
+                      "Symmetric left/right consistency tolerance τ", 0, 10},
+      tolerance);
+    v(core::ParamInfo{"edge-low", "Edge low threshold", "",
+                      "Canny hysteresis low threshold on the 0..255-normalised image", 0, 1000},
+      edgeLow);
+    v(core::ParamInfo{"edge-high", "Edge high threshold", "",
+                      "Canny hysteresis high threshold on the 0..255-normalised image", 0, 1000},
+      edgeHigh);
+    v(core::ParamInfo{"edge-sigma", "Edge smoothing", "px",
+                      "Gaussian sigma before edge detection, at every pyramid level", 0, 10},
+      edgeSigma);
+    v(core::ParamInfo{"min-shape", "Minimal shape", "px",
+                      "Adaptive shapes with fewer pixels fall back to the square window", 1, 961},
+      minShape);
+    v(core::ParamInfo{"margin", "Interval margin", "px",
+                      "Half-width around the coarser level's disparity for the finer search", 0,
+                      64},
+      margin);
+    v(core::ParamInfo{"line-shift", "Line shift", "px",
+                      "Search ±N lines across the epipolar direction (paper: 1)", 0, 1},
+      lineShift);
+    v(core::ParamInfo{"min-score", "Minimal score", "",
+                      "Matches whose NCC peak is below this are rejected", -1, 1},
+      minScore);
+    v(core::ParamInfo{"subpixel", "Sub-pixel", "", "Sub-pixel peak interpolation"}, subpixel);
+    v(core::ParamInfo{"adaptive", "Adaptive shapes", "",
+                      "Contour-adaptive template shapes (off: plain square windows)"},
+      adaptive);
+    v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
+      threads);
+  }
+  void validate() const;
+};
+
+struct MatchResult {
+  cv::Mat disparity;  // CV_32F, left-image geometry, NaN = rejected or unmatched
+  cv::Mat score;      // CV_32F, NCC of the retained match, NaN where disparity is NaN
+  int levelsUsed = 1;
+  core::RunStatus status = core::RunStatus::Completed;
+};
+
+// Pyramid depth N = ceil(1 + log2(ΔP1 / ΔPN)) with ΔP1 = dmax - dmin and ΔPN = 20 px, at least 1.
+int autoLevels(int dmin, int dmax);
+
+// left/right: single-channel float32 (NaN = nodata) of the same size. Throws core::Error:
+// InvalidParameter (dmin > dmax, bad parameters), MismatchedInputs (sizes), UnsupportedInput
+// (empty or not float32). Returns status Canceled (and empty maps) when `progress` is canceled.
+MatchResult matchStereo(const cv::Mat& left, const cv::Mat& right, const MatchParams& params,
+                        core::Progress* progress = nullptr);
+
+}  // namespace delineo::stereo

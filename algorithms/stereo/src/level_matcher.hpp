@@ -1,0 +1,44 @@
+#pragma once
+// One resolution level of the adaptive-window matcher (internal to delineo_stereo).
+#include <opencv2/core.hpp>
+
+#include "delineo/core/progress.hpp"
+
+namespace delineo::stereo::detail {
+
+struct LevelInput {
+  cv::Mat ref;         // CV_32F, reference image, values finite (nodata filled)
+  cv::Mat other;       // CV_32F, image searched at x_other = x_ref - d, y_other = y_ref + dy
+  cv::Mat refValid;    // CV_8U, 1 where ref holds data
+  cv::Mat otherValid;  // CV_8U, 1 where other holds data
+  cv::Mat refEdges;    // CV_8U, non-zero on contour pixels of ref
+  cv::Mat lo, hi;      // CV_32S, per-pixel inclusive search interval (lo > hi: not searched)
+  int dmin = 0;        // the level's full range; an interval touching neither end of it whose
+  int dmax = 0;        // peak lies on its border is rejected (true peak outside the interval)
+};
+
+struct LevelSettings {
+  int window = 15;
+  int lineShift = 1;  // 0 or 1
+  int minShape = 25;
+  double minScore = 0.3;
+  bool subpixel = true;
+  bool adaptive = true;
+  int threads = 1;
+};
+
+struct LevelOutput {
+  cv::Mat disparity;  // CV_32F, NaN = no match
+  cv::Mat lineShift;  // CV_32F, sub-pixel shift across lines of the match
+  cv::Mat score;      // CV_32F, NCC of the peak
+};
+
+// Returns false when `progress` was canceled (outputs are then incomplete).
+bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
+                core::Progress* progress);
+
+// Sub-pixel offset of a peak from its 3x3 neighbourhood s[i][j], i = d-1..d+1, j = dy-1..dy+1
+// (NaN where not evaluated). Returns (offset along d, offset along dy), each in [-1, 1].
+cv::Point2f subpixelPeak(const float s[3][3], bool haveLineNeighbours);
+
+}  // namespace delineo::stereo::detail

@@ -1,0 +1,410 @@
+// Coarse-to-fine driver of the adaptive matcher, symmetric validation, and the SGBM backend.
+#include "delineo/stereo/match.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+#include "level_matcher.hpp"
+
+namespace delineo::stereo {
+
+using core::Error;
+using core::ErrorCode;
+
+namespace {
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr double kCoarsestRange = 20.0;  // ΔP_N of the paper, px
+constexpr int kMinLevelSide = 32;        // px, coarsest level kept at least this large
+
+int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+int ceilDiv(int a, int b) { return -floorDiv(-a, b); }
+
+// Grey mapping shared by both images: 1st..99th percentile of their valid pixels to 0..255, so
+// Canny thresholds and SGBM penalties mean the same on 8-bit, 16-bit and float inputs.
+struct GreyMapping {
+  double offset = 0, scale = 1;
+};
+
+GreyMapping greyMapping(const cv::Mat& a, const cv::Mat& b) {
+  std::vector<float> samples;
+  samples.reserve(20000);
+  for (const cv::Mat* m : {&a, &b}) {
+    const size_t total = m->total();
+    const size_t step = std::max<size_t>(1, total / 10000);
+    const float* p = m->ptr<float>();
+    for (size_t i = 0; i < total; i += step) {
+      if (std::isfinite(p[i])) samples.push_back(p[i]);
+    }
+  }
+  GreyMapping g;
+  if (samples.empty()) return g;
+  auto at = [&](double q) {
+    const size_t k = static_cast<size_t>(q * static_cast<double>(samples.size() - 1));
+    std::nth_element(samples.begin(), samples.begin() + static_cast<long>(k), samples.end());
+    return static_cast<double>(samples[k]);
+  };
+  const double lo = at(0.01), hi = at(0.99);
+  g.offset = lo;
+  g.scale = hi > lo ? 255.0 / (hi - lo) : 1.0;
+  return g;
+}
+
+// Values mapped to the grey scale with nodata filled by 0 after centring, and a validity mask.
+void prepare(const cv::Mat& src, const GreyMapping& g, cv::Mat& values, cv::Mat& valid) {
+  values.create(src.size(), CV_32F);
+  valid.create(src.size(), CV_8U);
+  for (int y = 0; y < src.rows; ++y) {
+    const float* s = src.ptr<float>(y);
+    float* v = values.ptr<float>(y);
+    uchar* m = valid.ptr<uchar>(y);
+    for (int x = 0; x < src.cols; ++x) {
+      const bool ok = std::isfinite(s[x]);
+      m[x] = ok ? 1 : 0;
+      // Centred on mid-grey: smaller magnitudes keep the float running sums accurate.
+      v[x] = ok ? static_cast<float>((s[x] - g.offset) * g.scale - 127.5) : 0.0F;
+    }
+  }
+}
+
+cv::Mat edgeMap(const cv::Mat& values, const MatchParams& p) {
+  cv::Mat grey;
+  values.convertTo(grey, CV_8U, 1.0, 127.5);
+  if (p.edgeSigma > 0) cv::GaussianBlur(grey, grey, cv::Size(0, 0), p.edgeSigma);
+  cv::Mat edges;
+  cv::Canny(grey, edges, p.edgeLow, p.edgeHigh, 3, true);
+  return edges;
+}
+
+struct Level {
+  cv::Mat left, right, leftValid, rightValid, leftEdges, rightEdges;
+  int dmin = 0, dmax = 0;
+};
+
+cv::Mat flipped(const cv::Mat& m) {
+  cv::Mat out;
+  cv::flip(m, out, 1);
+  return out;
+}
+
+// Keeps the matches of `disp` (with line shifts) whose match in the other map points back
+// within `tolerance` for at least one of the four floor/ceil neighbours. `sign`: +1 when disp is
+// the left map (x_other = x - d), -1 for the right map (x_other = x + d).
+cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& other, int sign,
+                 double tolerance) {
+  cv::Mat out = map.disparity.clone();
+  const int W = out.cols, H = out.rows;
+  for (int y = 0; y < H; ++y) {
+    float* d = out.ptr<float>(y);
+    const float* dy = map.lineShift.ptr<float>(y);
+    for (int x = 0; x < W; ++x) {
+      if (!std::isfinite(d[x])) continue;
+      const double xo = x - sign * d[x];
+      const double yo = y + dy[x];
+      const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
+      bool consistent = false;
+      for (int m = 0; m <= 1 && !consistent; ++m) {
+        for (int n = 0; n <= 1 && !consistent; ++n) {
+          const int qx = fx + n, qy = fy + m;
+          if (qx < 0 || qx >= W || qy < 0 || qy >= H) continue;
+          const float dq = other.disparity.at<float>(qy, qx);
+          if (!std::isfinite(dq)) continue;
+          const double ex = d[x] - dq;
+          const double ey = dy[x] + other.lineShift.at<float>(qy, qx);
+          consistent = std::hypot(ex, ey) <= tolerance;
+        }
+      }
+      if (!consistent) d[x] = kNaN;
+    }
+  }
+  return out;
+}
+
+// Search intervals of a level from the validated disparities of the next coarser level: the
+// min..max of the valid coarse disparities in the 3x3 neighbourhood of the parent pixel, doubled,
+// ± margin; the level's full range where the neighbourhood holds no valid disparity.
+void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
+                         cv::Mat& lo, cv::Mat& hi) {
+  const int cw = coarse.cols, ch = coarse.rows;
+  cv::Mat clo(coarse.size(), CV_32S), chi(coarse.size(), CV_32S);
+  for (int y = 0; y < ch; ++y) {
+    for (int x = 0; x < cw; ++x) {
+      float mn = std::numeric_limits<float>::infinity(), mx = -mn;
+      for (int v = std::max(0, y - 1); v <= std::min(ch - 1, y + 1); ++v) {
+        for (int u = std::max(0, x - 1); u <= std::min(cw - 1, x + 1); ++u) {
+          const float d = coarse.at<float>(v, u);
+          if (!std::isfinite(d)) continue;
+          mn = std::min(mn, d);
+          mx = std::max(mx, d);
+        }
+      }
+      if (mn > mx) {
+        clo.at<int>(y, x) = dmin;
+        chi.at<int>(y, x) = dmax;
+      } else {
+        clo.at<int>(y, x) = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - margin);
+        chi.at<int>(y, x) = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + margin);
+      }
+    }
+  }
+  lo.create(size, CV_32S);
+  hi.create(size, CV_32S);
+  for (int y = 0; y < size.height; ++y) {
+    const int cy = std::min(ch - 1, y / 2);
+    for (int x = 0; x < size.width; ++x) {
+      const int cx = std::min(cw - 1, x / 2);
+      lo.at<int>(y, x) = clo.at<int>(cy, cx);
+      hi.at<int>(y, x) = chi.at<int>(cy, cx);
+    }
+  }
+}
+
+int threadCount(const MatchParams& p) {
+  if (p.threads > 0) return p.threads;
+  return std::max(1U, std::thread::hardware_concurrency());
+}
+
+MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                          core::Progress* progress) {
+  MatchResult result;
+  int levels = p.levels > 0 ? p.levels : autoLevels(p.dmin, p.dmax);
+  while (levels > 1 && std::min(left.cols, left.rows) / (1 << (levels - 1)) < kMinLevelSide) {
+    --levels;
+  }
+  result.levelsUsed = levels;
+
+  const GreyMapping g = greyMapping(left, right);
+  std::vector<Level> pyramid(static_cast<size_t>(levels));
+  prepare(left, g, pyramid[0].left, pyramid[0].leftValid);
+  prepare(right, g, pyramid[0].right, pyramid[0].rightValid);
+  for (int k = 1; k < levels; ++k) {
+    Level& fine = pyramid[static_cast<size_t>(k - 1)];
+    Level& coarse = pyramid[static_cast<size_t>(k)];
+    cv::pyrDown(fine.left, coarse.left);
+    cv::pyrDown(fine.right, coarse.right);
+    // A coarse pixel holds data only when its whole footprint did.
+    for (auto [src, dst] : {std::pair{&fine.leftValid, &coarse.leftValid},
+                            std::pair{&fine.rightValid, &coarse.rightValid}}) {
+      cv::Mat f, c;
+      src->convertTo(f, CV_32F);
+      cv::pyrDown(f, c);
+      *dst = c > 0.999F;
+      *dst /= 255;
+    }
+  }
+  for (int k = 0; k < levels; ++k) {
+    Level& lv = pyramid[static_cast<size_t>(k)];
+    lv.leftEdges = edgeMap(lv.left, p);
+    lv.rightEdges = edgeMap(lv.right, p);
+    lv.dmin = floorDiv(p.dmin, 1 << k);
+    lv.dmax = ceilDiv(p.dmax, 1 << k);
+  }
+
+  // Progress weight of each level ∝ its area.
+  std::vector<double> weight(static_cast<size_t>(levels));
+  double total = 0;
+  for (int k = 0; k < levels; ++k) total += (weight[static_cast<size_t>(k)] = std::pow(0.25, k));
+
+  detail::LevelSettings s;
+  s.window = p.window;
+  s.lineShift = p.lineShift;
+  s.minShape = p.minShape;
+  s.minScore = p.minScore;
+  s.subpixel = p.subpixel;
+  s.adaptive = p.adaptive;
+  s.threads = threadCount(p);
+
+  cv::Mat coarseLeft, coarseRight;  // validated disparities of the previous (coarser) level
+  double done = 0;
+  detail::LevelOutput leftOut, rightOut;
+  for (int k = levels - 1; k >= 0; --k) {
+    const Level& lv = pyramid[static_cast<size_t>(k)];
+    if (progress != nullptr) {
+      progress->setStage("matching level " + std::to_string(levels - k) + "/" +
+                         std::to_string(levels));
+    }
+    detail::LevelInput inL, inR;
+    inL.ref = lv.left;
+    inL.other = lv.right;
+    inL.refValid = lv.leftValid;
+    inL.otherValid = lv.rightValid;
+    inL.refEdges = lv.leftEdges;
+    inL.dmin = inR.dmin = lv.dmin;
+    inL.dmax = inR.dmax = lv.dmax;
+    cv::Mat loR, hiR;
+    if (coarseLeft.empty()) {
+      inL.lo = cv::Mat(lv.left.size(), CV_32S, cv::Scalar(lv.dmin));
+      inL.hi = cv::Mat(lv.left.size(), CV_32S, cv::Scalar(lv.dmax));
+      loR = inL.lo;
+      hiR = inL.hi;
+    } else {
+      intervalsFromCoarse(coarseLeft, lv.left.size(), lv.dmin, lv.dmax, p.margin, inL.lo, inL.hi);
+      intervalsFromCoarse(coarseRight, lv.left.size(), lv.dmin, lv.dmax, p.margin, loR, hiR);
+    }
+    // Right -> left: mirrored images turn x_left = x_right + d into x'_other = x'_ref - d.
+    inR.ref = flipped(lv.right);
+    inR.other = flipped(lv.left);
+    inR.refValid = flipped(lv.rightValid);
+    inR.otherValid = flipped(lv.leftValid);
+    inR.refEdges = flipped(lv.rightEdges);
+    inR.lo = flipped(loR);
+    inR.hi = flipped(hiR);
+
+    const double w = weight[static_cast<size_t>(k)] / total;
+    core::Progress::Range leftRange(progress, done, done + 0.5 * w);
+    if (!detail::matchLevel(inL, s, leftOut, progress ? &leftRange : nullptr) ||
+        core::isCanceled(progress)) {
+      result.status = core::RunStatus::Canceled;
+      return result;
+    }
+    core::Progress::Range rightRange(progress, done + 0.5 * w, done + w);
+    detail::LevelOutput mirrored;
+    if (!detail::matchLevel(inR, s, mirrored, progress ? &rightRange : nullptr) ||
+        core::isCanceled(progress)) {
+      result.status = core::RunStatus::Canceled;
+      return result;
+    }
+    done += w;
+    rightOut.disparity = flipped(mirrored.disparity);
+    rightOut.lineShift = flipped(mirrored.lineShift);
+    rightOut.score = flipped(mirrored.score);
+    coarseLeft = validate(leftOut, rightOut, +1, p.tolerance);
+    coarseRight = validate(rightOut, leftOut, -1, p.tolerance);
+  }
+  result.disparity = coarseLeft;
+  result.score = leftOut.score.clone();
+  result.score.setTo(kNaN, result.disparity != result.disparity);
+  return result;
+}
+
+// NCC of the square window at the rounded disparity: the score map of the SGBM backend.
+cv::Mat squareScore(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity,
+                    int window) {
+  const int r = window / 2;
+  cv::Mat score(disparity.size(), CV_32F, cv::Scalar(kNaN));
+  cv::parallel_for_(cv::Range(r, disparity.rows - r), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      for (int x = r; x < disparity.cols - r; ++x) {
+        const float d = disparity.at<float>(y, x);
+        if (!std::isfinite(d)) continue;
+        const int xr = x - static_cast<int>(std::lround(d));
+        if (xr - r < 0 || xr + r >= disparity.cols) continue;
+        double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+        for (int v = -r; v <= r; ++v) {
+          const float* a = left.ptr<float>(y + v) + x;
+          const float* b = right.ptr<float>(y + v) + xr;
+          for (int u = -r; u <= r; ++u) {
+            sa += a[u];
+            sb += b[u];
+            saa += a[u] * a[u];
+            sbb += b[u] * b[u];
+            sab += a[u] * b[u];
+          }
+        }
+        const double n = static_cast<double>(window) * window;
+        const double va = saa - sa * sa / n, vb = sbb - sb * sb / n;
+        if (va > 1e-6 && vb > 1e-6) {
+          score.at<float>(y, x) = static_cast<float>((sab - sa * sb / n) / std::sqrt(va * vb));
+        }
+      }
+    }
+  });
+  return score;
+}
+
+MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                      core::Progress* progress) {
+  MatchResult result;
+  if (progress != nullptr) progress->setStage("matching (SGBM)");
+  core::report(progress, 0.0);
+  if (core::isCanceled(progress)) {
+    result.status = core::RunStatus::Canceled;
+    return result;
+  }
+  const GreyMapping g = greyMapping(left, right);
+  cv::Mat lv, rv, lvalid, rvalid, l8, r8;
+  prepare(left, g, lv, lvalid);
+  prepare(right, g, rv, rvalid);
+  lv.convertTo(l8, CV_8U, 1.0, 127.5);
+  rv.convertTo(r8, CV_8U, 1.0, 127.5);
+  // SGBM searches [minDisparity, minDisparity + numDisparities) with numDisparities a multiple
+  // of 16; its minDisparity may be negative, so any integer range maps directly.
+  const int range = p.dmax - p.dmin + 1;
+  const int numDisparities = ((range + 15) / 16) * 16;
+  const int block = 5;  // SGBM's own aggregation does the smoothing: a small block is customary
+  auto sgbm = cv::StereoSGBM::create(p.dmin, numDisparities, block, 8 * block * block,
+                                     32 * block * block,
+                                     std::max(1, static_cast<int>(std::ceil(p.tolerance))), 0, 10,
+                                     100, 2, cv::StereoSGBM::MODE_SGBM_3WAY);
+  cv::Mat raw;
+  sgbm->compute(l8, r8, raw);
+  if (core::isCanceled(progress)) {
+    result.status = core::RunStatus::Canceled;
+    return result;
+  }
+  result.disparity = cv::Mat(left.size(), CV_32F, cv::Scalar(kNaN));
+  for (int y = 0; y < raw.rows; ++y) {
+    const short* s = raw.ptr<short>(y);
+    float* d = result.disparity.ptr<float>(y);
+    for (int x = 0; x < raw.cols; ++x) {
+      const float v = s[x] / 16.0F;
+      if (s[x] < p.dmin * 16 || v > static_cast<float>(p.dmax) || !lvalid.at<uchar>(y, x)) continue;
+      const int xr = x - static_cast<int>(std::lround(v));
+      if (xr < 0 || xr >= raw.cols || !rvalid.at<uchar>(y, xr)) continue;
+      d[x] = v;
+    }
+  }
+  result.score = squareScore(lv, rv, result.disparity, p.window);
+  result.disparity.setTo(kNaN, result.score != result.score);
+  core::report(progress, 1.0);
+  return result;
+}
+
+}  // namespace
+
+void MatchParams::validate() const {
+  core::checkDeclaredRanges(*this);
+  if (dmin > dmax) {
+    throw Error(ErrorCode::InvalidParameter, "empty disparity range: dmin = " +
+                                                 std::to_string(dmin) + " > dmax = " +
+                                                 std::to_string(dmax));
+  }
+  if (window % 2 == 0) {
+    throw Error(ErrorCode::InvalidParameter, "window = " + std::to_string(window) + " must be odd");
+  }
+  if (edgeLow > edgeHigh) {
+    throw Error(ErrorCode::InvalidParameter, "edge-low must not exceed edge-high");
+  }
+}
+
+int autoLevels(int dmin, int dmax) {
+  const double range = static_cast<double>(dmax) - dmin;
+  if (range <= kCoarsestRange) return 1;
+  return static_cast<int>(std::ceil(1.0 + std::log(range / kCoarsestRange) / std::log(2.0)));
+}
+
+MatchResult matchStereo(const cv::Mat& left, const cv::Mat& right, const MatchParams& params,
+                        core::Progress* progress) {
+  params.validate();
+  if (left.empty() || right.empty() || left.type() != CV_32FC1 || right.type() != CV_32FC1) {
+    throw Error(ErrorCode::UnsupportedInput,
+                "stereo matching needs non-empty single-channel float32 images");
+  }
+  if (left.size() != right.size()) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "left image is " + std::to_string(left.cols) + "x" + std::to_string(left.rows) +
+                    " but right image is " + std::to_string(right.cols) + "x" +
+                    std::to_string(right.rows));
+  }
+  if (params.method == "sgbm") return matchSgbm(left, right, params, progress);
+  return matchAdaptive(left, right, params, progress);
+}
+
+}  // namespace delineo::stereo

@@ -1,0 +1,195 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "delineo/core/error.hpp"
+#include "delineo/stereo/match.hpp"
+#include "synthetic.hpp"
+
+namespace delineo::stereo {
+namespace {
+
+using testing::shiftedRight;
+using testing::squareScene;
+using testing::texture;
+
+struct Stats {
+  double density = 0, meanAbsError = 0, maxAbsError = 0;
+};
+
+Stats compare(const cv::Mat& disparity, double truth, int border) {
+  Stats s;
+  int valid = 0, total = 0;
+  for (int y = border; y < disparity.rows - border; ++y) {
+    for (int x = border; x < disparity.cols - border; ++x) {
+      ++total;
+      const float d = disparity.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      ++valid;
+      const double e = std::abs(d - truth);
+      s.meanAbsError += e;
+      s.maxAbsError = std::max(s.maxAbsError, e);
+    }
+  }
+  s.density = static_cast<double>(valid) / total;
+  if (valid > 0) s.meanAbsError /= valid;
+  return s;
+}
+
+TEST(Match, SubPixelShiftIsRecovered) {
+  const cv::Mat left = texture({160, 120}, 21);
+  const cv::Mat right = shiftedRight(left, 3.3);
+  MatchParams p;
+  p.dmin = -4;
+  p.dmax = 12;
+  const MatchResult r = matchStereo(left, right, p);
+  ASSERT_EQ(r.status, core::RunStatus::Completed);
+  ASSERT_EQ(r.disparity.type(), CV_32F);
+  ASSERT_EQ(r.disparity.size(), left.size());
+  const Stats s = compare(r.disparity, 3.3, 20);
+  EXPECT_GT(s.density, 0.95);
+  EXPECT_LT(s.meanAbsError, 0.1);
+  EXPECT_LT(s.maxAbsError, 1.0);
+  // Score is the NCC of the retained match: high on a clean shift.
+  EXPECT_GT(r.score.at<float>(60, 80), 0.9F);
+}
+
+TEST(Match, NegativeDisparitiesAndMultiResolution) {
+  const cv::Mat left = texture({320, 256}, 22);
+  const cv::Mat right = shiftedRight(left, -17.6);
+  MatchParams p;
+  p.dmin = -60;
+  p.dmax = 40;
+  const MatchResult r = matchStereo(left, right, p);
+  EXPECT_EQ(r.levelsUsed, autoLevels(-60, 40));
+  EXPECT_EQ(r.levelsUsed, 4);
+  const Stats s = compare(r.disparity, -17.6, 24);
+  EXPECT_GT(s.density, 0.9);
+  EXPECT_LT(s.meanAbsError, 0.15);
+}
+
+TEST(Match, AutoLevelsFollowsThePaper) {
+  EXPECT_EQ(autoLevels(0, 10), 1);
+  EXPECT_EQ(autoLevels(0, 20), 1);
+  EXPECT_EQ(autoLevels(0, 40), 2);
+  EXPECT_EQ(autoLevels(0, 60), 3);
+  EXPECT_EQ(autoLevels(-20, 236), 5);
+}
+
+TEST(Match, ValidationRejectsTheOccludedStrip) {
+  const auto scene = squareScene({160, 120}, cv::Rect(60, 30, 60, 60), 2, 14);
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 20;
+  const MatchResult r = matchStereo(scene.left, scene.right, p);
+  int occluded = 0, occludedRejected = 0, visible = 0, visibleGood = 0;
+  for (int y = 10; y < scene.left.rows - 10; ++y) {
+    for (int x = 25; x < scene.left.cols - 10; ++x) {
+      const float d = r.disparity.at<float>(y, x);
+      if (scene.occluded.at<uchar>(y, x)) {
+        ++occluded;
+        if (!std::isfinite(d)) ++occludedRejected;
+      } else {
+        ++visible;
+        if (std::isfinite(d) && std::abs(d - scene.truth.at<float>(y, x)) < 1.0F) ++visibleGood;
+      }
+    }
+  }
+  ASSERT_GT(occluded, 500);
+  EXPECT_GT(static_cast<double>(occludedRejected) / occluded, 0.9);
+  EXPECT_GT(static_cast<double>(visibleGood) / visible, 0.85);
+}
+
+// Matched pixels within `band` px of the square's vertical outline: how many, and how many
+// are off by more than 1 px (a step drawn at the wrong place).
+struct OutlineStats {
+  int matched = 0, wrong = 0, total = 0;
+};
+
+OutlineStats outlineStats(const MatchResult& r, const testing::SquareScene& s, int band) {
+  OutlineStats o;
+  for (int y = s.square.y + 5; y < s.square.br().y - 5; ++y) {
+    for (int x = s.square.x - band; x < s.square.br().x + band; ++x) {
+      const bool nearOutline =
+          std::abs(x - s.square.x) < band || std::abs(x - s.square.br().x) < band;
+      if (!nearOutline || s.occluded.at<uchar>(y, x)) continue;
+      ++o.total;
+      const float d = r.disparity.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      ++o.matched;
+      if (std::abs(d - s.truth.at<float>(y, x)) > 1.0F) ++o.wrong;
+    }
+  }
+  return o;
+}
+
+TEST(Match, AdaptiveShapesKeepTheOutlineSharperThanSquareWindows) {
+  const auto scene = squareScene({160, 120}, cv::Rect(60, 30, 60, 60), 2, 14);
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 20;
+  const OutlineStats adaptive = outlineStats(matchStereo(scene.left, scene.right, p), scene, 7);
+  p.adaptive = false;
+  const OutlineStats square = outlineStats(matchStereo(scene.left, scene.right, p), scene, 7);
+  // Square windows fatten the foreground by about half a window; adaptive shapes do not.
+  EXPECT_GT(square.wrong, square.total / 5);
+  EXPECT_LT(adaptive.wrong * 5, square.wrong) << adaptive.wrong << " vs " << square.wrong;
+  EXPECT_GT(adaptive.matched, adaptive.total * 7 / 10);
+}
+
+TEST(Match, SgbmFollowsTheSameConventions) {
+  const cv::Mat left = texture({200, 120}, 23);
+  const cv::Mat right = shiftedRight(left, -6.0);
+  MatchParams p;
+  p.method = "sgbm";
+  p.dmin = -20;
+  p.dmax = 10;
+  const MatchResult r = matchStereo(left, right, p);
+  ASSERT_EQ(r.disparity.type(), CV_32F);
+  const Stats s = compare(r.disparity, -6.0, 30);
+  EXPECT_GT(s.density, 0.8);
+  EXPECT_LT(s.meanAbsError, 0.3);
+  EXPECT_GT(r.score.at<float>(60, 100), 0.8F);
+}
+
+TEST(Match, CancelMidRun) {
+  const cv::Mat left = texture({200, 160}, 24);
+  const cv::Mat right = shiftedRight(left, 5.0);
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 40;
+  p.threads = 1;
+  core::Progress progress;
+  progress.cancelAfterReports(3);
+  const MatchResult r = matchStereo(left, right, p, &progress);
+  EXPECT_EQ(r.status, core::RunStatus::Canceled);
+  EXPECT_TRUE(r.disparity.empty());
+  // An uncanceled run reports monotone progress up to 1.
+  core::Progress full;
+  EXPECT_EQ(matchStereo(left, right, p, &full).status, core::RunStatus::Completed);
+  EXPECT_GT(full.reportCount(), 3);
+  EXPECT_DOUBLE_EQ(full.fraction(), 1.0);
+}
+
+TEST(Match, BadInputsThrow) {
+  const cv::Mat a = texture({60, 40}, 25);
+  const cv::Mat b = texture({61, 40}, 26);
+  MatchParams p;
+  EXPECT_THROW(matchStereo(a, b, p), core::Error);
+  p.dmin = 5;
+  p.dmax = 4;
+  EXPECT_THROW(matchStereo(a, a, p), core::Error);
+  p = MatchParams{};
+  p.window = 8;
+  EXPECT_THROW(matchStereo(a, a, p), core::Error);
+  p = MatchParams{};
+  p.method = "census";
+  EXPECT_THROW(matchStereo(a, a, p), core::Error);
+  EXPECT_THROW(matchStereo(cv::Mat(), a, MatchParams{}), core::Error);
+  cv::Mat bytes;
+  a.convertTo(bytes, CV_8U);
+  EXPECT_THROW(matchStereo(bytes, bytes, MatchParams{}), core::Error);
+}
+
+}  // namespace
+}  // namespace delineo::stereo
