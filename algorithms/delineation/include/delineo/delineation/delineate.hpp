@@ -1,0 +1,74 @@
+#pragma once
+// Building delineation on an epipolar pair: builds the energy images from the correlation cost
+// service and runs the statistical active polygon. Coordinates are left-image pixels.
+#include <optional>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/core/geometry.hpp"
+#include "delineo/core/progress.hpp"
+#include "delineo/delineation/active_polygon.hpp"
+#include "delineo/delineation/params.hpp"
+
+namespace delineo::stereo {
+class CorrelationCostService;
+}
+
+namespace delineo::delineation {
+
+struct DisparityInterval {
+  int min = 0;
+  int max = 0;  // inclusive
+};
+
+struct DelineationRequest {
+  // Initial contour: the operator's polygon or rectangle. Ignored when `initMask` is set.
+  core::Polygon init;
+  // Alternative init: CV_8U mask of the left image, non-zero on an above-ground region; its
+  // largest connected component is used.
+  cv::Mat initMask;
+  DisparityInterval roof;                     // Δd_b, required
+  std::optional<DisparityInterval> ground;    // Δd_g; estimated from a ring around the init when unset
+  std::optional<DisparityInterval> searchRange;  // full search range, when the caller knows it
+};
+
+// The energy inputs of one building, in ROI coordinates, plus what was derived on the way.
+struct PreparedEnergy {
+  cv::Rect roi;
+  EnergyImages images;
+  IntPolygon init;              // ROI coordinates
+  DisparityInterval ground;     // given or estimated
+  double groundDisparity = 0;   // representative ground level used for the occlusion band
+  double roofDisparity = 0;     // median roof disparity near the initial contour
+};
+
+struct DelineationResult {
+  core::Polygon polygon;  // left-image coordinates
+  EnergyTerms terms;
+  int iterations = 0;
+  int vertexCount = 0;
+  core::RunStatus status = core::RunStatus::Completed;
+  cv::Rect roi;
+  DisparityInterval roof, ground;
+  double noMatchCost = 0;
+};
+
+// Checks the request against the images; throws core::Error(InvalidParameter) for an empty or
+// inverted interval, a roof interval outside the search range, an init outside the image or a
+// degenerate init, and MismatchedInputs for images of different sizes.
+cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
+                          const DelineationRequest& request, const DelineationParams& params);
+
+// Builds c_roof, c_ground, NoMatchCost, the occlusion widths and the gradient images from a
+// cost service covering `roi` (left and right: single-channel images of one size).
+PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const cv::Mat& left,
+                             const cv::Mat& right, const DelineationRequest& request,
+                             const DelineationParams& params);
+
+// The whole pipeline for one building. Cancel returns the best polygon so far (status Canceled).
+DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
+                            const DelineationRequest& request, const DelineationParams& params,
+                            const IterationObserver& observer = {},
+                            core::Progress* progress = nullptr);
+
+}  // namespace delineo::delineation

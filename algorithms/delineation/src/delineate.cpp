@@ -1,0 +1,334 @@
+#include "delineo/delineation/delineate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+#include "delineo/stereo/cost_service.hpp"
+
+namespace delineo::delineation {
+
+namespace {
+
+using core::Error;
+using core::ErrorCode;
+
+std::string str(const DisparityInterval& d) {
+  return std::to_string(d.min) + ":" + std::to_string(d.max);
+}
+
+void requireInterval(const DisparityInterval& d, const char* what) {
+  if (d.min > d.max) {
+    throw Error(ErrorCode::InvalidParameter,
+                std::string(what) + " disparity interval " + str(d) + " is empty (min > max)");
+  }
+}
+
+bool contains(const DisparityInterval& outer, const DisparityInterval& inner) {
+  return outer.min <= inner.min && inner.max <= outer.max;
+}
+
+// Value at quantile q in [0, 1] of the finite values of a CV_32F image (optionally masked).
+double quantile(const cv::Mat& values, double q, const cv::Mat& mask = {}) {
+  std::vector<float> v;
+  v.reserve(values.total());
+  for (int y = 0; y < values.rows; ++y) {
+    const float* p = values.ptr<float>(y);
+    const uchar* m = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+    for (int x = 0; x < values.cols; ++x) {
+      if ((m == nullptr || m[x]) && std::isfinite(p[x])) v.push_back(p[x]);
+    }
+  }
+  if (v.empty()) return std::nan("");
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+cv::Mat toFloat(const cv::Mat& image) {
+  cv::Mat f;
+  image.convertTo(f, CV_32F);
+  return f;
+}
+
+// The initial contour in left-image coordinates, from the polygon or the mask.
+core::Polygon initialPolygon(const DelineationRequest& request, cv::Size imageSize) {
+  if (request.initMask.empty()) return request.init;
+  if (request.initMask.size() != imageSize || request.initMask.type() != CV_8U) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "the initial above-ground mask must be CV_8U of the left image's size");
+  }
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(request.initMask != 0, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  if (contours.empty()) {
+    throw Error(ErrorCode::InvalidParameter, "the initial above-ground mask is empty");
+  }
+  const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+    return cv::contourArea(a) < cv::contourArea(b);
+  });
+  std::vector<cv::Point> simplified;
+  cv::approxPolyDP(*largest, simplified, 1.0, true);
+  core::Polygon p;
+  // Contour points are pixel centres of border pixels: their corners are half a pixel out.
+  for (const auto& v : simplified) p.outer.emplace_back(v.x + 0.5, v.y + 0.5);
+  return p;
+}
+
+// Normalised gradient: Sobel of a lightly smoothed image divided by the 99th percentile of the
+// magnitude, so that the edge weight does not depend on the image's contrast.
+void normalisedGradient(const cv::Mat& image, cv::Mat& gx, cv::Mat& gy) {
+  cv::Mat f = toFloat(image);
+  cv::patchNaNs(f, 0.0);
+  cv::GaussianBlur(f, f, {0, 0}, 0.7);
+  cv::Sobel(f, gx, CV_32F, 1, 0, 3, 1.0 / 8);
+  cv::Sobel(f, gy, CV_32F, 0, 1, 3, 1.0 / 8);
+}
+
+void normaliseBy99(cv::Mat& gx, cv::Mat& gy) {
+  cv::Mat mag;
+  cv::magnitude(gx, gy, mag);
+  const double scale = quantile(mag, 0.99);
+  if (std::isfinite(scale) && scale > 1e-6) {
+    gx /= scale;
+    gy /= scale;
+  }
+}
+
+}  // namespace
+
+cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
+                          const DelineationRequest& request, const DelineationParams& params) {
+  params.validate();
+  if (left.empty() || right.empty()) {
+    throw Error(ErrorCode::MismatchedInputs, "delineation needs both images of the pair");
+  }
+  if (left.size() != right.size()) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "left (" + std::to_string(left.cols) + "x" + std::to_string(left.rows) +
+                    ") and right (" + std::to_string(right.cols) + "x" +
+                    std::to_string(right.rows) + ") images differ in size");
+  }
+  if (left.channels() != 1 || right.channels() != 1) {
+    throw Error(ErrorCode::UnsupportedInput, "delineation needs single-band images");
+  }
+  requireInterval(request.roof, "roof");
+  if (request.ground) requireInterval(*request.ground, "ground");
+  if (request.searchRange) {
+    requireInterval(*request.searchRange, "search");
+    if (!contains(*request.searchRange, request.roof)) {
+      throw Error(ErrorCode::InvalidParameter, "roof disparity interval " + str(request.roof) +
+                                                   " lies outside the search range " +
+                                                   str(*request.searchRange));
+    }
+    if (request.ground && !contains(*request.searchRange, *request.ground)) {
+      throw Error(ErrorCode::InvalidParameter, "ground disparity interval " +
+                                                   str(*request.ground) +
+                                                   " lies outside the search range " +
+                                                   str(*request.searchRange));
+    }
+  }
+  const core::Polygon init = initialPolygon(request, left.size());
+  if (init.outer.size() < 3 || core::area(init) < 4.0 || !core::isSimple(init.outer)) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the initial polygon is degenerate (fewer than 3 distinct vertices, "
+                "self-intersecting, or smaller than 4 px²)");
+  }
+  const cv::Rect2d box = core::boundingBox(init.outer);
+  if (box.x < 0 || box.y < 0 || box.x + box.width > left.cols || box.y + box.height > left.rows) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the initial polygon (bounding box " + std::to_string(box.x) + "," +
+                    std::to_string(box.y) + " " + std::to_string(box.width) + "x" +
+                    std::to_string(box.height) + ") is outside the image (" +
+                    std::to_string(left.cols) + "x" + std::to_string(left.rows) + ")");
+  }
+  const int m = params.roiMargin;
+  const cv::Rect grown(static_cast<int>(std::floor(box.x)) - m, static_cast<int>(std::floor(box.y)) - m,
+                       static_cast<int>(std::ceil(box.x + box.width)) - static_cast<int>(std::floor(box.x)) + 2 * m,
+                       static_cast<int>(std::ceil(box.y + box.height)) - static_cast<int>(std::floor(box.y)) + 2 * m);
+  return grown & cv::Rect(0, 0, left.cols, left.rows);
+}
+
+PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const cv::Mat& left,
+                             const cv::Mat& right, const DelineationRequest& request,
+                             const DelineationParams& params) {
+  PreparedEnergy out;
+  out.roi = costs.roi();
+  const cv::Rect roi = out.roi;
+  const cv::Size size = roi.size();
+  EnergyImages& im = out.images;
+
+  // Initial polygon in ROI coordinates.
+  const core::Polygon init = initialPolygon(request, left.size());
+  core::Ring local;
+  for (const auto& v : init.outer) local.emplace_back(v.x - roi.x, v.y - roi.y);
+  out.init.outer = polygonise(local, params.initialSpacing, size);
+  const cv::Mat initMask = core::rasterize(toPolygon(out.init), size);
+
+  im.roofCost = costs.minCost(request.roof.min, request.roof.max);
+  const cv::Mat bestCost = costs.bestCost();
+  im.noMatchCost = static_cast<float>(quantile(bestCost, 1.0 - params.occlusionPercent / 100.0));
+  if (!std::isfinite(im.noMatchCost)) im.noMatchCost = 1.0f;
+
+  // Ground interval: given, or the median best disparity in a ring outside the init.
+  if (request.ground) {
+    out.ground = *request.ground;
+    out.groundDisparity = 0.5 * (out.ground.min + out.ground.max);
+  } else {
+    cv::Mat ring;
+    cv::dilate(initMask, ring, cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                                          {2 * params.ringWidth + 1, 2 * params.ringWidth + 1}));
+    ring &= ~initMask;
+    ring &= (bestCost <= im.noMatchCost);
+    cv::Mat bestDisparity;
+    costs.bestDisparity().convertTo(bestDisparity, CV_32F);
+    const double median = quantile(bestDisparity, 0.5, ring);
+    if (!std::isfinite(median)) {
+      throw Error(ErrorCode::ProcessingFailed,
+                  "cannot estimate the ground disparity: no matched pixel around the initial polygon");
+    }
+    const int g = static_cast<int>(std::lround(median));
+    out.ground = {g - params.groundTolerance, g + params.groundTolerance};
+    // The ground interval must not overlap the roof's, or both costs would agree on the roof.
+    if (g < request.roof.min) out.ground.max = std::min(out.ground.max, request.roof.min - 1);
+    else if (g > request.roof.max) out.ground.min = std::max(out.ground.min, request.roof.max + 1);
+    if (out.ground.min > out.ground.max) {
+      throw Error(ErrorCode::ProcessingFailed,
+                  "the ground disparity estimated around the initial polygon (" +
+                      std::to_string(g) + ") falls inside the roof interval " + str(request.roof));
+    }
+    out.groundDisparity = g;
+  }
+  im.groundCost = costs.minCost(out.ground.min, out.ground.max);
+
+  // Roof disparity per pixel: argmin of Crit within the roof interval, median-filtered.
+  const int d0 = std::max(request.roof.min, costs.dmin()), d1 = std::min(request.roof.max, costs.dmax());
+  cv::Mat roofDisparity(size, CV_32F, cv::Scalar(0.5f * (d0 + d1)));
+  for (int y = 0; y < size.height; ++y) {
+    float* rd = roofDisparity.ptr<float>(y);
+    for (int x = 0; x < size.width; ++x) {
+      float best = std::numeric_limits<float>::infinity();
+      for (int d = d0; d <= d1; ++d) {
+        const float c = costs.cost(roi.x + x, roi.y + y, d);
+        if (c < best) {
+          best = c;
+          rd[x] = static_cast<float>(d);
+        }
+      }
+    }
+  }
+  cv::medianBlur(roofDisparity, roofDisparity, 5);
+  // d_xy: the roof disparity at the nearest roof-like pixel of the initial region (inside the
+  // init, roof interval matching better than the ground's). The paper takes the nearest pixel
+  // of the initial contour; an operator's rough contour often lies on the ground, so its own
+  // disparity would be the ground's.
+  cv::Mat roofLike = initMask & (im.roofCost < im.groundCost);
+  cv::Mat dxy(size, CV_32F);
+  if (cv::countNonZero(roofLike) == 0) {
+    dxy.setTo(0.5 * (request.roof.min + request.roof.max));
+    out.roofDisparity = 0.5 * (request.roof.min + request.roof.max);
+  } else {
+    cv::Mat seeds = ~roofLike, dist, labels;
+    cv::distanceTransform(seeds, dist, labels, cv::DIST_L2, 3, cv::DIST_LABEL_PIXEL);
+    std::vector<float> labelDisparity(static_cast<size_t>(size.area()) + 1, 0.f);
+    for (int y = 0; y < size.height; ++y) {
+      for (int x = 0; x < size.width; ++x) {
+        if (roofLike.at<uchar>(y, x)) labelDisparity[labels.at<int>(y, x)] = roofDisparity.at<float>(y, x);
+      }
+    }
+    for (int y = 0; y < size.height; ++y) {
+      for (int x = 0; x < size.width; ++x) dxy.at<float>(y, x) = labelDisparity[labels.at<int>(y, x)];
+    }
+    out.roofDisparity = quantile(roofDisparity, 0.5, roofLike);
+  }
+
+  // Occlusion band: walls seen in the left image and ground hidden in the right one lie next to
+  // the roof on the -x side when the roof is nearer (larger d, since x_right = x_left - d).
+  im.occlusionSide = out.roofDisparity >= out.groundDisparity ? -1 : +1;
+  cv::Mat width = cv::abs(dxy - out.groundDisparity);
+  width.convertTo(im.occlusionWidth, CV_32S);  // rounds to nearest
+
+  // Gradients: left on the ROI (computed with a border so that the ROI edge is exact), right
+  // resampled at (x - d_xy, y).
+  const cv::Rect full(0, 0, left.cols, left.rows);
+  const cv::Rect leftBox = cv::Rect(roi.x - 3, roi.y - 3, roi.width + 6, roi.height + 6) & full;
+  cv::Mat lgx, lgy;
+  normalisedGradient(left(leftBox), lgx, lgy);
+  const cv::Rect inBox(roi.x - leftBox.x, roi.y - leftBox.y, roi.width, roi.height);
+  im.leftGradX = lgx(inBox).clone();
+  im.leftGradY = lgy(inBox).clone();
+  normaliseBy99(im.leftGradX, im.leftGradY);
+  const cv::Rect rightBox = cv::Rect(0, roi.y - 3, right.cols, roi.height + 6) & full;
+  cv::Mat rgx, rgy;
+  normalisedGradient(right(rightBox), rgx, rgy);
+  cv::Mat mapX(size, CV_32F), mapY(size, CV_32F);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      mapX.at<float>(y, x) = static_cast<float>(roi.x + x - rightBox.x) - dxy.at<float>(y, x);
+      mapY.at<float>(y, x) = static_cast<float>(roi.y + y - rightBox.y);
+    }
+  }
+  cv::remap(rgx, im.rightGradX, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+  cv::remap(rgy, im.rightGradY, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+  normaliseBy99(im.rightGradX, im.rightGradY);
+  return out;
+}
+
+DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
+                            const DelineationRequest& request, const DelineationParams& params,
+                            const IterationObserver& observer, core::Progress* progress) {
+  DelineationResult result;
+  result.roi = regionOfInterest(left, right, request, params);
+  result.roof = request.roof;
+  DisparityInterval search;
+  if (request.searchRange) {
+    search = *request.searchRange;
+  } else if (request.ground) {
+    search = {std::min(request.roof.min, request.ground->min),
+              std::max(request.roof.max, request.ground->max)};
+  } else {
+    search = {request.roof.min - params.groundSearch, request.roof.max};
+  }
+  if (progress) progress->setStage("correlation costs");
+  core::Progress::Range costProgress(progress, 0.0, 0.3);
+  stereo::CostParams costParams;
+  costParams.window = params.costWindow;
+  const auto costs = stereo::CorrelationCostService::compute(toFloat(left), toFloat(right), result.roi,
+                                                            search.min, search.max, costParams,
+                                                            progress ? &costProgress : nullptr);
+  result.polygon = initialPolygon(request, left.size());
+  if (!costs || core::isCanceled(progress)) {
+    result.status = core::RunStatus::Canceled;
+    result.vertexCount = static_cast<int>(result.polygon.outer.size());
+    return result;
+  }
+  const PreparedEnergy prepared = prepareEnergy(*costs, left, right, request, params);
+  result.ground = prepared.ground;
+  result.noMatchCost = prepared.images.noMatchCost;
+  if (progress) progress->setStage("active polygon");
+  core::Progress::Range optimiseProgress(progress, 0.3, 1.0);
+  const cv::Point offset = result.roi.tl();
+  IterationObserver forward;
+  if (observer) {
+    forward = [&](const IterationReport& report) {
+      IterationReport shifted = report;
+      for (size_t r = 0; r < shifted.polygon.ringCount(); ++r) {
+        for (auto& v : shifted.polygon.ring(r)) v += offset;
+      }
+      observer(shifted);
+    };
+  }
+  const ActivePolygonResult r = optimiseActivePolygon(
+      prepared.images, prepared.init, params, forward, progress ? &optimiseProgress : nullptr);
+  result.polygon = toPolygon(r.polygon, cv::Point2d(offset));
+  result.terms = r.terms;
+  result.iterations = r.iterations;
+  result.vertexCount = r.polygon.vertexCount();
+  result.status = r.status;
+  if (progress && r.status == core::RunStatus::Completed) progress->report(1.0);
+  return result;
+}
+
+}  // namespace delineo::delineation

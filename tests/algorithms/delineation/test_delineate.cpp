@@ -1,0 +1,170 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+#include "delineo/delineation/delineate.hpp"
+#include "delineo/stereo/cost_service.hpp"
+
+using namespace delineo;
+using namespace delineo::delineation;
+
+namespace {
+
+cv::Mat texture(cv::Size size, double mean, double contrast, int seed) {
+  cv::Mat t(size, CV_32F);
+  cv::RNG rng(static_cast<uint64_t>(seed));
+  rng.fill(t, cv::RNG::NORMAL, 0.0, 1.0);
+  cv::GaussianBlur(t, t, {0, 0}, 1.2);
+  cv::Scalar m, s;
+  cv::meanStdDev(t, m, s);
+  return (t - m[0]) * (contrast / s[0]) + mean;
+}
+
+// A flat roof [x0, x1) x [y0, y1) at disparity dr on flat ground at dg, left view vertical
+// (no walls seen), right view with x_right = x_left - d: it sees the east wall and loses the
+// ground strip [x0 - (dr - dg), x0) behind the roof.
+struct Pair {
+  cv::Mat left, right;
+  core::Polygon truth;
+};
+
+Pair raisedRoof(cv::Size size, cv::Rect roof, int dr, int dg) {
+  const cv::Mat ground = texture(size + cv::Size(64, 0), 100, 25, 1);
+  const cv::Mat top = texture(size + cv::Size(64, 0), 160, 25, 2);
+  const cv::Mat wall = texture(size + cv::Size(64, 0), 60, 10, 3);
+  Pair p;
+  p.left.create(size, CV_32F);
+  p.right.create(size, CV_32F);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const bool onRoof = roof.contains({x, y});
+      p.left.at<float>(y, x) = onRoof ? top.at<float>(y, x) : ground.at<float>(y, x);
+      const int xr = x;  // right pixel
+      const int xRoof = xr + dr, xGround = xr + dg;
+      float v;
+      if (roof.contains({xRoof, y})) v = top.at<float>(y, xRoof);
+      else if (y >= roof.y && y < roof.br().y && xGround < roof.br().x &&
+               xRoof >= roof.br().x)
+        v = wall.at<float>(y, xGround);  // east wall between the roof edge and the ground
+      else v = ground.at<float>(y, std::clamp(xGround, 0, size.width + 63));
+      p.right.at<float>(y, x) = 0.95f * v + 4.0f;
+    }
+  }
+  p.truth.outer = {{double(roof.x), double(roof.y)}, {double(roof.br().x), double(roof.y)},
+                   {double(roof.br().x), double(roof.br().y)}, {double(roof.x), double(roof.br().y)}};
+  return p;
+}
+
+double iou(const core::Polygon& a, const core::Polygon& b, cv::Size size) {
+  const cv::Mat ma = core::rasterize(a, size), mb = core::rasterize(b, size);
+  return double(cv::countNonZero(ma & mb)) / cv::countNonZero(ma | mb);
+}
+
+core::Polygon grownBox(cv::Rect r, int g) {
+  return core::Polygon{{{double(r.x - g), double(r.y - g)}, {double(r.br().x + g), double(r.y - g)},
+                        {double(r.br().x + g), double(r.br().y + g)}, {double(r.x - g), double(r.br().y + g)}},
+                       {}};
+}
+
+}  // namespace
+
+TEST(Delineate, ConvergesOnASyntheticPairWithGivenGround) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  int reports = 0;
+  const auto r = delineate(pair.left, pair.right, req, DelineationParams{},
+                           [&](const IterationReport&) { ++reports; });
+  EXPECT_EQ(r.status, core::RunStatus::Completed);
+  EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.9);
+  EXPECT_GT(reports, 0);
+  EXPECT_GE(r.vertexCount, 4);
+}
+
+TEST(Delineate, EstimatesTheGroundFromTheRing) {
+  const cv::Rect roof(40, 30, 70, 60);
+  const Pair pair = raisedRoof({160, 130}, roof, 18, 6);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {17, 19};
+  const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
+  EXPECT_NEAR(0.5 * (r.ground.min + r.ground.max), 6.0, 1.0);
+  EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.9);
+}
+
+TEST(Delineate, OcclusionBandLiesOnTheMinusXSideForRaisedRoofs) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  const DelineationParams params;
+  const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, params);
+  const auto costs = stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15);
+  const PreparedEnergy prepared = prepareEnergy(*costs, pair.left, pair.right, req, params);
+  EXPECT_EQ(prepared.images.occlusionSide, -1);
+  EXPECT_NEAR(prepared.roofDisparity, 14.0, 0.5);
+  // The data agree: at the true outline, the band on the -x side explains the unmatched
+  // strip better than the same band on the +x side.
+  IntPolygon truth{{{roof.x - roi.x, roof.y - roi.y}, {roof.br().x - roi.x, roof.y - roi.y},
+                    {roof.br().x - roi.x, roof.br().y - roi.y}, {roof.x - roi.x, roof.br().y - roi.y}},
+                   {}};
+  EnergyImages flipped = prepared.images;
+  flipped.occlusionSide = +1;
+  const EnergyWeights w{params.edgeWeight, params.rigidity};
+  EXPECT_LT(referenceEnergy(prepared.images, w, truth).total(), referenceEnergy(flipped, w, truth).total());
+}
+
+TEST(Delineate, CancelReturnsThePolygonSoFar) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  core::Progress counting;
+  delineate(pair.left, pair.right, req, DelineationParams{}, {}, &counting);
+  ASSERT_GT(counting.reportCount(), 4);
+  core::Progress progress;
+  progress.cancelAfterReports(counting.reportCount() / 2);
+  const auto r = delineate(pair.left, pair.right, req, DelineationParams{}, {}, &progress);
+  EXPECT_EQ(r.status, core::RunStatus::Canceled);
+  EXPECT_GE(r.polygon.outer.size(), 3u);
+  EXPECT_TRUE(core::isSimple(r.polygon.outer));
+}
+
+TEST(Delineate, RejectsBadInputs) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest ok;
+  ok.init = grownBox(roof, 8);
+  ok.roof = {13, 15};
+  const DelineationParams params;
+  auto expectCode = [&](const DelineationRequest& req, core::ErrorCode code, const cv::Mat& right) {
+    try {
+      regionOfInterest(pair.left, right, req, params);
+      ADD_FAILURE() << "no error";
+    } catch (const core::Error& e) {
+      EXPECT_EQ(e.code(), code) << e.what();
+    }
+  };
+  DelineationRequest outside = ok;
+  outside.init = grownBox(cv::Rect(150, 100, 60, 60), 0);
+  expectCode(outside, core::ErrorCode::InvalidParameter, pair.right);
+  DelineationRequest empty = ok;
+  empty.roof = {15, 13};
+  expectCode(empty, core::ErrorCode::InvalidParameter, pair.right);
+  DelineationRequest beyond = ok;
+  beyond.searchRange = DisparityInterval{0, 12};
+  expectCode(beyond, core::ErrorCode::InvalidParameter, pair.right);
+  DelineationRequest degenerate = ok;
+  degenerate.init.outer = {{10, 10}, {20, 20}, {30, 30}};
+  expectCode(degenerate, core::ErrorCode::InvalidParameter, pair.right);
+  expectCode(ok, core::ErrorCode::MismatchedInputs, pair.right(cv::Rect(0, 0, 100, 100)));
+  EXPECT_NO_THROW(regionOfInterest(pair.left, pair.right, ok, params));
+}
