@@ -53,6 +53,12 @@ inline double hashedNormal(std::uint64_t seed, std::int64_t a, std::int64_t b, s
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
 }
 
+// Lattice value in [0, 1): one avalanche per lattice point keeps texturing cheap.
+inline double latticeValue(std::uint64_t seed, std::int64_t ix, std::int64_t iy) {
+  return toUnit(mix64(seed ^ (static_cast<std::uint64_t>(ix) * 0x9e3779b97f4a7c15ULL) ^
+                      (static_cast<std::uint64_t>(iy) * 0xc2b2ae3d27d4eb4fULL)));
+}
+
 // Smooth value noise in [0, 1] on a unit lattice.
 inline double valueNoise(std::uint64_t seed, double x, double y) {
   const double fx = std::floor(x), fy = std::floor(y);
@@ -60,10 +66,10 @@ inline double valueNoise(std::uint64_t seed, double x, double y) {
   const double tx = x - fx, ty = y - fy;
   const double sx = tx * tx * tx * (tx * (tx * 6 - 15) + 10);  // quintic fade: C2 smooth
   const double sy = ty * ty * ty * (ty * (ty * 6 - 15) + 10);
-  const double v00 = toUnit(hash3(seed, ix, iy));
-  const double v10 = toUnit(hash3(seed, ix + 1, iy));
-  const double v01 = toUnit(hash3(seed, ix, iy + 1));
-  const double v11 = toUnit(hash3(seed, ix + 1, iy + 1));
+  const double v00 = latticeValue(seed, ix, iy);
+  const double v10 = latticeValue(seed, ix + 1, iy);
+  const double v01 = latticeValue(seed, ix, iy + 1);
+  const double v11 = latticeValue(seed, ix + 1, iy + 1);
   const double a = v00 + (v10 - v00) * sx;
   const double b = v01 + (v11 - v01) * sx;
   return a + (b - a) * sy;

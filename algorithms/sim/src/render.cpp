@@ -191,7 +191,9 @@ RowRenderer::SurfacePoint RowRenderer::pointOn(const Profile& prof, double y, st
   sp.x = groundX(seg) + t / ss_;
   sp.y = y;
   sp.z = za + t * (zb - za);
-  sp.wall = std::abs(zb - za) > wallSlope_ * sampleMetres_;
+  // A wall is the open segment between a low and a high sample; a sample landing exactly on
+  // its lower vertex (t == 0, e.g. a nadir view) sees that vertex's own surface.
+  sp.wall = t > 0.0 && std::abs(zb - za) > wallSlope_ * sampleMetres_;
   if (sp.wall) {
     sp.owner = zb > za ? prof.obj[i + 1] : prof.obj[i];  // a wall belongs to its top
   } else {
@@ -246,8 +248,8 @@ double RowRenderer::radiance(const Profile& prof, const SurfacePoint& sp, std::i
       const std::uint64_t s = layout_.groundSeed;
       const double patches = fbm(s, xm, ym, 30.0, 3);
       const double detail = fbm(s + 1, xm, ym, 2.5, 3);
-      const double fine = valueNoise(s + 2, xm / 0.8, ym / 0.8);
-      albedo = 0.22 + 0.3 * patches + 0.16 * (detail - 0.5) + 0.06 * (fine - 0.5);
+      const double fine = valueNoise(s + 2, xm / 1.0, ym / 1.0);
+      albedo = 0.2 + 0.35 * patches + 0.5 * (detail - 0.5) + 0.2 * (fine - 0.5);
       break;
     }
     case kRoof: {
@@ -266,18 +268,18 @@ double RowRenderer::radiance(const Profile& prof, const SurfacePoint& sp, std::i
       const cv::Point2d l = b.toLocal(sp.x, sp.y);
       const double um = l.x * gsd, vm = l.y * gsd;
       const double grain = fbm(b.textureSeed, xm, ym, 3.0, 3) - 0.5;
-      const double fineGrain = fbm(b.textureSeed + 7, xm, ym, 0.9, 2) - 0.5;
+      const double fineGrain = fbm(b.textureSeed + 7, xm, ym, 1.6, 2) - 0.5;
       double pattern;
       if (b.roof == RoofType::Flat) {
         // Membrane sheets with seams every 4 m.
-        pattern = -0.5 * seam(um / 4.0, 0.04) + 0.3 * grain + 0.2 * fineGrain;
+        pattern = -0.5 * seam(um / 4.0, 0.06) + 0.5 * grain + 0.4 * fineGrain;
       } else {
         // Tile courses parallel to the eaves.
         const double run = (b.roof == RoofType::Hip &&
                             b.halfLength - std::abs(l.x) < b.halfWidth - std::abs(l.y))
                                ? um
                                : vm;
-        pattern = 0.25 * std::sin(2.0 * std::numbers::pi * run / 0.9) + 0.3 * grain + 0.2 * fineGrain;
+        pattern = 0.2 * std::sin(2.0 * std::numbers::pi * run / 1.5) + 0.5 * grain + 0.4 * fineGrain;
       }
       albedo = b.roofAlbedo + 0.4 * b.roofContrast * pattern;
       break;
@@ -289,7 +291,7 @@ double RowRenderer::radiance(const Profile& prof, const SurfacePoint& sp, std::i
     }
     case kTree: {
       const Tree& tree = layout_.trees[indexOf(sp.owner)];
-      albedo = tree.albedo + 0.22 * (fbm(tree.textureSeed, xm, ym + sp.z, 1.2, 3) - 0.5);
+      albedo = tree.albedo + 0.4 * (fbm(tree.textureSeed, xm, ym + sp.z, 1.6, 2) - 0.5);
       break;
     }
   }
