@@ -1,0 +1,224 @@
+// Stereo benchmark: the same pair and range through the adaptive matcher (contour-adaptive
+// shapes), the same matcher with plain square windows, and OpenCV SGBM; one run each.
+// Prints density, bad-1 / bad-2 on matched non-occluded pixels, bad-2 counting unmatched pixels
+// as bad, RMS on flat-roof pixels (simulated scenes) and time.
+//
+// Usage: bench_stereo [--size N] [--data DIR] [--methods adaptive,square,sgbm] [--no-data]
+//   --size N   side of the simulated scene (default 1000; the ctest smoke run uses a tiny one)
+//   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/io/raster.hpp"
+#include "delineo/stereo/match.hpp"
+#ifdef DELINEO_BENCH_HAVE_SIM
+#include "delineo/sim/scene.hpp"
+#endif
+
+namespace {
+using namespace delineo;
+namespace fs = std::filesystem;
+
+struct Case {
+  std::string name;
+  cv::Mat left, right;  // CV_32F
+  cv::Mat truth;        // CV_32F, NaN where unknown
+  cv::Mat evaluate;     // CV_8U, 1 where scored (known and non-occluded)
+  cv::Mat roof;         // CV_8U, 1 on flat-roof pixels (may be empty)
+  int dmin = 0, dmax = 0;
+};
+
+struct Row {
+  double density = 0, bad1 = 0, bad2 = 0, bad2All = 0, roofRms = NAN, seconds = 0;
+};
+
+Row score(const cv::Mat& disparity, const Case& c, double seconds) {
+  Row r;
+  r.seconds = seconds;
+  long total = 0, matched = 0, bad1 = 0, bad2 = 0, roofN = 0;
+  double roofSq = 0;
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (!c.evaluate.at<uchar>(y, x)) continue;
+      ++total;
+      const float d = disparity.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      ++matched;
+      const double e = std::abs(d - c.truth.at<float>(y, x));
+      if (e > 1.0) ++bad1;
+      if (e > 2.0) ++bad2;
+      if (!c.roof.empty() && c.roof.at<uchar>(y, x)) {
+        ++roofN;
+        roofSq += e * e;
+      }
+    }
+  }
+  r.density = total ? 100.0 * matched / total : 0;
+  r.bad1 = matched ? 100.0 * bad1 / matched : 0;
+  r.bad2 = matched ? 100.0 * bad2 / matched : 0;
+  r.bad2All = total ? 100.0 * (bad2 + total - matched) / total : 0;
+  if (roofN > 0) r.roofRms = std::sqrt(roofSq / roofN);
+  return r;
+}
+
+void runCase(const Case& c, const std::vector<std::string>& methods) {
+  std::printf("\n%s: %dx%d, range %d..%d\n", c.name.c_str(), c.left.cols, c.left.rows, c.dmin,
+              c.dmax);
+  std::printf("  %-10s %8s %8s %8s %10s %9s %8s\n", "method", "density%", "bad1%", "bad2%",
+              "bad2+unm%", "roofRMS", "time s");
+  for (const std::string& m : methods) {
+    stereo::MatchParams p;
+    p.dmin = c.dmin;
+    p.dmax = c.dmax;
+    if (m == "sgbm") p.method = "sgbm";
+    if (m == "square") p.adaptive = false;
+    const auto start = std::chrono::steady_clock::now();
+    const stereo::MatchResult result = stereo::matchStereo(c.left, c.right, p);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const Row r = score(result.disparity, c, seconds);
+    std::printf("  %-10s %8.1f %8.2f %8.2f %10.2f %9.3f %8.2f\n", m.c_str(), r.density, r.bad1,
+                r.bad2, r.bad2All, r.roofRms, r.seconds);
+  }
+}
+
+#ifdef DELINEO_BENCH_HAVE_SIM
+Case simulated(int size) {
+  sim::SceneParams sp;
+  sp.width = size;
+  sp.height = size;
+  sp.buildings = std::max(1, size * size / 40000);
+  sp.trees = std::max(1, size * size / 30000);
+  const sim::Scene scene = sim::simulateScene(sp);
+  Case c;
+  c.name = "simulated scene (seed 1, default noise)";
+  scene.left.convertTo(c.left, CV_32F);
+  scene.right.convertTo(c.right, CV_32F);
+  c.truth = scene.disparity;
+  c.evaluate = (scene.occlusion == 0) & (scene.disparity == scene.disparity);
+  c.evaluate /= 255;
+  // Flat roofs away from their outlines: building label, eroded by 2 px, with a locally constant
+  // true disparity (gable and hip roofs excluded).
+  cv::Mat building = scene.labels == sim::kLabelBuilding;
+  cv::erode(building, building, cv::Mat::ones(5, 5, CV_8U));
+  cv::Mat gx, gy;
+  cv::Mat truthFilled = scene.disparity.clone();
+  truthFilled.setTo(0, scene.disparity != scene.disparity);
+  cv::Sobel(truthFilled, gx, CV_32F, 1, 0);
+  cv::Sobel(truthFilled, gy, CV_32F, 0, 1);
+  cv::Mat flat = (cv::abs(gx) < 1e-3) & (cv::abs(gy) < 1e-3);
+  c.roof = building & flat & c.evaluate;
+  c.roof /= 255;
+  c.dmin = scene.disparityMin;
+  c.dmax = scene.disparityMax;
+  return c;
+}
+#endif
+
+
+cv::Mat readFloat(const fs::path& p) { return io::readGreyFloat(p.string()); }
+
+std::vector<Case> realCases(const fs::path& data) {
+  std::vector<Case> cases;
+  const fs::path cones = data / "middlebury-cones";
+  if (fs::exists(cones / "Cones_LEFT.tif") && fs::exists(cones / "Occlusion_LEFT.png")) {
+    Case c;
+    c.name = "Middlebury Cones (quarter size)";
+    c.left = readFloat(cones / "Cones_LEFT.tif");
+    c.right = readFloat(cones / "Cones_RIGHT.tif");
+    c.truth = readFloat(cones / "Cones_LEFT_GT.tif");
+    const cv::Mat occ = readFloat(cones / "Occlusion_LEFT.png");
+    c.evaluate = (occ > 0) & (c.truth > 0);
+    c.evaluate /= 255;
+    c.dmin = 0;
+    c.dmax = 60;
+    cases.push_back(c);
+  }
+  const fs::path aloe = data / "middlebury-aloe";
+  if (fs::exists(aloe / "aloeL.jpg") && fs::exists(aloe / "aloeGT.png")) {
+    Case c;
+    c.name = "Middlebury Aloe (full size)";
+    c.left = readFloat(aloe / "aloeL.jpg");
+    c.right = readFloat(aloe / "aloeR.jpg");
+    c.truth = readFloat(aloe / "aloeGT.png");
+    c.evaluate = c.truth > 0;
+    c.evaluate /= 255;
+    double mx = 0;
+    cv::minMaxLoc(c.truth, nullptr, &mx);
+    c.dmin = 0;
+    c.dmax = static_cast<int>(std::ceil(mx)) + 8;
+    cases.push_back(c);
+  }
+  const fs::path dublin = data / "aerial-dublin";
+  if (fs::exists(dublin / "dublin_0004_left.png") && fs::exists(dublin / "dublin_0004_left_gt_disp.png")) {
+    Case c;
+    c.name = "DublinCity aerial tile (LiDAR GT, scored where valid)";
+    c.left = readFloat(dublin / "dublin_0004_left.png");
+    c.right = readFloat(dublin / "dublin_0004_right.png");
+    io::ReadOptions keep;
+    const io::Raster gt = io::readRaster((dublin / "dublin_0004_left_gt_disp.png").string(), keep);
+    gt.data.convertTo(c.truth, CV_32F, 1.0 / 256.0);
+    c.evaluate = c.truth > 0;
+    c.evaluate /= 255;
+    c.dmin = 0;
+    c.dmax = 150;
+    cases.push_back(c);
+  }
+  return cases;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int size = 1000;
+  std::string data = "/work/shared/data";
+  bool useData = true;
+  std::vector<std::string> methods = {"adaptive", "square", "sgbm"};
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--size" && i + 1 < argc) {
+      size = std::atoi(argv[++i]);
+    } else if (a == "--data" && i + 1 < argc) {
+      data = argv[++i];
+    } else if (a == "--no-data") {
+      useData = false;
+    } else if (a == "--methods" && i + 1 < argc) {
+      methods.clear();
+      std::string list = argv[++i];
+      size_t start = 0;
+      while (start <= list.size()) {
+        size_t comma = list.find(',', start);
+        if (comma == std::string::npos) comma = list.size();
+        methods.push_back(list.substr(start, comma - start));
+        start = comma + 1;
+      }
+    } else {
+      std::fprintf(stderr, "usage: bench_stereo [--size N] [--data DIR] [--no-data] "
+                           "[--methods adaptive,square,sgbm]\n");
+      return 2;
+    }
+  }
+  std::printf("bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
+              "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
+#ifdef DELINEO_BENCH_HAVE_SIM
+  runCase(simulated(size), methods);
+#else
+  std::printf("simulated scenes: skipped (delineo::sim not built)\n");
+#endif
+  if (useData) {
+    if (!fs::exists(data)) {
+      std::printf("\nreal datasets: skipped (%s not found)\n", data.c_str());
+    } else {
+      for (const Case& c : realCases(data)) runCase(c, methods);
+    }
+  }
+  return 0;
+}
