@@ -198,6 +198,7 @@ void DisparityHistogramWidget::mouseMoveEvent(QMouseEvent* event) {
 
 void DisparityHistogramWidget::mouseReleaseEvent(QMouseEvent* event) {
   if (event->button() != Qt::LeftButton || drag_ == DragPart::None) return;
+  mouseMoveEvent(event);  // the release position is the final one
   drag_ = DragPart::None;
   flushPendingSignal();
   update();

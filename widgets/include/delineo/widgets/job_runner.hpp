@@ -33,6 +33,16 @@ using JobId = quint64;
 
 enum class JobOutcome { Finished, Canceled, Failed };
 
+// Type of the result callback: void(R), or void() for jobs without a result.
+template <class R>
+struct JobResultCallback {
+  using type = std::function<void(R)>;
+};
+template <>
+struct JobResultCallback<void> {
+  using type = std::function<void()>;
+};
+
 class JobRunner : public QObject {
   Q_OBJECT
  public:
@@ -45,7 +55,7 @@ class JobRunner : public QObject {
   // same key first. Returns the job id (never 0).
   template <class R>
   JobId run(const QString& name, std::function<R(core::Progress&)> work,
-            std::function<void(R)> onResult = {}, const QString& key = {}) {
+            typename JobResultCallback<R>::type onResult = {}, const QString& key = {}) {
     if constexpr (std::is_void_v<R>) {
       return start(name, key, std::move(work), std::move(onResult));
     } else {

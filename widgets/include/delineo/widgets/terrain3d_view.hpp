@@ -34,6 +34,9 @@ class Terrain3DView : public QWidget {
   enum class Backend { OpenGLWidget, Offscreen };
   // The backend this platform gets.
   static Backend preferredBackend();
+  // Sets the default QSurfaceFormat VTK needs (OpenGL 3.2 core, depth 24, stencil 8). Call it in
+  // main() BEFORE the QApplication is created; harmless on the offscreen platform.
+  static void setDefaultSurfaceFormat();
 
   explicit Terrain3DView(QWidget* parent = nullptr);
   ~Terrain3DView() override;
@@ -66,6 +69,7 @@ class Terrain3DView : public QWidget {
   friend class GLSurface;
   friend class OffscreenSurface;
   void setInteracting(bool interacting);
+  void sceneChanged();
 
   Backend backend_;
   std::unique_ptr<Scene> scene_;
