@@ -167,7 +167,8 @@ class Optimiser {
       bool moved = true;
       while (moved && budgetLeft()) {
         moved = sweepMoves();
-        if (params_.edgeMoves) moved |= sweepEdgeMoves();
+        // Edge moves cost as much as vertex moves: only when single vertices are stuck.
+        if (!moved && params_.edgeMoves) moved = sweepEdgeMoves();
         endSweep("moves");
         any |= moved;
       }
@@ -181,7 +182,8 @@ class Optimiser {
       if (!any) break;
       any = false;
       if (!budgetLeft()) break;
-      any = sweepMoves() | (params_.edgeMoves && sweepEdgeMoves());
+      any = sweepMoves();
+      if (!any && params_.edgeMoves) any = sweepEdgeMoves();
       endSweep("moves");
     }
   }
