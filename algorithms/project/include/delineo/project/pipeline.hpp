@@ -1,0 +1,96 @@
+#pragma once
+// The project's processing steps, shared by the GUI (run in its job runner) and by
+// `delineo-cli run PROJECT`: reading the pair, dense matching, the active polygon for one
+// building, roof height, export of accepted buildings and the bundled sample project.
+//
+// Each algorithm library is optional at build time: a step whose library is absent throws
+// core::Error(ProcessingFailed) saying so, and the *Available() functions tell callers first.
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/core/progress.hpp"
+#include "delineo/io/raster.hpp"
+#include "delineo/project/project.hpp"
+
+namespace delineo::project {
+
+bool matchingAvailable();
+bool delineationAvailable();
+bool simulationAvailable();
+
+// The pair as float32 grey (NaN = no data). Throws FileNotFound / UnreadableFile naming the
+// image, MismatchedInputs when the two images differ in size (an epipolar pair shares rows).
+struct StereoPair {
+  cv::Mat left, right;
+  io::GeoReference geo;  // of the left image
+};
+StereoPair readStereoPair(const Project& project);
+
+// The project's disparity raster (float32, NaN = no data), or an empty matrix when the project
+// names none. Throws like io::readRaster, and MismatchedInputs when its size differs from `size`.
+cv::Mat readDisparity(const Project& project, cv::Size size);
+
+// Dense matching with the project's "matching" parameters; dmin/dmax come from the project's
+// disparity range. Canceled → empty disparity and status Canceled.
+struct MatchingOutcome {
+  cv::Mat disparity;
+  core::RunStatus status = core::RunStatus::Completed;
+};
+MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, const cv::Mat& right,
+                                 core::Progress* progress);
+
+// Roof disparity interval suggested from the disparities inside a polygon: the 20th..90th
+// percentile band of its finite values (ground and walls inside a rough polygon sit below the
+// roof). nullopt when the polygon holds fewer than 10 finite disparities.
+std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon);
+
+// Median disparity inside `polygon` turned into metres by the project's height model; NaN when
+// the model is unknown or no disparity is finite there.
+double roofHeight(const Project& project, const cv::Mat& disparity, const core::Polygon& polygon);
+
+// The active polygon for one building. `onContour` (may be empty) receives intermediate
+// contours in left-image pixels from the worker thread.
+struct DelineationOutcome {
+  core::Polygon outline;
+  double energy = 0.0;
+  int iterations = 0;
+  core::RunStatus status = core::RunStatus::Completed;
+};
+using ContourListener = std::function<void(const core::Polygon&)>;
+DelineationOutcome delineateBuilding(const Project& project, const Building& building,
+                                     const StereoPair& pair, core::Progress* progress,
+                                     const ContourListener& onContour = {});
+
+// `delineo-cli run`: matching when the disparity is missing (written to outputDir/disparity.tif
+// and recorded in the project), then the active polygon for every Pending building (status
+// becomes Automatic, history updated), then export of accepted + automatic + corrected outlines
+// to outputDir/buildings.geojson. The caller saves the project.
+struct RunSummary {
+  bool matched = false;
+  int delineated = 0;
+  int skipped = 0;  // pending buildings whose active polygon failed (reason in `messages`)
+  std::vector<std::string> messages;
+  std::string exported;  // path of the written GeoJSON, empty when nothing was written
+  core::RunStatus status = core::RunStatus::Completed;
+};
+RunSummary runPendingSteps(Project& project, core::Progress* progress);
+
+// Features of the buildings with the given statuses (attributes: id, status, vertices,
+// roof_height_m, energy), in left-image pixels.
+std::vector<core::Feature> buildingFeatures(const Project& project,
+                                            const std::vector<BuildingStatus>& statuses);
+// Writes the accepted buildings (GeoJSON or GeoPackage by extension), georeferenced like the
+// left image when it has a geotransform. Returns the number written. Throws WriteFailed.
+int exportBuildings(const Project& project, const std::string& path,
+                    const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted});
+
+// The bundled sample: a deterministic simulated scene written into `directory` (left, right,
+// ground-truth DEM and labels) and a project file "sample.delineo.json" referencing them, with
+// no disparity yet so the first step of the workflow is there to run. Reuses an existing
+// sample. Returns the project path. Throws ProcessingFailed without the simulator.
+std::string ensureSampleProject(const std::string& directory, core::Progress* progress = nullptr);
+
+}  // namespace delineo::project

@@ -1,0 +1,289 @@
+#include "delineo/project/pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+#include "delineo/io/vector.hpp"
+
+#ifdef DELINEO_HAVE_STEREO
+#include "delineo/stereo/match.hpp"
+#endif
+#ifdef DELINEO_HAVE_SIM
+#include "delineo/sim/scene.hpp"
+#endif
+#ifdef DELINEO_HAVE_DELINEATION
+#include "delineo/project/delineation_bridge.hpp"
+#endif
+
+namespace delineo::project {
+
+namespace fs = std::filesystem;
+using core::Error;
+using core::ErrorCode;
+
+bool matchingAvailable() {
+#ifdef DELINEO_HAVE_STEREO
+  return true;
+#else
+  return false;
+#endif
+}
+
+bool delineationAvailable() {
+#ifdef DELINEO_HAVE_DELINEATION
+  return true;
+#else
+  return false;
+#endif
+}
+
+bool simulationAvailable() {
+#ifdef DELINEO_HAVE_SIM
+  return true;
+#else
+  return false;
+#endif
+}
+
+StereoPair readStereoPair(const Project& project) {
+  if (project.left.empty() || project.right.empty()) {
+    throw Error(ErrorCode::InvalidParameter, "the project names no left or right image");
+  }
+  StereoPair pair;
+  pair.left = io::readGreyFloat(project.left, &pair.geo);
+  pair.right = io::readGreyFloat(project.right);
+  if (pair.left.size() != pair.right.size()) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "left image is " + std::to_string(pair.left.cols) + "x" +
+                    std::to_string(pair.left.rows) + " but right image " + project.right + " is " +
+                    std::to_string(pair.right.cols) + "x" + std::to_string(pair.right.rows) +
+                    "; an epipolar pair must have the same size",
+                project.left);
+  }
+  return pair;
+}
+
+cv::Mat readDisparity(const Project& project, cv::Size size) {
+  if (project.disparity.empty()) return {};
+  io::ReadOptions options;
+  options.type = io::PixelType::Float32;
+  options.toGrey = true;
+  io::Raster raster = io::readRaster(project.disparity, options);
+  if (raster.data.size() != size) {
+    throw Error(ErrorCode::MismatchedInputs, "the disparity raster does not have the size of the left image",
+                project.disparity);
+  }
+  return raster.data;
+}
+
+MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, const cv::Mat& right,
+                                 core::Progress* progress) {
+#ifdef DELINEO_HAVE_STEREO
+  auto params = parameters<stereo::MatchParams>(project, "matching");
+  params.dmin = project.disparityMin;
+  params.dmax = project.disparityMax;
+  params.validate();
+  stereo::MatchResult result = stereo::matchStereo(left, right, params, progress);
+  MatchingOutcome outcome;
+  outcome.status = result.status;
+  if (result.status == core::RunStatus::Completed) outcome.disparity = result.disparity;
+  return outcome;
+#else
+  (void)project, (void)left, (void)right, (void)progress;
+  throw Error(ErrorCode::ProcessingFailed, "dense matching is not part of this build");
+#endif
+}
+
+namespace {
+std::vector<float> finiteValuesInside(const cv::Mat& values, const core::Polygon& polygon) {
+  std::vector<float> out;
+  if (values.empty() || polygon.outer.size() < 3) return out;
+  const cv::Mat mask = core::rasterize(polygon, values.size());
+  for (int y = 0; y < values.rows; ++y) {
+    const float* v = values.ptr<float>(y);
+    const uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < values.cols; ++x) {
+      if (m[x] != 0 && std::isfinite(v[x])) out.push_back(v[x]);
+    }
+  }
+  return out;
+}
+
+float percentile(std::vector<float>& values, double q) {
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size() - 1) + 0.5));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+}  // namespace
+
+std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon) {
+  std::vector<float> values = finiteValuesInside(disparity, polygon);
+  if (values.size() < 10) return std::nullopt;
+  const float low = percentile(values, 0.2);
+  const float high = percentile(values, 0.9);
+  return DisparityInterval{static_cast<int>(std::floor(low)), static_cast<int>(std::ceil(high))};
+}
+
+double roofHeight(const Project& project, const cv::Mat& disparity, const core::Polygon& polygon) {
+  if (!project.height.known()) return std::nan("");
+  std::vector<float> values = finiteValuesInside(disparity, polygon);
+  if (values.empty()) return std::nan("");
+  return project.height.heightAt(percentile(values, 0.5));
+}
+
+DelineationOutcome delineateBuilding(const Project& project, const Building& building,
+                                     const StereoPair& pair, core::Progress* progress,
+                                     const ContourListener& onContour) {
+#ifdef DELINEO_HAVE_DELINEATION
+  return runActivePolygon(project, building, pair, progress, onContour);
+#else
+  (void)project, (void)building, (void)pair, (void)progress, (void)onContour;
+  throw Error(ErrorCode::ProcessingFailed, "the active polygon is not part of this build");
+#endif
+}
+
+std::vector<core::Feature> buildingFeatures(const Project& project,
+                                            const std::vector<BuildingStatus>& statuses) {
+  std::vector<core::Feature> features;
+  for (const auto& b : project.buildings) {
+    if (std::find(statuses.begin(), statuses.end(), b.status) == statuses.end()) continue;
+    core::Feature f;
+    f.polygon = b.currentPolygon();
+    f.attributes["id"] = static_cast<long long>(b.id);
+    f.attributes["status"] = toString(b.status);
+    long long vertices = static_cast<long long>(f.polygon.outer.size());
+    for (const auto& hole : f.polygon.holes) vertices += static_cast<long long>(hole.size());
+    f.attributes["vertices"] = vertices;
+    if (std::isfinite(b.roofHeight)) f.attributes["roof_height_m"] = b.roofHeight;
+    if (std::isfinite(b.energy)) f.attributes["energy"] = b.energy;
+    features.push_back(std::move(f));
+  }
+  return features;
+}
+
+int exportBuildings(const Project& project, const std::string& path,
+                    const std::vector<BuildingStatus>& statuses) {
+  const auto features = buildingFeatures(project, statuses);
+  io::GeoReference geo;
+  std::error_code ec;
+  if (!project.left.empty() && fs::exists(project.left, ec)) {
+    try {
+      geo = io::readRaster(project.left).geo;
+    } catch (const Error&) {
+      geo = {};  // pixel coordinates then; the image problem is reported where it is read
+    }
+  }
+  std::error_code mk;
+  fs::create_directories(fs::absolute(path).parent_path(), mk);
+  io::writeFeatures(path, features, geo);
+  return static_cast<int>(features.size());
+}
+
+RunSummary runPendingSteps(Project& project, core::Progress* progress) {
+  RunSummary summary;
+  const StereoPair pair = readStereoPair(project);
+  const std::vector<int> pending = project.pendingBuildings();
+  const double matchShare = project.disparity.empty() ? (pending.empty() ? 1.0 : 0.5) : 0.0;
+  cv::Mat disparity;
+  if (project.disparity.empty()) {
+    core::Progress::Range range(progress, 0.0, matchShare);
+    range.setStage("matching");
+    MatchingOutcome matched = computeDisparity(project, pair.left, pair.right, &range);
+    if (matched.status == core::RunStatus::Canceled) {
+      summary.status = core::RunStatus::Canceled;
+      return summary;
+    }
+    const std::string out = (fs::path(project.outputDir) / "disparity.tif").string();
+    fs::create_directories(project.outputDir);
+    io::writeFloatGeoTiff(out, matched.disparity, pair.geo);
+    project.disparity = out;
+    disparity = matched.disparity;
+    summary.matched = true;
+  } else {
+    disparity = readDisparity(project, pair.left.size());
+  }
+  for (size_t i = 0; i < pending.size(); ++i) {
+    const double begin = matchShare + (1.0 - matchShare) * static_cast<double>(i) / static_cast<double>(pending.size());
+    const double end = matchShare + (1.0 - matchShare) * static_cast<double>(i + 1) / static_cast<double>(pending.size());
+    core::Progress::Range range(progress, begin, end);
+    range.setStage("building " + std::to_string(pending[i]));
+    Building& b = *project.find(pending[i]);
+    if (!b.roofInterval) b.roofInterval = suggestRoofInterval(disparity, b.initial);
+    try {
+      DelineationOutcome outcome = delineateBuilding(project, b, pair, &range);
+      if (outcome.status == core::RunStatus::Canceled) {
+        summary.status = core::RunStatus::Canceled;
+        return summary;
+      }
+      b.outline = outcome.outline;
+      b.energy = outcome.energy;
+      b.roofHeight = roofHeight(project, disparity, b.outline);
+      b.status = BuildingStatus::Automatic;
+      b.addHistory("delineated", "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices");
+      ++summary.delineated;
+    } catch (const Error& e) {
+      if (!core::isInputError(e.code()) || e.code() == ErrorCode::InvalidParameter) {
+        ++summary.skipped;
+        summary.messages.push_back("building " + std::to_string(b.id) + ": " + e.what());
+      } else {
+        throw;
+      }
+    }
+  }
+  const auto features = buildingFeatures(
+      project, {BuildingStatus::Automatic, BuildingStatus::Corrected, BuildingStatus::Accepted});
+  if (!features.empty()) {
+    summary.exported = (fs::path(project.outputDir) / "buildings.geojson").string();
+    exportBuildings(project, summary.exported,
+                    {BuildingStatus::Automatic, BuildingStatus::Corrected, BuildingStatus::Accepted});
+  }
+  core::report(progress, 1.0);
+  return summary;
+}
+
+std::string ensureSampleProject(const std::string& directory, core::Progress* progress) {
+  const fs::path dir(directory);
+  const fs::path projectPath = dir / "sample.delineo.json";
+  std::error_code ec;
+  if (fs::exists(projectPath, ec) && fs::exists(dir / "left.tif", ec) && fs::exists(dir / "right.tif", ec)) {
+    return projectPath.string();
+  }
+#ifdef DELINEO_HAVE_SIM
+  sim::SceneParams params;
+  params.seed = 2024;
+  params.width = 512;
+  params.height = 384;
+  params.buildings = 7;
+  params.trees = 8;
+  const sim::Scene scene = sim::simulateScene(params, progress);
+  if (scene.status == core::RunStatus::Canceled) {
+    throw Error(ErrorCode::ProcessingFailed, "creating the sample scene was canceled");
+  }
+  fs::create_directories(dir, ec);
+  io::writeGeoTiff((dir / "left.tif").string(), scene.left);
+  io::writeGeoTiff((dir / "right.tif").string(), scene.right);
+  io::writeFloatGeoTiff((dir / "dem.tif").string(), scene.dem);
+  io::writeGeoTiff((dir / "labels.tif").string(), scene.labels);
+  Project p;
+  p.name = "Sample scene (simulated, seed " + std::to_string(params.seed) + ")";
+  p.left = (dir / "left.tif").string();
+  p.right = (dir / "right.tif").string();
+  p.dem = (dir / "dem.tif").string();
+  p.labels = (dir / "labels.tif").string();
+  p.outputDir = (dir / "output").string();
+  p.disparityMin = scene.disparityMin;
+  p.disparityMax = scene.disparityMax;
+  p.height = {scene.groundDisparity, scene.metresPerDisparity, scene.gsd};
+  saveProject(p, projectPath.string());
+  return projectPath.string();
+#else
+  (void)progress;
+  throw Error(ErrorCode::ProcessingFailed, "the scene simulator is not part of this build", directory);
+#endif
+}
+
+}  // namespace delineo::project

@@ -1,0 +1,368 @@
+#include "delineo/project/project.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "delineo/core/error.hpp"
+
+namespace delineo::project {
+
+namespace fs = std::filesystem;
+using core::Error;
+using core::ErrorCode;
+using nlohmann::json;
+
+std::string toString(BuildingStatus status) {
+  switch (status) {
+    case BuildingStatus::Pending: return "pending";
+    case BuildingStatus::Automatic: return "automatic";
+    case BuildingStatus::Corrected: return "corrected";
+    case BuildingStatus::Accepted: return "accepted";
+    case BuildingStatus::Rejected: return "rejected";
+  }
+  return "pending";
+}
+
+BuildingStatus statusFromString(const std::string& name) {
+  for (auto s : {BuildingStatus::Pending, BuildingStatus::Automatic, BuildingStatus::Corrected,
+                 BuildingStatus::Accepted, BuildingStatus::Rejected}) {
+    if (toString(s) == name) return s;
+  }
+  throw Error(ErrorCode::UnreadableFile, "unknown building status '" + name + "'");
+}
+
+std::string currentUtcTime() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char buffer[32];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return buffer;
+}
+
+void Building::addHistory(const std::string& action, const std::string& detail) {
+  history.push_back({action, currentUtcTime(), detail});
+}
+
+Building* Project::find(int id) {
+  auto it = std::find_if(buildings.begin(), buildings.end(), [&](const Building& b) { return b.id == id; });
+  return it == buildings.end() ? nullptr : &*it;
+}
+
+const Building* Project::find(int id) const { return const_cast<Project*>(this)->find(id); }
+
+int Project::nextBuildingId() const {
+  int next = 1;
+  for (const auto& b : buildings) next = std::max(next, b.id + 1);
+  return next;
+}
+
+std::vector<int> Project::pendingBuildings() const {
+  std::vector<int> ids;
+  for (const auto& b : buildings) {
+    if (b.status == BuildingStatus::Pending) ids.push_back(b.id);
+  }
+  return ids;
+}
+
+std::vector<std::string> Project::missingFiles() const {
+  std::vector<std::string> missing;
+  for (const std::string* p : {&left, &right, &disparity, &dem, &labels}) {
+    std::error_code ec;
+    if (!p->empty() && !fs::exists(*p, ec)) missing.push_back(*p);
+  }
+  return missing;
+}
+
+namespace {
+
+bool sameNumber(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
+
+bool samePolygon(const core::Polygon& a, const core::Polygon& b) {
+  return a.outer == b.outer && a.holes == b.holes;
+}
+
+bool sameBuilding(const Building& a, const Building& b) {
+  return a.id == b.id && samePolygon(a.initial, b.initial) && samePolygon(a.outline, b.outline) &&
+         a.status == b.status && a.roofInterval == b.roofInterval &&
+         sameNumber(a.roofHeight, b.roofHeight) && sameNumber(a.energy, b.energy) &&
+         a.history == b.history;
+}
+
+// ---- paths ---------------------------------------------------------------------------------
+
+std::string relativeTo(const std::string& path, const std::string& baseDir) {
+  if (path.empty() || baseDir.empty()) return path;
+  const fs::path abs = fs::path(path).lexically_normal();
+  const fs::path base = fs::path(baseDir).lexically_normal();
+  const fs::path rel = abs.lexically_relative(base);
+  // Only paths under the project folder become relative: "../../x" is harder to read than /x.
+  if (rel.empty() || *rel.begin() == "..") return abs.generic_string();
+  return rel.generic_string();
+}
+
+std::string resolveAgainst(const std::string& path, const std::string& baseDir) {
+  if (path.empty()) return path;
+  fs::path p(path);
+  if (p.is_relative() && !baseDir.empty()) p = fs::path(baseDir) / p;
+  return p.lexically_normal().string();
+}
+
+// ---- geometry ------------------------------------------------------------------------------
+
+json ringToJson(const core::Ring& ring) {
+  json out = json::array();
+  for (const auto& p : ring) out.push_back({p.x, p.y});
+  return out;
+}
+
+json polygonToJson(const core::Polygon& polygon) {
+  json out = json::array();
+  if (polygon.outer.empty()) return out;
+  out.push_back(ringToJson(polygon.outer));
+  for (const auto& hole : polygon.holes) out.push_back(ringToJson(hole));
+  return out;
+}
+
+[[noreturn]] void badField(const std::string& field, const std::string& problem) {
+  throw Error(ErrorCode::UnreadableFile, "field '" + field + "': " + problem);
+}
+
+core::Ring ringFromJson(const json& in, const std::string& field) {
+  if (!in.is_array()) badField(field, "a ring must be an array of [x, y] pairs");
+  core::Ring ring;
+  for (const auto& point : in) {
+    if (!point.is_array() || point.size() != 2 || !point[0].is_number() || !point[1].is_number()) {
+      badField(field, "a vertex must be [x, y] with two numbers");
+    }
+    ring.emplace_back(point[0].get<double>(), point[1].get<double>());
+  }
+  if (ring.size() < 3) badField(field, "a ring needs at least 3 vertices");
+  return ring;
+}
+
+// A polygon is [outer, hole, hole, ...] like GeoJSON (without the repeated closing vertex);
+// an empty array is an empty polygon.
+core::Polygon polygonFromJson(const json& in, const std::string& field) {
+  if (!in.is_array()) badField(field, "a polygon must be an array of rings");
+  core::Polygon polygon;
+  for (size_t i = 0; i < in.size(); ++i) {
+    core::Ring ring = ringFromJson(in[i], field + "[" + std::to_string(i) + "]");
+    if (i == 0) polygon.outer = std::move(ring);
+    else polygon.holes.push_back(std::move(ring));
+  }
+  return polygon;
+}
+
+json numberOrNull(double v) { return std::isnan(v) ? json(nullptr) : json(v); }
+
+template <class T>
+T get(const json& object, const char* key, const T& fallback, const std::string& where) {
+  auto it = object.find(key);
+  if (it == object.end() || it->is_null()) return fallback;
+  try {
+    return it->get<T>();
+  } catch (const json::exception&) {
+    badField(where + key, "wrong type");
+  }
+}
+
+}  // namespace
+
+bool Project::operator==(const Project& other) const {
+  if (!(name == other.name && left == other.left && right == other.right &&
+        disparity == other.disparity && dem == other.dem && labels == other.labels &&
+        outputDir == other.outputDir && disparityMin == other.disparityMin &&
+        disparityMax == other.disparityMax && height == other.height &&
+        parameters == other.parameters && buildings.size() == other.buildings.size())) {
+    return false;
+  }
+  for (size_t i = 0; i < buildings.size(); ++i) {
+    if (!sameBuilding(buildings[i], other.buildings[i])) return false;
+  }
+  return true;
+}
+
+json toJson(const Project& project, const std::string& baseDir) {
+  json out;
+  out["format"] = "delineo-project";
+  out["version"] = kFormatVersion;
+  out["name"] = project.name;
+  out["images"] = {{"left", relativeTo(project.left, baseDir)},
+                   {"right", relativeTo(project.right, baseDir)},
+                   {"disparity", relativeTo(project.disparity, baseDir)},
+                   {"dem", relativeTo(project.dem, baseDir)},
+                   {"labels", relativeTo(project.labels, baseDir)}};
+  out["outputDir"] = relativeTo(project.outputDir, baseDir);
+  out["disparityRange"] = {project.disparityMin, project.disparityMax};
+  out["heightModel"] = {{"groundDisparity", project.height.groundDisparity},
+                        {"metresPerPixel", project.height.metresPerPixel},
+                        {"gsd", project.height.gsd}};
+  out["parameters"] = project.parameters.is_null() ? json::object() : project.parameters;
+  json buildings = json::array();
+  for (const auto& b : project.buildings) {
+    json jb;
+    jb["id"] = b.id;
+    jb["status"] = toString(b.status);
+    jb["initial"] = polygonToJson(b.initial);
+    jb["outline"] = polygonToJson(b.outline);
+    jb["roofInterval"] = b.roofInterval ? json{b.roofInterval->low, b.roofInterval->high} : json(nullptr);
+    jb["roofHeight"] = numberOrNull(b.roofHeight);
+    jb["energy"] = numberOrNull(b.energy);
+    json history = json::array();
+    for (const auto& h : b.history) {
+      history.push_back({{"action", h.action}, {"time", h.time}, {"detail", h.detail}});
+    }
+    jb["history"] = std::move(history);
+    buildings.push_back(std::move(jb));
+  }
+  out["buildings"] = std::move(buildings);
+  return out;
+}
+
+Project fromJson(const json& in, const std::string& baseDir) {
+  if (!in.is_object()) badField("(root)", "a project must be a JSON object");
+  if (in.value("format", std::string()) != "delineo-project") {
+    badField("format", "not a Delineo project (expected \"delineo-project\")");
+  }
+  const int version = get<int>(in, "version", 0, "");
+  if (version < 1) badField("version", "missing or invalid");
+  if (version > kFormatVersion) {
+    badField("version", "format version " + std::to_string(version) +
+                            " is newer than this program supports (" +
+                            std::to_string(kFormatVersion) + ")");
+  }
+  Project p;
+  p.name = get<std::string>(in, "name", "", "");
+  const json images = in.value("images", json::object());
+  if (!images.is_object()) badField("images", "must be an object");
+  p.left = resolveAgainst(get<std::string>(images, "left", "", "images."), baseDir);
+  p.right = resolveAgainst(get<std::string>(images, "right", "", "images."), baseDir);
+  p.disparity = resolveAgainst(get<std::string>(images, "disparity", "", "images."), baseDir);
+  p.dem = resolveAgainst(get<std::string>(images, "dem", "", "images."), baseDir);
+  p.labels = resolveAgainst(get<std::string>(images, "labels", "", "images."), baseDir);
+  if (p.left.empty() || p.right.empty()) badField("images", "left and right images are required");
+  p.outputDir = resolveAgainst(get<std::string>(in, "outputDir", "output", ""), baseDir);
+  if (auto it = in.find("disparityRange"); it != in.end()) {
+    if (!it->is_array() || it->size() != 2 || !(*it)[0].is_number_integer() ||
+        !(*it)[1].is_number_integer() || (*it)[0].get<int>() > (*it)[1].get<int>()) {
+      badField("disparityRange", "must be [min, max] integers with min <= max");
+    }
+    p.disparityMin = (*it)[0].get<int>();
+    p.disparityMax = (*it)[1].get<int>();
+  }
+  if (auto it = in.find("heightModel"); it != in.end() && it->is_object()) {
+    p.height.groundDisparity = get<double>(*it, "groundDisparity", 0.0, "heightModel.");
+    p.height.metresPerPixel = get<double>(*it, "metresPerPixel", 0.0, "heightModel.");
+    p.height.gsd = get<double>(*it, "gsd", 1.0, "heightModel.");
+    if (!(p.height.gsd > 0)) badField("heightModel.gsd", "must be positive");
+  }
+  p.parameters = in.value("parameters", json::object());
+  if (!p.parameters.is_object()) badField("parameters", "must be an object of groups");
+  for (auto it = p.parameters.begin(); it != p.parameters.end(); ++it) {
+    if (!it->is_object()) badField("parameters." + it.key(), "must be an object");
+  }
+  const json buildings = in.value("buildings", json::array());
+  if (!buildings.is_array()) badField("buildings", "must be an array");
+  for (size_t i = 0; i < buildings.size(); ++i) {
+    const json& jb = buildings[i];
+    const std::string where = "buildings[" + std::to_string(i) + "].";
+    if (!jb.is_object()) badField(where, "must be an object");
+    Building b;
+    b.id = get<int>(jb, "id", 0, where);
+    if (b.id <= 0) badField(where + "id", "must be a positive integer");
+    if (p.find(b.id) != nullptr) badField(where + "id", "duplicate id " + std::to_string(b.id));
+    b.status = statusFromString(get<std::string>(jb, "status", "pending", where));
+    b.initial = polygonFromJson(jb.value("initial", json::array()), where + "initial");
+    b.outline = polygonFromJson(jb.value("outline", json::array()), where + "outline");
+    if (b.initial.outer.empty()) badField(where + "initial", "a building needs an initial polygon");
+    if (auto it = jb.find("roofInterval"); it != jb.end() && !it->is_null()) {
+      if (!it->is_array() || it->size() != 2 || !(*it)[0].is_number_integer() ||
+          !(*it)[1].is_number_integer() || (*it)[0].get<int>() > (*it)[1].get<int>()) {
+        badField(where + "roofInterval", "must be [low, high] integers with low <= high");
+      }
+      b.roofInterval = DisparityInterval{(*it)[0].get<int>(), (*it)[1].get<int>()};
+    }
+    b.roofHeight = get<double>(jb, "roofHeight", std::nan(""), where);
+    b.energy = get<double>(jb, "energy", std::nan(""), where);
+    const json history = jb.value("history", json::array());
+    if (!history.is_array()) badField(where + "history", "must be an array");
+    for (const auto& h : history) {
+      if (!h.is_object()) badField(where + "history", "entries must be objects");
+      b.history.push_back({get<std::string>(h, "action", "", where + "history."),
+                           get<std::string>(h, "time", "", where + "history."),
+                           get<std::string>(h, "detail", "", where + "history.")});
+    }
+    p.buildings.push_back(std::move(b));
+  }
+  return p;
+}
+
+Project loadProject(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(ErrorCode::FileNotFound, "project file does not exist", path);
+  std::ifstream in(path);
+  if (!in) throw Error(ErrorCode::UnreadableFile, "cannot open the project file", path);
+  json document;
+  try {
+    in >> document;
+  } catch (const json::parse_error& e) {
+    throw Error(ErrorCode::UnreadableFile, std::string("invalid JSON: ") + e.what(), path);
+  }
+  const std::string baseDir = fs::absolute(path).parent_path().lexically_normal().string();
+  try {
+    return fromJson(document, baseDir);
+  } catch (const Error& e) {
+    throw Error(e.code(), e.detail(), path);
+  }
+}
+
+void saveProject(const Project& project, const std::string& path) {
+  const fs::path target = fs::absolute(path).lexically_normal();
+  std::error_code ec;
+  fs::create_directories(target.parent_path(), ec);
+  const std::string text = toJson(project, target.parent_path().string()).dump(2) + "\n";
+  // Temporary file in the same folder so that the rename stays on one file system (atomic).
+  // (Built with append(): GCC 12 reports a false -Wrestrict on "." + std::string at -O3.)
+  std::string tempName(".");
+  tempName.append(target.filename().string()).append(".tmp").append(std::to_string(::getpid()));
+  const fs::path temp = target.parent_path() / tempName;
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(ErrorCode::WriteFailed, "cannot create a temporary file in the project folder", path);
+    out << text;
+    out.flush();
+    if (!out) {
+      out.close();
+      fs::remove(temp, ec);
+      throw Error(ErrorCode::WriteFailed, "writing the project failed (disk full?)", path);
+    }
+  }
+  fs::rename(temp, target, ec);
+  if (ec) {
+    fs::remove(temp, ec);
+    throw Error(ErrorCode::WriteFailed, "cannot replace the project file: " + ec.message(), path);
+  }
+}
+
+std::string autosavePath(const std::string& projectPath) {
+  const fs::path p(projectPath);
+  std::string name(".");
+  name.append(p.filename().string()).append(".autosave");
+  return (p.parent_path() / name).string();
+}
+
+bool hasNewerAutosave(const std::string& projectPath) {
+  std::error_code ec;
+  const std::string autosave = autosavePath(projectPath);
+  if (!fs::exists(autosave, ec)) return false;
+  if (!fs::exists(projectPath, ec)) return true;
+  return fs::last_write_time(autosave, ec) > fs::last_write_time(projectPath, ec);
+}
+
+}  // namespace delineo::project

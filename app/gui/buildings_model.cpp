@@ -1,0 +1,113 @@
+#include "buildings_model.hpp"
+
+#include <QBrush>
+#include <QColor>
+#include <cmath>
+
+#include "document.hpp"
+
+namespace delineo::gui {
+
+using project::BuildingStatus;
+
+BuildingsModel::BuildingsModel(QObject* parent) : QAbstractTableModel(parent) {}
+
+void BuildingsModel::setDocument(Document* document) {
+  beginResetModel();
+  if (document_ != nullptr) disconnect(document_, nullptr, this, nullptr);
+  document_ = document;
+  if (document_ != nullptr) {
+    // Buildings are few (tens to hundreds): a reset per change keeps the model simple, and the
+    // view keeps its selection through the selection model logic of the main window.
+    connect(document_, &Document::buildingChanged, this, [this] {
+      beginResetModel();
+      endResetModel();
+    });
+    connect(document_, &Document::buildingsReset, this, [this] {
+      beginResetModel();
+      endResetModel();
+    });
+  }
+  endResetModel();
+}
+
+int BuildingsModel::rowCount(const QModelIndex& parent) const {
+  if (parent.isValid() || document_ == nullptr) return 0;
+  return static_cast<int>(document_->project().buildings.size());
+}
+
+int BuildingsModel::columnCount(const QModelIndex& parent) const {
+  return parent.isValid() ? 0 : ColumnCount;
+}
+
+QString BuildingsModel::statusText(BuildingStatus status) {
+  switch (status) {
+    case BuildingStatus::Pending: return tr("pending");
+    case BuildingStatus::Automatic: return tr("automatic");
+    case BuildingStatus::Corrected: return tr("corrected");
+    case BuildingStatus::Accepted: return tr("accepted");
+    case BuildingStatus::Rejected: return tr("rejected");
+  }
+  return {};
+}
+
+QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
+  if (!index.isValid() || document_ == nullptr || index.row() >= rowCount()) return {};
+  const auto& b = document_->project().buildings[static_cast<size_t>(index.row())];
+  if (role == kIdRole) return b.id;
+  if (role == Qt::TextAlignmentRole && index.column() != Status) {
+    return QVariant::fromValue(Qt::AlignRight | Qt::AlignVCenter);
+  }
+  if (role == Qt::ForegroundRole && index.column() == Status) {
+    switch (b.status) {
+      case BuildingStatus::Accepted: return QBrush(QColor(0, 120, 60));
+      case BuildingStatus::Rejected: return QBrush(QColor(170, 40, 40));
+      case BuildingStatus::Corrected: return QBrush(QColor(180, 100, 0));
+      default: return {};
+    }
+  }
+  if (role != Qt::DisplayRole) return {};
+  switch (index.column()) {
+    case Id: return b.id;
+    case Status: return statusText(b.status);
+    case Vertices: {
+      const auto& poly = b.currentPolygon();
+      int n = static_cast<int>(poly.outer.size());
+      for (const auto& h : poly.holes) n += static_cast<int>(h.size());
+      return n;
+    }
+    case RoofHeight:
+      return std::isfinite(b.roofHeight) ? QVariant(QString::number(b.roofHeight, 'f', 1)) : QVariant(QStringLiteral("–"));
+    case Energy:
+      return std::isfinite(b.energy) ? QVariant(QString::number(b.energy, 'f', 1)) : QVariant(QStringLiteral("–"));
+    default: return {};
+  }
+}
+
+QVariant BuildingsModel::headerData(int section, Qt::Orientation orientation, int role) const {
+  if (orientation != Qt::Horizontal || role != Qt::DisplayRole) return {};
+  switch (section) {
+    case Id: return tr("Id");
+    case Status: return tr("Status");
+    case Vertices: return tr("Vertices");
+    case RoofHeight: return tr("Roof height (m)");
+    case Energy: return tr("Energy");
+    default: return {};
+  }
+}
+
+int BuildingsModel::idAt(int row) const {
+  if (document_ == nullptr || row < 0 || row >= rowCount()) return -1;
+  return document_->project().buildings[static_cast<size_t>(row)].id;
+}
+
+int BuildingsModel::rowOf(int id) const {
+  if (document_ == nullptr) return -1;
+  const auto& list = document_->project().buildings;
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (list[i].id == id) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace delineo::gui

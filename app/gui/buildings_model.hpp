@@ -1,0 +1,33 @@
+#pragma once
+// Table of the document's buildings: id, status, vertex count, roof height, energy.
+#include <QAbstractTableModel>
+
+#include "delineo/project/project.hpp"
+
+namespace delineo::gui {
+
+class Document;
+
+class BuildingsModel : public QAbstractTableModel {
+  Q_OBJECT
+ public:
+  enum Column { Id, Status, Vertices, RoofHeight, Energy, ColumnCount };
+  static constexpr int kIdRole = Qt::UserRole + 1;
+
+  explicit BuildingsModel(QObject* parent = nullptr);
+  void setDocument(Document* document);
+
+  int rowCount(const QModelIndex& parent = {}) const override;
+  int columnCount(const QModelIndex& parent = {}) const override;
+  QVariant data(const QModelIndex& index, int role) const override;
+  QVariant headerData(int section, Qt::Orientation orientation, int role) const override;
+
+  int idAt(int row) const;
+  int rowOf(int id) const;  // -1 when absent
+  static QString statusText(project::BuildingStatus status);
+
+ private:
+  Document* document_ = nullptr;
+};
+
+}  // namespace delineo::gui

@@ -1,0 +1,64 @@
+#pragma once
+// Undo commands: every change of a document is one of these, so Ctrl+Z / Ctrl+Y cover manual
+// edits, status changes, parameter changes and algorithm results alike.
+#include <QUndoCommand>
+#include <optional>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/project/project.hpp"
+
+namespace delineo::gui {
+
+class Document;
+
+// A building's full state before and after (nullopt = absent): add, remove, edit, result.
+class BuildingCommand : public QUndoCommand {
+ public:
+  // Commands with the same non-negative merge key on the same building merge (interval drags).
+  BuildingCommand(Document* document, int id, std::optional<project::Building> before,
+                  std::optional<project::Building> after, const QString& text, int mergeKey = -1);
+  void undo() override;
+  void redo() override;
+  int id() const override { return mergeKey_; }
+  bool mergeWith(const QUndoCommand* other) override;
+
+ private:
+  Document* document_;
+  int buildingId_;
+  std::optional<project::Building> before_, after_;
+  int mergeKey_;
+};
+
+class ParametersCommand : public QUndoCommand {
+ public:
+  ParametersCommand(Document* document, std::string group, nlohmann::json before,
+                    nlohmann::json after, const QString& text);
+  void undo() override;
+  void redo() override;
+  int id() const override { return 1000; }
+  bool mergeWith(const QUndoCommand* other) override;
+
+ private:
+  Document* document_;
+  std::string group_;
+  nlohmann::json before_, after_;
+};
+
+class DisparityCommand : public QUndoCommand {
+ public:
+  DisparityCommand(Document* document, cv::Mat before, std::string beforePath, cv::Mat after,
+                   const QString& text);
+  void undo() override;
+  void redo() override;
+
+ private:
+  Document* document_;
+  cv::Mat before_, after_;
+  std::string beforePath_;
+};
+
+// Merge keys of BuildingCommand.
+inline constexpr int kMergeRoofInterval = 2000;
+
+}  // namespace delineo::gui

@@ -1,0 +1,261 @@
+#include "document.hpp"
+
+#include <QCoreApplication>
+#include <QFileInfo>
+#include <filesystem>
+
+#include <opencv2/imgproc.hpp>
+
+#include "commands.hpp"
+#include "delineo/core/error.hpp"
+
+namespace delineo::gui {
+
+namespace fs = std::filesystem;
+using project::Building;
+using project::BuildingStatus;
+
+namespace {
+cv::Mat toDisplayGrey(const cv::Mat& grey) {
+  // Stretch the finite range to 0..255 for display; the read-out uses the same scale as the
+  // file for 8-bit images, which is the common case.
+  double lo = 0, hi = 255;
+  cv::Mat finiteMask = grey == grey;  // NaN != NaN
+  cv::minMaxLoc(grey, &lo, &hi, nullptr, nullptr, finiteMask);
+  cv::Mat out;
+  if (lo >= 0 && hi <= 255) {
+    grey.convertTo(out, CV_8U);
+  } else {
+    const double scale = hi > lo ? 255.0 / (hi - lo) : 1.0;
+    grey.convertTo(out, CV_8U, scale, -lo * scale);
+  }
+  return out;
+}
+}  // namespace
+
+std::unique_ptr<Document> Document::open(const QString& projectPath) {
+  project::Project p = project::loadProject(projectPath.toStdString());
+  return fromProject(std::move(p), projectPath);
+}
+
+std::unique_ptr<Document> Document::fromProject(project::Project project, const QString& path) {
+  std::unique_ptr<Document> doc(new Document);
+  doc->project_ = std::move(project);
+  doc->path_ = path;
+  doc->loadRasters();
+  doc->undo_.setClean();
+  connect(&doc->undo_, &QUndoStack::cleanChanged, doc.get(),
+          [d = doc.get()] { emit d->modifiedChanged(d->isModified()); });
+  return doc;
+}
+
+std::unique_ptr<Document> Document::fromPair(const QString& left, const QString& right) {
+  project::Project p;
+  p.name = QFileInfo(left).completeBaseName().toStdString();
+  p.left = fs::absolute(left.toStdString()).lexically_normal().string();
+  p.right = fs::absolute(right.toStdString()).lexically_normal().string();
+  p.outputDir = (fs::path(p.left).parent_path() / "output").string();
+  auto doc = fromProject(std::move(p), QString());
+  doc->extraDirty_ = true;  // never saved
+  return doc;
+}
+
+void Document::loadRasters() {
+  pair_ = project::readStereoPair(project_);
+  leftGrey_ = toDisplayGrey(pair_.left);
+  rightGrey_ = toDisplayGrey(pair_.right);
+  disparity_ = project::readDisparity(project_, pair_.left.size());
+  if (!project_.labels.empty()) {
+    io::Raster labels = io::readRaster(project_.labels);
+    if (labels.data.size() != pair_.left.size() || labels.data.channels() != 1) {
+      throw core::Error(core::ErrorCode::MismatchedInputs,
+                        "the label raster must have one band and the size of the left image",
+                        project_.labels);
+    }
+    labels.data.convertTo(labels_, CV_8U);
+  }
+  if (!project_.dem.empty()) {
+    io::ReadOptions options;
+    options.type = io::PixelType::Float32;
+    options.toGrey = true;
+    dem_ = io::readRaster(project_.dem, options).data;
+    if (dem_.size() != pair_.left.size()) {
+      throw core::Error(core::ErrorCode::MismatchedInputs,
+                        "the DEM must be in left-image geometry (same size as the left image)",
+                        project_.dem);
+    }
+  } else {
+    deriveDem();
+  }
+}
+
+void Document::deriveDem() {
+  // Without a DEM file, heights come from the disparity through the project's height model.
+  if (project_.dem.empty()) {
+    demDerived_ = true;
+    if (!disparity_.empty() && project_.height.known()) {
+      dem_ = (disparity_ - project_.height.groundDisparity) * project_.height.metresPerPixel;
+    } else {
+      dem_ = cv::Mat();
+    }
+  }
+}
+
+QString Document::displayName() const {
+  if (!project_.name.empty()) return QString::fromStdString(project_.name);
+  if (!path_.isEmpty()) return QFileInfo(path_).fileName();
+  return tr("Untitled project");
+}
+
+int Document::addBuilding(const core::Polygon& initial) {
+  Building b;
+  b.id = project_.nextBuildingId();
+  b.initial = initial;
+  if (!disparity_.empty()) b.roofInterval = project::suggestRoofInterval(disparity_, initial);
+  b.addHistory("picked", std::to_string(initial.outer.size()) + " vertices");
+  undo_.push(new BuildingCommand(this, b.id, std::nullopt, b, tr("Pick building %1").arg(b.id)));
+  return b.id;
+}
+
+void Document::removeBuilding(int id) {
+  const Building* b = project_.find(id);
+  if (b == nullptr) return;
+  undo_.push(new BuildingCommand(this, id, *b, std::nullopt, tr("Remove building %1").arg(id)));
+}
+
+void Document::editRing(int id, int ringIndex, const core::Ring& ring, const QString& description) {
+  const Building* current = project_.find(id);
+  if (current == nullptr || ring.size() < 3) return;
+  Building after = *current;
+  // A pending building's rough polygon is still the operator's input: edit it in place.
+  core::Polygon& target = after.hasOutline() ? after.outline : after.initial;
+  if (ringIndex == 0) {
+    target.outer = ring;
+  } else if (ringIndex - 1 < static_cast<int>(target.holes.size())) {
+    target.holes[static_cast<size_t>(ringIndex - 1)] = ring;
+  } else {
+    return;
+  }
+  if (after.status != BuildingStatus::Pending) after.status = BuildingStatus::Corrected;
+  if (after.hasOutline()) after.roofHeight = project::roofHeight(project_, disparity_, after.outline);
+  after.addHistory("edited", description.toStdString());
+  undo_.push(new BuildingCommand(this, id, *current, after,
+                                 description.isEmpty() ? tr("Edit building %1").arg(id) : description));
+}
+
+void Document::setDelineationResult(int id, const project::DelineationOutcome& outcome) {
+  const Building* current = project_.find(id);
+  if (current == nullptr) return;
+  Building after = *current;
+  after.outline = outcome.outline;
+  after.energy = outcome.energy;
+  after.status = BuildingStatus::Automatic;
+  after.roofHeight = project::roofHeight(project_, disparity_, after.outline);
+  after.addHistory("delineated", std::to_string(outcome.outline.outer.size()) + " vertices, " +
+                                     std::to_string(outcome.iterations) + " sweeps");
+  undo_.push(new BuildingCommand(this, id, *current, after, tr("Delineate building %1").arg(id)));
+}
+
+void Document::setStatus(int id, BuildingStatus status) {
+  const Building* current = project_.find(id);
+  if (current == nullptr || current->status == status) return;
+  Building after = *current;
+  after.status = status;
+  after.addHistory(project::toString(status));
+  QString text;
+  switch (status) {
+    case BuildingStatus::Accepted: text = tr("Accept building %1").arg(id); break;
+    case BuildingStatus::Rejected: text = tr("Reject building %1").arg(id); break;
+    default: text = tr("Reopen building %1").arg(id); break;
+  }
+  undo_.push(new BuildingCommand(this, id, *current, after, text));
+}
+
+void Document::setRoofInterval(int id, project::DisparityInterval interval) {
+  const Building* current = project_.find(id);
+  if (current == nullptr || current->roofInterval == interval) return;
+  Building after = *current;
+  after.roofInterval = interval;
+  undo_.push(new BuildingCommand(this, id, *current, after,
+                                 tr("Roof interval of building %1: %2..%3 px")
+                                     .arg(id)
+                                     .arg(interval.low)
+                                     .arg(interval.high),
+                                 kMergeRoofInterval));
+}
+
+void Document::setParameters(const std::string& group, const nlohmann::json& values) {
+  auto it = project_.parameters.find(group);
+  const nlohmann::json before = it == project_.parameters.end() ? nlohmann::json() : *it;
+  if (before == values) return;
+  undo_.push(new ParametersCommand(this, group, before, values,
+                                   tr("Change %1 parameters").arg(QString::fromStdString(group))));
+}
+
+void Document::setDisparity(const cv::Mat& disparity) {
+  undo_.push(new DisparityCommand(this, disparity_, project_.disparity, disparity, tr("Compute disparity")));
+}
+
+void Document::restoreBuilding(int id, const std::optional<Building>& state) {
+  auto& list = project_.buildings;
+  Building* existing = project_.find(id);
+  if (state) {
+    if (existing != nullptr) *existing = *state;
+    else list.push_back(*state);
+    std::sort(list.begin(), list.end(), [](const Building& a, const Building& b) { return a.id < b.id; });
+  } else if (existing != nullptr) {
+    list.erase(list.begin() + (existing - list.data()));
+  }
+  emit buildingChanged(id);
+}
+
+void Document::restoreParameters(const std::string& group, const nlohmann::json& values) {
+  if (values.is_null()) project_.parameters.erase(group);
+  else project_.parameters[group] = values;
+  emit parametersChanged(QString::fromStdString(group));
+}
+
+void Document::restoreDisparity(const cv::Mat& disparity, const std::string& path) {
+  disparity_ = disparity;
+  project_.disparity = path;
+  disparityOnDisk_ = !path.empty() || disparity.empty();
+  deriveDem();
+  emit disparityChanged();
+}
+
+void Document::save(const QString& path) {
+  project::Project toSave = project_;
+  if (!disparityOnDisk_ && !disparity_.empty()) {
+    const std::string out = (fs::path(project_.outputDir) / "disparity.tif").string();
+    std::error_code ec;
+    fs::create_directories(project_.outputDir, ec);
+    io::writeFloatGeoTiff(out, disparity_, pair_.geo);
+    project_.disparity = out;
+    toSave.disparity = out;
+    disparityOnDisk_ = true;
+  }
+  project::saveProject(toSave, path.toStdString());
+  std::error_code ec;
+  if (!path_.isEmpty()) fs::remove(project::autosavePath(path_.toStdString()), ec);
+  path_ = path;
+  fs::remove(project::autosavePath(path_.toStdString()), ec);
+  undo_.setClean();
+  setExtraDirty(false);
+}
+
+void Document::autosave() {
+  if (!isModified() || path_.isEmpty()) return;
+  project::saveProject(project_, project::autosavePath(path_.toStdString()));
+}
+
+int Document::exportAccepted(const QString& path) const {
+  return project::exportBuildings(project_, path.toStdString());
+}
+
+void Document::setExtraDirty(bool dirty) {
+  if (extraDirty_ == dirty) return;
+  extraDirty_ = dirty;
+  emit modifiedChanged(isModified());
+}
+
+}  // namespace delineo::gui

@@ -1,0 +1,93 @@
+#pragma once
+// The open project as the GUI sees it: the Qt-free project::Project, the rasters it names
+// (loaded once), and the undo stack through which every change goes. Views and models observe
+// the signals; they never modify the project directly.
+#include <QObject>
+#include <QString>
+#include <QUndoStack>
+#include <memory>
+#include <optional>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/io/raster.hpp"
+#include "delineo/project/pipeline.hpp"
+#include "delineo/project/project.hpp"
+
+namespace delineo::gui {
+
+class Document : public QObject {
+  Q_OBJECT
+ public:
+  // Loads the project and its rasters. Throws core::Error (missing project, corrupt file,
+  // unreadable or mismatched images); nothing is half-loaded on failure.
+  static std::unique_ptr<Document> open(const QString& projectPath);
+  // Opens an already-parsed project (e.g. after relocating a missing image or restoring an
+  // autosave). `path` is where it will be saved.
+  static std::unique_ptr<Document> fromProject(project::Project project, const QString& path);
+  // A new, unsaved project on a stereo pair.
+  static std::unique_ptr<Document> fromPair(const QString& left, const QString& right);
+
+  const project::Project& project() const { return project_; }
+  QString path() const { return path_; }
+  QString displayName() const;
+  QUndoStack* undoStack() { return &undo_; }
+  bool isModified() const { return !undo_.isClean() || extraDirty_; }
+
+  const project::StereoPair& pair() const { return pair_; }
+  const cv::Mat& leftGrey() const { return leftGrey_; }    // CV_8U for display and read-out
+  const cv::Mat& rightGrey() const { return rightGrey_; }
+  const cv::Mat& disparity() const { return disparity_; }  // CV_32F, empty when not computed
+  const cv::Mat& dem() const { return dem_; }              // CV_32F metres, file or derived
+  const cv::Mat& labels() const { return labels_; }        // CV_8U, may be empty
+  bool demIsDerived() const { return demDerived_; }
+
+  // ---- changes, each one an undoable command ----
+  int addBuilding(const core::Polygon& initial);
+  void removeBuilding(int id);
+  // Replaces ring `ringIndex` (0 outer, k hole k-1) of the building's current polygon.
+  void editRing(int id, int ringIndex, const core::Ring& ring, const QString& description);
+  // An active polygon result (status Automatic).
+  void setDelineationResult(int id, const project::DelineationOutcome& outcome);
+  void setStatus(int id, project::BuildingStatus status);
+  void setRoofInterval(int id, project::DisparityInterval interval);
+  void setParameters(const std::string& group, const nlohmann::json& values);
+  void setDisparity(const cv::Mat& disparity);
+
+  // ---- used by the undo commands only ----
+  void restoreBuilding(int id, const std::optional<project::Building>& state);
+  void restoreParameters(const std::string& group, const nlohmann::json& values);
+  void restoreDisparity(const cv::Mat& disparity, const std::string& path);
+
+  // Atomic save (writes a freshly computed disparity next to the outputs first). Throws
+  // core::Error(WriteFailed). Marks the document clean and removes the autosave.
+  void save(const QString& path);
+  // Writes the autosave companion file when modified; no-op otherwise.
+  void autosave();
+  // Exports the accepted buildings; returns how many.
+  int exportAccepted(const QString& path) const;
+
+ signals:
+  void buildingChanged(int id);  // added, modified or removed
+  void buildingsReset();
+  void parametersChanged(const QString& group);
+  void disparityChanged();
+  void modifiedChanged(bool modified);
+
+ private:
+  Document() = default;
+  void loadRasters();
+  void deriveDem();
+  void setExtraDirty(bool dirty);
+
+  project::Project project_;
+  QString path_;
+  QUndoStack undo_;
+  bool extraDirty_ = false;
+  bool disparityOnDisk_ = true;
+  project::StereoPair pair_;
+  cv::Mat leftGrey_, rightGrey_, disparity_, dem_, labels_;
+  bool demDerived_ = false;
+};
+
+}  // namespace delineo::gui

@@ -1,0 +1,1168 @@
+#include "main_window.hpp"
+
+#include <QAction>
+#include <QActionGroup>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QComboBox>
+#include <QDir>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QGuiApplication>
+#include <QHeaderView>
+#include <QLabel>
+#include <QMenu>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QMetaObject>
+#include <QScrollArea>
+#include <QSettings>
+#include <QStandardPaths>
+#include <QStatusBar>
+#include <QTabWidget>
+#include <QTableView>
+#include <QToolBar>
+#include <QUndoStack>
+#include <QVBoxLayout>
+#include <cmath>
+#include <map>
+#include <mutex>
+
+#include <opencv2/imgproc.hpp>
+
+#include "buildings_model.hpp"
+#include "delineo/core/error.hpp"
+#include "delineo/project/pipeline.hpp"
+#include "delineo/widgets/colour_maps.hpp"
+#include "delineo/widgets/disparity_histogram.hpp"
+#include "delineo/widgets/image_view.hpp"
+#include "delineo/widgets/parameter_form.hpp"
+#include "delineo/widgets/polygon_overlay.hpp"
+#include "delineo/widgets/terrain3d_view.hpp"
+#include "document.hpp"
+#include "error_text.hpp"
+
+#ifdef DELINEO_HAVE_DELINEATION
+#include "delineo/delineation/params.hpp"
+#endif
+#ifdef DELINEO_HAVE_STEREO
+#include "delineo/stereo/match.hpp"
+#endif
+
+namespace delineo::gui {
+
+using project::Building;
+using project::BuildingStatus;
+using widgets::ImageView;
+using widgets::InteractionMode;
+
+namespace {
+
+constexpr int kMaxRecent = 8;
+
+widgets::PolygonStatus overlayStatus(BuildingStatus status) {
+  switch (status) {
+    case BuildingStatus::Pending:
+    case BuildingStatus::Automatic: return widgets::PolygonStatus::Candidate;
+    case BuildingStatus::Corrected: return widgets::PolygonStatus::Edited;
+    case BuildingStatus::Accepted: return widgets::PolygonStatus::Accepted;
+    case BuildingStatus::Rejected: return widgets::PolygonStatus::Rejected;
+  }
+  return widgets::PolygonStatus::Candidate;
+}
+
+// Median of the finite values of `values` in a band of `width` px around the polygon (outside
+// it): the local ground level next to a building.
+std::optional<double> ringMedian(const cv::Mat& values, const core::Polygon& polygon, int width) {
+  if (values.empty() || polygon.outer.size() < 3) return std::nullopt;
+  const cv::Rect2d box = core::boundingBox(polygon.outer);
+  cv::Rect roi(static_cast<int>(box.x) - width - 2, static_cast<int>(box.y) - width - 2,
+               static_cast<int>(box.width) + 2 * width + 4, static_cast<int>(box.height) + 2 * width + 4);
+  roi &= cv::Rect(0, 0, values.cols, values.rows);
+  if (roi.empty()) return std::nullopt;
+  core::Polygon local = polygon;
+  for (auto& p : local.outer) p -= cv::Point2d(roi.x, roi.y);
+  local.holes.clear();
+  const cv::Mat inside = core::rasterize(local, roi.size());
+  cv::Mat grown;
+  cv::dilate(inside, grown, cv::getStructuringElement(cv::MORPH_RECT, {2 * width + 1, 2 * width + 1}));
+  std::vector<float> samples;
+  const cv::Mat patch = values(roi);
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      const float v = patch.at<float>(y, x);
+      if (grown.at<uchar>(y, x) != 0 && inside.at<uchar>(y, x) == 0 && std::isfinite(v)) samples.push_back(v);
+    }
+  }
+  if (samples.empty()) return std::nullopt;
+  std::nth_element(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples.size() / 2), samples.end());
+  return samples[samples.size() / 2];
+}
+
+core::Polygon rectanglePolygon(const QRectF& r) {
+  core::Polygon p;
+  p.outer = {{r.left(), r.top()}, {r.right(), r.top()}, {r.right(), r.bottom()}, {r.left(), r.bottom()}};
+  return p;
+}
+
+}  // namespace
+
+MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
+  setObjectName(QStringLiteral("MainWindow"));
+  setWindowIcon(QIcon(QStringLiteral(":/icons/delineo.svg")));
+  jobs_ = new widgets::JobRunner(this);
+  createViews();
+  createDocks();
+  createActions();
+  createMenus();
+  restoreSettings();
+  connect(&autosaveTimer_, &QTimer::timeout, this, &MainWindow::autosaveNow);
+  QSettings settings;
+  autosaveTimer_.start(std::max(5, settings.value(QStringLiteral("autosaveSeconds"), 60).toInt()) * 1000);
+  connect(jobs_, &widgets::JobRunner::failed, this,
+          [this](widgets::JobId, core::ErrorCode code, const QString& message) {
+            showMessage(tr("Job failed"), errorSentence(code) + QStringLiteral("\n\n") + message);
+          });
+  connect(jobs_, &widgets::JobRunner::activeCountChanged, this, [this](int count) {
+    if (count == 0) leftView_->polygons().clearEvolvingContour();
+    updateActions();
+  });
+  refreshTitle();
+  updateActions();
+}
+
+MainWindow::~MainWindow() {
+  // Workers hold copies of their inputs, but their results are delivered to this window:
+  // stop them before the views go away.
+  jobs_->cancelAll();
+  jobs_->waitForIdle(30000);
+}
+
+// ------------------------------------------------------------------------------------------
+// construction
+
+void MainWindow::createViews() {
+  leftView_ = new ImageView;
+  leftView_->setObjectName(QStringLiteral("leftView"));
+  leftView_->setToolTip(tr("Left image (reference): pick buildings here"));
+  setCentralWidget(leftView_);
+  rightView_ = new ImageView;
+  rightView_->setObjectName(QStringLiteral("rightView"));
+  disparityView_ = new ImageView;
+  disparityView_->setObjectName(QStringLiteral("disparityView"));
+  demView_ = new ImageView;
+  demView_->setObjectName(QStringLiteral("demView"));
+  for (ImageView* v : {rightView_, disparityView_, demView_}) widgets::linkViews(leftView_, v);
+
+  connect(leftView_, &ImageView::cursorMoved, this, [this](QPointF p) {
+    updateReadout(p, true, document_ ? document_->leftGrey() : cv::Mat());
+  });
+  connect(disparityView_, &ImageView::cursorMoved, this, [this](QPointF p) {
+    updateReadout(p, true, document_ ? document_->leftGrey() : cv::Mat());
+  });
+  connect(demView_, &ImageView::cursorMoved, this, [this](QPointF p) {
+    updateReadout(p, true, document_ ? document_->leftGrey() : cv::Mat());
+  });
+  connect(rightView_, &ImageView::cursorMoved, this, [this](QPointF p) {
+    updateReadout(p, false, document_ ? document_->rightGrey() : cv::Mat());
+  });
+  connect(leftView_, &ImageView::rectanglePicked, this,
+          [this](QRectF r) { onPicked(rectanglePolygon(r.normalized())); });
+  connect(leftView_, &ImageView::polygonPicked, this, [this](QPolygonF poly) {
+    core::Polygon p;
+    p.outer = widgets::toRing(poly);
+    onPicked(p);
+  });
+  connect(leftView_, &ImageView::pointPicked, this, &MainWindow::onObjectPicked);
+  connect(&leftView_->polygons(), &widgets::PolygonOverlay::editRequested, this, &MainWindow::onEditRequested);
+  connect(&leftView_->polygons(), &widgets::PolygonOverlay::selectionChanged, this,
+          &MainWindow::onSelectionFromOverlay);
+
+  readout_ = new QLabel;
+  readout_->setObjectName(QStringLiteral("readout"));
+  readout_->setMinimumWidth(420);
+  statusBar()->addWidget(readout_, 1);
+  auto* progress = new widgets::JobProgressWidget(jobs_);
+  progress->setObjectName(QStringLiteral("jobProgress"));
+  statusBar()->addPermanentWidget(progress);
+}
+
+void MainWindow::createDocks() {
+  setDockOptions(QMainWindow::AnimatedDocks | QMainWindow::AllowTabbedDocks | QMainWindow::AllowNestedDocks);
+  auto makeDock = [this](const QString& name, const QString& title, QWidget* content, Qt::DockWidgetArea area) {
+    auto* dock = new QDockWidget(title, this);
+    dock->setObjectName(name);
+    dock->setWidget(content);
+    addDockWidget(area, dock);
+    return dock;
+  };
+
+  auto* rightDock = makeDock(QStringLiteral("rightDock"), tr("Right image"), rightView_, Qt::RightDockWidgetArea);
+
+  auto* disparityPage = new QWidget;
+  auto* disparityLayout = new QHBoxLayout(disparityPage);
+  disparityLayout->setContentsMargins(0, 0, 0, 0);
+  disparityLegend_ = new widgets::ColourLegend;
+  disparityLegend_->setColourMap(widgets::ColourMap::Viridis);
+  disparityLegend_->setTitle(tr("Disparity"));
+  disparityLegend_->setUnit(tr("px"));
+  disparityLayout->addWidget(disparityView_, 1);
+  disparityLayout->addWidget(disparityLegend_);
+  auto* disparityDock = makeDock(QStringLiteral("disparityDock"), tr("Disparity"), disparityPage, Qt::RightDockWidgetArea);
+
+  auto* demPage = new QWidget;
+  auto* demLayout = new QGridLayout(demPage);
+  demLayout->setContentsMargins(0, 0, 0, 0);
+  demMode_ = new QComboBox;
+  demMode_->setObjectName(QStringLiteral("demMode"));
+  demMode_->addItem(tr("Hillshade"));
+  demMode_->addItem(tr("Height colours"));
+  demLegend_ = new widgets::ColourLegend;
+  demLegend_->setColourMap(widgets::ColourMap::Terrain);
+  demLegend_->setTitle(tr("Height"));
+  demLegend_->setUnit(tr("m"));
+  demLayout->addWidget(demMode_, 0, 0, 1, 2);
+  demLayout->addWidget(demView_, 1, 0);
+  demLayout->addWidget(demLegend_, 1, 1);
+  connect(demMode_, &QComboBox::currentIndexChanged, this, [this] { refreshRasters(); });
+  auto* demDock = makeDock(QStringLiteral("demDock"), tr("DEM"), demPage, Qt::RightDockWidgetArea);
+
+  view3DHost_ = new QWidget;
+  auto* host3D = new QVBoxLayout(view3DHost_);
+  host3D->setContentsMargins(0, 0, 0, 0);
+  view3DPlaceholder_ = new QLabel(tr("The 3D view appears when a DEM is available."));
+  view3DPlaceholder_->setAlignment(Qt::AlignCenter);
+  view3DPlaceholder_->setWordWrap(true);
+  host3D->addWidget(view3DPlaceholder_);
+  auto* view3DDock = makeDock(QStringLiteral("view3DDock"), tr("3D view"), view3DHost_, Qt::RightDockWidgetArea);
+  connect(view3DDock, &QDockWidget::visibilityChanged, this, [this](bool visible) {
+    if (visible) ensure3DView();
+  });
+
+  tabifyDockWidget(rightDock, disparityDock);
+  tabifyDockWidget(disparityDock, demDock);
+  tabifyDockWidget(demDock, view3DDock);
+  rightDock->raise();
+
+  buildingsModel_ = new BuildingsModel(this);
+  buildingsTable_ = new QTableView;
+  buildingsTable_->setObjectName(QStringLiteral("buildingsTable"));
+  buildingsTable_->setModel(buildingsModel_);
+  buildingsTable_->setSelectionBehavior(QAbstractItemView::SelectRows);
+  buildingsTable_->setSelectionMode(QAbstractItemView::SingleSelection);
+  buildingsTable_->verticalHeader()->hide();
+  buildingsTable_->horizontalHeader()->setStretchLastSection(true);
+  connect(buildingsTable_->selectionModel(), &QItemSelectionModel::selectionChanged, this,
+          &MainWindow::onSelectionFromTable);
+  connect(buildingsModel_, &QAbstractItemModel::modelReset, this, [this] {
+    // Keep the table's selection on the selected building across model resets.
+    updatingSelection_ = true;
+    const int row = buildingsModel_->rowOf(selectedId_);
+    if (row >= 0) buildingsTable_->selectRow(row);
+    updatingSelection_ = false;
+  });
+  makeDock(QStringLiteral("buildingsDock"), tr("Buildings"), buildingsTable_, Qt::LeftDockWidgetArea);
+
+  auto* paramsPage = new QWidget;
+  auto* paramsLayout = new QVBoxLayout(paramsPage);
+  auto* intervalTitle = new QLabel(tr("<b>Roof disparity interval</b> (drag on the histogram of the ROI; the line marks the ground)"));
+  intervalTitle->setWordWrap(true);
+  paramsLayout->addWidget(intervalTitle);
+  histogram_ = new widgets::DisparityHistogramWidget;
+  histogram_->setObjectName(QStringLiteral("histogram"));
+  histogram_->setToolTip(tr("Disparities inside the region of interest of the selected building. "
+                            "Drag the band or its handles to choose the roof interval [px]."));
+  paramsLayout->addWidget(histogram_);
+  intervalLabel_ = new QLabel;
+  intervalLabel_->setObjectName(QStringLiteral("intervalLabel"));
+  paramsLayout->addWidget(intervalLabel_);
+  connect(histogram_, &widgets::DisparityHistogramWidget::intervalChanged, this, [this](int a, int b) {
+    intervalLabel_->setText(tr("Roof: %1 .. %2 px").arg(a).arg(b));
+  });
+  connect(histogram_, &widgets::DisparityHistogramWidget::intervalEditingFinished, this, [this](int a, int b) {
+    if (document_ && selectedId_ > 0) document_->setRoofInterval(selectedId_, {a, b});
+  });
+  auto* tabs = new QTabWidget;
+  delineationForm_ = new widgets::ParameterForm;
+  delineationForm_->setObjectName(QStringLiteral("delineationForm"));
+  matchingForm_ = new widgets::ParameterForm;
+  matchingForm_->setObjectName(QStringLiteral("matchingForm"));
+#ifdef DELINEO_HAVE_DELINEATION
+  delineationForm_->setParams(delineation::DelineationParams{});
+#endif
+#ifdef DELINEO_HAVE_STEREO
+  matchingForm_->setParams(stereo::MatchParams{});
+#endif
+  for (auto* form : {delineationForm_, matchingForm_}) {
+    connect(form, &widgets::ParameterForm::changed, this, [this] {
+      if (!updatingForms_) readFormsIntoDocument();
+    });
+  }
+  auto* delineationScroll = new QScrollArea;
+  delineationScroll->setWidget(delineationForm_);
+  delineationScroll->setWidgetResizable(true);
+  auto* matchingScroll = new QScrollArea;
+  matchingScroll->setWidget(matchingForm_);
+  matchingScroll->setWidgetResizable(true);
+  tabs->addTab(delineationScroll, tr("Active polygon"));
+  tabs->addTab(matchingScroll, tr("Matching"));
+  paramsLayout->addWidget(tabs, 1);
+  auto* paramsDock = makeDock(QStringLiteral("parametersDock"), tr("Parameters"), paramsPage, Qt::LeftDockWidgetArea);
+  Q_UNUSED(paramsDock);
+}
+
+void MainWindow::createActions() {
+  auto make = [this](const QString& name, const QString& text, const QKeySequence& key = {}) {
+    auto* a = new QAction(text, this);
+    a->setObjectName(name);
+    if (!key.isEmpty()) a->setShortcut(key);
+    addAction(a);
+    return a;
+  };
+  connect(make(QStringLiteral("actionOpen"), tr("&Open project…"), QKeySequence::Open), &QAction::triggered, this, [this] {
+    if (!maybeSave()) return;
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open project"), {}, tr("Delineo projects (*.json)"));
+    if (!path.isEmpty()) openProject(path);
+  });
+  connect(make(QStringLiteral("actionNewFromPair"), tr("&New project from a stereo pair…"), QKeySequence::New),
+          &QAction::triggered, this, [this] {
+            if (!maybeSave()) return;
+            const QString filter = tr("Images (*.tif *.tiff *.png *.jpg)");
+            const QString left = QFileDialog::getOpenFileName(this, tr("Left image (reference)"), {}, filter);
+            if (left.isEmpty()) return;
+            const QString right = QFileDialog::getOpenFileName(this, tr("Right image"), QFileInfo(left).path(), filter);
+            if (!right.isEmpty()) openPair(left, right);
+          });
+  connect(make(QStringLiteral("actionOpenSample"), tr("Open the &sample project")), &QAction::triggered, this, [this] {
+    if (maybeSave()) openSample();
+  });
+  connect(make(QStringLiteral("actionSave"), tr("&Save"), QKeySequence::Save), &QAction::triggered, this, &MainWindow::save);
+  connect(make(QStringLiteral("actionSaveAs"), tr("Save &as…"), QKeySequence::SaveAs), &QAction::triggered, this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save project"), {}, tr("Delineo projects (*.json)"));
+    if (!path.isEmpty()) saveAs(path);
+  });
+  connect(make(QStringLiteral("actionExport"), tr("&Export accepted buildings…"), QKeySequence(tr("Ctrl+E"))),
+          &QAction::triggered, this, [this] {
+            const QString path = QFileDialog::getSaveFileName(this, tr("Export accepted buildings"), {},
+                                                              tr("GeoJSON (*.geojson);;GeoPackage (*.gpkg)"));
+            if (!path.isEmpty()) exportAccepted(path);
+          });
+  connect(make(QStringLiteral("actionQuit"), tr("&Quit"), QKeySequence::Quit), &QAction::triggered, this, &QWidget::close);
+
+  toolGroup_ = new QActionGroup(this);
+  auto tool = [&](const QString& name, const QString& text, const QString& key, InteractionMode mode, const QString& tip) {
+    QAction* a = make(name, text, QKeySequence(key));
+    a->setCheckable(true);
+    a->setToolTip(tip);
+    a->setStatusTip(tip);
+    toolGroup_->addAction(a);
+    connect(a, &QAction::triggered, this, [this, mode] { leftView_->setInteractionMode(mode); });
+    return a;
+  };
+  tool(QStringLiteral("actionNavigate"), tr("&Navigate"), QStringLiteral("N"), InteractionMode::Navigate,
+       tr("Pan with the mouse, zoom with the wheel, click a building to select it"))->setChecked(true);
+  tool(QStringLiteral("actionPickRectangle"), tr("Pick with a &rectangle"), QStringLiteral("B"),
+       InteractionMode::PickRectangle, tr("Drag a rectangle around a building"));
+  tool(QStringLiteral("actionPickPolygon"), tr("Pick with a &polygon"), QStringLiteral("P"),
+       InteractionMode::PickPolygon, tr("Click the corners of a rough polygon; double-click to close"));
+  tool(QStringLiteral("actionPickObject"), tr("Pick an above-ground &object"), QStringLiteral("O"),
+       InteractionMode::PickPoint, tr("Click a building: its above-ground region becomes the initial polygon"));
+  tool(QStringLiteral("actionEdit"), tr("&Edit outline"), QStringLiteral("E"), InteractionMode::EditPolygon,
+       tr("Drag vertices or edges of the selected building; every change can be undone"));
+  connect(leftView_, &ImageView::interactionModeChanged, this, [this](InteractionMode mode) {
+    static const std::map<InteractionMode, QString> names = {
+        {InteractionMode::Navigate, QStringLiteral("actionNavigate")},
+        {InteractionMode::PickRectangle, QStringLiteral("actionPickRectangle")},
+        {InteractionMode::PickPolygon, QStringLiteral("actionPickPolygon")},
+        {InteractionMode::PickPoint, QStringLiteral("actionPickObject")},
+        {InteractionMode::EditPolygon, QStringLiteral("actionEdit")}};
+    if (QAction* a = action(names.at(mode))) a->setChecked(true);
+  });
+
+  connect(make(QStringLiteral("actionMatch"), tr("Compute &disparity"), QKeySequence(tr("Ctrl+M"))),
+          &QAction::triggered, this, &MainWindow::startMatching);
+  connect(make(QStringLiteral("actionDelineate"), tr("Run the active &polygon"), QKeySequence(tr("Ctrl+R"))),
+          &QAction::triggered, this, [this] { startDelineation(selectedId_); });
+  connect(make(QStringLiteral("actionAccept"), tr("&Accept building"), QKeySequence(QStringLiteral("A"))),
+          &QAction::triggered, this, &MainWindow::acceptSelected);
+  connect(make(QStringLiteral("actionReject"), tr("Re&ject building"), QKeySequence(QStringLiteral("X"))),
+          &QAction::triggered, this, &MainWindow::rejectSelected);
+  connect(make(QStringLiteral("actionReopen"), tr("Re&open building")), &QAction::triggered, this, [this] {
+    if (document_ && selectedId_ > 0) {
+      const Building* b = document_->project().find(selectedId_);
+      if (b) document_->setStatus(selectedId_, b->hasOutline() ? BuildingStatus::Corrected : BuildingStatus::Pending);
+    }
+  });
+  connect(make(QStringLiteral("actionRemove"), tr("Re&move building"), QKeySequence::Delete), &QAction::triggered, this, [this] {
+    if (document_ && selectedId_ > 0) {
+      const int id = selectedId_;
+      selectBuilding(-1);
+      document_->removeBuilding(id);
+    }
+  });
+  connect(make(QStringLiteral("actionCancelJobs"), tr("&Cancel running jobs"), QKeySequence(Qt::Key_Escape)),
+          &QAction::triggered, jobs_, &widgets::JobRunner::cancelAll);
+
+  auto* undo = make(QStringLiteral("actionUndo"), tr("&Undo"));
+  undo->setShortcuts({QKeySequence::Undo});
+  auto* redo = make(QStringLiteral("actionRedo"), tr("&Redo"));
+  redo->setShortcuts({QKeySequence(tr("Ctrl+Y")), QKeySequence(tr("Ctrl+Shift+Z"))});
+  connect(undo, &QAction::triggered, this, [this] {
+    if (document_) document_->undoStack()->undo();
+  });
+  connect(redo, &QAction::triggered, this, [this] {
+    if (document_) document_->undoStack()->redo();
+  });
+
+  auto* labels = make(QStringLiteral("actionShowLabels"), tr("Show &labels"), QKeySequence(QStringLiteral("L")));
+  labels->setCheckable(true);
+  labels->setChecked(true);
+  connect(labels, &QAction::toggled, this, [this](bool on) { leftView_->setOverlayVisible(on); });
+}
+
+void MainWindow::createMenus() {
+  QMenu* file = menuBar()->addMenu(tr("&File"));
+  file->addAction(action(QStringLiteral("actionNewFromPair")));
+  file->addAction(action(QStringLiteral("actionOpen")));
+  file->addAction(action(QStringLiteral("actionOpenSample")));
+  recentMenu_ = file->addMenu(tr("Open &recent"));
+  recentMenu_->setObjectName(QStringLiteral("recentMenu"));
+  file->addSeparator();
+  file->addAction(action(QStringLiteral("actionSave")));
+  file->addAction(action(QStringLiteral("actionSaveAs")));
+  file->addAction(action(QStringLiteral("actionExport")));
+  file->addSeparator();
+  file->addAction(action(QStringLiteral("actionQuit")));
+
+  QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+  edit->addAction(action(QStringLiteral("actionUndo")));
+  edit->addAction(action(QStringLiteral("actionRedo")));
+
+  QMenu* building = menuBar()->addMenu(tr("&Building"));
+  for (const char* name : {"actionNavigate", "actionPickRectangle", "actionPickPolygon", "actionPickObject", "actionEdit"}) {
+    building->addAction(action(QString::fromLatin1(name)));
+  }
+  building->addSeparator();
+  building->addAction(action(QStringLiteral("actionDelineate")));
+  building->addAction(action(QStringLiteral("actionAccept")));
+  building->addAction(action(QStringLiteral("actionReject")));
+  building->addAction(action(QStringLiteral("actionReopen")));
+  building->addAction(action(QStringLiteral("actionRemove")));
+
+  QMenu* process = menuBar()->addMenu(tr("&Processing"));
+  process->addAction(action(QStringLiteral("actionMatch")));
+  process->addAction(action(QStringLiteral("actionDelineate")));
+  process->addAction(action(QStringLiteral("actionCancelJobs")));
+
+  QMenu* view = menuBar()->addMenu(tr("&View"));
+  view->addAction(action(QStringLiteral("actionShowLabels")));
+  view->addSeparator();
+  for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
+
+  QMenu* settingsMenu = menuBar()->addMenu(tr("&Settings"));
+  QMenu* language = settingsMenu->addMenu(tr("&Language"));
+  auto* languages = new QActionGroup(this);
+  const QString current = QSettings().value(QStringLiteral("language")).toString();
+  for (const auto& [code, name] : std::vector<std::pair<QString, QString>>{
+           {QString(), tr("System default")}, {QStringLiteral("en"), QStringLiteral("English")},
+           {QStringLiteral("fr"), QStringLiteral("Français")}}) {
+    QAction* a = language->addAction(name);
+    a->setObjectName(QStringLiteral("actionLanguage_") + (code.isEmpty() ? QStringLiteral("system") : code));
+    a->setCheckable(true);
+    a->setChecked(code == current);
+    languages->addAction(a);
+    connect(a, &QAction::triggered, this, [this, code = code] { setLanguage(code); });
+  }
+
+  auto* toolbar = addToolBar(tr("Tools"));
+  toolbar->setObjectName(QStringLiteral("toolsToolbar"));
+  for (const char* name : {"actionOpen", "actionSave", "actionUndo", "actionRedo", "actionNavigate",
+                           "actionPickRectangle", "actionPickPolygon", "actionPickObject", "actionEdit",
+                           "actionMatch", "actionDelineate", "actionAccept", "actionReject"}) {
+    toolbar->addAction(action(QString::fromLatin1(name)));
+  }
+  rebuildRecentMenu();
+}
+
+void MainWindow::restoreSettings() {
+  QSettings settings;
+  resize(1400, 900);
+  restoreGeometry(settings.value(QStringLiteral("window/geometry")).toByteArray());
+  restoreState(settings.value(QStringLiteral("window/state")).toByteArray());
+}
+
+QDockWidget* MainWindow::dock(const QString& objectName) const {
+  return findChild<QDockWidget*>(objectName);
+}
+
+QAction* MainWindow::action(const QString& objectName) const {
+  return findChild<QAction*>(objectName, Qt::FindDirectChildrenOnly);
+}
+
+void MainWindow::showDock(const QString& objectName) {
+  if (QDockWidget* d = dock(objectName)) {
+    d->show();
+    d->raise();
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// messages
+
+void MainWindow::showMessage(const QString& title, const QString& text) {
+  lastMessage_ = text;
+  statusBar()->showMessage(text.section(QLatin1Char('\n'), 0, 0), 10000);
+  emit messageShown(text);
+  if (interactive_) QMessageBox::warning(this, title, text);
+}
+
+bool MainWindow::askYesNo(const QString& title, const QString& text, bool defaultAnswer) {
+  if (!interactive_) return defaultAnswer;
+  return QMessageBox::question(this, title, text, QMessageBox::Yes | QMessageBox::No,
+                               defaultAnswer ? QMessageBox::Yes : QMessageBox::No) == QMessageBox::Yes;
+}
+
+// ------------------------------------------------------------------------------------------
+// documents
+
+bool MainWindow::openProject(const QString& path) {
+  const std::string projectPath = path.toStdString();
+  project::Project loaded;
+  try {
+    bool useAutosave = false;
+    if (project::hasNewerAutosave(projectPath)) {
+      useAutosave = interactive_
+                        ? askYesNo(tr("Recover unsaved changes"),
+                                   tr("An automatic backup of %1 is newer than the project file "
+                                      "(Delineo may have stopped unexpectedly). Restore it?")
+                                       .arg(QFileInfo(path).fileName()),
+                                   true)
+                        : restoreAutosave_;
+    }
+    loaded = project::loadProject(useAutosave ? project::autosavePath(projectPath) : projectPath);
+    // Missing images: ask for their new place, one by one; giving up leaves everything as it was.
+    for (const std::string& missing : loaded.missingFiles()) {
+      const QString missingPath = QString::fromStdString(missing);
+      QString replacement;
+      if (relocate_) {
+        replacement = relocate_(missingPath);
+      } else if (interactive_) {
+        if (askYesNo(tr("Image not found"),
+                     tr("The project refers to %1, which does not exist. Locate it?").arg(missingPath), true)) {
+          replacement = QFileDialog::getOpenFileName(this, tr("Locate %1").arg(QFileInfo(missingPath).fileName()),
+                                                     QFileInfo(path).path());
+        }
+      }
+      if (replacement.isEmpty()) {
+        showMessage(tr("Image not found"),
+                    tr("The project was not opened because %1 does not exist. Move the file back "
+                       "or locate it when opening the project.").arg(missingPath));
+        return false;
+      }
+      for (std::string* p : {&loaded.left, &loaded.right, &loaded.disparity, &loaded.dem, &loaded.labels}) {
+        if (*p == missing) *p = replacement.toStdString();
+      }
+    }
+    auto doc = Document::fromProject(std::move(loaded), path);
+    installDocument(std::move(doc));
+  } catch (const core::Error& e) {
+    showMessage(tr("Cannot open the project"), errorMessage(e));
+    return false;
+  }
+  addRecent(path);
+  return true;
+}
+
+bool MainWindow::openPair(const QString& left, const QString& right) {
+  try {
+    installDocument(Document::fromPair(left, right));
+  } catch (const core::Error& e) {
+    showMessage(tr("Cannot open the stereo pair"), errorMessage(e));
+    return false;
+  }
+  return true;
+}
+
+QString MainWindow::sampleDirectory() {
+  return QStandardPaths::writableLocation(QStandardPaths::AppLocalDataLocation) + QStringLiteral("/sample");
+}
+
+bool MainWindow::openSample() {
+  if (!project::simulationAvailable()) {
+    showMessage(tr("Sample project"), tr("This build has no scene simulator to make the sample project."));
+    return false;
+  }
+  const QString dir = sampleDirectory();
+  statusBar()->showMessage(tr("Preparing the sample project…"));
+  jobs_->run<std::string>(
+      tr("Sample project"),
+      [dir](core::Progress& p) { return project::ensureSampleProject(dir.toStdString(), &p); },
+      [this](std::string path) {
+        if (openProject(QString::fromStdString(path))) {
+          statusBar()->showMessage(tr("Sample project opened: pick a building on the left image."), 10000);
+        }
+      },
+      QStringLiteral("sample"));
+  return true;
+}
+
+void MainWindow::installDocument(std::unique_ptr<Document> document) {
+  jobs_->cancelAll();
+  selectedId_ = -1;
+  document_ = std::move(document);
+  buildingsModel_->setDocument(document_.get());
+  Document* doc = document_.get();
+  connect(doc, &Document::buildingChanged, this, [this](int id) {
+    refreshOverlays();
+    if (id == selectedId_) {
+      if (document_->project().find(id) == nullptr) selectBuilding(-1);
+      else refreshHistogram();
+    }
+    refresh3D();
+    updateActions();
+  });
+  connect(doc, &Document::disparityChanged, this, [this] {
+    refreshRasters();
+    refreshHistogram();
+    refresh3D();
+    updateActions();
+  });
+  connect(doc, &Document::parametersChanged, this, [this] { loadFormsFromDocument(); });
+  connect(doc, &Document::modifiedChanged, this, [this] { refreshTitle(); });
+  connect(doc->undoStack(), &QUndoStack::indexChanged, this, [this] {
+    refreshTitle();
+    updateActions();
+  });
+  leftView_->setImage(doc->leftGrey());
+  rightView_->setImage(doc->rightGrey());
+  if (!doc->labels().empty()) {
+    leftView_->setOverlay(doc->labels(), 0.25);
+    leftView_->setOverlayVisible(action(QStringLiteral("actionShowLabels"))->isChecked());
+  } else {
+    leftView_->clearOverlay();
+  }
+  leftView_->fitToWindow();
+  leftView_->polygons().clearEvolvingContour();
+  leftView_->polygons().setRoi({});
+  loadFormsFromDocument();
+  refreshRasters();
+  refreshOverlays();
+  refreshHistogram();
+  refresh3D();
+  refreshTitle();
+  updateActions();
+  emit documentOpened();
+  if (doc->disparity().empty() && project::matchingAvailable() &&
+      QSettings().value(QStringLiteral("autoMatch"), true).toBool()) {
+    statusBar()->showMessage(tr("No disparity yet: computing it in the background."), 8000);
+    startMatching();
+  }
+}
+
+bool MainWindow::maybeSave() {
+  if (!document_ || !document_->isModified()) return true;
+  if (!interactive_) return true;
+  const auto answer = QMessageBox::question(
+      this, tr("Unsaved changes"), tr("Save the changes to %1?").arg(document_->displayName()),
+      QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
+  if (answer == QMessageBox::Cancel) return false;
+  if (answer == QMessageBox::Save) return save();
+  return true;
+}
+
+bool MainWindow::save() {
+  if (!document_) return false;
+  if (document_->path().isEmpty()) {
+    if (!interactive_) return false;
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save project"), {}, tr("Delineo projects (*.json)"));
+    return !path.isEmpty() && saveAs(path);
+  }
+  return saveAs(document_->path());
+}
+
+bool MainWindow::saveAs(const QString& path) {
+  if (!document_) return false;
+  try {
+    document_->save(path);
+  } catch (const core::Error& e) {
+    showMessage(tr("Cannot save the project"), errorMessage(e));
+    return false;
+  }
+  addRecent(path);
+  refreshTitle();
+  statusBar()->showMessage(tr("Saved %1").arg(path), 5000);
+  return true;
+}
+
+int MainWindow::exportAccepted(const QString& path) {
+  if (!document_) return -1;
+  try {
+    const int n = document_->exportAccepted(path);
+    statusBar()->showMessage(tr("%n accepted building(s) exported to %1", nullptr, n).arg(path), 8000);
+    return n;
+  } catch (const core::Error& e) {
+    showMessage(tr("Cannot export"), errorMessage(e));
+    return -1;
+  }
+}
+
+void MainWindow::autosaveNow() {
+  if (!document_) return;
+  try {
+    document_->autosave();
+  } catch (const core::Error& e) {
+    statusBar()->showMessage(tr("Autosave failed: %1").arg(QString::fromStdString(e.detail())), 8000);
+  }
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+  if (!maybeSave()) {
+    event->ignore();
+    return;
+  }
+  QSettings settings;
+  settings.setValue(QStringLiteral("window/geometry"), saveGeometry());
+  settings.setValue(QStringLiteral("window/state"), saveState());
+  jobs_->cancelAll();
+  event->accept();
+}
+
+void MainWindow::addRecent(const QString& path) {
+  QSettings settings;
+  QStringList recent = settings.value(QStringLiteral("recentProjects")).toStringList();
+  const QString absolute = QFileInfo(path).absoluteFilePath();
+  recent.removeAll(absolute);
+  recent.prepend(absolute);
+  while (recent.size() > kMaxRecent) recent.removeLast();
+  settings.setValue(QStringLiteral("recentProjects"), recent);
+  rebuildRecentMenu();
+}
+
+void MainWindow::rebuildRecentMenu() {
+  recentMenu_->clear();
+  const QStringList recent = QSettings().value(QStringLiteral("recentProjects")).toStringList();
+  for (const QString& path : recent) {
+    QAction* a = recentMenu_->addAction(QFileInfo(path).fileName());
+    a->setToolTip(path);
+    connect(a, &QAction::triggered, this, [this, path] {
+      if (maybeSave()) openProject(path);
+    });
+  }
+  recentMenu_->setEnabled(!recent.isEmpty());
+}
+
+void MainWindow::setLanguage(const QString& code) {
+  QSettings().setValue(QStringLiteral("language"), code);
+  showMessage(tr("Language"), tr("The language will change the next time Delineo starts."));
+}
+
+// ------------------------------------------------------------------------------------------
+// refresh
+
+void MainWindow::refreshTitle() {
+  QString title = QStringLiteral("Delineo");
+  if (document_) title = document_->displayName() + QStringLiteral("[*] — Delineo");
+  setWindowTitle(title);
+  setWindowModified(document_ && document_->isModified());
+}
+
+void MainWindow::refreshRasters() {
+  if (!document_) return;
+  const cv::Mat& disparity = document_->disparity();
+  if (disparity.empty()) {
+    disparityView_->clearImage();
+  } else {
+    const auto [lo, hi] = widgets::finiteRange(disparity);
+    disparityView_->setImage(disparity, {widgets::ColourMap::Viridis, lo, hi});
+    disparityLegend_->setRange(lo, hi);
+  }
+  const cv::Mat& dem = document_->dem();
+  if (dem.empty()) {
+    demView_->clearImage();
+  } else if (demMode_->currentIndex() == 0) {
+    demView_->setImage(widgets::hillshade(dem, document_->project().height.gsd));
+    demLegend_->hide();
+  } else {
+    const auto [lo, hi] = widgets::finiteRange(dem);
+    demView_->setImage(dem, {widgets::ColourMap::Terrain, lo, hi});
+    demLegend_->setRange(lo, hi);
+    demLegend_->show();
+  }
+  // Views that got their first image fit themselves; keep them on the left view's position.
+  for (ImageView* v : {disparityView_, demView_}) {
+    if (v->hasImage()) v->setView(leftView_->viewCenter(), leftView_->zoom());
+  }
+}
+
+void MainWindow::refreshOverlays() {
+  if (!document_) {
+    leftView_->polygons().clearPolygons();
+    return;
+  }
+  std::vector<widgets::OverlayPolygon> polygons;
+  for (const Building& b : document_->project().buildings) {
+    widgets::OverlayPolygon p;
+    p.id = b.id;
+    p.polygon = b.currentPolygon();
+    p.status = overlayStatus(b.status);
+    p.label = QStringLiteral("#%1").arg(b.id);
+    if (b.status == BuildingStatus::Pending) p.colour = QColor(255, 200, 0);
+    polygons.push_back(std::move(p));
+  }
+  for (ImageView* v : {leftView_, rightView_, disparityView_, demView_}) {
+    // The right view is in its own geometry: the outlines would be shifted by the roof
+    // disparity, so it shows none rather than misplaced ones.
+    if (v == rightView_) continue;
+    v->polygons().setPolygons(polygons);
+    v->polygons().setSelectedId(selectedId_);
+  }
+}
+
+void MainWindow::refreshHistogram() {
+  histogram_->setValues({});
+  histogram_->clearGroundLevel();
+  intervalLabel_->clear();
+  leftView_->polygons().setRoi({});
+  if (!document_ || selectedId_ <= 0) return;
+  const Building* b = document_->project().find(selectedId_);
+  if (b == nullptr) return;
+  const cv::Rect2d box = core::boundingBox(b->initial.outer);
+  int margin = 24;
+#ifdef DELINEO_HAVE_DELINEATION
+  margin = project::parameters<delineation::DelineationParams>(document_->project(), "delineation").roiMargin;
+#endif
+  QRectF roi(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin);
+  roi &= QRectF(0, 0, document_->leftGrey().cols, document_->leftGrey().rows);
+  leftView_->polygons().setRoi(roi);
+  const cv::Mat& disparity = document_->disparity();
+  if (disparity.empty()) {
+    intervalLabel_->setText(tr("Compute the disparity to see the histogram."));
+    return;
+  }
+  const cv::Rect r(static_cast<int>(roi.left()), static_cast<int>(roi.top()), static_cast<int>(roi.width()),
+                   static_cast<int>(roi.height()));
+  histogram_->setDisparities(disparity(r & cv::Rect(0, 0, disparity.cols, disparity.rows)));
+  if (auto ground = ringMedian(disparity, b->initial, 8)) histogram_->setGroundLevel(*ground);
+  std::optional<project::DisparityInterval> interval = b->roofInterval;
+  if (!interval) interval = project::suggestRoofInterval(disparity, b->initial);
+  if (interval) {
+    histogram_->setInterval(interval->low, interval->high);
+    intervalLabel_->setText(tr("Roof: %1 .. %2 px").arg(interval->low).arg(interval->high));
+  }
+}
+
+void MainWindow::ensure3DView() {
+  if (view3D_ != nullptr || !document_ || document_->dem().empty()) return;
+  // VTK needs an X server in both of the view's backends (docs/qt6-vtk-facts.md).
+  if (qEnvironmentVariableIsEmpty("DISPLAY")) {
+    view3DPlaceholder_->setText(tr("The 3D view needs a display (X server)."));
+    return;
+  }
+  view3D_ = new widgets::Terrain3DView;
+  view3D_->setObjectName(QStringLiteral("view3D"));
+  view3DHost_->layout()->addWidget(view3D_);
+  view3DPlaceholder_->hide();
+  refresh3D();
+}
+
+void MainWindow::refresh3D() {
+  if (view3D_ == nullptr || !document_) return;
+  if (document_->dem().empty()) return;
+  view3D_->setDem(document_->dem(), document_->project().height.gsd);
+  view3D_->setTexture(document_->leftGrey());
+  std::vector<widgets::BuildingOutline> outlines;
+  for (const Building& b : document_->project().buildings) {
+    if (!b.hasOutline() || b.status == BuildingStatus::Rejected || !std::isfinite(b.roofHeight)) continue;
+    const double base = ringMedian(document_->dem(), b.outline, 6).value_or(0.0);
+    outlines.push_back({b.outline, base, b.roofHeight});
+  }
+  view3D_->setBuildings(outlines);
+}
+
+void MainWindow::updateActions() {
+  const bool hasDoc = document_ != nullptr;
+  const Building* b = hasDoc && selectedId_ > 0 ? document_->project().find(selectedId_) : nullptr;
+  action(QStringLiteral("actionSave"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionSaveAs"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionExport"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionMatch"))->setEnabled(hasDoc && project::matchingAvailable());
+  action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr && project::delineationAvailable());
+  action(QStringLiteral("actionAccept"))->setEnabled(b != nullptr && b->hasOutline() && b->status != BuildingStatus::Accepted);
+  action(QStringLiteral("actionReject"))->setEnabled(b != nullptr && b->status != BuildingStatus::Rejected);
+  action(QStringLiteral("actionReopen"))->setEnabled(
+      b != nullptr && (b->status == BuildingStatus::Accepted || b->status == BuildingStatus::Rejected));
+  action(QStringLiteral("actionRemove"))->setEnabled(b != nullptr);
+  action(QStringLiteral("actionCancelJobs"))->setEnabled(jobs_->activeCount() > 0);
+  QUndoStack* stack = hasDoc ? document_->undoStack() : nullptr;
+  QAction* undo = action(QStringLiteral("actionUndo"));
+  QAction* redo = action(QStringLiteral("actionRedo"));
+  undo->setEnabled(stack && stack->canUndo());
+  redo->setEnabled(stack && stack->canRedo());
+  undo->setText(stack && stack->canUndo() ? tr("&Undo %1").arg(stack->undoText()) : tr("&Undo"));
+  redo->setText(stack && stack->canRedo() ? tr("&Redo %1").arg(stack->redoText()) : tr("&Redo"));
+}
+
+void MainWindow::updateReadout(QPointF p, bool leftGeometry, const cv::Mat& ownGrey) {
+  if (!document_) return;
+  const int x = static_cast<int>(std::floor(p.x()));
+  const int y = static_cast<int>(std::floor(p.y()));
+  if (ownGrey.empty() || x < 0 || y < 0 || x >= ownGrey.cols || y >= ownGrey.rows) {
+    readout_->clear();
+    return;
+  }
+  QString text = tr("x %1  y %2  grey %3").arg(x).arg(y).arg(ownGrey.at<uchar>(y, x));
+  if (leftGeometry) {
+    const cv::Mat& disparity = document_->disparity();
+    if (!disparity.empty()) {
+      const float d = disparity.at<float>(y, x);
+      text += std::isfinite(d) ? tr("  disparity %1 px").arg(d, 0, 'f', 2) : tr("  disparity –");
+    }
+    const cv::Mat& dem = document_->dem();
+    if (!dem.empty()) {
+      const float h = dem.at<float>(y, x);
+      text += std::isfinite(h) ? tr("  height %1 m").arg(h, 0, 'f', 2) : tr("  height –");
+    }
+  } else {
+    text += tr("  (right image)");
+  }
+  readout_->setText(text);
+}
+
+// ------------------------------------------------------------------------------------------
+// buildings
+
+void MainWindow::selectBuilding(int id) {
+  if (document_ && id > 0 && document_->project().find(id) == nullptr) id = -1;
+  const bool changed = id != selectedId_;
+  selectedId_ = id;
+  updatingSelection_ = true;
+  for (ImageView* v : {leftView_, disparityView_, demView_}) v->polygons().setSelectedId(id);
+  const int row = buildingsModel_->rowOf(id);
+  if (row >= 0) buildingsTable_->selectRow(row);
+  else buildingsTable_->clearSelection();
+  updatingSelection_ = false;
+  if (id > 0) {
+    const cv::Rect2d box = core::boundingBox(document_->project().find(id)->currentPolygon().outer);
+    leftView_->setViewCenter(QPointF(box.x + box.width / 2, box.y + box.height / 2));
+  }
+  refreshHistogram();
+  updateActions();
+  if (changed) emit selectedBuildingChanged(id);
+}
+
+void MainWindow::onSelectionFromOverlay(int id) {
+  if (updatingSelection_ || id == selectedId_) return;
+  selectBuilding(id);
+}
+
+void MainWindow::onSelectionFromTable() {
+  if (updatingSelection_) return;
+  const auto rows = buildingsTable_->selectionModel()->selectedRows();
+  const int id = rows.isEmpty() ? -1 : buildingsModel_->idAt(rows.first().row());
+  if (id != selectedId_) selectBuilding(id);
+}
+
+void MainWindow::onPicked(const core::Polygon& polygon) {
+  if (!document_) return;
+  if (polygon.outer.size() < 3 || core::area(polygon) < 16.0 || !core::isSimple(polygon.outer)) {
+    showMessage(tr("Pick a building"), tr("The picked shape is too small or crosses itself; draw it again."));
+    return;
+  }
+  const int id = document_->addBuilding(polygon);
+  selectBuilding(id);
+  leftView_->setInteractionMode(InteractionMode::Navigate);
+}
+
+void MainWindow::onObjectPicked(QPointF imagePos) {
+  if (!document_) return;
+  const cv::Mat& dem = document_->dem();
+  const int x = static_cast<int>(imagePos.x());
+  const int y = static_cast<int>(imagePos.y());
+  if (dem.empty() || x < 0 || y < 0 || x >= dem.cols || y >= dem.rows) {
+    showMessage(tr("Pick an object"), tr("Picking an above-ground object needs a DEM or a disparity map."));
+    return;
+  }
+  // Above-ground region: pixels at least 2.5 m above the local ground (the low quantile of the
+  // heights in a window around the click), connected to the clicked pixel.
+  const cv::Rect window = cv::Rect(x - 60, y - 60, 121, 121) & cv::Rect(0, 0, dem.cols, dem.rows);
+  std::vector<float> heights;
+  for (int yy = window.y; yy < window.y + window.height; ++yy) {
+    for (int xx = window.x; xx < window.x + window.width; ++xx) {
+      const float h = dem.at<float>(yy, xx);
+      if (std::isfinite(h)) heights.push_back(h);
+    }
+  }
+  if (heights.empty()) return;
+  std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 10), heights.end());
+  const float ground = heights[heights.size() / 10];
+  cv::Mat above = (dem > ground + 2.5f);
+  cv::morphologyEx(above, above, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  if (above.at<uchar>(y, x) == 0) {
+    showMessage(tr("Pick an object"), tr("No above-ground object under the cursor."));
+    return;
+  }
+  cv::Mat mask = cv::Mat::zeros(dem.rows + 2, dem.cols + 2, CV_8U);
+  cv::floodFill(above, mask, cv::Point(x, y), 128, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
+  cv::Mat region = mask(cv::Rect(1, 1, dem.cols, dem.rows));
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(region, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  if (contours.empty()) return;
+  std::vector<cv::Point> simplified;
+  cv::approxPolyDP(contours.front(), simplified, 2.0, true);
+  core::Polygon p;
+  for (const auto& q : simplified) p.outer.emplace_back(q.x + 0.5, q.y + 0.5);
+  onPicked(p);
+}
+
+void MainWindow::onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description) {
+  if (!document_) return;
+  const core::Ring newRing = widgets::toRing(ring);
+  if (!core::isSimple(newRing)) {
+    showMessage(tr("Edit outline"), tr("That change would make the outline cross itself; it was not applied."));
+    refreshOverlays();
+    return;
+  }
+  document_->editRing(id, ringIndex, newRing, description);
+}
+
+void MainWindow::acceptSelected() {
+  if (!document_ || selectedId_ <= 0) return;
+  const Building* b = document_->project().find(selectedId_);
+  if (b == nullptr || !b->hasOutline()) return;
+  document_->setStatus(selectedId_, BuildingStatus::Accepted);
+}
+
+void MainWindow::rejectSelected() {
+  if (document_ && selectedId_ > 0) document_->setStatus(selectedId_, BuildingStatus::Rejected);
+}
+
+// ------------------------------------------------------------------------------------------
+// parameters
+
+void MainWindow::readFormsIntoDocument() {
+  if (!document_) return;
+#ifdef DELINEO_HAVE_DELINEATION
+  {
+    auto params = project::parameters<delineation::DelineationParams>(document_->project(), "delineation");
+    delineationForm_->readInto(params);
+    document_->setParameters("delineation", core::toJson(params));
+  }
+#endif
+#ifdef DELINEO_HAVE_STEREO
+  {
+    auto params = project::parameters<stereo::MatchParams>(document_->project(), "matching");
+    matchingForm_->readInto(params);
+    document_->setParameters("matching", core::toJson(params));
+  }
+#endif
+}
+
+void MainWindow::loadFormsFromDocument() {
+  if (!document_) return;
+  updatingForms_ = true;
+  try {
+#ifdef DELINEO_HAVE_DELINEATION
+    delineationForm_->setValues(project::parameters<delineation::DelineationParams>(document_->project(), "delineation"));
+#endif
+#ifdef DELINEO_HAVE_STEREO
+    matchingForm_->setValues(project::parameters<stereo::MatchParams>(document_->project(), "matching"));
+#endif
+  } catch (const core::Error& e) {
+    showMessage(tr("Parameters"), errorMessage(e));
+  }
+  updatingForms_ = false;
+}
+
+// ------------------------------------------------------------------------------------------
+// jobs
+
+widgets::JobId MainWindow::startMatching() {
+  if (!document_ || !project::matchingAvailable()) return 0;
+  const project::Project projectCopy = document_->project();
+  const project::StereoPair pair = document_->pair();
+  QPointer<Document> doc(document_.get());
+  matchingJob_ = jobs_->run<project::MatchingOutcome>(
+      tr("Dense matching"),
+      [projectCopy, pair](core::Progress& p) {
+        p.setStage("matching");
+        return project::computeDisparity(projectCopy, pair.left, pair.right, &p);
+      },
+      [this, doc](project::MatchingOutcome outcome) {
+        if (!doc || doc != document_.get() || outcome.status != core::RunStatus::Completed) return;
+        doc->setDisparity(outcome.disparity);
+        statusBar()->showMessage(tr("Disparity computed."), 5000);
+        emit matchingFinished();
+      },
+      QStringLiteral("matching"));
+  return matchingJob_;
+}
+
+widgets::JobId MainWindow::startDelineation(int id) {
+  if (!document_ || !project::delineationAvailable()) return 0;
+  const Building* current = document_->project().find(id);
+  if (current == nullptr) {
+    showMessage(tr("Active polygon"), tr("Select a building first."));
+    return 0;
+  }
+  if (document_->disparity().empty() && !current->roofInterval) {
+    showMessage(tr("Active polygon"), tr("Compute the disparity (or choose a roof interval) first."));
+    return 0;
+  }
+  readFormsIntoDocument();
+  Building building = *current;
+  if (id == selectedId_ && histogram_->sampleCount() > 0) {
+    building.roofInterval = project::DisparityInterval{histogram_->lowerBound(), histogram_->upperBound()};
+    document_->setRoofInterval(id, *building.roofInterval);
+  }
+  if (!building.roofInterval) building.roofInterval = project::suggestRoofInterval(document_->disparity(), building.initial);
+  if (!building.roofInterval) {
+    showMessage(tr("Active polygon"), tr("Choose the roof disparity interval on the histogram first."));
+    return 0;
+  }
+  const project::Project projectCopy = document_->project();
+  const project::StereoPair pair = document_->pair();
+  QPointer<Document> doc(document_.get());
+
+  // The worker streams intermediate contours; only the latest is kept and at most one repaint
+  // request is queued at a time, so a fast optimiser cannot flood the event loop.
+  struct ContourMailbox {
+    std::mutex mutex;
+    core::Polygon latest;
+    bool queued = false;
+  };
+  auto mailbox = std::make_shared<ContourMailbox>();
+  QPointer<MainWindow> self(this);
+  auto onContour = [mailbox, self](const core::Polygon& contour) {
+    std::lock_guard lock(mailbox->mutex);
+    mailbox->latest = contour;
+    if (mailbox->queued || !self) return;
+    mailbox->queued = true;
+    QMetaObject::invokeMethod(self.data(), [mailbox, self] {
+      core::Polygon latest;
+      {
+        std::lock_guard inner(mailbox->mutex);
+        latest = mailbox->latest;
+        mailbox->queued = false;
+      }
+      if (self) self->leftView_->polygons().setEvolvingContour(widgets::toQPolygon(latest.outer));
+    }, Qt::QueuedConnection);
+  };
+  leftView_->polygons().setEvolvingContour(widgets::toQPolygon(building.initial.outer));
+  const widgets::JobId job = jobs_->run<project::DelineationOutcome>(
+      tr("Active polygon, building %1").arg(id),
+      [projectCopy, building, pair, onContour](core::Progress& p) {
+        p.setStage("active polygon");
+        return project::delineateBuilding(projectCopy, building, pair, &p, onContour);
+      },
+      [this, doc, id](project::DelineationOutcome outcome) {
+        if (!doc || doc != document_.get() || outcome.status != core::RunStatus::Completed) return;
+        doc->setDelineationResult(id, outcome);
+        emit delineationFinished(id);
+      },
+      QStringLiteral("delineate-%1").arg(id));
+  return job;
+}
+
+}  // namespace delineo::gui

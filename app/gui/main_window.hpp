@@ -1,0 +1,167 @@
+#pragma once
+// The operator's delineation workstation: the left image in the centre, the right image,
+// disparity, DEM and 3D view in docks, the buildings list, the parameters dock (roof disparity
+// interval on the ROI histogram + parameter forms), background jobs with progress and cancel,
+// undo/redo of every change, projects with autosave and recovery.
+#include <QMainWindow>
+#include <QPointer>
+#include <QTimer>
+#include <functional>
+#include <memory>
+
+#include "delineo/project/project.hpp"
+#include "delineo/widgets/job_runner.hpp"
+
+class QAction;
+class QActionGroup;
+class QDockWidget;
+class QLabel;
+class QMenu;
+class QTableView;
+class QCheckBox;
+class QComboBox;
+class QStackedWidget;
+
+namespace delineo::widgets {
+class ImageView;
+class DisparityHistogramWidget;
+class ParameterForm;
+class ColourLegend;
+class Terrain3DView;
+}  // namespace delineo::widgets
+
+namespace delineo::gui {
+
+class Document;
+class BuildingsModel;
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+ public:
+  explicit MainWindow(QWidget* parent = nullptr);
+  ~MainWindow() override;
+
+  // ---- documents ----
+  // Each returns false (with a message shown, the current document unchanged) on failure.
+  bool openProject(const QString& path);
+  bool openPair(const QString& left, const QString& right);
+  // Creates the sample scene on first use (background job), then opens it; documentOpened()
+  // follows. Returns false when the sample cannot be made (no simulator in this build).
+  bool openSample();
+  bool save();
+  bool saveAs(const QString& path);
+  // Exports the accepted buildings; returns the number written or -1 on failure.
+  int exportAccepted(const QString& path);
+  Document* document() const { return document_.get(); }
+  static QString sampleDirectory();
+
+  // ---- actions on the selected building / the pair (also bound to menus) ----
+  int selectedBuilding() const { return selectedId_; }
+  void selectBuilding(int id);
+  // Starts dense matching (key "matching"); returns the job id or 0.
+  widgets::JobId startMatching();
+  // Starts the active polygon on the building (key "delineate-<id>": a new run on the same
+  // building cancels the previous one); returns the job id or 0.
+  widgets::JobId startDelineation(int id);
+  void acceptSelected();
+  void rejectSelected();
+  void autosaveNow();
+
+  // ---- accessors for tests and the screenshot tour ----
+  widgets::ImageView* leftView() const { return leftView_; }
+  widgets::ImageView* rightView() const { return rightView_; }
+  widgets::ImageView* disparityView() const { return disparityView_; }
+  widgets::ImageView* demView() const { return demView_; }
+  widgets::DisparityHistogramWidget* histogram() const { return histogram_; }
+  widgets::ParameterForm* delineationForm() const { return delineationForm_; }
+  widgets::ParameterForm* matchingForm() const { return matchingForm_; }
+  QTableView* buildingsTable() const { return buildingsTable_; }
+  BuildingsModel* buildingsModel() const { return buildingsModel_; }
+  widgets::JobRunner* jobs() const { return jobs_; }
+  QLabel* readout() const { return readout_; }
+  QDockWidget* dock(const QString& objectName) const;
+  QAction* action(const QString& objectName) const;
+  void showDock(const QString& objectName);
+
+  // ---- non-interactive mode (tests, screenshot tour): no modal dialog ----
+  void setInteractive(bool interactive) { interactive_ = interactive; }
+  QString lastMessage() const { return lastMessage_; }
+  // Answers "restore the newer autosave?" when not interactive (default: no).
+  void setRestoreAutosavePolicy(bool restore) { restoreAutosave_ = restore; }
+  // Asked for a replacement path of a missing image; empty = give up. Defaults to a file dialog.
+  void setRelocateHandler(std::function<QString(const QString& missing)> handler) {
+    relocate_ = std::move(handler);
+  }
+
+ signals:
+  void documentOpened();
+  void messageShown(const QString& text);
+  void selectedBuildingChanged(int id);
+  void delineationFinished(int id);
+  void matchingFinished();
+
+ protected:
+  void closeEvent(QCloseEvent* event) override;
+
+ private:
+  void createViews();
+  void createDocks();
+  void createActions();
+  void createMenus();
+  void restoreSettings();
+  void installDocument(std::unique_ptr<Document> document);
+  bool maybeSave();
+  void showMessage(const QString& title, const QString& text);
+  bool askYesNo(const QString& title, const QString& text, bool defaultAnswer);
+  void refreshTitle();
+  void refreshRasters();
+  void refreshOverlays();
+  void refreshHistogram();
+  void refresh3D();
+  void updateActions();
+  void updateReadout(QPointF imagePos, bool leftGeometry, const cv::Mat& ownGrey);
+  void onPicked(const core::Polygon& polygon);
+  void onObjectPicked(QPointF imagePos);
+  void onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description);
+  void onSelectionFromOverlay(int id);
+  void onSelectionFromTable();
+  void addRecent(const QString& path);
+  void rebuildRecentMenu();
+  void setLanguage(const QString& code);
+  void ensure3DView();
+  void readFormsIntoDocument();
+  void loadFormsFromDocument();
+
+  std::unique_ptr<Document> document_;
+  widgets::JobRunner* jobs_ = nullptr;
+  widgets::ImageView* leftView_ = nullptr;
+  widgets::ImageView* rightView_ = nullptr;
+  widgets::ImageView* disparityView_ = nullptr;
+  widgets::ImageView* demView_ = nullptr;
+  widgets::ColourLegend* disparityLegend_ = nullptr;
+  widgets::ColourLegend* demLegend_ = nullptr;
+  QComboBox* demMode_ = nullptr;
+  QWidget* view3DHost_ = nullptr;
+  QLabel* view3DPlaceholder_ = nullptr;
+  widgets::Terrain3DView* view3D_ = nullptr;
+  widgets::DisparityHistogramWidget* histogram_ = nullptr;
+  QLabel* intervalLabel_ = nullptr;
+  widgets::ParameterForm* delineationForm_ = nullptr;
+  widgets::ParameterForm* matchingForm_ = nullptr;
+  QTableView* buildingsTable_ = nullptr;
+  BuildingsModel* buildingsModel_ = nullptr;
+  QLabel* readout_ = nullptr;
+  QMenu* recentMenu_ = nullptr;
+  QActionGroup* toolGroup_ = nullptr;
+  QTimer autosaveTimer_;
+  int selectedId_ = -1;
+  bool interactive_ = true;
+  bool restoreAutosave_ = false;
+  bool updatingForms_ = false;
+  bool updatingSelection_ = false;
+  QString lastMessage_;
+  std::function<QString(const QString&)> relocate_;
+  widgets::JobId matchingJob_ = 0;
+};
+
+}  // namespace delineo::gui
