@@ -206,6 +206,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
   std::printf("bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
               "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
 #ifdef DELINEO_BENCH_HAVE_SIM

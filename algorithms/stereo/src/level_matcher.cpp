@@ -297,8 +297,11 @@ class LevelMatcher {
 
   void matchShape(int x, int y, const std::vector<int>& shape) {
     const int L = s_.lineShift;
+    const int w = s_.window;
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
-    // Template T = (A - mean_S) / sd_S over S, so that NCC = sum(T * B) / (|S| sd_S(B)).
+    // Template T = (A - mean_S) / sd_S on S and 0 elsewhere, and the indicator M of S, both
+    // dense w x w: NCC = sum(T * B) / (|S| sd_S(B)). Dense rows keep the inner loops
+    // element-wise (vectorisable) instead of gathers over S.
     const float* base = in_.ref.ptr<float>(y) + x;
     double sum = 0, sq = 0;
     for (int off : shape) {
@@ -311,26 +314,54 @@ class LevelMatcher {
     const double var = sq / count - mean * mean;
     if (var < kFlatVariance) return;
     const double sd = std::sqrt(var);
-    std::vector<float> templ(shape.size());
-    for (size_t i = 0; i < shape.size(); ++i) {
-      templ[i] = static_cast<float>((base[shape[i]] - mean) / sd);
+    std::vector<float> templ(static_cast<size_t>(n_), 0.0F), mask(static_cast<size_t>(n_), 0.0F);
+    for (int off : shape) {
+      // off = dy * W + dx with |dx|, |dy| <= r: recover the window cell.
+      const int dy = (off + r_ * W_ + r_) / W_ - r_;
+      const int dx = off - dy * W_;
+      const size_t cell = static_cast<size_t>((dy + r_) * w + (dx + r_));
+      templ[cell] = static_cast<float>((base[off] - mean) / sd);
+      mask[cell] = 1.0F;
+    }
+    // First and last window rows holding part of S: rows outside are skipped.
+    int rowFirst = w, rowLast = -1;
+    for (int v = 0; v < w; ++v) {
+      for (int u = 0; u < w; ++u) {
+        if (mask[static_cast<size_t>(v * w + u)] != 0.0F) {
+          rowFirst = std::min(rowFirst, v);
+          rowLast = std::max(rowLast, v);
+        }
+      }
     }
     PeakTracker tracker;
     float column[3];
     const float invCount = static_cast<float>(1.0 / count);
+    std::vector<float> accB(static_cast<size_t>(w)), accBB(static_cast<size_t>(w)),
+        accTB(static_cast<size_t>(w));
     for (int d = lo; d <= hi; ++d) {
       for (int k = 0; k < K_; ++k) {
         column[k] = kNaN;
         const int yb = y + k - L, xb = x - d;
         if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherStats_.ok.at<uchar>(yb, xb)) continue;
-        const float* b = in_.other.ptr<float>(yb) + xb;
-        const float* b2 = otherSq_.ptr<float>(yb) + xb;
+        std::fill(accB.begin(), accB.end(), 0.0F);
+        std::fill(accBB.begin(), accBB.end(), 0.0F);
+        std::fill(accTB.begin(), accTB.end(), 0.0F);
+        for (int v = rowFirst; v <= rowLast; ++v) {
+          const float* b = in_.other.ptr<float>(yb + v - r_) + xb - r_;
+          const float* b2 = otherSq_.ptr<float>(yb + v - r_) + xb - r_;
+          const float* m = &mask[static_cast<size_t>(v * w)];
+          const float* t = &templ[static_cast<size_t>(v * w)];
+          for (int u = 0; u < w; ++u) {
+            accB[u] += m[u] * b[u];
+            accBB[u] += m[u] * b2[u];
+            accTB[u] += t[u] * b[u];
+          }
+        }
         float sB = 0, sBB = 0, sTB = 0;
-        for (size_t i = 0; i < shape.size(); ++i) {
-          const float v = b[shape[i]];
-          sB += v;
-          sBB += b2[shape[i]];
-          sTB += templ[i] * v;
+        for (int u = 0; u < w; ++u) {
+          sB += accB[u];
+          sBB += accBB[u];
+          sTB += accTB[u];
         }
         const float meanB = sB * invCount;
         const float varB = sBB * invCount - meanB * meanB;
