@@ -78,9 +78,15 @@ inline double valueNoise(std::uint64_t seed, double x, double y) {
 // Fractal sum of `octaves` value-noise layers, normalised to [0, 1]; `scale` is the period of
 // the coarsest layer in the caller's units.
 inline double fbm(std::uint64_t seed, double x, double y, double scale, int octaves) {
+  // Each octave is rotated by about 31 degrees against the previous one so that the lattice
+  // axes do not show as horizontal/vertical streaks.
+  constexpr double kCos = 0.8571673007021123, kSin = 0.5150380749100542;
   double sum = 0.0, amp = 1.0, norm = 0.0, f = 1.0 / scale;
   for (int o = 0; o < octaves; ++o) {
     sum += amp * valueNoise(seed + static_cast<std::uint64_t>(o) * 0x632be5abULL, x * f, y * f);
+    const double rx = kCos * x - kSin * y;
+    y = kSin * x + kCos * y;
+    x = rx;
     norm += amp;
     amp *= 0.5;
     f *= 2.0;

@@ -286,12 +286,12 @@ double RowRenderer::radiance(const Profile& prof, const SurfacePoint& sp, std::i
     }
     case kBox: {
       const Building& b = layout_.buildings[indexOf(sp.owner)];
-      albedo = b.boxAlbedo + 0.08 * (fbm(b.textureSeed + 3, xm, ym + sp.z, 1.0, 2) - 0.5);
+      albedo = b.boxAlbedo + 0.08 * (fbm(b.textureSeed + 3, xm, ym, 1.0, 2) - 0.5);
       break;
     }
     case kTree: {
       const Tree& tree = layout_.trees[indexOf(sp.owner)];
-      albedo = tree.albedo + 0.4 * (fbm(tree.textureSeed, xm, ym + sp.z, 1.6, 2) - 0.5);
+      albedo = tree.albedo + 0.9 * (fbm(tree.textureSeed, xm, ym, 1.3, 2) - 0.5);
       break;
     }
   }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <string>
 
@@ -39,6 +40,18 @@ double number(const Feature& f, const std::string& key) {
   if (const double* d = std::get_if<double>(&v)) return *d;
   return static_cast<double>(std::get<long long>(v));
 }
+// Default-size scenes shared by the tests that only read them (each takes a fraction of a second).
+const Scene& defaultScene(int seed) {
+  static std::map<int, Scene> cache;
+  auto it = cache.find(seed);
+  if (it == cache.end()) {
+    SceneParams p;
+    p.seed = seed;
+    it = cache.emplace(seed, sim::simulateScene(p)).first;
+  }
+  return it->second;
+}
+
 std::string text(const Feature& f, const std::string& key) {
   return std::get<std::string>(f.attributes.at(key));
 }
@@ -289,9 +302,7 @@ TEST(SimScene, FootprintsCoverTheRoofLabels) {
 TEST(SimScene, EveryShapeAndRoofTypeOccurs) {
   std::set<std::string> shapes, roofs;
   for (int seed : {1, 2, 3}) {
-    SceneParams p;
-    p.seed = seed;
-    const Scene s = sim::simulateScene(p);
+    const Scene& s = defaultScene(seed);
     for (const Feature& f : s.footprints) {
       shapes.insert(text(f, "shape"));
       roofs.insert(text(f, "roof_type"));
@@ -305,9 +316,7 @@ TEST(SimScene, EveryShapeAndRoofTypeOccurs) {
 TEST(SimScene, CourtyardsAreHolesWithGroundInside) {
   int courtyards = 0;
   for (int seed : {1, 2, 3}) {
-    SceneParams p;
-    p.seed = seed;
-    const Scene s = sim::simulateScene(p);
+    const Scene& s = defaultScene(seed);
     for (const Feature& f : s.footprints) {
       if (text(f, "shape") != "courtyard") continue;
       ++courtyards;
