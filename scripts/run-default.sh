@@ -15,8 +15,8 @@ mkdir -p "$out"
 echo "== Writing results to $out"
 
 "$cli" simulate --out "$out" --seed 7 --width 800 --height 600 --buildings 10 --trees 12
-dmin=$(jq '.disparity_range[0]' "$out/scene.json")
-dmax=$(jq '.disparity_range[1]' "$out/scene.json")
+dmin=$(jq '.disparity_min' "$out/scene.json")
+dmax=$(jq '.disparity_max' "$out/scene.json")
 "$cli" match --left "$out/left.tif" --right "$out/right.tif" --dmin "$dmin" --dmax "$dmax" \
   --out "$out/disparity.tif" --score "$out/score.tif"
 "$cli" eval-disparity --pred "$out/disparity.tif" --truth "$out/disparity_gt.tif" \
