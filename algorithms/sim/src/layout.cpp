@@ -211,7 +211,7 @@ double Terrain::z(double x, double y) const {
 }
 
 cv::Point2d Building::toLocal(double x, double y) const {
-  const double c = std::cos(angle), s = std::sin(angle);
+  const double c = cosAngle, s = sinAngle;
   const double dx = x - centre.x, dy = y - centre.y;
   return {dx * c + dy * s, -dx * s + dy * c};
 }
@@ -221,7 +221,7 @@ double Building::roofZ(double x, double y, double* gx, double* gy) const {
   if (gy) *gy = 0.0;
   if (roof == RoofType::Flat) return eaveZ;
   const cv::Point2d l = toLocal(x, y);
-  const double c = std::cos(angle), s = std::sin(angle);
+  const double c = cosAngle, s = sinAngle;
   const double runV = halfWidth - std::abs(l.y);
   const double runU = halfLength - std::abs(l.x);
   double run = runV;
@@ -352,6 +352,8 @@ Layout makeLayout(const SceneParams& p) {
       const cv::Point2d centre(rng.uniform(0.0, p.width), rng.uniform(0.0, p.height));
       bld.centre = centre;
       bld.angle = angle;
+      bld.cosAngle = std::cos(angle);
+      bld.sinAngle = std::sin(angle);
       bld.halfLength = hl;
       bld.halfWidth = hw;
       bld.footprint.outer = transform(geom.outer, centre, angle, mirror);

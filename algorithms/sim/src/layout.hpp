@@ -41,6 +41,7 @@ struct Building {
   core::Polygon footprint;  // ground px
   cv::Point2d centre;       // ground px, centre of the local frame
   double angle = 0.0;       // rad, local u axis direction
+  double cosAngle = 1.0, sinAngle = 0.0;
   double halfLength = 0.0;  // px, along u (pitched roofs: the ridge direction)
   double halfWidth = 0.0;   // px, along v
   double baseZ = 0.0, eaveZ = 0.0, ridgeZ = 0.0, topZ = 0.0;  // m

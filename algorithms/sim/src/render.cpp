@@ -42,6 +42,8 @@ void rowCrossings(const core::Ring& ring, double y, std::vector<double>& xs) {
 RowRenderer::RowRenderer(const SceneParams& params, const Layout& layout)
     : p_(params), layout_(layout), left_(leftView(params)), right_(rightView(params)) {
   ss_ = params.supersampling;
+  sunX_ = layout.sunSide * std::cos(layout.sunElevation);
+  sunZ_ = std::sin(layout.sunElevation);
   sampleMetres_ = params.gsd / ss_;
   double objectTop = -std::numeric_limits<double>::max();
   for (const auto& b : layout.buildings) {
@@ -212,8 +214,7 @@ double RowRenderer::radiance(const Profile& prof, const SurfacePoint& sp, std::i
                              double t) const {
   const size_t i = static_cast<size_t>(seg);
   const double shadow = prof.shadow[i] + t * (prof.shadow[i + 1] - prof.shadow[i]);
-  const double sunX = layout_.sunSide * std::cos(layout_.sunElevation);
-  const double sunZ = std::sin(layout_.sunElevation);
+  const double sunX = sunX_, sunZ = sunZ_;
   const double gsd = p_.gsd;
   const double xm = sp.x * gsd, ym = sp.y * gsd;  // texture coordinates in metres
 

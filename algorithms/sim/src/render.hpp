@@ -63,6 +63,7 @@ class RowRenderer {
   double sampleMetres_ = 0.0;  // ground distance between samples
   double wallSlope_ = 3.0;     // |dZ/dX| above which a profile segment is a wall
   double zMin_ = 0.0, zMax_ = 0.0;
+  double sunX_ = 0.0, sunZ_ = 1.0;  // unit vector towards the sun (it lies in the row plane)
   std::vector<cv::Rect2d> buildingBounds_;
 };
 
