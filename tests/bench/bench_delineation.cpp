@@ -7,6 +7,7 @@
 #include <ctime>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <random>
@@ -164,6 +165,11 @@ int main(int argc, char** argv) {
           std::printf("%-5d %-3d %-9s %-6s %-5s %7.3f %7.2f %7.2f %7.2f %8.1f %5d %5zu\n", sceneParams.seed, id,
                       text(fp, "shape").c_str(), text(fp, "roof_type").c_str(), initName, sc.iou, sc.p1,
                       sc.polis, sc.corner, ms(t0, t1), r.vertexCount, r.polygon.holes.size());
+          if (std::getenv("BENCH_VERBOSE")) {
+            const cv::Rect2d a = core::boundingBox(r.polygon.outer), b = core::boundingBox(fp.polygon.outer);
+            std::printf("      bbox pred %.1f %.1f %.1f %.1f truth %.1f %.1f %.1f %.1f\n", a.x, a.y, a.br().x,
+                        a.br().y, b.x, b.y, b.br().x, b.br().y);
+          }
         } catch (const std::exception& e) {
           ++failures;
           std::printf("%-5d %-3d failed: %s\n", sceneParams.seed, id, e.what());

@@ -14,7 +14,7 @@ struct DelineationParams {
   int maxIterations = 400;         // sweeps (moves, edge moves, deletions) over all rounds
   int roiMargin = 24;              // px added around the initial polygon to make the ROI
   int costWindow = 5;              // px, side of the correlation window of Crit
-  int groundTolerance = 1;         // px, half width of the ground interval estimated from the ring
+  int groundTolerance = 3;         // px, half width of the ground interval estimated from the ring
   int groundSearch = 64;           // px searched below the roof interval when ground is unknown
   int ringWidth = 8;               // px, width of the band outside the init used to estimate ground
   bool edgeMoves = true;           // also translate whole edges (two vertices at once)
