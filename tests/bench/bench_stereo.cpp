@@ -103,8 +103,7 @@ Case simulated(int size) {
   scene.left.convertTo(c.left, CV_32F);
   scene.right.convertTo(c.right, CV_32F);
   c.truth = scene.disparity;
-  c.evaluate = (scene.occlusion == 0) & (scene.disparity == scene.disparity);
-  c.evaluate /= 255;
+  const cv::Mat scored = (scene.occlusion == 0) & (scene.disparity == scene.disparity);
   // Flat roofs away from their outlines: building label, eroded by 2 px, with a locally constant
   // true disparity (gable and hip roofs excluded).
   cv::Mat building = scene.labels == sim::kLabelBuilding;
@@ -115,8 +114,9 @@ Case simulated(int size) {
   cv::Sobel(truthFilled, gx, CV_32F, 1, 0);
   cv::Sobel(truthFilled, gy, CV_32F, 0, 1);
   cv::Mat flat = (cv::abs(gx) < 1e-3) & (cv::abs(gy) < 1e-3);
-  c.roof = building & flat & c.evaluate;
+  c.roof = building & flat & scored;
   c.roof /= 255;
+  c.evaluate = scored / 255;
   c.dmin = scene.disparityMin;
   c.dmax = scene.disparityMax;
   return c;
