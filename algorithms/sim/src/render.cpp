@@ -86,7 +86,6 @@ void RowRenderer::buildProfile(double y, Profile& prof) const {
   const size_t n = static_cast<size_t>(samples_);
   prof.z.resize(n);
   prof.obj.assign(n, encode(kGround, 0));
-  prof.shadow.assign(n, 0.0f);
   const Terrain& ter = layout_.terrain;
   for (size_t i = 0; i < n; ++i) prof.z[i] = ter.z(groundX(static_cast<std::int64_t>(i)), y);
 
@@ -95,7 +94,7 @@ void RowRenderer::buildProfile(double y, Profile& prof) const {
     *i1 = std::min<std::int64_t>(samples_,
                                  static_cast<std::int64_t>(std::ceil((xb - gridX0_) * ss_ - 0.5)));
   };
-  std::vector<double> xs;
+  std::vector<double> xs, cuts;
   for (size_t b = 0; b < layout_.buildings.size(); ++b) {
     const cv::Rect2d& bb = buildingBounds_[b];
     if (y < bb.y || y > bb.y + bb.height) continue;
@@ -104,6 +103,7 @@ void RowRenderer::buildProfile(double y, Profile& prof) const {
     rowCrossings(bld.footprint.outer, y, xs);
     for (const auto& h : bld.footprint.holes) rowCrossings(h, y, xs);
     std::sort(xs.begin(), xs.end());
+    cuts.insert(cuts.end(), xs.begin(), xs.end());
     for (size_t c = 0; c + 1 < xs.size(); c += 2) {
       std::int64_t i0, i1;
       sampleRange(xs[c], xs[c + 1], &i0, &i1);
@@ -116,6 +116,7 @@ void RowRenderer::buildProfile(double y, Profile& prof) const {
       xs.clear();
       rowCrossings(box.ring, y, xs);
       std::sort(xs.begin(), xs.end());
+      cuts.insert(cuts.end(), xs.begin(), xs.end());
       for (size_t c = 0; c + 1 < xs.size(); c += 2) {
         std::int64_t i0, i1;
         sampleRange(xs[c], xs[c + 1], &i0, &i1);
@@ -143,17 +144,87 @@ void RowRenderer::buildProfile(double y, Profile& prof) const {
     }
   }
 
+  // Grid positions, then the vertical walls: at each polygon edge crossing insert the surface
+  // just outside and just inside, at the same X.
+  prof.x.resize(n);
+  for (size_t i = 0; i < n; ++i) prof.x[i] = groundX(static_cast<std::int64_t>(i));
+  if (!cuts.empty()) {
+    std::sort(cuts.begin(), cuts.end());
+    std::vector<double> mx, mz;
+    std::vector<std::int32_t> mobj;
+    mx.reserve(n + 2 * cuts.size());
+    mz.reserve(n + 2 * cuts.size());
+    mobj.reserve(n + 2 * cuts.size());
+    constexpr double kSide = 1e-7;  // px: far below any feature, far above rounding at 1e4 px
+    size_t c = 0;
+    for (size_t i = 0; i < n; ++i) {
+      while (c < cuts.size() && cuts[c] <= prof.x[i]) {
+        if (cuts[c] > prof.x[0]) {
+          for (double side : {-kSide, kSide}) {
+            double z;
+            std::int32_t obj;
+            surfaceAt(cuts[c] + side, y, &z, &obj);
+            mx.push_back(cuts[c]);
+            mz.push_back(z);
+            mobj.push_back(obj);
+          }
+        }
+        ++c;
+      }
+      mx.push_back(prof.x[i]);
+      mz.push_back(prof.z[i]);
+      mobj.push_back(prof.obj[i]);
+    }
+    prof.x.swap(mx);
+    prof.z.swap(mz);
+    prof.obj.swap(mobj);
+  }
+  const size_t m = prof.x.size();
+  prof.shadow.assign(m, 0.0f);
+
   // Cast shadows with the sun in the plane of the row: sweep along the light direction
-  // keeping the height of the highest shadow ray reaching the current sample.
-  const double drop = std::tan(layout_.sunElevation) * sampleMetres_;
+  // keeping the height of the highest shadow ray reaching the current vertex.
+  const double dropPerPx = std::tan(layout_.sunElevation) * p_.gsd;
   double ray = -std::numeric_limits<double>::max();
   const bool fromWest = layout_.sunSide < 0;
-  for (size_t step = 0; step < n; ++step) {
-    const size_t i = fromWest ? step : n - 1 - step;
+  for (size_t step = 0; step < m; ++step) {
+    const size_t i = fromWest ? step : m - 1 - step;
+    if (step > 0) {
+      const size_t prev = fromWest ? i - 1 : i + 1;
+      ray -= dropPerPx * std::abs(prof.x[i] - prof.x[prev]);
+    }
     if (ray > prof.z[i] + 1e-3) prof.shadow[i] = 1.0f;
-    ray = std::max(ray, prof.z[i]) - drop;
+    ray = std::max(ray, prof.z[i]);
   }
   prof.zMax = *std::max_element(prof.z.begin(), prof.z.end());
+}
+
+void RowRenderer::surfaceAt(double x, double y, double* z, std::int32_t* obj) const {
+  *z = layout_.terrain.z(x, y);
+  *obj = encode(kGround, 0);
+  for (size_t b = 0; b < layout_.buildings.size(); ++b) {
+    const cv::Rect2d& bb = buildingBounds_[b];
+    if (y < bb.y || y > bb.y + bb.height || x < bb.x || x > bb.x + bb.width) continue;
+    const Building& bld = layout_.buildings[b];
+    if (!insidePolygon(bld.footprint, x, y)) continue;
+    *z = bld.roofZ(x, y);
+    *obj = encode(kRoof, b);
+    for (const Box& box : bld.boxes) {
+      core::Polygon boxPolygon;
+      boxPolygon.outer = box.ring;
+      if (box.topZ > *z && insidePolygon(boxPolygon, x, y)) {
+        *z = box.topZ;
+        *obj = encode(kBox, b);
+      }
+    }
+  }
+  for (size_t k = 0; k < layout_.trees.size(); ++k) {
+    double zt;
+    if (layout_.trees[k].crownZ(x, y, &zt) && zt > *z) {
+      *z = zt;
+      *obj = encode(kTree, k);
+    }
+  }
 }
 
 void RowRenderer::renderView(const ViewGeometry& view, const Profile& prof, ZBuffer& zb) const {
@@ -163,10 +234,11 @@ void RowRenderer::renderView(const ViewGeometry& view, const Profile& prof, ZBuf
   zb.t.assign(static_cast<size_t>(wOut), 0.0);
   // Output sample k sits at x = (k + 0.5) / ss, so a ground point maps to sample coordinate
   // project(X, Z) * ss - 0.5.
-  double xa = view.project(groundX(0), prof.z[0]) * ss_ - 0.5;
-  for (std::int64_t i = 0; i + 1 < samples_; ++i) {
+  const std::int64_t vertices = static_cast<std::int64_t>(prof.x.size());
+  double xa = view.project(prof.x[0], prof.z[0]) * ss_ - 0.5;
+  for (std::int64_t i = 0; i + 1 < vertices; ++i) {
     const double za = prof.z[static_cast<size_t>(i)], zbv = prof.z[static_cast<size_t>(i + 1)];
-    const double xb = view.project(groundX(i + 1), zbv) * ss_ - 0.5;
+    const double xb = view.project(prof.x[static_cast<size_t>(i + 1)], zbv) * ss_ - 0.5;
     if (xb > xa) {  // back-facing segments (xb <= xa) are always hidden in a height field
       const std::int64_t k0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(xa)));
       const std::int64_t k1 = std::min<std::int64_t>(wOut, static_cast<std::int64_t>(std::ceil(xb)));
@@ -190,12 +262,12 @@ RowRenderer::SurfacePoint RowRenderer::pointOn(const Profile& prof, double y, st
   const size_t i = static_cast<size_t>(seg);
   const double za = prof.z[i], zb = prof.z[i + 1];
   SurfacePoint sp;
-  sp.x = groundX(seg) + t / ss_;
+  sp.x = prof.x[i] + t * (prof.x[i + 1] - prof.x[i]);
   sp.y = y;
   sp.z = za + t * (zb - za);
   // A wall is the open segment between a low and a high sample; a sample landing exactly on
   // its lower vertex (t == 0, e.g. a nadir view) sees that vertex's own surface.
-  sp.wall = t > 0.0 && std::abs(zb - za) > wallSlope_ * sampleMetres_;
+  sp.wall = t > 0.0 && std::abs(zb - za) > wallSlope_ * (prof.x[i + 1] - prof.x[i]) * p_.gsd;
   if (sp.wall) {
     sp.owner = zb > za ? prof.obj[i + 1] : prof.obj[i];  // a wall belongs to its top
   } else {
@@ -307,8 +379,9 @@ bool RowRenderer::occludedInRight(const Profile& prof, std::int32_t seg, double 
   // The right view's ray through the point climbs towards +X by `run` px per metre.
   const double run = -right_.shiftPerMetre;
   if (run <= 0.0) return false;  // a nadir right view sees every point of a height field
-  for (std::int64_t j = seg + 1; j < samples_; ++j) {
-    const double rayZ = z + (groundX(j) - x) / run;
+  const std::int64_t vertices = static_cast<std::int64_t>(prof.x.size());
+  for (std::int64_t j = seg + 1; j < vertices; ++j) {
+    const double rayZ = z + (prof.x[static_cast<size_t>(j)] - x) / run;
     if (rayZ > prof.zMax + 1e-3) break;
     if (prof.z[static_cast<size_t>(j)] > rayZ + 5e-4) return true;
   }

@@ -1,8 +1,8 @@
 #pragma once
 // Row renderer: each image row is independent because both views share rows (epipolar pair).
 // For every sub-row the scene is a height profile Z(X) sampled on a ground grid of
-// `supersampling` samples per pixel; the polyline through these samples (steep pieces are the
-// walls) is projected into each view and z-buffered (highest point wins), then shaded.
+// `supersampling` samples per pixel plus exact vertical walls at polygon edges; the polyline is
+// projected into each view and z-buffered (highest point wins), then shaded.
 #include <cstdint>
 #include <vector>
 
@@ -29,7 +29,11 @@ class RowRenderer {
   double zMax() const { return zMax_; }
 
  private:
+  // The row's surface as a polyline: grid samples plus, at every footprint or superstructure
+  // edge, a pair of vertices at the same X (outside then inside height) forming an exactly
+  // vertical wall at the polygon's true position.
   struct Profile {
+    std::vector<double> x;          // px, non-decreasing
     std::vector<double> z;          // m
     std::vector<std::int32_t> obj;  // encoded object id
     std::vector<float> shadow;      // 0 lit, 1 in cast shadow
@@ -48,6 +52,8 @@ class RowRenderer {
   };
 
   void buildProfile(double y, Profile& prof) const;
+  // Height and object of the surface at one point (the same max rule as buildProfile).
+  void surfaceAt(double x, double y, double* z, std::int32_t* obj) const;
   void renderView(const ViewGeometry& view, const Profile& prof, ZBuffer& zb) const;
   SurfacePoint pointOn(const Profile& prof, double y, std::int32_t seg, double t) const;
   double radiance(const Profile& prof, const SurfacePoint& sp, std::int32_t seg, double t) const;

@@ -299,6 +299,39 @@ TEST(SimScene, FootprintsCoverTheRoofLabels) {
   }
 }
 
+// Walls stand exactly on the footprint edges, so the outline of a flat roof and its labels
+// agree at every pixel centre (trees may hide parts of a roof).
+TEST(SimScene, FlatRoofOutlinesAreExactAtPixelCentres) {
+  int flatRoofs = 0;
+  for (int seed : {1, 2, 3}) {
+    const Scene& s = defaultScene(seed);
+    for (const Feature& f : s.footprints) {
+      if (text(f, "roof_type") != "flat") continue;
+      ++flatRoofs;
+      const cv::Mat inside = delineo::core::rasterize(f.polygon, s.left.size());
+      const cv::Mat seen = (s.labels == sim::kLabelBuilding) | (s.labels == sim::kLabelVegetation);
+      const int missing = cv::countNonZero(inside & ~seen);
+      EXPECT_LE(missing, 2) << "seed " << seed << " building " << number(f, "id");
+      // And no roof pixel of this building's height lies just outside its outline.
+      cv::Mat ring;
+      cv::dilate(inside, ring, cv::Mat::ones(5, 5, CV_8U));
+      ring &= ~inside;
+      const double eave = number(f, "roof_disparity_min");
+      int outside = 0;
+      for (int y = 0; y < s.labels.rows; ++y) {
+        for (int x = 0; x < s.labels.cols; ++x) {
+          if (ring.at<uchar>(y, x) && s.labels.at<uchar>(y, x) == sim::kLabelBuilding &&
+              std::abs(s.disparity.at<float>(y, x) - eave) < 1e-3) {
+            ++outside;
+          }
+        }
+      }
+      EXPECT_LE(outside, 2) << "seed " << seed << " building " << number(f, "id");
+    }
+  }
+  EXPECT_GT(flatRoofs, 10);
+}
+
 TEST(SimScene, EveryShapeAndRoofTypeOccurs) {
   std::set<std::string> shapes, roofs;
   for (int seed : {1, 2, 3}) {
