@@ -423,6 +423,12 @@ void RowRenderer::renderRow(int y, const RowOutput& out) const {
       if (zr.seg[kk] >= 0) {
         const SurfacePoint sp = pointOn(prof, ySub, zr.seg[kk], zr.t[kk]);
         accR[px] += radiance(prof, sp, zr.seg[kk], zr.t[kk]);
+        if (gtSample) {
+          out.disparityRight[px] =
+              static_cast<float>(sp.z / p_.metresPerDisparity + p_.groundDisparity);
+        }
+      } else if (gtSample) {
+        out.disparityRight[px] = std::numeric_limits<float>::quiet_NaN();
       }
     }
   }

@@ -15,6 +15,7 @@ struct RowOutput {
   float* left = nullptr;       // W radiance values in grey levels, before gain/offset/noise
   float* right = nullptr;      // W
   float* disparity = nullptr;  // W ground truth at pixel centres (left view)
+  float* disparityRight = nullptr;  // W ground truth at the right view's pixel centres
   float* dem = nullptr;        // W
   std::uint8_t* labels = nullptr;
   std::uint8_t* occlusion = nullptr;

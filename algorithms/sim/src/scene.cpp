@@ -79,6 +79,7 @@ Scene simulateScene(const SceneParams& params, core::Progress* progress) {
   const int w = params.width, h = params.height;
   cv::Mat radianceLeft(h, w, CV_32F), radianceRight(h, w, CV_32F);
   scene.disparity.create(h, w, CV_32F);
+  scene.disparityRight.create(h, w, CV_32F);
   scene.dem.create(h, w, CV_32F);
   scene.labels.create(h, w, CV_8U);
   scene.occlusion.create(h, w, CV_8U);
@@ -95,6 +96,7 @@ Scene simulateScene(const SceneParams& params, core::Progress* progress) {
       out.left = radianceLeft.ptr<float>(y);
       out.right = radianceRight.ptr<float>(y);
       out.disparity = scene.disparity.ptr<float>(y);
+      out.disparityRight = scene.disparityRight.ptr<float>(y);
       out.dem = scene.dem.ptr<float>(y);
       out.labels = scene.labels.ptr<std::uint8_t>(y);
       out.occlusion = scene.occlusion.ptr<std::uint8_t>(y);

@@ -29,6 +29,7 @@ nlohmann::json sceneDescription(const Scene& scene, const SceneParams& params) {
   j["files"] = {{"left", SceneFiles::left},
                 {"right", SceneFiles::right},
                 {"disparity", SceneFiles::disparity},
+                {"disparity_right", SceneFiles::disparityRight},
                 {"occlusion", SceneFiles::occlusion},
                 {"dem", SceneFiles::dem},
                 {"labels", SceneFiles::labels},

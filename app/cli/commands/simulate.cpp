@@ -40,6 +40,7 @@ int run(const std::vector<std::string>& args) {
   io::writeGeoTiff(path(sim::SceneFiles::left), scene.left);
   io::writeGeoTiff(path(sim::SceneFiles::right), scene.right);
   io::writeFloatGeoTiff(path(sim::SceneFiles::disparity), scene.disparity);
+  io::writeFloatGeoTiff(path(sim::SceneFiles::disparityRight), scene.disparityRight);
   io::writeGeoTiff(path(sim::SceneFiles::occlusion), scene.occlusion);
   io::writeFloatGeoTiff(path(sim::SceneFiles::dem), scene.dem);
   io::writeGeoTiff(path(sim::SceneFiles::labels), scene.labels);

@@ -230,6 +230,41 @@ TEST(SimScene, OccludedPixelsDoNotMatch) {
   EXPECT_GT(hidden.meanAbs, 4.0 * visible.meanAbs);
 }
 
+// The occlusion mask (ray casting in the left geometry) agrees with what the right view's
+// z-buffer shows: a visible point is found again at x - d, a hidden one is covered there by a
+// nearer (higher-disparity) surface.
+TEST(SimScene, OcclusionAgreesWithTheRightViewGroundTruth) {
+  const SceneParams p = smallParams(14);
+  const Scene s = sim::simulateScene(p);
+  const cv::Mat smooth = smoothVisibleMask(s);
+  int visibleChecked = 0, visibleAgree = 0, hiddenChecked = 0, hiddenCovered = 0;
+  for (int y = 0; y < s.left.rows; ++y) {
+    for (int x = 0; x < s.left.cols; ++x) {
+      const float d = s.disparity.at<float>(y, x);
+      const int xr = static_cast<int>(std::lround(x - d));
+      if (x < 1 || x + 1 >= s.left.cols || xr < 1 || xr + 1 >= s.right.cols) continue;
+      const float dr = s.disparityRight.at<float>(y, xr);
+      if (s.occlusion.at<uchar>(y, x) == 0) {
+        if (!smooth.at<uchar>(y, x)) continue;
+        ++visibleChecked;
+        // The right pixel centre is within half a pixel of the point: same smooth surface.
+        if (std::abs(dr - d) < 0.6f) ++visibleAgree;
+      } else if (s.occlusion.at<uchar>(y, x - 1) && s.occlusion.at<uchar>(y, x + 1)) {
+        // Away from the occlusion boundary, where the occluder's edge may fall between the
+        // right pixel centres.
+        ++hiddenChecked;
+        if (dr > d + 0.3f) ++hiddenCovered;
+      }
+    }
+  }
+  ASSERT_GT(visibleChecked, 10000);
+  ASSERT_GT(hiddenChecked, 500);
+  EXPECT_EQ(visibleAgree, visibleChecked);
+  // Measured 99.6 %: the rest are wall points just below a roof edge, covered by the roof at a
+  // disparity less than 0.3 px higher.
+  EXPECT_GT(hiddenCovered, 0.99 * hiddenChecked) << hiddenCovered << " of " << hiddenChecked;
+}
+
 TEST(SimScene, DemLabelsAndDisparityAgree) {
   const SceneParams p = smallParams(5);
   const Scene s = sim::simulateScene(p);

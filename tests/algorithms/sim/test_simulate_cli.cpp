@@ -64,6 +64,8 @@ TEST(SimulateCli, WritesEveryFileMatchingTheLibrary) {
   asFloat.type = io::PixelType::Float32;
   EXPECT_TRUE(identical(io::readRaster(file(sim::SceneFiles::disparity), asFloat).data, scene.disparity));
   EXPECT_TRUE(identical(io::readRaster(file(sim::SceneFiles::dem), asFloat).data, scene.dem));
+  EXPECT_TRUE(identical(io::readRaster(file(sim::SceneFiles::disparityRight), asFloat).data,
+                        scene.disparityRight));
 
   const auto features = io::readFeatures(file(sim::SceneFiles::footprints));
   ASSERT_EQ(features.size(), scene.footprints.size());

@@ -109,6 +109,8 @@ struct Scene {
   cv::Mat disparity;    // CV_32F, left geometry: x_right = x_left - d; NaN where no surface
   cv::Mat occlusion;    // CV_8U, 255 where the left pixel's point is not seen in the right view
                         // (hidden by nearer surfaces, or projected outside the right image)
+  cv::Mat disparityRight;  // CV_32F, right geometry: the point seen at right pixel x is at
+                           // left x + d (for left-right consistency checks)
   cv::Mat dem;          // CV_32F, metres, height of the left pixel's visible point
   cv::Mat labels;       // CV_8U, Label values of the left pixel's visible point
   // One Feature per building: the roof outline at roof-edge (eave) height projected into the
@@ -154,6 +156,7 @@ struct SceneFiles {
   static constexpr const char* left = "left.tif";
   static constexpr const char* right = "right.tif";
   static constexpr const char* disparity = "disparity_gt.tif";
+  static constexpr const char* disparityRight = "disparity_right_gt.tif";
   static constexpr const char* occlusion = "occlusion_gt.tif";
   static constexpr const char* dem = "dem_gt.tif";
   static constexpr const char* labels = "labels_gt.tif";
