@@ -1,4 +1,750 @@
 <?xml version="1.0" encoding="utf-8"?>
 <!DOCTYPE TS>
 <TS version="2.1" language="fr_FR" sourcelanguage="en">
+<context>
+    <name>ErrorText</name>
+    <message>
+        <source>the file</source>
+        <translation>le fichier</translation>
+    </message>
+    <message>
+        <source>A parameter value is not valid.</source>
+        <translation>Une valeur de paramètre n’est pas valide.</translation>
+    </message>
+    <message>
+        <source>The file %1 does not exist.</source>
+        <translation>Le fichier %1 n’existe pas.</translation>
+    </message>
+    <message>
+        <source>The file %1 cannot be read: it is damaged or not in a supported format.</source>
+        <translation>Le fichier %1 ne peut pas être lu : il est endommagé ou dans un format non pris en charge.</translation>
+    </message>
+    <message>
+        <source>The file %1 is not supported.</source>
+        <translation>Le fichier %1 n’est pas pris en charge.</translation>
+    </message>
+    <message>
+        <source>The input files do not match each other.</source>
+        <translation>Les fichiers d’entrée ne correspondent pas entre eux.</translation>
+    </message>
+    <message>
+        <source>Delineo could not write %1.</source>
+        <translation>Delineo n’a pas pu écrire %1.</translation>
+    </message>
+    <message>
+        <source>The processing failed.</source>
+        <translation>Le traitement a échoué.</translation>
+    </message>
+    <message>
+        <source>An unexpected error occurred.</source>
+        <translation>Une erreur inattendue s’est produite.</translation>
+    </message>
+    <message>
+        <source>File: %1</source>
+        <translation>Fichier : %1</translation>
+    </message>
+</context>
+<context>
+    <name>Parameters</name>
+    <message>
+        <source>on</source>
+        <translation>oui</translation>
+    </message>
+    <message>
+        <source>off</source>
+        <translation>non</translation>
+    </message>
+    <message>
+        <source>Unit: %1</source>
+        <translation>Unité : %1</translation>
+    </message>
+    <message>
+        <source>Default: %1</source>
+        <translation>Par défaut : %1</translation>
+    </message>
+    <message>
+        <source>Occlusion</source>
+        <translation>Occlusion</translation>
+    </message>
+    <message>
+        <source>Percentage p of ROI pixels taken as unmatched; NoMatchCost is the (100-p)% quantile of the best costs (paper: 10)</source>
+        <translation>Pourcentage p des pixels de la zone d’intérêt considérés comme non appariés ; NoMatchCost est le quantile à (100-p) % des meilleurs coûts (article : 10)</translation>
+    </message>
+    <message>
+        <source>Edge weight</source>
+        <translation>Poids des contours</translation>
+    </message>
+    <message>
+        <source>Weight lambda of the left and right image edge terms (paper: 5)</source>
+        <translation>Poids lambda des termes de contour des images gauche et droite (article : 5)</translation>
+    </message>
+    <message>
+        <source>Rigidity</source>
+        <translation>Rigidité</translation>
+    </message>
+    <message>
+        <source>Weight beta of the vertex angle prior R (paper: 15)</source>
+        <translation>Poids bêta de l’a priori R sur les angles aux sommets (article : 15)</translation>
+    </message>
+    <message>
+        <source>Initial spacing</source>
+        <translation>Espacement initial</translation>
+    </message>
+    <message>
+        <source>Refined spacing</source>
+        <translation>Espacement affiné</translation>
+    </message>
+    <message>
+        <source>Move radius</source>
+        <translation>Rayon de déplacement</translation>
+    </message>
+    <message>
+        <source>Max iterations</source>
+        <translation>Itérations maximales</translation>
+    </message>
+    <message>
+        <source>ROI margin</source>
+        <translation>Marge de la zone d’intérêt</translation>
+    </message>
+    <message>
+        <source>Cost window</source>
+        <translation>Fenêtre de coût</translation>
+    </message>
+    <message>
+        <source>Ground tolerance</source>
+        <translation>Tolérance du sol</translation>
+    </message>
+    <message>
+        <source>Ground search</source>
+        <translation>Recherche du sol</translation>
+    </message>
+    <message>
+        <source>Ring width</source>
+        <translation>Largeur de la couronne</translation>
+    </message>
+    <message>
+        <source>Edge moves</source>
+        <translation>Déplacements de côtés</translation>
+    </message>
+    <message>
+        <source>Courtyards</source>
+        <translation>Cours intérieures</translation>
+    </message>
+    <message>
+        <source>Min courtyard area</source>
+        <translation>Aire minimale d’une cour</translation>
+    </message>
+    <message>
+        <source>Method</source>
+        <translation>Méthode</translation>
+    </message>
+    <message>
+        <source>Minimum disparity</source>
+        <translation>Disparité minimale</translation>
+    </message>
+    <message>
+        <source>Maximum disparity</source>
+        <translation>Disparité maximale</translation>
+    </message>
+    <message>
+        <source>Pyramid levels</source>
+        <translation>Niveaux de pyramide</translation>
+    </message>
+    <message>
+        <source>Template size</source>
+        <translation>Taille du gabarit</translation>
+    </message>
+    <message>
+        <source>Validation tolerance</source>
+        <translation>Tolérance de validation</translation>
+    </message>
+    <message>
+        <source>Edge low threshold</source>
+        <translation>Seuil bas des contours</translation>
+    </message>
+    <message>
+        <source>Edge high threshold</source>
+        <translation>Seuil haut des contours</translation>
+    </message>
+    <message>
+        <source>Edge smoothing</source>
+        <translation>Lissage des contours</translation>
+    </message>
+    <message>
+        <source>Minimal shape</source>
+        <translation>Forme minimale</translation>
+    </message>
+    <message>
+        <source>Interval margin</source>
+        <translation>Marge d’intervalle</translation>
+    </message>
+    <message>
+        <source>Line shift</source>
+        <translation>Décalage de ligne</translation>
+    </message>
+    <message>
+        <source>Minimal score</source>
+        <translation>Score minimal</translation>
+    </message>
+    <message>
+        <source>Sub-pixel</source>
+        <translation>Sous-pixel</translation>
+    </message>
+    <message>
+        <source>Adaptive shapes</source>
+        <translation>Formes adaptatives</translation>
+    </message>
+    <message>
+        <source>Threads</source>
+        <translation>Fils d’exécution</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::gui::BuildingsModel</name>
+    <message>
+        <source>pending</source>
+        <translation>en attente</translation>
+    </message>
+    <message>
+        <source>automatic</source>
+        <translation>automatique</translation>
+    </message>
+    <message>
+        <source>corrected</source>
+        <translation>corrigé</translation>
+    </message>
+    <message>
+        <source>accepted</source>
+        <translation>accepté</translation>
+    </message>
+    <message>
+        <source>rejected</source>
+        <translation>rejeté</translation>
+    </message>
+    <message>
+        <source>Id</source>
+        <translation>N°</translation>
+    </message>
+    <message>
+        <source>Status</source>
+        <translation>État</translation>
+    </message>
+    <message>
+        <source>Vertices</source>
+        <translation>Sommets</translation>
+    </message>
+    <message>
+        <source>Roof height (m)</source>
+        <translation>Hauteur du toit (m)</translation>
+    </message>
+    <message>
+        <source>Energy</source>
+        <translation>Énergie</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::gui::Document</name>
+    <message>
+        <source>Untitled project</source>
+        <translation>Projet sans titre</translation>
+    </message>
+    <message>
+        <source>Pick building %1</source>
+        <translation>Désigner le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Remove building %1</source>
+        <translation>Supprimer le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Edit building %1</source>
+        <translation>Modifier le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Delineate building %1</source>
+        <translation>Délimiter le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Accept building %1</source>
+        <translation>Accepter le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Reject building %1</source>
+        <translation>Rejeter le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Reopen building %1</source>
+        <translation>Rouvrir le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Roof interval of building %1: %2..%3 px</source>
+        <translation>Intervalle du toit du bâtiment %1 : %2..%3 px</translation>
+    </message>
+    <message>
+        <source>Change %1 parameters</source>
+        <translation>Modifier les paramètres %1</translation>
+    </message>
+    <message>
+        <source>Compute disparity</source>
+        <translation>Calculer la disparité</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::gui::MainWindow</name>
+    <message>
+        <source>Job failed</source>
+        <translation>Échec de la tâche</translation>
+    </message>
+    <message>
+        <source>Left image (reference): pick buildings here</source>
+        <translation>Image gauche (référence) : désignez les bâtiments ici</translation>
+    </message>
+    <message>
+        <source>Right image</source>
+        <translation>Image droite</translation>
+    </message>
+    <message>
+        <source>Disparity</source>
+        <translation>Disparité</translation>
+    </message>
+    <message>
+        <source>px</source>
+        <translation>px</translation>
+    </message>
+    <message>
+        <source>Hillshade</source>
+        <translation>Ombrage</translation>
+    </message>
+    <message>
+        <source>Height colours</source>
+        <translation>Couleurs des hauteurs</translation>
+    </message>
+    <message>
+        <source>Height</source>
+        <translation>Hauteur</translation>
+    </message>
+    <message>
+        <source>m</source>
+        <translation>m</translation>
+    </message>
+    <message>
+        <source>DEM</source>
+        <translation>MNE</translation>
+    </message>
+    <message>
+        <source>The 3D view appears when a DEM is available.</source>
+        <translation>La vue 3D apparaît lorsqu’un MNE est disponible.</translation>
+    </message>
+    <message>
+        <source>3D view</source>
+        <translation>Vue 3D</translation>
+    </message>
+    <message>
+        <source>Buildings</source>
+        <translation>Bâtiments</translation>
+    </message>
+    <message>
+        <source>&lt;b&gt;Roof disparity interval&lt;/b&gt; (drag on the histogram of the ROI; the line marks the ground)</source>
+        <translation>&lt;b&gt;Intervalle de disparité du toit&lt;/b&gt; (faites glisser sur l’histogramme de la zone d’intérêt ; le trait marque le sol)</translation>
+    </message>
+    <message>
+        <source>Disparities inside the region of interest of the selected building. Drag the band or its handles to choose the roof interval [px].</source>
+        <translation>Disparités dans la zone d’intérêt du bâtiment sélectionné. Faites glisser la bande ou ses poignées pour choisir l’intervalle du toit [px].</translation>
+    </message>
+    <message>
+        <source>Roof: %1 .. %2 px</source>
+        <translation>Toit : %1 .. %2 px</translation>
+    </message>
+    <message>
+        <source>Active polygon</source>
+        <translation>Polygone actif</translation>
+    </message>
+    <message>
+        <source>Matching</source>
+        <translation>Appariement</translation>
+    </message>
+    <message>
+        <source>Parameters</source>
+        <translation>Paramètres</translation>
+    </message>
+    <message>
+        <source>&amp;Open project…</source>
+        <translation>&amp;Ouvrir un projet…</translation>
+    </message>
+    <message>
+        <source>Open project</source>
+        <translation>Ouvrir un projet</translation>
+    </message>
+    <message>
+        <source>Delineo projects (*.json)</source>
+        <translation>Projets Delineo (*.json)</translation>
+    </message>
+    <message>
+        <source>&amp;New project from a stereo pair…</source>
+        <translation>&amp;Nouveau projet à partir d’un couple stéréo…</translation>
+    </message>
+    <message>
+        <source>Images (*.tif *.tiff *.png *.jpg)</source>
+        <translation>Images (*.tif *.tiff *.png *.jpg)</translation>
+    </message>
+    <message>
+        <source>Left image (reference)</source>
+        <translation>Image gauche (référence)</translation>
+    </message>
+    <message>
+        <source>Open the &amp;sample project</source>
+        <translation>Ouvrir le projet d’&amp;exemple</translation>
+    </message>
+    <message>
+        <source>&amp;Save</source>
+        <translation>&amp;Enregistrer</translation>
+    </message>
+    <message>
+        <source>Save &amp;as…</source>
+        <translation>Enregistrer &amp;sous…</translation>
+    </message>
+    <message>
+        <source>Save project</source>
+        <translation>Enregistrer le projet</translation>
+    </message>
+    <message>
+        <source>&amp;Export accepted buildings…</source>
+        <translation>E&amp;xporter les bâtiments acceptés…</translation>
+    </message>
+    <message>
+        <source>Ctrl+E</source>
+        <translation>Ctrl+E</translation>
+    </message>
+    <message>
+        <source>Export accepted buildings</source>
+        <translation>Exporter les bâtiments acceptés</translation>
+    </message>
+    <message>
+        <source>GeoJSON (*.geojson);;GeoPackage (*.gpkg)</source>
+        <translation>GeoJSON (*.geojson);;GeoPackage (*.gpkg)</translation>
+    </message>
+    <message>
+        <source>&amp;Quit</source>
+        <translation>&amp;Quitter</translation>
+    </message>
+    <message>
+        <source>&amp;Navigate</source>
+        <translation>&amp;Naviguer</translation>
+    </message>
+    <message>
+        <source>Pan with the mouse, zoom with the wheel, click a building to select it</source>
+        <translation>Déplacez avec la souris, zoomez avec la molette, cliquez sur un bâtiment pour le sélectionner</translation>
+    </message>
+    <message>
+        <source>Pick with a &amp;rectangle</source>
+        <translation>Désigner par un &amp;rectangle</translation>
+    </message>
+    <message>
+        <source>Drag a rectangle around a building</source>
+        <translation>Tracez un rectangle autour d’un bâtiment</translation>
+    </message>
+    <message>
+        <source>Pick with a &amp;polygon</source>
+        <translation>Désigner par un &amp;polygone</translation>
+    </message>
+    <message>
+        <source>Click the corners of a rough polygon; double-click to close</source>
+        <translation>Cliquez les coins d’un polygone approximatif ; double-cliquez pour le fermer</translation>
+    </message>
+    <message>
+        <source>Pick an above-ground &amp;object</source>
+        <translation>Désigner un &amp;objet sursol</translation>
+    </message>
+    <message>
+        <source>Click a building: its above-ground region becomes the initial polygon</source>
+        <translation>Cliquez sur un bâtiment : sa région sursol devient le polygone initial</translation>
+    </message>
+    <message>
+        <source>&amp;Edit outline</source>
+        <translation>&amp;Modifier le contour</translation>
+    </message>
+    <message>
+        <source>Drag vertices or edges of the selected building; every change can be undone</source>
+        <translation>Faites glisser les sommets ou les côtés du bâtiment sélectionné ; chaque modification peut être annulée</translation>
+    </message>
+    <message>
+        <source>Compute &amp;disparity</source>
+        <translation>Calculer la &amp;disparité</translation>
+    </message>
+    <message>
+        <source>Ctrl+M</source>
+        <translation>Ctrl+M</translation>
+    </message>
+    <message>
+        <source>Run the active &amp;polygon</source>
+        <translation>Lancer le &amp;polygone actif</translation>
+    </message>
+    <message>
+        <source>Ctrl+R</source>
+        <translation>Ctrl+R</translation>
+    </message>
+    <message>
+        <source>&amp;Accept building</source>
+        <translation>&amp;Accepter le bâtiment</translation>
+    </message>
+    <message>
+        <source>Re&amp;ject building</source>
+        <translation>Re&amp;jeter le bâtiment</translation>
+    </message>
+    <message>
+        <source>Re&amp;open building</source>
+        <translation>Ro&amp;uvrir le bâtiment</translation>
+    </message>
+    <message>
+        <source>Re&amp;move building</source>
+        <translation>&amp;Supprimer le bâtiment</translation>
+    </message>
+    <message>
+        <source>&amp;Cancel running jobs</source>
+        <translation>A&amp;nnuler les tâches en cours</translation>
+    </message>
+    <message>
+        <source>&amp;Undo</source>
+        <translation>&amp;Annuler</translation>
+    </message>
+    <message>
+        <source>&amp;Redo</source>
+        <translation>&amp;Rétablir</translation>
+    </message>
+    <message>
+        <source>Ctrl+Y</source>
+        <translation>Ctrl+Y</translation>
+    </message>
+    <message>
+        <source>Ctrl+Shift+Z</source>
+        <translation>Ctrl+Shift+Z</translation>
+    </message>
+    <message>
+        <source>Show &amp;labels</source>
+        <translation>Afficher les é&amp;tiquettes</translation>
+    </message>
+    <message>
+        <source>&amp;File</source>
+        <translation>&amp;Fichier</translation>
+    </message>
+    <message>
+        <source>Open &amp;recent</source>
+        <translation>Projets &amp;récents</translation>
+    </message>
+    <message>
+        <source>&amp;Edit</source>
+        <translation>&amp;Édition</translation>
+    </message>
+    <message>
+        <source>&amp;Building</source>
+        <translation>&amp;Bâtiment</translation>
+    </message>
+    <message>
+        <source>&amp;Processing</source>
+        <translation>&amp;Traitements</translation>
+    </message>
+    <message>
+        <source>&amp;View</source>
+        <translation>&amp;Affichage</translation>
+    </message>
+    <message>
+        <source>&amp;Settings</source>
+        <translation>&amp;Réglages</translation>
+    </message>
+    <message>
+        <source>&amp;Language</source>
+        <translation>&amp;Langue</translation>
+    </message>
+    <message>
+        <source>System default</source>
+        <translation>Langue du système</translation>
+    </message>
+    <message>
+        <source>Tools</source>
+        <translation>Outils</translation>
+    </message>
+    <message>
+        <source>Recover unsaved changes</source>
+        <translation>Récupérer les modifications non enregistrées</translation>
+    </message>
+    <message>
+        <source>An automatic backup of %1 is newer than the project file (Delineo may have stopped unexpectedly). Restore it?</source>
+        <translation>Une sauvegarde automatique de %1 est plus récente que le fichier du projet (Delineo s’est peut-être arrêté inopinément). La restaurer ?</translation>
+    </message>
+    <message>
+        <source>Image not found</source>
+        <translation>Image introuvable</translation>
+    </message>
+    <message>
+        <source>The project refers to %1, which does not exist. Locate it?</source>
+        <translation>Le projet fait référence à %1, qui n’existe pas. Le localiser ?</translation>
+    </message>
+    <message>
+        <source>Locate %1</source>
+        <translation>Localiser %1</translation>
+    </message>
+    <message>
+        <source>The project was not opened because %1 does not exist. Move the file back or locate it when opening the project.</source>
+        <translation>Le projet n’a pas été ouvert car %1 n’existe pas. Remettez le fichier en place ou localisez-le à l’ouverture du projet.</translation>
+    </message>
+    <message>
+        <source>Cannot open the project</source>
+        <translation>Impossible d’ouvrir le projet</translation>
+    </message>
+    <message>
+        <source>Cannot open the stereo pair</source>
+        <translation>Impossible d’ouvrir le couple stéréo</translation>
+    </message>
+    <message>
+        <source>Sample project</source>
+        <translation>Projet d’exemple</translation>
+    </message>
+    <message>
+        <source>This build has no scene simulator to make the sample project.</source>
+        <translation>Cette version ne contient pas le simulateur de scène nécessaire au projet d’exemple.</translation>
+    </message>
+    <message>
+        <source>Preparing the sample project…</source>
+        <translation>Préparation du projet d’exemple…</translation>
+    </message>
+    <message>
+        <source>Sample project opened: pick a building on the left image.</source>
+        <translation>Projet d’exemple ouvert : désignez un bâtiment sur l’image gauche.</translation>
+    </message>
+    <message>
+        <source>No disparity yet: computing it in the background.</source>
+        <translation>Pas encore de disparité : calcul en arrière-plan.</translation>
+    </message>
+    <message>
+        <source>Unsaved changes</source>
+        <translation>Modifications non enregistrées</translation>
+    </message>
+    <message>
+        <source>Save the changes to %1?</source>
+        <translation>Enregistrer les modifications de %1 ?</translation>
+    </message>
+    <message>
+        <source>Cannot save the project</source>
+        <translation>Impossible d’enregistrer le projet</translation>
+    </message>
+    <message>
+        <source>Saved %1</source>
+        <translation>%1 enregistré</translation>
+    </message>
+    <message numerus="yes">
+        <source>%n accepted building(s) exported to %1</source>
+        <translation>
+            <numerusform>%n bâtiment accepté exporté vers %1</numerusform>
+            <numerusform>%n bâtiments acceptés exportés vers %1</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Cannot export</source>
+        <translation>Impossible d’exporter</translation>
+    </message>
+    <message>
+        <source>Autosave failed: %1</source>
+        <translation>Échec de la sauvegarde automatique : %1</translation>
+    </message>
+    <message>
+        <source>Language</source>
+        <translation>Langue</translation>
+    </message>
+    <message>
+        <source>The language will change the next time Delineo starts.</source>
+        <translation>La langue changera au prochain démarrage de Delineo.</translation>
+    </message>
+    <message>
+        <source>Compute the disparity to see the histogram.</source>
+        <translation>Calculez la disparité pour voir l’histogramme.</translation>
+    </message>
+    <message>
+        <source>The 3D view needs a display (X server).</source>
+        <translation>La vue 3D a besoin d’un affichage (serveur X).</translation>
+    </message>
+    <message>
+        <source>&amp;Undo %1</source>
+        <translation>&amp;Annuler : %1</translation>
+    </message>
+    <message>
+        <source>&amp;Redo %1</source>
+        <translation>&amp;Rétablir : %1</translation>
+    </message>
+    <message>
+        <source>x %1  y %2  grey %3</source>
+        <translation>x %1  y %2  gris %3</translation>
+    </message>
+    <message>
+        <source>  disparity %1 px</source>
+        <translation>  disparité %1 px</translation>
+    </message>
+    <message>
+        <source>  disparity –</source>
+        <translation>  disparité –</translation>
+    </message>
+    <message>
+        <source>  height %1 m</source>
+        <translation>  hauteur %1 m</translation>
+    </message>
+    <message>
+        <source>  height –</source>
+        <translation>  hauteur –</translation>
+    </message>
+    <message>
+        <source>  (right image)</source>
+        <translation>  (image droite)</translation>
+    </message>
+    <message>
+        <source>Pick a building</source>
+        <translation>Désigner un bâtiment</translation>
+    </message>
+    <message>
+        <source>The picked shape is too small or crosses itself; draw it again.</source>
+        <translation>La forme tracée est trop petite ou se recoupe ; tracez-la de nouveau.</translation>
+    </message>
+    <message>
+        <source>Pick an object</source>
+        <translation>Désigner un objet</translation>
+    </message>
+    <message>
+        <source>Picking an above-ground object needs a DEM or a disparity map.</source>
+        <translation>Désigner un objet sursol nécessite un MNE ou une carte de disparité.</translation>
+    </message>
+    <message>
+        <source>No above-ground object under the cursor.</source>
+        <translation>Aucun objet sursol sous le curseur.</translation>
+    </message>
+    <message>
+        <source>Edit outline</source>
+        <translation>Modifier le contour</translation>
+    </message>
+    <message>
+        <source>That change would make the outline cross itself; it was not applied.</source>
+        <translation>Cette modification ferait se recouper le contour ; elle n’a pas été appliquée.</translation>
+    </message>
+    <message>
+        <source>Dense matching</source>
+        <translation>Appariement dense</translation>
+    </message>
+    <message>
+        <source>Disparity computed.</source>
+        <translation>Disparité calculée.</translation>
+    </message>
+    <message>
+        <source>Select a building first.</source>
+        <translation>Sélectionnez d’abord un bâtiment.</translation>
+    </message>
+    <message>
+        <source>Compute the disparity (or choose a roof interval) first.</source>
+        <translation>Calculez d’abord la disparité (ou choisissez un intervalle de toit).</translation>
+    </message>
+    <message>
+        <source>Choose the roof disparity interval on the histogram first.</source>
+        <translation>Choisissez d’abord l’intervalle de disparité du toit sur l’histogramme.</translation>
+    </message>
+    <message>
+        <source>Active polygon, building %1</source>
+        <translation>Polygone actif, bâtiment %1</translation>
+    </message>
+</context>
 </TS>

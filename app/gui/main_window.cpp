@@ -611,8 +611,9 @@ bool MainWindow::openSample() {
 void MainWindow::installDocument(std::unique_ptr<Document> document) {
   jobs_->cancelAll();
   selectedId_ = -1;
+  // The model lets go of the old document while it still exists.
+  buildingsModel_->setDocument(document.get());
   document_ = std::move(document);
-  buildingsModel_->setDocument(document_.get());
   Document* doc = document_.get();
   connect(doc, &Document::buildingChanged, this, [this](int id) {
     refreshOverlays();

@@ -16,7 +16,7 @@
 #include "delineo/sim/scene.hpp"
 #endif
 #ifdef DELINEO_HAVE_DELINEATION
-#include "delineo/project/delineation_bridge.hpp"
+#include "delineation_bridge.hpp"
 #endif
 
 namespace delineo::project {
@@ -123,9 +123,20 @@ float percentile(std::vector<float>& values, double q) {
 std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon) {
   std::vector<float> values = finiteValuesInside(disparity, polygon);
   if (values.size() < 10) return std::nullopt;
-  const float low = percentile(values, 0.2);
-  const float high = percentile(values, 0.9);
-  return DisparityInterval{static_cast<int>(std::floor(low)), static_cast<int>(std::ceil(high))};
+  // A rough polygon holds ground as well as roof: the low decile stands for the ground, and the
+  // roof is what lies clearly above it. Its 10th..95th percentiles make the band, which drops
+  // stray matches and walls.
+  const float ground = percentile(values, 0.1);
+  const float high = percentile(values, 0.98);
+  const float threshold = ground + std::max(2.0f, 0.3f * (high - ground));
+  std::vector<float> above;
+  for (float v : values) {
+    if (v > threshold) above.push_back(v);
+  }
+  if (above.size() < 10) above = values;
+  const float low = percentile(above, 0.1);
+  const float top = percentile(above, 0.95);
+  return DisparityInterval{static_cast<int>(std::floor(low)), static_cast<int>(std::ceil(top))};
 }
 
 double roofHeight(const Project& project, const cv::Mat& disparity, const core::Polygon& polygon) {

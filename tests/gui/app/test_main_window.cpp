@@ -1,0 +1,369 @@
+// Drives the real main window on a generated sample project: open, match (with an event-loop
+// latency measurement), pick a building with the mouse, set the roof interval, run the active
+// polygon, drag a vertex, undo, redo, accept, save, reload, export; plus bad inputs, autosave
+// recovery and the French translation.
+#include <QAction>
+#include <QElapsedTimer>
+#include <QFile>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QStandardPaths>
+#include <QTableView>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QTranslator>
+#include <QUndoStack>
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <opencv2/imgproc.hpp>
+
+#include "buildings_model.hpp"
+#include "delineo/io/raster.hpp"
+#include "delineo/io/vector.hpp"
+#include "delineo/project/pipeline.hpp"
+#include "delineo/widgets/disparity_histogram.hpp"
+#include "delineo/widgets/image_view.hpp"
+#include "delineo/widgets/polygon_overlay.hpp"
+#include "document.hpp"
+#include "main_window.hpp"
+
+using namespace delineo;
+using gui::MainWindow;
+using project::BuildingStatus;
+
+namespace {
+
+// Statuses compared as their names, so a failure prints them.
+QString st(BuildingStatus status) { return QString::fromStdString(project::toString(status)); }
+
+// Bounding rectangle of the largest building label component (the sample's ground truth).
+cv::Rect largestBuilding(const cv::Mat& labels) {
+  cv::Mat components, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(labels == 1, components, stats, centroids, 4);
+  int best = 1;
+  for (int i = 2; i < n; ++i) {
+    if (stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = i;
+  }
+  return {stats.at<int>(best, cv::CC_STAT_LEFT), stats.at<int>(best, cv::CC_STAT_TOP),
+          stats.at<int>(best, cv::CC_STAT_WIDTH), stats.at<int>(best, cv::CC_STAT_HEIGHT)};
+}
+
+double percentile99(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[static_cast<size_t>(0.99 * static_cast<double>(v.size() - 1))];
+}
+
+}  // namespace
+
+class MainWindowTest : public QObject {
+  Q_OBJECT
+ private:
+  QTemporaryDir dir_;
+  QString projectPath_;
+  std::unique_ptr<MainWindow> window_;
+  int buildingId_ = -1;
+
+  // Runs the event loop while `job` is active, recording how late a 5 ms timer fires.
+  std::vector<double> measureLatencyWhileRunning(widgets::JobId job) {
+    std::vector<double> lateness;
+    QElapsedTimer clock;
+    QTimer timer;
+    timer.setTimerType(Qt::PreciseTimer);
+    qint64 last = 0;
+    clock.start();
+    connect(&timer, &QTimer::timeout, [&] {
+      const qint64 now = clock.nsecsElapsed();
+      if (last != 0) lateness.push_back(std::max(0.0, (now - last) / 1e6 - 5.0));
+      last = now;
+    });
+    timer.start(5);
+    [&] { QTRY_VERIFY_WITH_TIMEOUT(!window_->jobs()->isActive(job), 240000); }();
+    timer.stop();
+    return lateness;
+  }
+
+ private slots:
+  void initTestCase() {
+    QStandardPaths::setTestModeEnabled(true);
+    QCoreApplication::setOrganizationName(QStringLiteral("DelineoTest"));
+    QSettings().clear();
+    QSettings().setValue(QStringLiteral("autoMatch"), false);
+    QVERIFY(dir_.isValid());
+    if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
+    // Made on a worker thread, as the application does (its job runner).
+    const std::string sampleDir = dir_.filePath(QStringLiteral("sample")).toStdString();
+    std::string made;
+    std::thread maker([&] { made = project::ensureSampleProject(sampleDir); });
+    maker.join();
+    projectPath_ = QString::fromStdString(made);
+    window_ = std::make_unique<MainWindow>();
+    window_->setInteractive(false);
+    window_->resize(1300, 850);
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
+  }
+
+  void opensProjectAndMatchesWithResponsiveUi() {
+    QSignalSpy opened(window_.get(), &MainWindow::documentOpened);
+    QVERIFY(window_->openProject(projectPath_));
+    QCOMPARE(opened.count(), 1);
+    QVERIFY(window_->document()->disparity().empty());
+    QVERIFY(window_->leftView()->hasImage());
+    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
+    const widgets::JobId job = window_->startMatching();
+    QVERIFY(job != 0);
+    const std::vector<double> lateness = measureLatencyWhileRunning(job);
+    QVERIFY(!window_->document()->disparity().empty());
+    QVERIFY(lateness.size() > 20);
+    const double p99 = percentile99(lateness);
+    qInfo("event-loop lateness during matching: %zu ticks, p99 %.2f ms, max %.2f ms", lateness.size(), p99,
+          *std::max_element(lateness.begin(), lateness.end()));
+    QVERIFY2(p99 < 50.0, qPrintable(QStringLiteral("p99 lateness %1 ms").arg(p99)));
+    QVERIFY(window_->disparityView()->hasImage());
+    // Matching is an undoable result.
+    QVERIFY(window_->document()->undoStack()->canUndo());
+  }
+
+  void picksABuildingWithARectangleDrag() {
+    gui::Document* doc = window_->document();
+    QVERIFY(doc);
+    const cv::Rect truth = largestBuilding(doc->labels());
+    widgets::ImageView* view = window_->leftView();
+    view->setView(QPointF(truth.x + truth.width / 2.0, truth.y + truth.height / 2.0), 1.5);
+    window_->action(QStringLiteral("actionPickRectangle"))->trigger();
+    QCOMPARE(view->interactionMode(), widgets::InteractionMode::PickRectangle);
+    const QPoint a = view->imageToWidget(QPointF(truth.x - 6, truth.y - 6)).toPoint();
+    const QPoint b = view->imageToWidget(QPointF(truth.br().x + 6, truth.br().y + 6)).toPoint();
+    QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, a);
+    QTest::mouseMove(view, (a + b) / 2);
+    QTest::mouseMove(view, b);
+    QTest::mouseRelease(view, Qt::LeftButton, Qt::NoModifier, b);
+    QCOMPARE(window_->buildingsModel()->rowCount(), 1);
+    buildingId_ = window_->selectedBuilding();
+    QVERIFY(buildingId_ > 0);
+    const project::Building* building = doc->project().find(buildingId_);
+    QCOMPARE(st(building->status), st(BuildingStatus::Pending));
+    QCOMPARE(building->initial.outer.size(), size_t(4));
+    QVERIFY(std::abs(building->initial.outer[0].x - (truth.x - 6)) < 1.5);
+    // The table shows it selected, the histogram is filled and has a roof interval.
+    QCOMPARE(window_->buildingsTable()->selectionModel()->selectedRows().size(), 1);
+    QVERIFY(window_->histogram()->sampleCount() > 100);
+    QVERIFY(building->roofInterval.has_value());
+    QVERIFY(window_->histogram()->groundLevel().has_value());
+    QVERIFY(building->roofInterval->low > *window_->histogram()->groundLevel());
+  }
+
+  void setsTheRoofIntervalOnTheHistogram() {
+    gui::Document* doc = window_->document();
+    const auto before = *doc->project().find(buildingId_)->roofInterval;
+    widgets::DisparityHistogramWidget* histogram = window_->histogram();
+    histogram->setFocus();
+    QTest::keyClick(histogram, Qt::Key_Right, Qt::ShiftModifier);  // upper bound + 1
+    auto after = *doc->project().find(buildingId_)->roofInterval;
+    QCOMPARE(after.high, before.high + 1);
+    QCOMPARE(after.low, before.low);
+    QTest::keyClick(histogram, Qt::Key_Left, Qt::ShiftModifier);  // back
+    QCOMPARE(doc->project().find(buildingId_)->roofInterval->high, before.high);
+    // Interval steps merge into one undo entry.
+    QVERIFY(doc->undoStack()->undoText().contains(QStringLiteral("Roof interval")));
+  }
+
+  void runsTheActivePolygonInTheBackground() {
+    if (!project::delineationAvailable()) QSKIP("no active polygon in this build");
+    gui::Document* doc = window_->document();
+    QSignalSpy finished(window_.get(), &MainWindow::delineationFinished);
+    const widgets::JobId job = window_->startDelineation(buildingId_);
+    QVERIFY(job != 0);
+    // A second run on the same building cancels the first one.
+    QSignalSpy canceled(window_->jobs(), &widgets::JobRunner::canceled);
+    const widgets::JobId second = window_->startDelineation(buildingId_);
+    QVERIFY(second != job);
+    const std::vector<double> lateness = measureLatencyWhileRunning(second);
+    QTRY_COMPARE_WITH_TIMEOUT(canceled.count(), 1, 10000);
+    QCOMPARE(canceled.first().first().value<widgets::JobId>(), job);
+    QCOMPARE(finished.count(), 1);
+    if (!lateness.empty()) qInfo("event-loop lateness during delineation: p99 %.2f ms", percentile99(lateness));
+    QVERIFY(percentile99(lateness) < 50.0);
+    const project::Building* b = doc->project().find(buildingId_);
+    QCOMPARE(st(b->status), st(BuildingStatus::Automatic));
+    QVERIFY(b->outline.outer.size() >= 4);
+    QVERIFY(std::isfinite(b->energy));
+    QVERIFY(std::isfinite(b->roofHeight));
+    QVERIFY(b->roofHeight > 2.0);
+    // The outline covers most of the true roof.
+    const cv::Mat outline = core::rasterize(b->outline, doc->labels().size());
+    const cv::Rect truth = largestBuilding(doc->labels());
+    cv::Mat truthMask = (doc->labels() == 1);
+    const double overlap = cv::countNonZero(outline(truth) & truthMask(truth));
+    const double truthArea = cv::countNonZero(truthMask(truth));
+    QVERIFY2(overlap / truthArea > 0.6, qPrintable(QString::number(overlap / truthArea)));
+    // The overlay shows the result; the evolving contour is gone.
+    QTRY_VERIFY(window_->leftView()->polygons().evolvingContour().isEmpty());
+    const auto* shown = window_->leftView()->polygons().selectedPolygon();
+    QVERIFY(shown != nullptr);
+    QCOMPARE(shown->polygon.outer.size(), b->outline.outer.size());
+    // Undo of the algorithm result restores the pending building; redo brings it back.
+    doc->undoStack()->undo();
+    QCOMPARE(st(doc->project().find(buildingId_)->status), st(BuildingStatus::Pending));
+    doc->undoStack()->redo();
+    QCOMPARE(st(doc->project().find(buildingId_)->status), st(BuildingStatus::Automatic));
+  }
+
+  void dragsAVertexThenUndoesAndRedoes() {
+    gui::Document* doc = window_->document();
+    const project::Building* b = doc->project().find(buildingId_);
+    if (b->status == BuildingStatus::Pending) QSKIP("needs the delineation result");
+    const core::Ring original = b->outline.outer;
+    widgets::ImageView* view = window_->leftView();
+    window_->selectBuilding(buildingId_);
+    window_->action(QStringLiteral("actionEdit"))->trigger();
+    view->polygons().setSnapToRightAngles(false);
+    const QPointF vertex(original[0].x, original[0].y);
+    const QPoint from = view->imageToWidget(vertex).toPoint();
+    const QPoint to = from + QPoint(9, 6);
+    QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, from);
+    QTest::mouseMove(view, from + QPoint(3, 2));
+    QTest::mouseMove(view, to);
+    QTest::mouseRelease(view, Qt::LeftButton, Qt::NoModifier, to);
+    b = doc->project().find(buildingId_);
+    QCOMPARE(st(b->status), st(BuildingStatus::Corrected));
+    QVERIFY(b->outline.outer != original);
+    QVERIFY(b->history.back().action == "edited");
+    // Ctrl+Z / Ctrl+Y through the window's shortcuts.
+    QTest::keyClick(window_.get(), Qt::Key_Z, Qt::ControlModifier);
+    QVERIFY(doc->project().find(buildingId_)->outline.outer == original);
+    QCOMPARE(st(doc->project().find(buildingId_)->status), st(BuildingStatus::Automatic));
+    QVERIFY(view->polygons().selectedPolygon()->polygon.outer == original);
+    QTest::keyClick(window_.get(), Qt::Key_Y, Qt::ControlModifier);
+    QCOMPARE(st(doc->project().find(buildingId_)->status), st(BuildingStatus::Corrected));
+    QVERIFY(view->polygons().selectedPolygon()->polygon.outer != original);
+  }
+
+  void acceptsSavesReloadsAndExports() {
+    gui::Document* doc = window_->document();
+    window_->selectBuilding(buildingId_);
+    if (!doc->project().find(buildingId_)->hasOutline()) QSKIP("needs the delineation result");
+    window_->acceptSelected();
+    QCOMPARE(st(doc->project().find(buildingId_)->status), st(BuildingStatus::Accepted));
+    QCOMPARE(window_->buildingsModel()->data(window_->buildingsModel()->index(0, gui::BuildingsModel::Status),
+                                             Qt::DisplayRole).toString(), QStringLiteral("accepted"));
+    QVERIFY(doc->isModified());
+    const QString saved = dir_.filePath(QStringLiteral("sample/saved.delineo.json"));
+    QVERIFY(window_->saveAs(saved));
+    QVERIFY(!doc->isModified());
+    const project::Project inMemory = doc->project();
+
+    MainWindow reopened;
+    reopened.setInteractive(false);
+    QVERIFY(reopened.openProject(saved));
+    const project::Project& loaded = reopened.document()->project();
+    QCOMPARE(loaded.buildings.size(), inMemory.buildings.size());
+    QVERIFY(loaded.buildings[0].outline.outer == inMemory.buildings[0].outline.outer);
+    QCOMPARE(st(loaded.buildings[0].status), st(BuildingStatus::Accepted));
+    QVERIFY(!reopened.document()->disparity().empty());  // written next to the outputs at save
+    QCOMPARE(reopened.buildingsModel()->rowCount(), 1);
+
+    const QString exported = dir_.filePath(QStringLiteral("sample/accepted.geojson"));
+    QCOMPARE(reopened.exportAccepted(exported), 1);
+    const auto features = io::readFeatures(exported.toStdString());
+    QCOMPARE(features.size(), size_t(1));
+    QCOMPARE(std::get<long long>(features[0].attributes.at("id")), static_cast<long long>(buildingId_));
+  }
+
+  void badInputsShowAMessageAndChangeNothing() {
+    gui::Document* before = window_->document();
+    QSignalSpy messages(window_.get(), &MainWindow::messageShown);
+    // Corrupt project file.
+    const QString corrupt = dir_.filePath(QStringLiteral("corrupt.json"));
+    std::ofstream(corrupt.toStdString()) << "{\"format\": \"delineo-project\", \"version\": 1, \"images\": ";
+    QVERIFY(!window_->openProject(corrupt));
+    QCOMPARE(window_->document(), before);
+    QCOMPARE(messages.count(), 1);
+    QVERIFY(window_->lastMessage().contains(QStringLiteral("corrupt.json")));
+    // Unreadable image.
+    const QString fake = dir_.filePath(QStringLiteral("fake.tif"));
+    std::ofstream(fake.toStdString()) << "not an image";
+    QVERIFY(!window_->openPair(fake, fake));
+    QCOMPARE(window_->document(), before);
+    QCOMPARE(messages.count(), 2);
+    // Left and right of different heights.
+    const QString small = dir_.filePath(QStringLiteral("small.tif"));
+    io::writeGeoTiff(small.toStdString(), cv::Mat(100, 512, CV_8U, cv::Scalar(90)));
+    QVERIFY(!window_->openPair(QString::fromStdString(before->project().left), small));
+    QCOMPARE(window_->document(), before);
+    QCOMPARE(messages.count(), 3);
+    QVERIFY(window_->lastMessage().contains(QStringLiteral("do not match")));
+  }
+
+  void missingImageCanBeRelocated() {
+    namespace fs = std::filesystem;
+    const fs::path folder = dir_.filePath(QStringLiteral("moved")).toStdString();
+    fs::create_directories(folder);
+    const project::Project original = window_->document()->project();
+    project::Project p = original;
+    p.buildings.clear();
+    p.right = (folder / "right-renamed.tif").string();  // does not exist yet
+    p.dem.clear();
+    p.labels.clear();
+    p.disparity.clear();
+    const std::string path = (folder / "p.json").string();
+    project::saveProject(p, path);
+    gui::Document* before = window_->document();
+    window_->setRelocateHandler([](const QString&) { return QString(); });  // operator gives up
+    QVERIFY(!window_->openProject(QString::fromStdString(path)));
+    QCOMPARE(window_->document(), before);
+    QVERIFY(window_->lastMessage().contains(QStringLiteral("right-renamed.tif")));
+    QString asked;
+    window_->setRelocateHandler([&](const QString& missing) {
+      asked = missing;
+      return QString::fromStdString(original.right);
+    });
+    QVERIFY(window_->openProject(QString::fromStdString(path)));
+    QVERIFY(asked.endsWith(QStringLiteral("right-renamed.tif")));
+    QCOMPARE(window_->document()->project().right, original.right);
+    window_->setRelocateHandler({});
+  }
+
+  void autosaveIsOfferedAfterACrash() {
+    namespace fs = std::filesystem;
+    const QString path = dir_.filePath(QStringLiteral("sample/saved.delineo.json"));
+    QVERIFY(window_->openProject(path));
+    gui::Document* doc = window_->document();
+    core::Polygon extra;
+    extra.outer = {{20, 20}, {60, 20}, {60, 50}, {20, 50}};
+    doc->addBuilding(extra);
+    window_->autosaveNow();
+    const std::string autosave = project::autosavePath(path.toStdString());
+    QVERIFY(fs::exists(autosave));
+    // The "crash": the autosave is newer than the project file, which was never saved again.
+    fs::last_write_time(autosave, fs::last_write_time(path.toStdString()) + std::chrono::seconds(10));
+    MainWindow restored;
+    restored.setInteractive(false);
+    restored.setRestoreAutosavePolicy(true);
+    QVERIFY(restored.openProject(path));
+    QCOMPARE(restored.document()->project().buildings.size(), size_t(2));
+    MainWindow declined;
+    declined.setInteractive(false);
+    declined.setRestoreAutosavePolicy(false);
+    QVERIFY(declined.openProject(path));
+    QCOMPARE(declined.document()->project().buildings.size(), size_t(1));
+    doc->undoStack()->undo();
+  }
+
+  void frenchTranslationIsComplete() {
+    QTranslator translator;
+    QVERIFY(translator.load(QStringLiteral(":/i18n/delineo_fr.qm")));
+    QCOMPARE(translator.translate("delineo::gui::MainWindow", "Buildings"), QStringLiteral("Bâtiments"));
+    QCOMPARE(translator.translate("delineo::gui::BuildingsModel", "accepted"), QStringLiteral("accepté"));
+    QCOMPARE(translator.translate("ErrorText", "The input files do not match each other."),
+             QStringLiteral("Les fichiers d’entrée ne correspondent pas entre eux."));
+  }
+
+  void cleanupTestCase() { window_.reset(); }
+};
+
+QTEST_MAIN(MainWindowTest)
+#include "test_main_window.moc"
