@@ -46,6 +46,8 @@ bool onSegment(const cv::Point2d& p, const cv::Point2d& q, const cv::Point2d& r)
          q.y <= std::max(p.y, r.y);
 }
 int sign(double v) { return (v > 1e-12) - (v < -1e-12); }
+}  // namespace
+
 bool segmentsIntersect(const cv::Point2d& p1, const cv::Point2d& p2, const cv::Point2d& p3,
                        const cv::Point2d& p4) {
   const int d1 = sign(cross(p3, p4, p1)), d2 = sign(cross(p3, p4, p2));
@@ -57,7 +59,6 @@ bool segmentsIntersect(const cv::Point2d& p1, const cv::Point2d& p2, const cv::P
   if (d4 == 0 && onSegment(p1, p4, p2)) return true;
   return false;
 }
-}  // namespace
 
 bool isSimple(const Ring& ring) {
   const size_t n = ring.size();

@@ -103,20 +103,9 @@ void forEachCrossing(cv::Point a, cv::Point b, int h, Fn&& fn) {
 double cross(cv::Point o, cv::Point a, cv::Point b) {
   return static_cast<double>(a.x - o.x) * (b.y - o.y) - static_cast<double>(a.y - o.y) * (b.x - o.x);
 }
-bool onSegment(cv::Point p, cv::Point q, cv::Point r) {
-  return std::min(p.x, r.x) <= q.x && q.x <= std::max(p.x, r.x) && std::min(p.y, r.y) <= q.y &&
-         q.y <= std::max(p.y, r.y);
-}
-int sgn(double v) { return (v > 0) - (v < 0); }
+// Integer vertices: the cross products are exact, so core's tolerance never matters.
 bool segmentsTouch(cv::Point p1, cv::Point p2, cv::Point p3, cv::Point p4) {
-  const int d1 = sgn(cross(p3, p4, p1)), d2 = sgn(cross(p3, p4, p2));
-  const int d3 = sgn(cross(p1, p2, p3)), d4 = sgn(cross(p1, p2, p4));
-  if (d1 * d2 < 0 && d3 * d4 < 0) return true;
-  if (d1 == 0 && onSegment(p3, p1, p4)) return true;
-  if (d2 == 0 && onSegment(p3, p2, p4)) return true;
-  if (d3 == 0 && onSegment(p1, p3, p2)) return true;
-  if (d4 == 0 && onSegment(p1, p4, p2)) return true;
-  return false;
+  return core::segmentsIntersect(p1, p2, p3, p4);
 }
 // Edges s→a and s→b share s: they may only meet there (no fold-back along a common line).
 bool adjacentOverlap(cv::Point s, cv::Point a, cv::Point b) {

@@ -30,6 +30,10 @@ struct Feature {
 double signedArea(const Ring& ring);
 double area(const Polygon& polygon);  // outer minus holes, always >= 0
 cv::Rect2d boundingBox(const Ring& ring);
+// True when segments p1-p2 and p3-p4 share at least one point (crossing, touching at an end
+// point, or overlapping collinearly).
+bool segmentsIntersect(const cv::Point2d& p1, const cv::Point2d& p2, const cv::Point2d& p3,
+                       const cv::Point2d& p4);
 // True when no two non-adjacent edges of the ring intersect and it has >= 3 vertices.
 bool isSimple(const Ring& ring);
 // Rasterises a polygon (with holes) into a CV_8U mask of the given size: 255 where the pixel
