@@ -253,6 +253,7 @@ void MainWindow::createDocks() {
   buildingsTable_->setSelectionBehavior(QAbstractItemView::SelectRows);
   buildingsTable_->setSelectionMode(QAbstractItemView::SingleSelection);
   buildingsTable_->verticalHeader()->hide();
+  buildingsTable_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   buildingsTable_->horizontalHeader()->setStretchLastSection(true);
   connect(buildingsTable_->selectionModel(), &QItemSelectionModel::selectionChanged, this,
           &MainWindow::onSelectionFromTable);
