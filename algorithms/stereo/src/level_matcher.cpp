@@ -1,17 +1,25 @@
 // One level of the adaptive-window NCC matcher.
 //
-// Two paths share the per-pixel search intervals:
-//  - pixels whose template window holds no contour pixel (or all pixels when adaptive shapes are
-//    off) use a square window; a band of rows is swept disparity by disparity with running
-//    column sums of the product image, so a correlation costs O(1) per pixel and disparity;
-//  - pixels with a contour inside their window get the adaptive shape S (4-connected flood fill
-//    from the centre that does not cross contour pixels) and a direct NCC over S.
-// Memory is bounded by a few rows per band: no cost volume is stored.
+// The image is cut into tiles; every pixel has its own search interval [lo, hi] (from the
+// coarser level). The main line (dy = 0) is searched over the whole interval, the ±1 line shifts
+// only around its peak (a local ascent on the 2D correlation surface), which costs 6 to a few
+// tens of correlations per pixel instead of 2 × the interval.
+//  - Pixels whose template window holds no contour pixel (or all pixels when adaptive shapes are
+//    off) use a square window. A tile is swept disparity by disparity over the union of those
+//    pixels' intervals: the product image of the tile is box-filtered (running column and row
+//    sums), so a correlation costs O(1) per pixel and disparity. Pixels whose interval is much
+//    wider than the tile's typical one (rejected at the coarser level) are correlated directly
+//    when that is cheaper than widening the sweep.
+//  - Pixels with a contour inside their window get the adaptive shape S (4-connected flood fill
+//    from the centre that does not cross contour pixels) and a direct NCC over S, computed on
+//    dense w x w rows (element-wise, vectorisable).
+// Memory is bounded by a few tile-sized buffers per worker: no cost volume is stored.
 #include "level_matcher.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <thread>
 #include <vector>
@@ -22,7 +30,11 @@ namespace delineo::stereo::detail {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr int kBandRows = 32;
+constexpr float kNegInf = -std::numeric_limits<float>::infinity();
+constexpr int kTileRows = 32;
+constexpr int kTileCols = 64;
+// Steps of the local ascent over line shifts: the dy = ±1 peak lies next to the dy = 0 one.
+constexpr int kMaxAscentSteps = 4;
 // Variance (grey levels², images normalised to ~0..255) under which a window is flat: its NCC
 // is meaningless.
 constexpr double kFlatVariance = 0.01;
@@ -64,51 +76,56 @@ WindowStats windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
   return s;
 }
 
-// Best peak of one pixel's correlation surface with its 3x3 neighbourhood, built while the
-// disparities are visited in increasing order.
-struct PeakTracker {
-  float best = -std::numeric_limits<float>::infinity();
+// Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
+struct LinePeak {
+  float best = kNegInf;
   int bestD = 0;
-  int bestK = 0;
-  float prev[3] = {kNaN, kNaN, kNaN};   // scores at d - 1, per line shift
-  float nb[3][3] = {{kNaN, kNaN, kNaN}, {kNaN, kNaN, kNaN}, {kNaN, kNaN, kNaN}};
+  float below = kNaN;  // score at bestD - 1
+  float above = kNaN;  // score at bestD + 1
+  float prev = kNaN;   // score at the previous d
 
-  void reset() { *this = PeakTracker{}; }
-
-  // scores[k] for line shift index k at disparity d; firstOfInterval: d - 1 was not visited.
-  void update(int d, const float* scores, int K, bool firstOfInterval) {
-    if (firstOfInterval) std::fill(prev, prev + 3, kNaN);
-    if (d == bestD + 1) std::copy(scores, scores + K, nb[2]);
-    int k = 0;
-    float m = -std::numeric_limits<float>::infinity();
-    for (int i = 0; i < K; ++i) {
-      if (scores[i] > m) {  // NaN never wins
-        m = scores[i];
-        k = i;
-      }
-    }
-    if (m > best) {
-      best = m;
+  void update(int d, float s) {
+    if (d == bestD + 1) above = s;
+    if (s > best) {  // NaN never wins
+      best = s;
       bestD = d;
-      bestK = k;
-      std::copy(prev, prev + 3, nb[0]);
-      std::fill(nb[1], nb[1] + 3, kNaN);
-      std::copy(scores, scores + K, nb[1]);
-      std::fill(nb[2], nb[2] + 3, kNaN);
+      below = prev;
+      above = kNaN;
     }
-    std::fill(prev, prev + 3, kNaN);
-    std::copy(scores, scores + K, prev);
+    prev = s;
   }
+};
+
+// Dense w x w template of an adaptive shape: T = (A - mean_S) / sd_S on S and 0 elsewhere, and
+// the indicator M of S. NCC(d, dy) = sum(T * B) / (|S| sd_S(B)).
+struct ShapeTemplate {
+  std::vector<float> templ, mask;
+  std::vector<uint32_t> visited;  // == stamp: visited by the current flood fill
+  uint32_t stamp = 0;
+  std::vector<int> queue;
+  int rowFirst = 0, rowLast = -1;  // window rows holding part of S
+  int count = 0;
+};
+
+// Per-worker buffers, reused from tile to tile.
+struct Scratch {
+  ShapeTemplate shape;
+  std::vector<LinePeak> peaks;       // per tile pixel (square path)
+  std::vector<uchar> square;         // 1 where the tile pixel takes the square path
+  std::vector<uchar> swept;          // 1 where the square pixel is served by the sweep
+  std::vector<float> product, cols;  // sweep: product rows of the tile and running column sums
 };
 
 class LevelMatcher {
  public:
   LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out)
       : in_(in), s_(s), out_(out), W_(in.ref.cols), H_(in.ref.rows), r_(s.window / 2),
-        n_(s.window * s.window), K_(2 * s.lineShift + 1) {
+        n_(s.window * s.window), L_(s.lineShift) {
     refStats_ = windowStats(in.ref, in.refValid, s.window);
     otherStats_ = windowStats(in.other, in.otherValid, s.window);
     cv::multiply(in.other, in.other, otherSq_);
+    // Pixels a shape never enters: contours and nodata.
+    blocked_ = (in.refEdges != 0) | (in.refValid == 0);
     if (s.adaptive) {
       cv::Mat edges = in.refEdges != 0;
       cv::dilate(edges, nearEdge_,
@@ -122,20 +139,24 @@ class LevelMatcher {
   }
 
   bool run(core::Progress* progress) {
-    const int bands = (H_ + kBandRows - 1) / kBandRows;
+    const int tilesX = (W_ + kTileCols - 1) / kTileCols;
+    const int tiles = tilesX * ((H_ + kTileRows - 1) / kTileRows);
     std::atomic<int> next{0}, done{0};
     std::atomic<bool> canceled{false};
     auto worker = [&] {
-      for (int b = next++; b < bands; b = next++) {
+      Scratch scratch;
+      for (int t = next++; t < tiles; t = next++) {
         if (canceled.load() || core::isCanceled(progress)) {
           canceled.store(true);
           return;
         }
-        matchBand(b * kBandRows, std::min(H_, (b + 1) * kBandRows));
-        core::report(progress, static_cast<double>(++done) / bands);
+        const int x0 = (t % tilesX) * kTileCols, y0 = (t / tilesX) * kTileRows;
+        matchTile(cv::Rect(x0, y0, std::min(kTileCols, W_ - x0), std::min(kTileRows, H_ - y0)),
+                  scratch);
+        core::report(progress, static_cast<double>(++done) / tiles);
       }
     };
-    const int threads = std::max(1, std::min(s_.threads, bands));
+    const int threads = std::max(1, std::min(s_.threads, tiles));
     std::vector<std::thread> pool;
     for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
     worker();
@@ -144,268 +165,354 @@ class LevelMatcher {
   }
 
  private:
-  enum PathKind : uchar { kSkip = 0, kSquare = 1, kShape = 2 };
-
-  void matchBand(int y0, int y1) {
-    const int rows = y1 - y0;
-    std::vector<uchar> kind(static_cast<size_t>(rows) * W_, kSkip);
-    // Adaptive shapes of this band, stored as offsets into the window (row-major, W x W).
-    std::vector<std::vector<int>> shapes(static_cast<size_t>(rows) * W_);
-    std::vector<uchar> mask(static_cast<size_t>(n_));
-    std::vector<int> queue(static_cast<size_t>(n_));
-    int dLo = std::numeric_limits<int>::max(), dHi = std::numeric_limits<int>::min();
-    std::vector<int> rowLo(rows, dLo), rowHi(rows, dHi);
-    for (int y = y0; y < y1; ++y) {
+  void matchTile(const cv::Rect& tile, Scratch& sc) {
+    const size_t area = static_cast<size_t>(tile.area());
+    sc.square.assign(area, 0);
+    for (int y = tile.y; y < tile.br().y; ++y) {
       const int* lo = in_.lo.ptr<int>(y);
       const int* hi = in_.hi.ptr<int>(y);
       const uchar* ok = refStats_.ok.ptr<uchar>(y);
       const uchar* near = nearEdge_.ptr<uchar>(y);
-      for (int x = 0; x < W_; ++x) {
-        const size_t i = static_cast<size_t>(y - y0) * W_ + x;
+      for (int x = tile.x; x < tile.br().x; ++x) {
         if (lo[x] > hi[x] || !ok[x]) continue;
-        if (near[x]) {
-          std::vector<int> shape = buildShape(x, y, mask, queue);
-          if (static_cast<int>(shape.size()) >= s_.minShape &&
-              static_cast<int>(shape.size()) < n_) {
-            shapes[i] = std::move(shape);
-            kind[i] = kShape;
-            continue;
-          }
+        if (near[x] && buildShape(x, y, sc.shape)) {
+          matchShapePixel(x, y, sc.shape);
+          continue;
         }
-        kind[i] = kSquare;
-        dLo = std::min(dLo, lo[x]);
-        dHi = std::max(dHi, hi[x]);
-        rowLo[y - y0] = std::min(rowLo[y - y0], lo[x]);
-        rowHi[y - y0] = std::max(rowHi[y - y0], hi[x]);
+        sc.square[static_cast<size_t>(y - tile.y) * tile.width + (x - tile.x)] = 1;
       }
     }
-    if (dLo <= dHi) sweepSquare(y0, y1, dLo, dHi, kind, rowLo, rowHi);
-    for (int y = y0; y < y1; ++y) {
-      for (int x = 0; x < W_; ++x) {
-        const size_t i = static_cast<size_t>(y - y0) * W_ + x;
-        if (kind[i] == kShape) matchShape(x, y, shapes[i]);
+    matchSquarePixels(tile, sc);
+  }
+
+  // ---- square windows --------------------------------------------------------------------
+
+  // NCC of the square window at (x, y) against (x - d, y + dy); NaN where the other window is
+  // missing or flat.
+  float squareScore(int x, int y, int d, int dy) const {
+    const int yb = y + dy, xb = x - d;
+    if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherStats_.ok.at<uchar>(yb, xb)) return kNaN;
+    float sab = 0;
+    for (int v = -r_; v <= r_; ++v) {
+      const float* a = in_.ref.ptr<float>(y + v) + x - r_;
+      const float* b = in_.other.ptr<float>(yb + v) + xb - r_;
+      float acc = 0;
+      for (int u = 0; u < s_.window; ++u) acc += a[u] * b[u];
+      sab += acc;
+    }
+    return (sab / static_cast<float>(n_) - refStats_.mean.at<float>(y, x) *
+                                               otherStats_.mean.at<float>(yb, xb)) /
+           (refStats_.sd.at<float>(y, x) * otherStats_.sd.at<float>(yb, xb));
+  }
+
+  void matchSquarePixels(const cv::Rect& tile, Scratch& sc) {
+    const size_t area = static_cast<size_t>(tile.area());
+    sc.peaks.assign(area, LinePeak{});
+    sc.swept.assign(area, 0);
+    // Which square pixels the box-filter sweep serves: the sweep costs ~5 operations per tile
+    // pixel and disparity of the union of the served intervals, a direct correlation n_ per
+    // disparity of the pixel's own interval. Pixels are added by increasing interval width
+    // while that keeps the total cheaper.
+    std::vector<std::pair<int, int>> byWidth;  // (width, tile index)
+    for (size_t i = 0; i < area; ++i) {
+      if (!sc.square[i]) continue;
+      const int x = tile.x + static_cast<int>(i) % tile.width;
+      const int y = tile.y + static_cast<int>(i) / tile.width;
+      byWidth.emplace_back(in_.hi.at<int>(y, x) - in_.lo.at<int>(y, x) + 1, static_cast<int>(i));
+    }
+    if (byWidth.empty()) return;
+    std::sort(byWidth.begin(), byWidth.end());
+    const double sweepUnit = 5.0 * (tile.width + 2 * r_) * (tile.height + 2 * r_);
+    double directRemaining = 0;
+    for (const auto& [width, i] : byWidth) directRemaining += static_cast<double>(n_) * width;
+    int uLo = std::numeric_limits<int>::max(), uHi = std::numeric_limits<int>::min();
+    double bestTotal = directRemaining;  // nothing swept
+    size_t bestCount = 0;
+    for (size_t k = 0; k < byWidth.size(); ++k) {
+      const int i = byWidth[k].second;
+      const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
+      uLo = std::min(uLo, in_.lo.at<int>(y, x));
+      uHi = std::max(uHi, in_.hi.at<int>(y, x));
+      directRemaining -= static_cast<double>(n_) * byWidth[k].first;
+      const double total = sweepUnit * (uHi - uLo + 1) + directRemaining;
+      if (total <= bestTotal) {
+        bestTotal = total;
+        bestCount = k + 1;
       }
+    }
+    uLo = std::numeric_limits<int>::max();
+    uHi = std::numeric_limits<int>::min();
+    for (size_t k = 0; k < bestCount; ++k) {
+      const int i = byWidth[k].second;
+      const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
+      sc.swept[static_cast<size_t>(i)] = 1;
+      uLo = std::min(uLo, in_.lo.at<int>(y, x));
+      uHi = std::max(uHi, in_.hi.at<int>(y, x));
+    }
+    if (bestCount > 0) sweepTile(tile, uLo, uHi, sc);
+    for (size_t k = bestCount; k < byWidth.size(); ++k) {
+      const int i = byWidth[k].second;
+      const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
+      LinePeak& peak = sc.peaks[static_cast<size_t>(i)];
+      for (int d = in_.lo.at<int>(y, x); d <= in_.hi.at<int>(y, x); ++d) {
+        peak.update(d, squareScore(x, y, d, 0));
+      }
+    }
+    for (const auto& [width, i] : byWidth) {
+      const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
+      finish(x, y, sc.peaks[static_cast<size_t>(i)],
+             [&](int d, int dy) { return squareScore(x, y, d, dy); });
     }
   }
 
-  // Window pixels 4-connected to the centre without crossing a contour pixel. Contour pixels
-  // themselves are left out: a step edge's contour pixel usually carries the brighter side's
-  // grey level, and keeping it would let the step dominate the correlation of the other side.
-  // A centre on a contour propagates to both sides (its side is undecidable). Returns offsets
-  // relative to the centre in image row-major units (dy * W + dx).
-  std::vector<int> buildShape(int x, int y, std::vector<uchar>& mask, std::vector<int>& queue) {
-    const int w = s_.window;
-    std::fill(mask.begin(), mask.end(), 0);
-    int head = 0, tail = 0;
-    const int centre = r_ * w + r_;
-    mask[centre] = 1;
-    queue[tail++] = centre;
-    std::vector<int> offsets;
-    offsets.reserve(static_cast<size_t>(n_));
-    while (head < tail) {
-      const int p = queue[head++];
-      const int px = p % w, py = p / w;
-      offsets.push_back((py - r_) * W_ + (px - r_));
-      const int nx[4] = {px - 1, px + 1, px, px};
-      const int ny[4] = {py, py, py - 1, py + 1};
-      for (int k = 0; k < 4; ++k) {
-        if (nx[k] < 0 || nx[k] >= w || ny[k] < 0 || ny[k] >= w) continue;
-        const int q = ny[k] * w + nx[k];
-        if (mask[q]) continue;
-        mask[q] = 1;  // visited
-        const int ix = x + nx[k] - r_, iy = y + ny[k] - r_;
-        if (!in_.refValid.at<uchar>(iy, ix) || in_.refEdges.at<uchar>(iy, ix) != 0) continue;
-        queue[tail++] = q;
-      }
-    }
-    return offsets;
-  }
-
-  // Adds sign * ref(yy, x) * other(yy + dy, x - d) to col[x] for every x where both exist.
-  void addProductRow(float* col, int yy, int dy, int d, float sign) const {
-    if (yy < 0 || yy >= H_ || yy + dy < 0 || yy + dy >= H_) return;
-    const float* a = in_.ref.ptr<float>(yy);
-    const float* b = in_.other.ptr<float>(yy + dy);
-    const int xs = std::max(0, d), xe = std::min(W_, W_ + d);
-    for (int x = xs; x < xe; ++x) col[x] += sign * a[x] * b[x - d];
-  }
-
-  void sweepSquare(int y0, int y1, int dLo, int dHi, const std::vector<uchar>& kind,
-                   const std::vector<int>& rowLo, const std::vector<int>& rowHi) {
-    const int rows = y1 - y0;
-    const int L = s_.lineShift;
-    std::vector<PeakTracker> trackers(static_cast<size_t>(rows) * W_);
-    std::vector<float> col(static_cast<size_t>(K_) * W_);
-    std::vector<double> prefix(static_cast<size_t>(W_) + 1);
-    std::vector<float> scores(static_cast<size_t>(K_) * W_);
+  // Main-line scores of the swept pixels of `tile` for every d in [dLo, dHi]: per d, the
+  // product A(x', y') B(x' - d, y') over the tile grown by the window radius is box-filtered
+  // with running column sums and a running row sum.
+  void sweepTile(const cv::Rect& tile, int dLo, int dHi, Scratch& sc) {
+    const int gx0 = tile.x - r_, gw = tile.width + 2 * r_;  // grown tile columns
+    const int gy0 = tile.y - r_, gh = tile.height + 2 * r_;
+    sc.product.assign(static_cast<size_t>(gw) * gh, 0.0F);
+    sc.cols.resize(static_cast<size_t>(gw));
     const float invN = 1.0F / static_cast<float>(n_);
     for (int d = dLo; d <= dHi; ++d) {
-      std::fill(col.begin(), col.end(), 0.0F);
-      for (int k = 0; k < K_; ++k) {
-        for (int yy = y0 - r_; yy <= y0 + r_; ++yy) addProductRow(&col[k * W_], yy, k - L, d, 1);
-      }
-      for (int y = y0; y < y1; ++y) {
-        if (y > y0) {
-          for (int k = 0; k < K_; ++k) {
-            addProductRow(&col[k * W_], y + r_, k - L, d, 1.0F);
-            addProductRow(&col[k * W_], y - r_ - 1, k - L, d, -1.0F);
-          }
+      // Product rows (0 outside either image: such windows are never scored).
+      for (int j = 0; j < gh; ++j) {
+        float* p = &sc.product[static_cast<size_t>(j) * gw];
+        const int y = gy0 + j;
+        if (y < 0 || y >= H_) {
+          std::fill(p, p + gw, 0.0F);
+          continue;
         }
-        const int ry = y - y0;
-        if (d < rowLo[ry] || d > rowHi[ry]) continue;
+        const float* a = in_.ref.ptr<float>(y);
+        const float* b = in_.other.ptr<float>(y);
+        const int xs = std::max({gx0, 0, d}), xe = std::min({gx0 + gw, W_, W_ + d});
+        for (int x = gx0; x < std::min(xs, gx0 + gw); ++x) p[x - gx0] = 0.0F;
+        for (int x = xs; x < xe; ++x) p[x - gx0] = a[x] * b[x - d];
+        for (int x = std::max(xe, gx0); x < gx0 + gw; ++x) p[x - gx0] = 0.0F;
+      }
+      float* cols = sc.cols.data();
+      std::fill(cols, cols + gw, 0.0F);
+      for (int j = 0; j < s_.window; ++j) {
+        const float* p = &sc.product[static_cast<size_t>(j) * gw];
+        for (int c = 0; c < gw; ++c) cols[c] += p[c];
+      }
+      for (int ty = 0; ty < tile.height; ++ty) {
+        if (ty > 0) {
+          const float* add = &sc.product[static_cast<size_t>(ty + 2 * r_) * gw];
+          const float* sub = &sc.product[static_cast<size_t>(ty - 1) * gw];
+          for (int c = 0; c < gw; ++c) cols[c] += add[c] - sub[c];
+        }
+        const int y = tile.y + ty;
         const int* lo = in_.lo.ptr<int>(y);
         const int* hi = in_.hi.ptr<int>(y);
         const float* meanA = refStats_.mean.ptr<float>(y);
         const float* sdA = refStats_.sd.ptr<float>(y);
-        for (int k = 0; k < K_; ++k) {
-          const int yb = y + k - L;
-          float* sc = &scores[k * W_];
-          const float* c = &col[k * W_];
-          prefix[0] = 0.0;
-          for (int x = 0; x < W_; ++x) prefix[x + 1] = prefix[x] + c[x];
-          const bool rowInside = yb >= 0 && yb < H_;
-          const float* meanB = rowInside ? otherStats_.mean.ptr<float>(yb) : nullptr;
-          const float* sdB = rowInside ? otherStats_.sd.ptr<float>(yb) : nullptr;
-          const uchar* okB = rowInside ? otherStats_.ok.ptr<uchar>(yb) : nullptr;
-          for (int x = 0; x < W_; ++x) {
-            sc[x] = kNaN;
-            if (!rowInside || kind[static_cast<size_t>(ry) * W_ + x] != kSquare || d < lo[x] ||
-                d > hi[x]) {
-              continue;
-            }
-            const int xb = x - d;
-            if (xb < 0 || xb >= W_ || !okB[xb]) continue;
-            const float sab = static_cast<float>(prefix[x + r_ + 1] - prefix[x - r_]);
-            sc[x] = (sab * invN - meanA[x] * meanB[xb]) / (sdA[x] * sdB[xb]);
-          }
+        const float* meanB = otherStats_.mean.ptr<float>(y);
+        const float* sdB = otherStats_.sd.ptr<float>(y);
+        const uchar* okB = otherStats_.ok.ptr<uchar>(y);
+        const uchar* swept = &sc.swept[static_cast<size_t>(ty) * tile.width];
+        LinePeak* peaks = &sc.peaks[static_cast<size_t>(ty) * tile.width];
+        double window = 0;  // running row sum: double keeps it exact enough over a tile row
+        for (int c = 0; c < s_.window - 1; ++c) window += cols[c];
+        for (int tx = 0; tx < tile.width; ++tx) {
+          window += cols[tx + 2 * r_];
+          const auto sab = static_cast<float>(window);
+          window -= cols[tx];
+          const int x = tile.x + tx;
+          if (!swept[tx] || d < lo[x] || d > hi[x]) continue;
+          const int xb = x - d;
+          const float s = (xb >= 0 && xb < W_ && okB[xb])
+                              ? (sab * invN - meanA[x] * meanB[xb]) / (sdA[x] * sdB[xb])
+                              : kNaN;
+          peaks[tx].update(d, s);
         }
-        float column[3];
-        for (int x = 0; x < W_; ++x) {
-          if (kind[static_cast<size_t>(ry) * W_ + x] != kSquare || d < lo[x] || d > hi[x]) continue;
-          for (int k = 0; k < K_; ++k) column[k] = scores[k * W_ + x];
-          trackers[static_cast<size_t>(ry) * W_ + x].update(d, column, K_, d == lo[x]);
-        }
-      }
-    }
-    for (int y = y0; y < y1; ++y) {
-      for (int x = 0; x < W_; ++x) {
-        const size_t i = static_cast<size_t>(y - y0) * W_ + x;
-        if (kind[i] == kSquare) finish(x, y, trackers[i]);
       }
     }
   }
 
-  void matchShape(int x, int y, const std::vector<int>& shape) {
-    const int L = s_.lineShift;
+  // ---- adaptive shapes -------------------------------------------------------------------
+
+  // Window pixels 4-connected to the centre without crossing a contour pixel. Contour pixels
+  // themselves are left out: a step edge's contour pixel usually carries the brighter side's
+  // grey level, and keeping it would let the step dominate the correlation of the other side.
+  // A centre on a contour propagates to both sides (its side is undecidable). Fills the dense
+  // template; returns false when the shape is the full square (the square path serves it),
+  // smaller than minShape, or flat.
+  bool buildShape(int x, int y, ShapeTemplate& t) const {
     const int w = s_.window;
-    const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
-    // Template T = (A - mean_S) / sd_S on S and 0 elsewhere, and the indicator M of S, both
-    // dense w x w: NCC = sum(T * B) / (|S| sd_S(B)). Dense rows keep the inner loops
-    // element-wise (vectorisable) instead of gathers over S.
-    const float* base = in_.ref.ptr<float>(y) + x;
+    if (t.visited.size() != static_cast<size_t>(n_)) t.visited.assign(static_cast<size_t>(n_), 0);
+    t.queue.resize(static_cast<size_t>(n_));
+    t.mask.assign(static_cast<size_t>(n_), 0.0F);
+    // Visit stamps instead of clearing: one increment per shape.
+    if (++t.stamp == 0) {
+      std::fill(t.visited.begin(), t.visited.end(), 0);
+      t.stamp = 1;
+    }
+    const uint32_t stamp = t.stamp;
+    const uchar* blocked = blocked_.ptr<uchar>(y - r_) + (x - r_);
+    const size_t step = blocked_.step1();
+    int head = 0, tail = 0;
+    const int centre = r_ * w + r_;
+    t.visited[static_cast<size_t>(centre)] = stamp;
+    t.queue[static_cast<size_t>(tail++)] = centre;
+    auto visit = [&](int q, int qx, int qy) {
+      if (t.visited[static_cast<size_t>(q)] == stamp) return;
+      t.visited[static_cast<size_t>(q)] = stamp;
+      if (blocked[static_cast<size_t>(qy) * step + static_cast<size_t>(qx)]) return;
+      t.queue[static_cast<size_t>(tail++)] = q;
+    };
+    while (head < tail) {
+      const int p = t.queue[static_cast<size_t>(head++)];
+      const int px = p % w, py = p / w;
+      t.mask[static_cast<size_t>(p)] = 1.0F;
+      if (px > 0) visit(p - 1, px - 1, py);
+      if (px < w - 1) visit(p + 1, px + 1, py);
+      if (py > 0) visit(p - w, px, py - 1);
+      if (py < w - 1) visit(p + w, px, py + 1);
+    }
+    t.count = tail;
+    if (t.count < s_.minShape || t.count >= n_) return false;
     double sum = 0, sq = 0;
-    for (int off : shape) {
-      const double v = base[off];
-      sum += v;
-      sq += v * v;
-    }
-    const double count = static_cast<double>(shape.size());
-    const double mean = sum / count;
-    const double var = sq / count - mean * mean;
-    if (var < kFlatVariance) return;
-    const double sd = std::sqrt(var);
-    std::vector<float> templ(static_cast<size_t>(n_), 0.0F), mask(static_cast<size_t>(n_), 0.0F);
-    for (int off : shape) {
-      // off = dy * W + dx with |dx|, |dy| <= r: recover the window cell.
-      const int dy = (off + r_ * W_ + r_) / W_ - r_;
-      const int dx = off - dy * W_;
-      const size_t cell = static_cast<size_t>((dy + r_) * w + (dx + r_));
-      templ[cell] = static_cast<float>((base[off] - mean) / sd);
-      mask[cell] = 1.0F;
-    }
-    // First and last window rows holding part of S: rows outside are skipped.
-    int rowFirst = w, rowLast = -1;
+    t.rowFirst = w;
+    t.rowLast = -1;
     for (int v = 0; v < w; ++v) {
+      const float* a = in_.ref.ptr<float>(y + v - r_) + x - r_;
+      const float* m = &t.mask[static_cast<size_t>(v * w)];
       for (int u = 0; u < w; ++u) {
-        if (mask[static_cast<size_t>(v * w + u)] != 0.0F) {
-          rowFirst = std::min(rowFirst, v);
-          rowLast = std::max(rowLast, v);
-        }
+        if (m[u] == 0.0F) continue;
+        sum += a[u];
+        sq += static_cast<double>(a[u]) * a[u];
+        t.rowFirst = std::min(t.rowFirst, v);
+        t.rowLast = std::max(t.rowLast, v);
       }
     }
-    PeakTracker tracker;
-    float column[3];
-    const float invCount = static_cast<float>(1.0 / count);
-    std::vector<float> accB(static_cast<size_t>(w)), accBB(static_cast<size_t>(w)),
-        accTB(static_cast<size_t>(w));
-    for (int d = lo; d <= hi; ++d) {
-      for (int k = 0; k < K_; ++k) {
-        column[k] = kNaN;
-        const int yb = y + k - L, xb = x - d;
-        if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherStats_.ok.at<uchar>(yb, xb)) continue;
-        std::fill(accB.begin(), accB.end(), 0.0F);
-        std::fill(accBB.begin(), accBB.end(), 0.0F);
-        std::fill(accTB.begin(), accTB.end(), 0.0F);
-        for (int v = rowFirst; v <= rowLast; ++v) {
-          const float* b = in_.other.ptr<float>(yb + v - r_) + xb - r_;
-          const float* b2 = otherSq_.ptr<float>(yb + v - r_) + xb - r_;
-          const float* m = &mask[static_cast<size_t>(v * w)];
-          const float* t = &templ[static_cast<size_t>(v * w)];
-          for (int u = 0; u < w; ++u) {
-            accB[u] += m[u] * b[u];
-            accBB[u] += m[u] * b2[u];
-            accTB[u] += t[u] * b[u];
-          }
-        }
-        float sB = 0, sBB = 0, sTB = 0;
-        for (int u = 0; u < w; ++u) {
-          sB += accB[u];
-          sBB += accBB[u];
-          sTB += accTB[u];
-        }
-        const float meanB = sB * invCount;
-        const float varB = sBB * invCount - meanB * meanB;
-        if (varB < static_cast<float>(kFlatVariance)) continue;
-        column[k] = sTB * invCount / std::sqrt(varB);
+    const double mean = sum / t.count;
+    const double var = sq / t.count - mean * mean;
+    if (var < kFlatVariance) return false;
+    const double sd = std::sqrt(var);
+    t.templ.assign(static_cast<size_t>(n_), 0.0F);
+    for (int v = t.rowFirst; v <= t.rowLast; ++v) {
+      const float* a = in_.ref.ptr<float>(y + v - r_) + x - r_;
+      for (int u = 0; u < w; ++u) {
+        const size_t cell = static_cast<size_t>(v * w + u);
+        if (t.mask[cell] != 0.0F) t.templ[cell] = static_cast<float>((a[u] - mean) / sd);
       }
-      tracker.update(d, column, K_, d == lo);
     }
-    finish(x, y, tracker);
+    return true;
   }
 
-  void finish(int x, int y, const PeakTracker& t) {
-    if (!(t.best >= static_cast<float>(s_.minScore))) return;
+  // NCC over the shape at (x, y) against (x - d, y + dy); NaN where the other window is
+  // missing or flat on S.
+  float shapeScore(int x, int y, int d, int dy, const ShapeTemplate& t) const {
+    const int yb = y + dy, xb = x - d;
+    if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherStats_.ok.at<uchar>(yb, xb)) return kNaN;
+    const int w = s_.window;
+    float accB[32] = {}, accBB[32] = {}, accTB[32] = {};
+    for (int v = t.rowFirst; v <= t.rowLast; ++v) {
+      const float* b = in_.other.ptr<float>(yb + v - r_) + xb - r_;
+      const float* b2 = otherSq_.ptr<float>(yb + v - r_) + xb - r_;
+      const float* m = &t.mask[static_cast<size_t>(v * w)];
+      const float* tt = &t.templ[static_cast<size_t>(v * w)];
+      for (int u = 0; u < w; ++u) {
+        accB[u] += m[u] * b[u];
+        accBB[u] += m[u] * b2[u];
+        accTB[u] += tt[u] * b[u];
+      }
+    }
+    float sB = 0, sBB = 0, sTB = 0;
+    for (int u = 0; u < w; ++u) {
+      sB += accB[u];
+      sBB += accBB[u];
+      sTB += accTB[u];
+    }
+    const float invCount = 1.0F / static_cast<float>(t.count);
+    const float meanB = sB * invCount;
+    const float varB = sBB * invCount - meanB * meanB;
+    if (varB < static_cast<float>(kFlatVariance)) return kNaN;
+    return sTB * invCount / std::sqrt(varB);
+  }
+
+  void matchShapePixel(int x, int y, const ShapeTemplate& t) {
+    LinePeak peak;
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
+    for (int d = lo; d <= hi; ++d) peak.update(d, shapeScore(x, y, d, 0, t));
+    finish(x, y, peak, [&](int d, int dy) { return shapeScore(x, y, d, dy, t); });
+  }
+
+  // ---- peak ------------------------------------------------------------------------------
+
+  // From the main-line peak: local ascent over the line shifts (3x3 neighbourhoods of the 2D
+  // surface, d within the pixel's interval, |dy| <= lineShift), rejection tests, sub-pixel
+  // offset, output.
+  template <class Score>
+  void finish(int x, int y, const LinePeak& peak, Score&& score) {
+    if (!(peak.best > kNegInf)) return;
+    const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
+    int cd = peak.bestD, cdy = 0;
+    float best = peak.best;
+    float s[3][3];
+    auto at = [&](int d, int dy) -> float {
+      if (d < lo || d > hi || dy < -L_ || dy > L_) return kNaN;
+      return score(d, dy);
+    };
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) s[i][j] = kNaN;
+    }
+    s[0][1] = peak.below;
+    s[1][1] = peak.best;
+    s[2][1] = peak.above;
+    if (L_ > 0) {
+      for (int step = 0;; ++step) {
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 3; ++j) {
+            if (cdy + j - 1 == 0 && step == 0) continue;  // main line known
+            if (i == 1 && j == 1) continue;
+            s[i][j] = at(cd + i - 1, cdy + j - 1);
+          }
+        }
+        int bi = 1, bj = 1;
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 3; ++j) {
+            if (s[i][j] > s[bi][bj]) {
+              bi = i;
+              bj = j;
+            }
+          }
+        }
+        if ((bi == 1 && bj == 1) || step == kMaxAscentSteps) break;
+        cd += bi - 1;
+        cdy += bj - 1;
+        best = s[bi][bj];
+        s[1][1] = best;
+      }
+    }
+    if (!(best >= static_cast<float>(s_.minScore))) return;
     // A peak on the border of a guided interval is a slope, not a peak: the true maximum lies
     // outside the interval.
-    if ((t.bestD == lo && lo > in_.dmin) || (t.bestD == hi && hi < in_.dmax)) return;
+    if ((cd == lo && lo > in_.dmin) || (cd == hi && hi < in_.dmax)) return;
     float du = 0, dv = 0;
     if (s_.subpixel) {
-      float s[3][3];
-      bool lineNeighbours = true;
+      bool lineNeighbours = L_ > 0;
       for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) {
-          const int k = t.bestK + j - 1;
-          s[i][j] = (k >= 0 && k < K_) ? t.nb[i][k] : kNaN;
-          if (j != 1 && !std::isfinite(s[i][j])) lineNeighbours = false;
-        }
+        if (!std::isfinite(s[i][0]) || !std::isfinite(s[i][2])) lineNeighbours = false;
       }
       const cv::Point2f off = subpixelPeak(s, lineNeighbours);
       du = off.x;
       dv = off.y;
     }
-    out_.disparity.at<float>(y, x) = static_cast<float>(t.bestD) + du;
-    out_.lineShift.at<float>(y, x) = static_cast<float>(t.bestK - s_.lineShift) + dv;
-    out_.score.at<float>(y, x) = std::min(t.best, 1.0F);
+    out_.disparity.at<float>(y, x) = static_cast<float>(cd) + du;
+    out_.lineShift.at<float>(y, x) = static_cast<float>(cdy) + dv;
+    out_.score.at<float>(y, x) = std::min(best, 1.0F);
   }
 
   const LevelInput& in_;
   const LevelSettings& s_;
   LevelOutput& out_;
-  const int W_, H_, r_, n_, K_;
+  const int W_, H_, r_, n_, L_;
   WindowStats refStats_, otherStats_;
   cv::Mat otherSq_;
   cv::Mat nearEdge_;
+  cv::Mat blocked_;  // CV_8U, non-zero on contour and nodata pixels of ref
 };
 
 }  // namespace
