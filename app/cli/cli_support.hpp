@@ -128,6 +128,8 @@ class StderrProgress : public core::Progress {
   void report(double fraction) override;
   void setStage(const std::string& stage) override;
   void finish();
+  // Commands with a --quiet flag switch the shared progress off (or on) before running.
+  void setQuiet(bool quiet) { quiet_ = quiet; }
 
  private:
   bool quiet_;

@@ -1,11 +1,23 @@
 // Stereo benchmark: the same pair and range through the adaptive matcher (contour-adaptive
 // shapes), the same matcher with plain square windows, and OpenCV SGBM; one run each.
 // Prints density, bad-1 / bad-2 on matched non-occluded pixels, bad-2 counting unmatched pixels
-// as bad, RMS on flat-roof pixels (simulated scenes) and time.
+// as bad, RMS on flat-roof pixels and the roof-outline score (simulated scenes), and time.
+//
+// Roof-outline score ("edge%"): for every roof outline pixel of a simulated scene crossed along
+// x (a building pixel xb whose horizontal neighbour xg = xb - dir is ground, with 3 building
+// pixels on one side and 3 ground pixels on the other, and a true step |d_roof - d_ground| >= 2
+// px), walk the row from xg - 7 dir towards xb + 7 dir and take the first matched pixel whose
+// predicted disparity lies on the roof side of the mid-level (d_roof + d_ground) / 2: the
+// predicted start of the roof. The outline pixel counts as located when that pixel is within
+// 1 px of xb; no roof-side pixel in the walk counts as missed. edge% = located / outline pixels.
 //
 // Usage: bench_stereo [--size N] [--data DIR] [--methods adaptive,square,sgbm] [--no-data]
+//                     [--dump DIR] [--params JSON]
 //   --size N   side of the simulated scene (default 1000; the ctest smoke run uses a tiny one)
 //   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
+//   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
+//              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored, white outline.
+//   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,8 +27,12 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <nlohmann/json.hpp>
+
+#include "delineo/core/params.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
 #ifdef DELINEO_BENCH_HAVE_SIM
@@ -34,11 +50,58 @@ struct Case {
   cv::Mat evaluate;     // CV_8U, 1 where scored (known and non-occluded)
   cv::Mat roof;         // CV_8U, 1 on flat-roof pixels (may be empty)
   int dmin = 0, dmax = 0;
+  struct OutlinePixel {
+    int y, xb, dir;  // building pixel xb, ground at xb - dir
+    float dRoof, dGround;
+  };
+  std::vector<OutlinePixel> outline;  // simulated scenes only
 };
 
 struct Row {
-  double density = 0, bad1 = 0, bad2 = 0, bad2All = 0, roofRms = NAN, seconds = 0;
+  double density = 0, bad1 = 0, bad2 = 0, bad2All = 0, roofRms = NAN, edge = NAN, seconds = 0;
 };
+
+constexpr int kOutlineWalk = 7;
+
+double outlineScore(const cv::Mat& disparity, const Case& c) {
+  if (c.outline.empty()) return NAN;
+  long located = 0;
+  for (const Case::OutlinePixel& o : c.outline) {
+    const float mid = 0.5F * (o.dRoof + o.dGround);
+    const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
+    const float* row = disparity.ptr<float>(o.y);
+    const int xg = o.xb - o.dir;
+    for (int k = -kOutlineWalk; k <= 2 * kOutlineWalk; ++k) {
+      const int x = xg + o.dir * k;
+      if (x < 0 || x >= disparity.cols) break;
+      if (!std::isfinite(row[x]) || (row[x] - mid) * sign <= 0) continue;
+      if (std::abs((x - o.xb) * o.dir) <= 1) ++located;
+      break;
+    }
+  }
+  return 100.0 * static_cast<double>(located) / static_cast<double>(c.outline.size());
+}
+
+void dumpErrors(const cv::Mat& disparity, const Case& c, const std::string& path) {
+  cv::Mat img(disparity.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int y = 0; y < img.rows; ++y) {
+    for (int x = 0; x < img.cols; ++x) {
+      if (!c.evaluate.at<uchar>(y, x)) continue;
+      const float d = disparity.at<float>(y, x);
+      cv::Vec3b& px = img.at<cv::Vec3b>(y, x);
+      const bool roof = !c.roof.empty() && c.roof.at<uchar>(y, x);
+      if (!std::isfinite(d)) {
+        px = cv::Vec3b(255, 0, 0);
+        continue;
+      }
+      const double e = std::abs(d - c.truth.at<float>(y, x));
+      const uchar dim = roof ? 255 : 140;
+      px = e <= 1 ? cv::Vec3b(0, dim, 0) : e <= 2 ? cv::Vec3b(0, 255, 255) : cv::Vec3b(0, 0, 255);
+    }
+  }
+  for (const Case::OutlinePixel& o : c.outline) img.at<cv::Vec3b>(o.y, o.xb) = {255, 255, 255};
+  cv::imwrite(path, img);
+}
 
 Row score(const cv::Mat& disparity, const Case& c, double seconds) {
   Row r;
@@ -66,27 +129,39 @@ Row score(const cv::Mat& disparity, const Case& c, double seconds) {
   r.bad2 = matched ? 100.0 * bad2 / matched : 0;
   r.bad2All = total ? 100.0 * (bad2 + total - matched) / total : 0;
   if (roofN > 0) r.roofRms = std::sqrt(roofSq / roofN);
+  r.edge = outlineScore(disparity, c);
   return r;
 }
 
-void runCase(const Case& c, const std::vector<std::string>& methods) {
+void runCase(const Case& c, const std::vector<std::string>& methods, const std::string& dump,
+             const nlohmann::json& overrides) {
   std::printf("\n%s: %dx%d, range %d..%d\n", c.name.c_str(), c.left.cols, c.left.rows, c.dmin,
               c.dmax);
-  std::printf("  %-10s %8s %8s %8s %10s %9s %8s\n", "method", "density%", "bad1%", "bad2%",
-              "bad2+unm%", "roofRMS", "time s");
+  std::printf("  %-10s %8s %8s %8s %10s %9s %7s %8s\n", "method", "density%", "bad1%", "bad2%",
+              "bad2+unm%", "roofRMS", "edge%", "time s");
   for (const std::string& m : methods) {
     stereo::MatchParams p;
     p.dmin = c.dmin;
     p.dmax = c.dmax;
-    if (m == "sgbm") p.method = "sgbm";
+    if (m == "sgbm") {
+      p.method = "sgbm";
+    } else {
+      core::fromJson(p, overrides);
+    }
     if (m == "square") p.adaptive = false;
     const auto start = std::chrono::steady_clock::now();
     const stereo::MatchResult result = stereo::matchStereo(c.left, c.right, p);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const Row r = score(result.disparity, c, seconds);
-    std::printf("  %-10s %8.1f %8.2f %8.2f %10.2f %9.3f %8.2f\n", m.c_str(), r.density, r.bad1,
-                r.bad2, r.bad2All, r.roofRms, r.seconds);
+    std::printf("  %-10s %8.1f %8.2f %8.2f %10.2f %9.3f %7.1f %8.2f\n", m.c_str(), r.density,
+                r.bad1, r.bad2, r.bad2All, r.roofRms, r.edge, r.seconds);
+    if (!dump.empty() && !c.outline.empty()) {
+      cv::Mat grey;
+      c.left.convertTo(grey, CV_8U);
+      cv::imwrite(dump + "/left.png", grey);
+      dumpErrors(result.disparity, c, dump + "/errors_" + m + ".png");
+    }
   }
 }
 
@@ -119,6 +194,25 @@ Case simulated(int size) {
   c.evaluate = scored / 255;
   c.dmin = scene.disparityMin;
   c.dmax = scene.disparityMax;
+  auto label = [&](int y, int x) {
+    return x >= 0 && x < size ? scene.labels.at<uchar>(y, x) : uchar{255};
+  };
+  for (int y = 0; y < size; ++y) {
+    for (int xb = 0; xb < size; ++xb) {
+      for (const int dir : {-1, 1}) {
+        bool clean = true;
+        for (int k = 0; k < 3 && clean; ++k) {
+          clean = label(y, xb + dir * k) == sim::kLabelBuilding &&
+                  label(y, xb - dir * (k + 1)) == sim::kLabelGround;
+        }
+        if (!clean) continue;
+        const float dRoof = scene.disparity.at<float>(y, xb);
+        const float dGround = scene.disparity.at<float>(y, xb - dir);
+        if (!(std::abs(dRoof - dGround) >= 2.0F)) continue;  // also rejects NaN
+        c.outline.push_back({y, xb, dir, dRoof, dGround});
+      }
+    }
+  }
   return c;
 }
 #endif
@@ -126,14 +220,25 @@ Case simulated(int size) {
 
 cv::Mat readFloat(const fs::path& p) { return io::readGreyFloat(p.string()); }
 
+// Grey values as float without the nodata → NaN conversion: Cones_LEFT/RIGHT.tif declare
+// nodata = 255, which would turn every white pixel into a hole.
+cv::Mat readFloatKeepingNodata(const fs::path& p) {
+  io::ReadOptions keep;
+  keep.type = io::PixelType::Keep;
+  keep.toGrey = true;
+  cv::Mat out;
+  io::readRaster(p.string(), keep).data.convertTo(out, CV_32F);
+  return out;
+}
+
 std::vector<Case> realCases(const fs::path& data) {
   std::vector<Case> cases;
   const fs::path cones = data / "middlebury-cones";
   if (fs::exists(cones / "Cones_LEFT.tif") && fs::exists(cones / "Occlusion_LEFT.png")) {
     Case c;
     c.name = "Middlebury Cones (quarter size)";
-    c.left = readFloat(cones / "Cones_LEFT.tif");
-    c.right = readFloat(cones / "Cones_RIGHT.tif");
+    c.left = readFloatKeepingNodata(cones / "Cones_LEFT.tif");
+    c.right = readFloatKeepingNodata(cones / "Cones_RIGHT.tif");
     c.truth = readFloat(cones / "Cones_LEFT_GT.tif");
     const cv::Mat occ = readFloat(cones / "Occlusion_LEFT.png");
     c.evaluate = (occ > 0) & (c.truth > 0);
@@ -181,6 +286,8 @@ int main(int argc, char** argv) {
   int size = 1000;
   std::string data = "/work/shared/data";
   bool useData = true;
+  std::string dump;
+  nlohmann::json overrides = nlohmann::json::object();
   std::vector<std::string> methods = {"adaptive", "square", "sgbm"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -188,6 +295,10 @@ int main(int argc, char** argv) {
       size = std::atoi(argv[++i]);
     } else if (a == "--data" && i + 1 < argc) {
       data = argv[++i];
+    } else if (a == "--dump" && i + 1 < argc) {
+      dump = argv[++i];
+    } else if (a == "--params" && i + 1 < argc) {
+      overrides = nlohmann::json::parse(argv[++i]);
     } else if (a == "--no-data") {
       useData = false;
     } else if (a == "--methods" && i + 1 < argc) {
@@ -202,7 +313,7 @@ int main(int argc, char** argv) {
       }
     } else {
       std::fprintf(stderr, "usage: bench_stereo [--size N] [--data DIR] [--no-data] "
-                           "[--methods adaptive,square,sgbm]\n");
+                           "[--methods adaptive,square,sgbm] [--dump DIR] [--params JSON]\n");
       return 2;
     }
   }
@@ -210,7 +321,7 @@ int main(int argc, char** argv) {
   std::printf("bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
               "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
 #ifdef DELINEO_BENCH_HAVE_SIM
-  runCase(simulated(size), methods);
+  runCase(simulated(size), methods, dump, overrides);
 #else
   std::printf("simulated scenes: skipped (delineo::sim not built)\n");
 #endif
@@ -218,7 +329,7 @@ int main(int argc, char** argv) {
     if (!fs::exists(data)) {
       std::printf("\nreal datasets: skipped (%s not found)\n", data.c_str());
     } else {
-      for (const Case& c : realCases(data)) runCase(c, methods);
+      for (const Case& c : realCases(data)) runCase(c, methods, "", overrides);
     }
   }
   return 0;

@@ -127,8 +127,9 @@ class LevelMatcher {
     // Pixels a shape never enters: contours and nodata.
     blocked_ = (in.refEdges != 0) | (in.refValid == 0);
     if (s.adaptive) {
-      cv::Mat edges = in.refEdges != 0;
-      cv::dilate(edges, nearEdge_,
+      // Shapes also serve pixels whose window holds nodata or leaves the image (the input is
+      // padded with nodata): S stops there as it stops at contours.
+      cv::dilate(blocked_, nearEdge_,
                  cv::getStructuringElement(cv::MORPH_RECT, cv::Size(s.window, s.window)));
     } else {
       nearEdge_ = cv::Mat::zeros(in.ref.size(), CV_8U);
@@ -173,13 +174,14 @@ class LevelMatcher {
       const int* hi = in_.hi.ptr<int>(y);
       const uchar* ok = refStats_.ok.ptr<uchar>(y);
       const uchar* near = nearEdge_.ptr<uchar>(y);
+      const uchar* refValid = in_.refValid.ptr<uchar>(y);
       for (int x = tile.x; x < tile.br().x; ++x) {
-        if (lo[x] > hi[x] || !ok[x]) continue;
+        if (lo[x] > hi[x] || !refValid[x]) continue;
         if (near[x] && buildShape(x, y, sc.shape)) {
           matchShapePixel(x, y, sc.shape);
           continue;
         }
-        sc.square[static_cast<size_t>(y - tile.y) * tile.width + (x - tile.x)] = 1;
+        if (ok[x]) sc.square[static_cast<size_t>(y - tile.y) * tile.width + (x - tile.x)] = 1;
       }
     }
     matchSquarePixels(tile, sc);
@@ -405,8 +407,18 @@ class LevelMatcher {
   // missing or flat on S.
   float shapeScore(int x, int y, int d, int dy, const ShapeTemplate& t) const {
     const int yb = y + dy, xb = x - d;
-    if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherStats_.ok.at<uchar>(yb, xb)) return kNaN;
+    if (yb < r_ || yb >= H_ - r_ || xb < r_ || xb >= W_ - r_) return kNaN;
     const int w = s_.window;
+    if (!otherStats_.ok.at<uchar>(yb, xb)) {
+      // Window partly nodata (or flat: the variance test below decides): S must avoid nodata.
+      for (int v = t.rowFirst; v <= t.rowLast; ++v) {
+        const uchar* valid = in_.otherValid.ptr<uchar>(yb + v - r_) + xb - r_;
+        const float* m = &t.mask[static_cast<size_t>(v * w)];
+        for (int u = 0; u < w; ++u) {
+          if (m[u] != 0.0F && !valid[u]) return kNaN;
+        }
+      }
+    }
     float accB[32] = {}, accBB[32] = {}, accTB[32] = {};
     for (int v = t.rowFirst; v <= t.rowLast; ++v) {
       const float* b = in_.other.ptr<float>(yb + v - r_) + xb - r_;
@@ -557,8 +569,31 @@ cv::Point2f subpixelPeak(const float s[3][3], bool haveLineNeighbours) {
 
 bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
                 core::Progress* progress) {
-  LevelMatcher matcher(in, settings, out);
-  return matcher.run(progress);
+  // Padding every input by the window radius with nodata lets adaptive shapes serve the pixels
+  // whose window leaves the image (their shape stops at the border), and keeps every window
+  // access inside the buffers.
+  const int r = settings.window / 2;
+  auto pad = [r](const cv::Mat& m, double value) {
+    cv::Mat padded;
+    cv::copyMakeBorder(m, padded, r, r, r, r, cv::BORDER_CONSTANT, cv::Scalar(value));
+    return padded;
+  };
+  LevelInput padded = in;
+  padded.ref = pad(in.ref, 0);
+  padded.other = pad(in.other, 0);
+  padded.refValid = pad(in.refValid, 0);
+  padded.otherValid = pad(in.otherValid, 0);
+  padded.refEdges = pad(in.refEdges, 0);
+  padded.lo = pad(in.lo, 1);  // lo > hi: not searched
+  padded.hi = pad(in.hi, 0);
+  LevelOutput paddedOut;
+  LevelMatcher matcher(padded, settings, paddedOut);
+  if (!matcher.run(progress)) return false;
+  const cv::Rect inner(r, r, in.ref.cols, in.ref.rows);
+  out.disparity = paddedOut.disparity(inner).clone();
+  out.lineShift = paddedOut.lineShift(inner).clone();
+  out.score = paddedOut.score(inner).clone();
+  return true;
 }
 
 }  // namespace delineo::stereo::detail

@@ -39,6 +39,8 @@ int run(const std::vector<std::string>& args) {
   opts.apply(params);
 
   auto& progress = cli::commandProgress();
+  const bool quiet = opts.has("quiet");
+  progress.setQuiet(quiet);
   io::GeoReference geo;
   progress.setStage("reading images");
   const cv::Mat left = io::readGreyFloat(opts.get("left"), &geo);
@@ -57,6 +59,7 @@ int run(const std::vector<std::string>& args) {
 
   io::writeFloatGeoTiff(opts.get("out"), result.disparity, geo);
   if (!opts.get("score").empty()) io::writeFloatGeoTiff(opts.get("score"), result.score, geo);
+  if (quiet) return cli::kExitOk;
   const int valid = cv::countNonZero(result.disparity == result.disparity);
   std::fprintf(stderr, "match: %s, %d level(s), %.1f %% of pixels matched, written to %s\n",
                params.method.c_str(), result.levelsUsed,
