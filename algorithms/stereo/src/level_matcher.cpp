@@ -35,6 +35,8 @@ constexpr int kTileRows = 32;
 constexpr int kTileCols = 64;
 // Steps of the local ascent over line shifts: the dy = ±1 peak lies next to the dy = 0 one.
 constexpr int kMaxAscentSteps = 4;
+// NCC gain a neighbouring line must bring over the current one for the ascent to move there.
+constexpr float kLineShiftGain = 0.05F;
 // Variance (grey levels², images normalised to ~0..255) under which a window is flat: its NCC
 // is meaningless.
 constexpr double kFlatVariance = 0.01;
@@ -485,7 +487,10 @@ class LevelMatcher {
         int bi = 1, bj = 1;
         for (int i = 0; i < 3; ++i) {
           for (int j = 0; j < 3; ++j) {
-            if (s[i][j] > s[bi][bj]) {
+            // Leaving the current line needs a clear gain: on weakly textured surfaces the
+            // neighbouring lines correlate almost as well and noise would pick among them.
+            const float gain = j != 1 ? kLineShiftGain : 0.0F;
+            if (s[i][j] > s[bi][bj] + gain) {
               bi = i;
               bj = j;
             }
@@ -504,11 +509,7 @@ class LevelMatcher {
     if ((cd == lo && lo > in_.dmin) || (cd == hi && hi < in_.dmax)) return;
     float du = 0, dv = 0;
     if (s_.subpixel) {
-      bool lineNeighbours = L_ > 0;
-      for (int i = 0; i < 3; ++i) {
-        if (!std::isfinite(s[i][0]) || !std::isfinite(s[i][2])) lineNeighbours = false;
-      }
-      const cv::Point2f off = subpixelPeak(s, lineNeighbours);
+      const cv::Point2f off = subpixelPeak(s);
       du = off.x;
       dv = off.y;
     }
@@ -529,34 +530,7 @@ class LevelMatcher {
 
 }  // namespace
 
-cv::Point2f subpixelPeak(const float s[3][3], bool haveLineNeighbours) {
-  bool all = haveLineNeighbours;
-  for (int i = 0; i < 3 && all; ++i) {
-    for (int j = 0; j < 3; ++j) all = all && std::isfinite(s[i][j]);
-  }
-  if (all) {
-    // Least-squares quadratic a + b u + c v + e u² + f v² + g uv over the 3x3 grid.
-    double rowSum[3] = {0, 0, 0}, colSum[3] = {0, 0, 0};
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        rowSum[i] += s[i][j];
-        colSum[j] += s[i][j];
-      }
-    }
-    const double b = (rowSum[2] - rowSum[0]) / 6.0;
-    const double c = (colSum[2] - colSum[0]) / 6.0;
-    const double e = (rowSum[2] + rowSum[0] - 2.0 * rowSum[1]) / 6.0;
-    const double f = (colSum[2] + colSum[0] - 2.0 * colSum[1]) / 6.0;
-    const double g = (s[2][2] - s[2][0] - s[0][2] + s[0][0]) / 4.0;
-    const double det = 4.0 * e * f - g * g;
-    if (e < 0 && det > 0) {
-      const double u = (g * c - 2.0 * f * b) / det;
-      const double v = (g * b - 2.0 * e * c) / det;
-      if (std::abs(u) <= 1.0 && std::abs(v) <= 1.0) {
-        return {static_cast<float>(u), static_cast<float>(v)};
-      }
-    }
-  }
+cv::Point2f subpixelPeak(const float s[3][3]) {
   // Separable parabolas through the peak row and column.
   auto parabola = [](float m, float c0, float p) -> float {
     if (!std::isfinite(m) || !std::isfinite(p)) return 0.0F;
