@@ -13,11 +13,12 @@
 // 1 px of xb; no roof-side pixel in the walk counts as missed. edge% = located / outline pixels.
 //
 // Usage: bench_stereo [--size N] [--data DIR] [--methods adaptive,square,sgbm] [--no-data]
-//                     [--dump DIR] [--params JSON]
+//                     [--dump DIR] [--params JSON] [--range N]
 //   --size N   side of the simulated scene (default 1000; the ctest smoke run uses a tiny one)
 //   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
 //   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
 //              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored, white outline.
+//   --range N  search at least N disparities on the simulated scene (dmax raised)
 //   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 #include <chrono>
 #include <cmath>
@@ -297,6 +298,7 @@ int main(int argc, char** argv) {
   std::string data = "/work/shared/data";
   bool useData = true;
   std::string dump;
+  int range = 0;
   nlohmann::json overrides = nlohmann::json::object();
   std::vector<std::string> methods = {"adaptive", "square", "sgbm"};
   for (int i = 1; i < argc; ++i) {
@@ -305,6 +307,8 @@ int main(int argc, char** argv) {
       size = std::atoi(argv[++i]);
     } else if (a == "--data" && i + 1 < argc) {
       data = argv[++i];
+    } else if (a == "--range" && i + 1 < argc) {
+      range = std::atoi(argv[++i]);
     } else if (a == "--dump" && i + 1 < argc) {
       dump = argv[++i];
     } else if (a == "--params" && i + 1 < argc) {
@@ -323,7 +327,7 @@ int main(int argc, char** argv) {
       }
     } else {
       std::fprintf(stderr, "usage: bench_stereo [--size N] [--data DIR] [--no-data] "
-                           "[--methods adaptive,square,sgbm] [--dump DIR] [--params JSON]\n");
+                           "[--methods adaptive,square,sgbm] [--dump DIR] [--params JSON] [--range N]\n");
       return 2;
     }
   }
@@ -331,7 +335,9 @@ int main(int argc, char** argv) {
   std::printf("bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
               "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
 #ifdef DELINEO_BENCH_HAVE_SIM
-  runCase(simulated(size), methods, dump, overrides);
+  Case sim = simulated(size);
+  if (range > sim.dmax - sim.dmin + 1) sim.dmax = sim.dmin + range - 1;
+  runCase(sim, methods, dump, overrides);
 #else
   std::printf("simulated scenes: skipped (delineo::sim not built)\n");
 #endif

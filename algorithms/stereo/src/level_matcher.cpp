@@ -2,8 +2,9 @@
 //
 // The image is cut into tiles; every pixel has its own search interval [lo, hi] (from the
 // coarser level). The main line (dy = 0) is searched over the whole interval, the ±1 line shifts
-// only around its peak (a local ascent on the 2D correlation surface), which costs 6 to a few
-// tens of correlations per pixel instead of 2 × the interval.
+// only around its peak (a local ascent on the 2D correlation surface that starts with the two
+// neighbouring lines at the peak's d), which costs 2 correlations per pixel, a few tens when
+// the ascent moves, instead of 2 × the interval.
 //  - Pixels whose template window holds no contour pixel (or all pixels when adaptive shapes are
 //    off) use a square window. A tile is swept disparity by disparity over the union of those
 //    pixels' intervals: the product image of the tile is box-filtered (running column and row
@@ -102,9 +103,6 @@ struct LinePeak {
 // the indicator M of S. NCC(d, dy) = sum(T * B) / (|S| sd_S(B)).
 struct ShapeTemplate {
   std::vector<float> templ, mask;
-  std::vector<uint32_t> visited;  // == stamp: visited by the current flood fill
-  uint32_t stamp = 0;
-  std::vector<int> queue;
   int rowFirst = 0, rowLast = -1;  // window rows holding part of S
   int count = 0;
 };
@@ -126,8 +124,22 @@ class LevelMatcher {
     refStats_ = windowStats(in.ref, in.refValid, s.window);
     otherStats_ = windowStats(in.other, in.otherValid, s.window);
     cv::multiply(in.other, in.other, otherSq_);
-    // Pixels a shape never enters: contours and nodata.
+    // Pixels a shape never enters: contours and nodata. blockedBits_(y, x): bit u set when
+    // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
     blocked_ = (in.refEdges != 0) | (in.refValid == 0);
+    blockedBits_ = cv::Mat(in.ref.size(), CV_32S, cv::Scalar(0));
+    for (int y = 0; y < H_; ++y) {
+      const uchar* b = blocked_.ptr<uchar>(y);
+      int* bits = blockedBits_.ptr<int>(y);
+      uint32_t word = (1U << s.window) - 1U;  // columns left of the image: blocked
+      for (int x = -r_; x < W_; ++x) {
+        // After this step, word covers columns x - r .. x + r (out of the image: blocked).
+        const int incoming = x + r_;
+        const uint32_t entering = incoming >= W_ || b[incoming] ? 1U : 0U;
+        word = (word >> 1) | (entering << (s.window - 1));
+        if (x >= 0) bits[x] = static_cast<int>(word);
+      }
+    }
     if (s.adaptive) {
       // Shapes also serve pixels whose window holds nodata or leaves the image (the input is
       // padded with nodata): S stops there as it stops at contours.
@@ -179,7 +191,7 @@ class LevelMatcher {
       const uchar* refValid = in_.refValid.ptr<uchar>(y);
       for (int x = tile.x; x < tile.br().x; ++x) {
         if (lo[x] > hi[x] || !refValid[x]) continue;
-        if (near[x] && buildShape(x, y, sc.shape)) {
+        if (near[x] && buildShape(x, y, sc.shape, ok[x] != 0)) {
           matchShapePixel(x, y, sc.shape);
           continue;
         }
@@ -342,40 +354,64 @@ class LevelMatcher {
   // A centre on a contour propagates to both sides (its side is undecidable). Fills the dense
   // template; returns false when the shape is the full square (the square path serves it),
   // smaller than minShape, or flat.
-  bool buildShape(int x, int y, ShapeTemplate& t) const {
+  bool buildShape(int x, int y, ShapeTemplate& t, bool squareServes) const {
     const int w = s_.window;
-    if (t.visited.size() != static_cast<size_t>(n_)) t.visited.assign(static_cast<size_t>(n_), 0);
-    t.queue.resize(static_cast<size_t>(n_));
-    t.mask.assign(static_cast<size_t>(n_), 0.0F);
-    // Visit stamps instead of clearing: one increment per shape.
-    if (++t.stamp == 0) {
-      std::fill(t.visited.begin(), t.visited.end(), 0);
-      t.stamp = 1;
+    const uint32_t full = w == 32 ? ~0U : (1U << w) - 1U;
+    // Bit-parallel flood fill on w-bit rows: a row's reach grows from the rows above and below
+    // and is then filled along the row through free pixels (shift-and-mask doubling, the
+    // "occluded fill" of bitboards), until no row changes.
+    uint32_t free[32], reach[32];
+    int blockedCount = 0;
+    for (int v = 0; v < w; ++v) {
+      free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
+      blockedCount += w - __builtin_popcount(free[v]);
+      reach[v] = 0;
     }
-    const uint32_t stamp = t.stamp;
-    const uchar* blocked = blocked_.ptr<uchar>(y - r_) + (x - r_);
-    const size_t step = blocked_.step1();
-    int head = 0, tail = 0;
-    const int centre = r_ * w + r_;
-    t.visited[static_cast<size_t>(centre)] = stamp;
-    t.queue[static_cast<size_t>(tail++)] = centre;
-    auto visit = [&](int q, int qx, int qy) {
-      if (t.visited[static_cast<size_t>(q)] == stamp) return;
-      t.visited[static_cast<size_t>(q)] = stamp;
-      if (blocked[static_cast<size_t>(qy) * step + static_cast<size_t>(qx)]) return;
-      t.queue[static_cast<size_t>(tail++)] = q;
+    auto fillRow = [full](uint32_t seeds, uint32_t open) {
+      uint32_t up = seeds, g = open;
+      up |= g & (up << 1); g &= g << 1;
+      up |= g & (up << 2); g &= g << 2;
+      up |= g & (up << 4); g &= g << 4;
+      up |= g & (up << 8); g &= g << 8;
+      up |= g & (up << 16);
+      uint32_t down = seeds;
+      g = open;
+      down |= g & (down >> 1); g &= g >> 1;
+      down |= g & (down >> 2); g &= g >> 2;
+      down |= g & (down >> 4); g &= g >> 4;
+      down |= g & (down >> 8); g &= g >> 8;
+      down |= g & (down >> 16);
+      return (up | down) & full;
     };
-    while (head < tail) {
-      const int p = t.queue[static_cast<size_t>(head++)];
-      const int px = p % w, py = p / w;
-      t.mask[static_cast<size_t>(p)] = 1.0F;
-      if (px > 0) visit(p - 1, px - 1, py);
-      if (px < w - 1) visit(p + 1, px + 1, py);
-      if (py > 0) visit(p - w, px, py - 1);
-      if (py < w - 1) visit(p + w, px, py + 1);
+    // The centre belongs to S even on a contour, and propagates to both sides.
+    reach[r_] = fillRow(1U << r_, free[r_]) | (1U << r_);
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (int pass = 0; pass < 2; ++pass) {
+        for (int k = 0; k < w; ++k) {
+          const int v = pass == 0 ? k : w - 1 - k;
+          const uint32_t nb = (v > 0 ? reach[v - 1] : 0U) | (v < w - 1 ? reach[v + 1] : 0U);
+          const uint32_t seeds = (reach[v] | nb) & free[v];
+          if ((seeds & ~reach[v]) == 0) continue;
+          reach[v] |= fillRow(seeds, free[v]);
+          changed = true;
+        }
+      }
     }
-    t.count = tail;
+    t.count = 0;
+    for (int v = 0; v < w; ++v) t.count += __builtin_popcount(reach[v]);
+    // When S is the whole window minus its contour pixels (no part of the window is cut off)
+    // and the square window is usable, the square serves the pixel: the few contour pixels
+    // change its NCC little, and the square path is much cheaper.
+    const bool cut = t.count + blockedCount - ((free[r_] >> r_) & 1U ? 0 : 1) < n_;
+    if (squareServes && !cut) return false;
     if (t.count < s_.minShape || t.count >= n_) return false;
+    t.mask.assign(static_cast<size_t>(n_), 0.0F);
+    for (int v = 0; v < w; ++v) {
+      for (uint32_t bits = reach[v]; bits != 0; bits &= bits - 1) {
+        t.mask[static_cast<size_t>(v * w + __builtin_ctz(bits))] = 1.0F;
+      }
+    }
     double sum = 0, sq = 0;
     t.rowFirst = w;
     t.rowLast = -1;
@@ -477,11 +513,16 @@ class LevelMatcher {
     s[2][1] = peak.above;
     if (L_ > 0) {
       for (int step = 0;; ++step) {
-        for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < 3; ++j) {
-            if (cdy + j - 1 == 0 && step == 0) continue;  // main line known
-            if (i == 1 && j == 1) continue;
-            s[i][j] = at(cd + i - 1, cdy + j - 1);
+        if (step == 0) {
+          // The main line is known; the neighbouring lines at the peak's d decide whether the
+          // ascent leaves it (and give the sub-pixel line shift when it does not).
+          s[1][0] = at(cd, -1);
+          s[1][2] = at(cd, 1);
+        } else {
+          for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) {
+              if (i != 1 || j != 1) s[i][j] = at(cd + i - 1, cdy + j - 1);
+            }
           }
         }
         int bi = 1, bj = 1;
@@ -525,7 +566,8 @@ class LevelMatcher {
   WindowStats refStats_, otherStats_;
   cv::Mat otherSq_;
   cv::Mat nearEdge_;
-  cv::Mat blocked_;  // CV_8U, non-zero on contour and nodata pixels of ref
+  cv::Mat blocked_;      // CV_8U, non-zero on contour and nodata pixels of ref
+  cv::Mat blockedBits_;  // CV_32S, blocked pixels of the window row centred on each pixel
 };
 
 }  // namespace
