@@ -79,6 +79,49 @@ WindowStats windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
   return s;
 }
 
+// Sums over the rows of a shape: Σ M·B, Σ M·B², Σ T·B, with M and T stored as rows of P floats
+// (P a compile-time 16 or 32 ≥ window: fixed-length loops that vectorise fully; the entries
+// past the window are 0, and the images are padded on the right so that reading P columns
+// stays inside them).
+template <int P>
+inline void shapeSums(const float* b, const float* b2, size_t stride, const float* mask,
+                      const float* templ, int rows, float out[3]) {
+  float accB[P] = {}, accBB[P] = {}, accTB[P] = {};
+  for (int v = 0; v < rows; ++v) {
+    const float* bv = b + static_cast<size_t>(v) * stride;
+    const float* qv = b2 + static_cast<size_t>(v) * stride;
+    const float* m = mask + static_cast<size_t>(v) * P;
+    const float* t = templ + static_cast<size_t>(v) * P;
+    for (int u = 0; u < P; ++u) {
+      accB[u] += m[u] * bv[u];
+      accBB[u] += m[u] * qv[u];
+      accTB[u] += t[u] * bv[u];
+    }
+  }
+  float sB = 0, sBB = 0, sTB = 0;
+  for (int u = 0; u < P; ++u) {
+    sB += accB[u];
+    sBB += accBB[u];
+    sTB += accTB[u];
+  }
+  out[0] = sB;
+  out[1] = sBB;
+  out[2] = sTB;
+}
+
+// The hot loop of the adaptive path, also built for AVX2 (picked at run time when the CPU has
+// it).
+__attribute__((target_clones("avx2", "default"))) void shapeSums16(
+    const float* b, const float* b2, size_t stride, const float* mask, const float* templ,
+    int rows, float out[3]) {
+  shapeSums<16>(b, b2, stride, mask, templ, rows, out);
+}
+__attribute__((target_clones("avx2", "default"))) void shapeSums32(
+    const float* b, const float* b2, size_t stride, const float* mask, const float* templ,
+    int rows, float out[3]) {
+  shapeSums<32>(b, b2, stride, mask, templ, rows, out);
+}
+
 // Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
 struct LinePeak {
   float best = kNegInf;
@@ -120,7 +163,7 @@ class LevelMatcher {
  public:
   LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out)
       : in_(in), s_(s), out_(out), W_(in.ref.cols), H_(in.ref.rows), r_(s.window / 2),
-        n_(s.window * s.window), L_(s.lineShift) {
+        n_(s.window * s.window), L_(s.lineShift), rowStride_(s.window <= 16 ? 16 : 32) {
     refStats_ = windowStats(in.ref, in.refValid, s.window);
     otherStats_ = windowStats(in.other, in.otherValid, s.window);
     cv::multiply(in.other, in.other, otherSq_);
@@ -406,36 +449,36 @@ class LevelMatcher {
     const bool cut = t.count + blockedCount - ((free[r_] >> r_) & 1U ? 0 : 1) < n_;
     if (squareServes && !cut) return false;
     if (t.count < s_.minShape || t.count >= n_) return false;
-    t.mask.assign(static_cast<size_t>(n_), 0.0F);
-    for (int v = 0; v < w; ++v) {
-      for (uint32_t bits = reach[v]; bits != 0; bits &= bits - 1) {
-        t.mask[static_cast<size_t>(v * w + __builtin_ctz(bits))] = 1.0F;
-      }
-    }
-    double sum = 0, sq = 0;
+    // Mask, statistics and template straight from the reach bits (no per-cell tests).
+    const int P = rowStride_;
+    t.mask.assign(static_cast<size_t>(w * P), 0.0F);
+    t.templ.assign(static_cast<size_t>(w * P), 0.0F);
+    float sum = 0, sq = 0;  // ≤ 961 values of magnitude ≤ ~128: float is exact enough
     t.rowFirst = w;
     t.rowLast = -1;
     for (int v = 0; v < w; ++v) {
+      if (reach[v] == 0) continue;
+      t.rowFirst = std::min(t.rowFirst, v);
+      t.rowLast = v;
       const float* a = in_.ref.ptr<float>(y + v - r_) + x - r_;
-      const float* m = &t.mask[static_cast<size_t>(v * w)];
-      for (int u = 0; u < w; ++u) {
-        if (m[u] == 0.0F) continue;
+      float* m = &t.mask[static_cast<size_t>(v * P)];
+      for (uint32_t bits = reach[v]; bits != 0; bits &= bits - 1) {
+        const int u = __builtin_ctz(bits);
+        m[u] = 1.0F;
         sum += a[u];
-        sq += static_cast<double>(a[u]) * a[u];
-        t.rowFirst = std::min(t.rowFirst, v);
-        t.rowLast = std::max(t.rowLast, v);
+        sq += a[u] * a[u];
       }
     }
-    const double mean = sum / t.count;
-    const double var = sq / t.count - mean * mean;
-    if (var < kFlatVariance) return false;
-    const double sd = std::sqrt(var);
-    t.templ.assign(static_cast<size_t>(n_), 0.0F);
+    const float mean = sum / static_cast<float>(t.count);
+    const float var = sq / static_cast<float>(t.count) - mean * mean;
+    if (var < static_cast<float>(kFlatVariance)) return false;
+    const float invSd = 1.0F / std::sqrt(var);
     for (int v = t.rowFirst; v <= t.rowLast; ++v) {
       const float* a = in_.ref.ptr<float>(y + v - r_) + x - r_;
-      for (int u = 0; u < w; ++u) {
-        const size_t cell = static_cast<size_t>(v * w + u);
-        if (t.mask[cell] != 0.0F) t.templ[cell] = static_cast<float>((a[u] - mean) / sd);
+      float* tt = &t.templ[static_cast<size_t>(v * P)];
+      for (uint32_t bits = reach[v]; bits != 0; bits &= bits - 1) {
+        const int u = __builtin_ctz(bits);
+        tt[u] = (a[u] - mean) * invSd;
       }
     }
     return true;
@@ -451,30 +494,20 @@ class LevelMatcher {
       // Window partly nodata (or flat: the variance test below decides): S must avoid nodata.
       for (int v = t.rowFirst; v <= t.rowLast; ++v) {
         const uchar* valid = in_.otherValid.ptr<uchar>(yb + v - r_) + xb - r_;
-        const float* m = &t.mask[static_cast<size_t>(v * w)];
+        const float* m = &t.mask[static_cast<size_t>(v * rowStride_)];
         for (int u = 0; u < w; ++u) {
           if (m[u] != 0.0F && !valid[u]) return kNaN;
         }
       }
     }
-    float accB[32] = {}, accBB[32] = {}, accTB[32] = {};
-    for (int v = t.rowFirst; v <= t.rowLast; ++v) {
-      const float* b = in_.other.ptr<float>(yb + v - r_) + xb - r_;
-      const float* b2 = otherSq_.ptr<float>(yb + v - r_) + xb - r_;
-      const float* m = &t.mask[static_cast<size_t>(v * w)];
-      const float* tt = &t.templ[static_cast<size_t>(v * w)];
-      for (int u = 0; u < w; ++u) {
-        accB[u] += m[u] * b[u];
-        accBB[u] += m[u] * b2[u];
-        accTB[u] += tt[u] * b[u];
-      }
-    }
-    float sB = 0, sBB = 0, sTB = 0;
-    for (int u = 0; u < w; ++u) {
-      sB += accB[u];
-      sBB += accBB[u];
-      sTB += accTB[u];
-    }
+    const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
+    const int rows = t.rowLast - t.rowFirst + 1;
+    const int top = yb + t.rowFirst - r_;
+    float sums[3];
+    (rowStride_ == 16 ? shapeSums16 : shapeSums32)(
+        in_.other.ptr<float>(top) + xb - r_, otherSq_.ptr<float>(top) + xb - r_,
+        in_.other.step1(), &t.mask[first], &t.templ[first], rows, sums);
+    const float sB = sums[0], sBB = sums[1], sTB = sums[2];
     const float invCount = 1.0F / static_cast<float>(t.count);
     const float meanB = sB * invCount;
     const float varB = sBB * invCount - meanB * meanB;
@@ -563,6 +596,7 @@ class LevelMatcher {
   const LevelSettings& s_;
   LevelOutput& out_;
   const int W_, H_, r_, n_, L_;
+  const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
   WindowStats refStats_, otherStats_;
   cv::Mat otherSq_;
   cv::Mat nearEdge_;
@@ -588,10 +622,12 @@ bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput
   // Padding every input by the window radius with nodata lets adaptive shapes serve the pixels
   // whose window leaves the image (their shape stops at the border), and keeps every window
   // access inside the buffers.
+  // The right side gets 32 more columns: dense shape rows read up to 32 floats from a window's
+  // left column.
   const int r = settings.window / 2;
   auto pad = [r](const cv::Mat& m, double value) {
     cv::Mat padded;
-    cv::copyMakeBorder(m, padded, r, r, r, r, cv::BORDER_CONSTANT, cv::Scalar(value));
+    cv::copyMakeBorder(m, padded, r, r, r, r + 32, cv::BORDER_CONSTANT, cv::Scalar(value));
     return padded;
   };
   LevelInput padded = in;
