@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
 #include "delineo/stereo/match.hpp"
@@ -66,6 +69,57 @@ TEST(Match, NegativeDisparitiesAndMultiResolution) {
   const Stats s = compare(r.disparity, -17.6, 24);
   EXPECT_GT(s.density, 0.9);
   EXPECT_LT(s.meanAbsError, 0.15);
+}
+
+TEST(Match, AdaptiveShapesMatchTheImageBorder) {
+  // Rows within the window radius of the top and bottom borders: a square window leaves the
+  // image there, an adaptive shape stops at the border.
+  const cv::Mat left = texture({160, 120}, 27);
+  const cv::Mat right = shiftedRight(left, 3.3);
+  MatchParams p;
+  p.dmin = -4;
+  p.dmax = 12;
+  const int r = p.window / 2;
+  auto borderStats = [&](const MatchResult& res) {
+    int matched = 0, total = 0;
+    double error = 0;
+    for (int y = 0; y < left.rows; ++y) {
+      if (y >= r && y < left.rows - r) continue;
+      for (int x = 20; x < left.cols - 20; ++x) {
+        ++total;
+        const float d = res.disparity.at<float>(y, x);
+        if (!std::isfinite(d)) continue;
+        ++matched;
+        error += std::abs(d - 3.3);
+      }
+    }
+    return std::pair{static_cast<double>(matched) / total, matched ? error / matched : 0.0};
+  };
+  const auto [density, meanError] = borderStats(matchStereo(left, right, p));
+  EXPECT_GT(density, 0.8);
+  EXPECT_LT(meanError, 0.2);
+  p.adaptive = false;
+  EXPECT_EQ(borderStats(matchStereo(left, right, p)).first, 0.0);
+}
+
+TEST(Match, LineShiftAbsorbsAVerticalOffset) {
+  // Residual rectification error: the right image is also one line lower.
+  const cv::Mat left = texture({160, 120}, 28, 0.7);  // fine texture: one line matters
+  const cv::Mat shifted = shiftedRight(left, 4.0);
+  cv::Mat right;
+  const cv::Mat down = (cv::Mat_<double>(2, 3) << 1, 0, 0, 0, 1, 1);
+  cv::warpAffine(shifted, right, down, shifted.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  MatchParams p;
+  p.dmin = -4;
+  p.dmax = 12;
+  const Stats withShift = compare(matchStereo(left, right, p).disparity, 4.0, 20);
+  EXPECT_GT(withShift.density, 0.85);
+  EXPECT_LT(withShift.meanAbsError, 0.08);
+  // Without the line search the half-line of misregistration biases the sub-pixel peaks
+  // (measured: mean error 0.15 vs 0.05 px).
+  p.lineShift = 0;
+  const Stats without = compare(matchStereo(left, right, p).disparity, 4.0, 20);
+  EXPECT_GT(without.meanAbsError, 2.0 * withShift.meanAbsError);
 }
 
 TEST(Match, AutoLevelsFollowsThePaper) {
