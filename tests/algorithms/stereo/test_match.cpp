@@ -115,7 +115,7 @@ TEST(Match, LineShiftAbsorbsAVerticalOffset) {
   const Stats withShift = compare(matchStereo(left, right, p).disparity, 4.0, 20);
   EXPECT_GT(withShift.density, 0.85);
   EXPECT_LT(withShift.meanAbsError, 0.08);
-  // Without the line search the half-line of misregistration biases the sub-pixel peaks
+  // Without the line search the one-line misregistration biases the sub-pixel peaks
   // (measured: mean error 0.15 vs 0.05 px).
   p.lineShift = 0;
   const Stats without = compare(matchStereo(left, right, p).disparity, 4.0, 20);
