@@ -78,5 +78,20 @@ if has delineate && [ -s "$scene/footprints_gt.geojson" ] && has rough-init; the
   check delineate_roi_outside 3 "" -- "$cli" delineate --left "$scene/left.tif" --right "$scene/right.tif" --roi 5000,5000,50,50 --roof-disparity 10:20 --out "$work/x.geojson"
 fi
 
+if has simulate; then
+  # Ctrl-C: the command stops at its next progress poll and exits with 130.
+  "$cli" simulate --out "$work/big" --width 3000 --height 3000 --buildings 40 >"$work/sigint.out" 2>"$work/sigint.err" &
+  pid=$!
+  sleep 1
+  kill -INT "$pid"
+  wait "$pid"
+  rc=$?
+  if [ "$rc" -eq 130 ] && grep -qi "canceled" "$work/sigint.err"; then
+    echo "ok   sigint_cancels"; passed=$((passed + 1))
+  else
+    echo "FAIL sigint_cancels: exit $rc"; tail -3 "$work/sigint.err"; failures=$((failures + 1))
+  fi
+fi
+
 echo "$passed passed, $failures failed"
 [ "$failures" -eq 0 ]
