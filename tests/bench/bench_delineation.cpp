@@ -14,6 +14,9 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "delineo/delineation/delineate.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/cost_service.hpp"
@@ -106,10 +109,60 @@ core::Polygon jittered(const core::Polygon& p, std::mt19937& rng, double amount)
   return {p.outer, {}};
 }
 
+// Diagnostic picture of one run: the left image around the ROI (3x), with the true outline in
+// green, the init in blue and the result in red; beside it the same crop of c_roof < c_ground
+// (white: the roof interval matches better).
+void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi,
+                 const DelineationRequest& req, const core::Polygon& truth, const core::Polygon& result) {
+  const int k = 3;
+  cv::Mat crop;
+  cv::normalize(left(roi), crop, 0, 255, cv::NORM_MINMAX, CV_8U);
+  cv::resize(crop, crop, {}, k, k, cv::INTER_NEAREST);
+  cv::cvtColor(crop, crop, cv::COLOR_GRAY2BGR);
+  cv::Mat roofBetter;
+  DelineationRequest r = req;
+  const auto [rs, gs] = costIntervals(r.roof, *r.ground, DelineationParams{}.balanceIntervals);
+  const auto costs = stereo::CorrelationCostService::compute(left, right, roi, std::min(rs.min, gs.min),
+                                                            std::max(rs.max, gs.max), {});
+  if (costs) {
+    const cv::Mat cr = costs->minCost(rs.min, rs.max), cg = costs->minCost(gs.min, gs.max);
+    roofBetter = cr < cg;
+    core::Polygon local = truth;
+    for (auto& v : local.outer) v -= cv::Point2d(roi.tl());
+    for (auto& h : local.holes) for (auto& v : h) v -= cv::Point2d(roi.tl());
+    const cv::Mat inside = core::rasterize(local, roi.size());
+    std::printf("      diag roof %d:%d ground %d:%d  mean c_roof %.3f c_ground %.3f inside truth; outside %.3f %.3f\n",
+                r.roof.min, r.roof.max, r.ground->min, r.ground->max, cv::mean(cr, inside)[0], cv::mean(cg, inside)[0],
+                cv::mean(cr, ~inside)[0], cv::mean(cg, ~inside)[0]);
+    cv::resize(roofBetter, roofBetter, {}, k, k, cv::INTER_NEAREST);
+    cv::cvtColor(roofBetter, roofBetter, cv::COLOR_GRAY2BGR);
+    roofBetter *= 0.6;
+  }
+  auto draw = [&](cv::Mat& img, const core::Polygon& p, cv::Scalar colour) {
+    auto ring = [&](const core::Ring& rg) {
+      std::vector<cv::Point> pts;
+      for (const auto& v : rg) pts.emplace_back(int(std::lround((v.x - roi.x) * k)), int(std::lround((v.y - roi.y) * k)));
+      cv::polylines(img, pts, true, colour, 1);
+    };
+    ring(p.outer);
+    for (const auto& h : p.holes) ring(h);
+  };
+  for (cv::Mat* img : {&crop, &roofBetter}) {
+    if (img->empty()) continue;
+    draw(*img, truth, {0, 200, 0});
+    draw(*img, req.init, {255, 80, 0});
+    draw(*img, result, {0, 0, 255});
+  }
+  cv::Mat both = crop;
+  if (!roofBetter.empty()) cv::hconcat(crop, roofBetter, both);
+  cv::imwrite(path, both);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int scenes = 3, referenceRuns = 3;
+  std::string dumpDir;  // --dump DIR: one diagnostic PNG per run
   sim::SceneParams sceneParams;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--tiny")) {
@@ -121,10 +174,12 @@ int main(int argc, char** argv) {
       sceneParams.trees = 2;
     } else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc) {
       scenes = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) {
+      dumpDir = argv[++i];
     } else if (!std::strcmp(argv[i], "--reference-runs") && i + 1 < argc) {
       referenceRuns = std::atoi(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: bench_delineation [--tiny] [--scenes N] [--reference-runs N]\n");
+      std::fprintf(stderr, "usage: bench_delineation [--tiny] [--scenes N] [--reference-runs N] [--dump DIR]\n");
       return 2;
     }
   }
@@ -165,6 +220,11 @@ int main(int argc, char** argv) {
           std::printf("%-5d %-3d %-9s %-6s %-5s %7.3f %7.2f %7.2f %7.2f %8.1f %5d %5zu\n", sceneParams.seed, id,
                       text(fp, "shape").c_str(), text(fp, "roof_type").c_str(), initName, sc.iou, sc.p1,
                       sc.polis, sc.corner, ms(t0, t1), r.vertexCount, r.polygon.holes.size());
+          if (!dumpDir.empty()) {
+            dumpPicture(dumpDir + "/s" + std::to_string(sceneParams.seed) + "_b" + std::to_string(id) + "_" +
+                            initName + ".png",
+                        left, right, r.roi, req, fp.polygon, r.polygon);
+          }
           if (std::getenv("BENCH_VERBOSE")) {
             const cv::Rect2d a = core::boundingBox(r.polygon.outer), b = core::boundingBox(fp.polygon.outer);
             std::printf("      bbox pred %.1f %.1f %.1f %.1f truth %.1f %.1f %.1f %.1f\n", a.x, a.y, a.br().x,
@@ -180,9 +240,10 @@ int main(int argc, char** argv) {
       req.init = grownBox(fp.polygon, 8);
       try {
         const cv::Rect roi = regionOfInterest(left, right, req, params);
+        const auto [roofSearched, groundSearched] = costIntervals(req.roof, *req.ground, params.balanceIntervals);
         const auto costs = stereo::CorrelationCostService::compute(
-            left, right, roi, std::min(req.roof.min, req.ground->min),
-            std::max(req.roof.max, req.ground->max), stereo::CostParams{params.costWindow, 1.0});
+            left, right, roi, std::min(roofSearched.min, groundSearched.min),
+            std::max(roofSearched.max, groundSearched.max), stereo::CostParams{params.costWindow, 1.0});
         const PreparedEnergy prepared = prepareEnergy(*costs, left, right, req, params);
         ++sideTotal;
         const int expectedSide = number(fp, "roof_disparity_min", 0) > g ? -1 : +1;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include <opencv2/imgproc.hpp>
 
@@ -99,6 +100,23 @@ void normaliseBy99(cv::Mat& gx, cv::Mat& gy) {
 
 }  // namespace
 
+std::pair<DisparityInterval, DisparityInterval> costIntervals(const DisparityInterval& roof,
+                                                              const DisparityInterval& ground,
+                                                              bool balance) {
+  DisparityInterval r = roof, g = ground;
+  if (!balance) return {r, g};
+  const int roofWidth = r.max - r.min + 1, groundWidth = g.max - g.min + 1;
+  const bool roofAbove = r.min + r.max >= g.min + g.max;
+  if (roofWidth < groundWidth) {
+    if (roofAbove) r.max += groundWidth - roofWidth;
+    else r.min -= groundWidth - roofWidth;
+  } else if (groundWidth < roofWidth) {
+    if (roofAbove) g.min -= roofWidth - groundWidth;
+    else g.max += roofWidth - groundWidth;
+  }
+  return {r, g};
+}
+
 cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
                           const DelineationRequest& request, const DelineationParams& params) {
   params.validate();
@@ -167,7 +185,6 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   out.init.outer = polygonise(local, params.initialSpacing, size);
   const cv::Mat initMask = core::rasterize(toPolygon(out.init), size);
 
-  im.roofCost = costs.minCost(request.roof.min, request.roof.max);
   const cv::Mat bestCost = costs.bestCost();
   im.noMatchCost = static_cast<float>(quantile(bestCost, 1.0 - params.occlusionPercent / 100.0));
   if (!std::isfinite(im.noMatchCost)) im.noMatchCost = 1.0f;
@@ -201,7 +218,10 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
     }
     out.groundDisparity = g;
   }
-  im.groundCost = costs.minCost(out.ground.min, out.ground.max);
+  std::tie(out.roofSearched, out.groundSearched) =
+      costIntervals(request.roof, out.ground, params.balanceIntervals);
+  im.roofCost = costs.minCost(out.roofSearched.min, out.roofSearched.max);
+  im.groundCost = costs.minCost(out.groundSearched.min, out.groundSearched.max);
 
   // Roof disparity per pixel: argmin of Crit within the roof interval, median-filtered.
   const int d0 = std::max(request.roof.min, costs.dmin()), d1 = std::min(request.roof.max, costs.dmax());
@@ -286,10 +306,14 @@ DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
   if (request.searchRange) {
     search = *request.searchRange;
   } else if (request.ground) {
-    search = {std::min(request.roof.min, request.ground->min),
-              std::max(request.roof.max, request.ground->max)};
+    const auto [r, g] = costIntervals(request.roof, *request.ground, params.balanceIntervals);
+    search = {std::min(r.min, g.min), std::max(r.max, g.max)};
   } else {
-    search = {request.roof.min - params.groundSearch, request.roof.max};
+    // Ground assumed below the roof, with an interval of 2 * ground-tolerance + 1 disparities.
+    const int below = request.roof.min - params.groundSearch;
+    const auto [r, g] = costIntervals(
+        request.roof, {below, below + 2 * params.groundTolerance}, params.balanceIntervals);
+    search = {std::min(r.min, g.min), std::max(r.max, request.roof.max)};
   }
   if (progress) progress->setStage("correlation costs");
   core::Progress::Range costProgress(progress, 0.0, 0.3);

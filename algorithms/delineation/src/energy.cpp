@@ -277,8 +277,15 @@ PolygonEnergy::RowTerms PolygonEnergy::rowTerms(int y, const std::vector<double>
   return t;
 }
 
-double PolygonEnergy::edgeTerm(cv::Point a, cv::Point b, int which) const {
-  return edgeTermOf(images_, weights_, a, b, which);
+const std::array<double, 2>& PolygonEnergy::edgeTerms(cv::Point a, cv::Point b) const {
+  // Vertices lie in [0, W] x [0, H] (validated moves), so 16 bits per coordinate suffice; the key
+  // keeps the direction so that results are bit-identical to the reference's.
+  const auto coord = [](int v) { return static_cast<std::uint64_t>(static_cast<std::uint16_t>(v)); };
+  const std::uint64_t key = coord(a.x) | coord(a.y) << 16 | coord(b.x) << 32 | coord(b.y) << 48;
+  if (edgeCache_.size() > (1u << 20)) edgeCache_.clear();  // bounded memory on huge runs
+  auto [it, inserted] = edgeCache_.try_emplace(key);
+  if (inserted) it->second = {edgeTermOf(images_, weights_, a, b, 0), edgeTermOf(images_, weights_, a, b, 1)};
+  return it->second;
 }
 
 double PolygonEnergy::vertexPrior(const IntRing& ring, int i) const {
@@ -308,7 +315,7 @@ void PolygonEnergy::rebuild() {
     for (int i = 0; i < n; ++i) {
       const int id = ringOffset_[r] + i;
       const cv::Point a = ring[i], b = ring[(i + 1) % n];
-      edgeTerms_[id] = {edgeTerm(a, b, 0), edgeTerm(a, b, 1)};
+      edgeTerms_[id] = edgeTerms(a, b);
       vertexPriors_[id] = vertexPrior(ring, i);
       forEachCrossing(a, b, size_.height,
                       [&](int y, double x) { rowCrossings_[y].push_back({x, id}); });
@@ -389,7 +396,10 @@ double PolygonEnergy::delta(const Change& c) const {
   for (int e : oldEdges) d -= edgeTerms_[e][0] + edgeTerms_[e][1];
   for (int v : oldVertices) d -= vertexPriors_[v];
   // New edges chain[1]→chain[2] ... chain[m+1]→chain[m+2]; new priors at chain[1..m+2].
-  for (int i = 1; i <= m + 1; ++i) d += edgeTerm(chain[i], chain[i + 1], 0) + edgeTerm(chain[i], chain[i + 1], 1);
+  for (int i = 1; i <= m + 1; ++i) {
+    const auto& e = edgeTerms(chain[i], chain[i + 1]);
+    d += e[0] + e[1];
+  }
   for (int i = 1; i <= m + 2; ++i) {
     d += weights_.rigidity * anglePrior(vertexAngle(chain[i - 1], chain[i], chain[i + 1]));
   }

@@ -2,6 +2,7 @@
 // Building delineation on an epipolar pair: builds the energy images from the correlation cost
 // service and runs the statistical active polygon. Coordinates are left-image pixels.
 #include <optional>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
@@ -40,7 +41,17 @@ struct PreparedEnergy {
   DisparityInterval ground;     // given or estimated
   double groundDisparity = 0;   // representative ground level used for the occlusion band
   double roofDisparity = 0;     // median roof disparity near the initial contour
+  // Intervals the costs c_roof and c_ground were taken over (balanced, see balanceIntervals).
+  DisparityInterval roofSearched, groundSearched;
 };
+
+// The intervals over which c_roof and c_ground are computed. With `balance`, the narrower one is
+// extended, on the side away from the other, to as many disparities as the wider one: the minimum
+// of Crit over more disparities is lower on textureless pixels (noise), which would otherwise
+// make a textureless roof look like ground (or the reverse).
+std::pair<DisparityInterval, DisparityInterval> costIntervals(const DisparityInterval& roof,
+                                                              const DisparityInterval& ground,
+                                                              bool balance);
 
 struct DelineationResult {
   core::Polygon polygon;  // left-image coordinates

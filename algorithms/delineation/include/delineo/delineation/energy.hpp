@@ -8,6 +8,8 @@
 // vertices in [0, W] x [0, H] (pixel corners); a pixel belongs to the polygon when its centre
 // does (same rule as core::rasterize).
 #include <array>
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -111,7 +113,9 @@ class PolygonEnergy {
     int edge;  // edge id: ringOffset[ring] + index of the edge's first vertex
   };
   RowTerms rowTerms(int y, const std::vector<double>& xs) const;
-  double edgeTerm(cv::Point a, cv::Point b, int which) const;  // which: 0 left, 1 right
+  // Left and right edge terms of a→b, memoised: the same candidate edges come back sweep after
+  // sweep, and sampling them is the most expensive part of a candidate's energy.
+  const std::array<double, 2>& edgeTerms(cv::Point a, cv::Point b) const;
   double vertexPrior(const IntRing& ring, int i) const;
   void rebuild();
 
@@ -125,6 +129,7 @@ class PolygonEnergy {
   std::vector<RowTerms> rowTerms_;
   std::vector<std::array<double, 2>> edgeTerms_;  // by edge id
   std::vector<double> vertexPriors_;              // by vertex id (same ids as edges)
+  mutable std::unordered_map<std::uint64_t, std::array<double, 2>> edgeCache_;
 };
 
 }  // namespace delineo::delineation

@@ -19,6 +19,7 @@ struct DelineationParams {
   int ringWidth = 8;               // px, width of the band outside the init used to estimate ground
   bool edgeMoves = true;           // also translate whole edges (two vertices at once)
   bool courtyards = true;          // look for inner courtyards after convergence (holes)
+  bool balanceIntervals = false;   // compare roof and ground costs over equally many disparities
   double minCourtyardArea = 120.0; // px², smallest courtyard tried
   template <class V>
   void visit(V&& v) {
@@ -70,6 +71,11 @@ struct DelineationParams {
     v(core::ParamInfo{"courtyards", "Courtyards", "",
                       "Search for inner courtyards (holes) after convergence"},
       courtyards);
+    v(core::ParamInfo{"balance-intervals", "Balance intervals", "",
+                      "Search the narrower of the roof and ground intervals over as many "
+                      "disparities as the wider one (extended away from the other), so that "
+                      "textureless pixels favour neither"},
+      balanceIntervals);
     v(core::ParamInfo{"min-courtyard-area", "Min courtyard area", "px²",
                       "Smallest interior ground region tried as a courtyard", 16, 1e9},
       minCourtyardArea);
