@@ -31,6 +31,7 @@ int run(const std::vector<std::string>& args) {
   if (!opts.parse(rest)) return cli::kExitOk;
   if (projectPath.empty()) projectPath = opts.get("project");
   auto& progress = cli::commandProgress();
+  progress.setQuiet(opts.has("quiet"));
   if (!opts.get("sample").empty()) {
     if (!projectPath.empty()) throw cli::UsageError("give either PROJECT or --sample, not both");
     progress.setStage("creating the sample scene");

@@ -1,0 +1,124 @@
+#!/usr/bin/env bash
+# End-to-end check of `delineo-cli run PROJECT` on a project with pending buildings: a simulated
+# pair, a project file written here with two rough rectangles (one with a roof interval, one
+# without, so the proposed interval is used), then: the run computes the disparity, delineates
+# both buildings, exports them and saves the project; a second run changes nothing; a corrupt
+# project and a missing image give exit code 3 naming the file.
+# Usage: e2e_run.sh PATH/TO/delineo-cli WORKDIR      (needs jq)
+set -uo pipefail
+cli="$1"
+work="$2"
+rm -rf "$work"
+mkdir -p "$work"
+failures=0
+passed=0
+
+fail() { echo "FAIL $*"; failures=$((failures + 1)); }
+pass() { echo "ok   $*"; passed=$((passed + 1)); }
+
+# run_cli NAME EXPECTED_CODE STDERR_NEEDLE -- command...: exit code and stderr checked.
+run_cli() {
+  local name="$1" want="$2" needle="$3"
+  shift 4
+  "$@" >"$work/$name.out" 2>"$work/$name.err"
+  local rc=$?
+  if [ "$rc" -ne "$want" ]; then
+    fail "$name: exit $rc, expected $want"; sed 's/^/  | /' "$work/$name.err" | tail -8; return 1
+  fi
+  if [ -n "$needle" ] && ! grep -qiF -- "$needle" "$work/$name.err"; then
+    fail "$name: stderr lacks '$needle'"; sed 's/^/  | /' "$work/$name.err" | tail -8; return 1
+  fi
+  pass "$name"
+}
+
+# expect NAME JQ_FILTER FILE: the filter must print "true".
+expect() {
+  local name="$1" filter="$2" file="$3"
+  if [ "$(jq -r "$filter" "$file" 2>/dev/null)" = "true" ]; then pass "$name"; else fail "$name ($filter)"; fi
+}
+
+if ! command -v jq >/dev/null; then echo "e2e_run: jq is required"; exit 1; fi
+for command in simulate rough-init run; do
+  if ! "$cli" --help | grep -q "^  $command "; then
+    echo "e2e_run: this build has no '$command' command; nothing to test"
+    exit 0
+  fi
+done
+
+# ---- the scene and the project --------------------------------------------------------------
+site="$work/site"
+run_cli simulate 0 "" -- "$cli" simulate --out "$site" --seed 5 --width 256 --height 192 --buildings 3 --trees 1 \
+  || exit 1
+run_cli rough_init 0 "" -- "$cli" rough-init --truth "$site/footprints_gt.geojson" --grow 6 --out "$work/init.geojson" \
+  || exit 1
+count=$(jq '.features | length' "$work/init.geojson")
+if [ "$count" -lt 2 ]; then fail "the simulated scene has $count building(s), need 2"; exit 1; fi
+
+# Project file (docs/project-file.md), paths relative to its folder. Building 1 carries a roof
+# interval around its true roof disparities; the others have none (`run` proposes one).
+project="$site/site.delineo.json"
+jq --argjson dmin "$(jq .disparity_min "$site/scene.json")" --argjson dmax "$(jq .disparity_max "$site/scene.json")" '
+  { format: "delineo-project", version: 1, name: "e2e run",
+    images: { left: "left.tif", right: "right.tif" },
+    outputDir: "output",
+    disparityRange: [$dmin, $dmax],
+    heightModel: { groundDisparity: 8.0, metresPerPixel: 0.5, gsd: 0.25 },
+    parameters: {},
+    buildings: [ .features | to_entries[] | {
+      id: (.key + 1),
+      status: "pending",
+      initial: [ .value.geometry.coordinates[0][:-1] ],
+      outline: [],
+      roofInterval: (if .key == 0 then [ (.value.properties.roof_disparity_min | floor) - 1,
+                                         (.value.properties.roof_disparity_max | ceil) + 1 ] else null end),
+      roofHeight: null, energy: null,
+      history: [ { action: "picked", time: "2024-05-01T12:00:00Z", detail: "e2e" } ] } ] }
+' "$work/init.geojson" >"$project"
+expect project_written '.buildings | length >= 2' "$project"
+given_interval=$(jq -c '.buildings[0].roofInterval' "$project")
+
+# ---- first run: matching, both buildings, export, save ----------------------------------------
+run_cli run_first 0 "disparity computed" -- "$cli" run "$project" --quiet
+grep -q "$count building(s) delineated, 0 skipped" "$work/run_first.err" \
+  && pass "run_first delineated $count" || fail "run_first summary: $(tail -1 "$work/run_first.err")"
+grep -q '%$' "$work/run_first.err" && fail "--quiet still printed progress" || pass "--quiet prints no progress"
+[ -s "$site/output/disparity.tif" ] && pass "disparity written" || fail "no output/disparity.tif"
+[ -s "$site/output/buildings.geojson" ] && pass "outlines exported" || fail "no output/buildings.geojson"
+expect export_has_all "(.features | length) == $count" "$site/output/buildings.geojson"
+expect export_statuses '[.features[].properties.status] | all(. == "automatic")' "$site/output/buildings.geojson"
+expect saved_disparity '.images.disparity == "output/disparity.tif"' "$project"
+expect saved_statuses '[.buildings[].status] | all(. == "automatic")' "$project"
+expect saved_outlines '[.buildings[].outline[0] | length] | all(. >= 4)' "$project"
+expect saved_intervals '[.buildings[].roofInterval] | all(. != null and .[0] <= .[1])' "$project"
+expect saved_given_interval_kept ".buildings[0].roofInterval == $given_interval" "$project"
+expect saved_heights '[.buildings[].roofHeight] | all(. != null and . > 2)' "$project"
+expect saved_energy '[.buildings[].energy] | all(. != null)' "$project"
+expect saved_history '[.buildings[].history | map(.action) | index("delineated")] | all(. != null)' "$project"
+# Each outline lies on its building: its vertex centroid is inside the operator's rectangle.
+expect outlines_inside_rectangles '[.buildings[] |
+    (.initial[0] | [(map(.[0]) | min), (map(.[1]) | min), (map(.[0]) | max), (map(.[1]) | max)]) as $box |
+    (.outline[0] | [(map(.[0]) | add / length), (map(.[1]) | add / length)]) as $c |
+    ($c[0] > $box[0] and $c[0] < $box[2] and $c[1] > $box[1] and $c[1] < $box[3])] | all' "$project"
+
+# ---- second run: nothing pending, nothing recomputed ------------------------------------------
+cp "$project" "$work/after_first.json"
+disparity_time=$(stat -c %Y "$site/output/disparity.tif")
+sleep 1
+run_cli run_second 0 "disparity already present; 0 building(s) delineated" -- "$cli" run "$project" --quiet
+cmp -s "$project" "$work/after_first.json" && pass "second run left the project unchanged" \
+  || { fail "second run changed the project"; diff "$work/after_first.json" "$project" | head -10; }
+[ "$(stat -c %Y "$site/output/disparity.tif")" = "$disparity_time" ] && pass "disparity not recomputed" \
+  || fail "second run rewrote the disparity"
+
+# ---- bad projects: exit 3, the message names the file ----------------------------------------
+printf '{"format": "delineo-project", "version": 1, "images": ' >"$work/corrupt.delineo.json"
+run_cli run_corrupt 3 "corrupt.delineo.json" -- "$cli" run "$work/corrupt.delineo.json" --quiet
+jq '.images.right = "gone.tif" | .buildings[0].status = "pending" | .buildings[0].outline = []' \
+  "$project" >"$site/missing.delineo.json"
+run_cli run_missing_image 3 "gone.tif" -- "$cli" run "$site/missing.delineo.json" --quiet
+expect missing_project_untouched '.buildings[0].status == "pending"' "$site/missing.delineo.json"
+run_cli run_no_project 3 "nope.delineo.json" -- "$cli" run "$work/nope.delineo.json" --quiet
+run_cli run_usage 2 "" -- "$cli" run
+
+echo "e2e_run: $passed passed, $failures failed"
+[ "$failures" -eq 0 ]
