@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
@@ -167,4 +169,27 @@ TEST(Delineate, RejectsBadInputs) {
   expectCode(degenerate, core::ErrorCode::InvalidParameter, pair.right);
   expectCode(ok, core::ErrorCode::MismatchedInputs, pair.right(cv::Rect(0, 0, 100, 100)));
   EXPECT_NO_THROW(regionOfInterest(pair.left, pair.right, ok, params));
+}
+
+TEST(Delineate, BalancedCostIntervalsHaveEqualWidthsAndGrowAwayFromEachOther) {
+  // Flat roof above the ground: the roof interval grows upwards to the ground's 7 disparities.
+  auto [roof, ground] = costIntervals({40, 41}, {5, 11}, true);
+  EXPECT_EQ(roof.min, 40);
+  EXPECT_EQ(roof.max, 46);
+  EXPECT_EQ(ground.min, 5);
+  EXPECT_EQ(ground.max, 11);
+  // Gable roof wider than the ground interval: the ground grows downwards.
+  std::tie(roof, ground) = costIntervals({30, 41}, {5, 11}, true);
+  EXPECT_EQ(roof.min, 30);
+  EXPECT_EQ(roof.max, 41);
+  EXPECT_EQ(ground.max - ground.min, roof.max - roof.min);
+  EXPECT_EQ(ground.max, 11);
+  // Roof below the ground (x_right = x_left - d with negative heights): directions reverse.
+  std::tie(roof, ground) = costIntervals({-20, -20}, {0, 4}, true);
+  EXPECT_EQ(roof.min, -24);
+  EXPECT_EQ(roof.max, -20);
+  // Balance off: the intervals are returned as given.
+  std::tie(roof, ground) = costIntervals({40, 41}, {5, 11}, false);
+  EXPECT_EQ(roof.max, 41);
+  EXPECT_EQ(ground.min, 5);
 }

@@ -32,7 +32,7 @@ mean_iou() { tr -d '\n ' <"$1" | grep -Eo '"mean":\{[^}]*\}' | grep -Eo '"iou":[
 above() { awk -v v="$1" -v f="$2" 'BEGIN { exit !(v != "" && v + 0 > f + 0) }'; }
 
 S=$WORK/scene
-# Seed 2 at 320x240 gives 3 buildings (flat L, T and gable shapes).
+# Seed 2 at 320x240 gives 3 flat-roofed buildings (U, rectangle and angled footprints).
 expect_rc simulate 0 "$CLI" simulate --out "$S" --width 320 --height 240 --buildings 3 --trees 2 --seed 2
 expect_rc rough_init 0 "$CLI" rough-init --truth "$S/footprints_gt.geojson" --out "$WORK/init.geojson" --grow 8
 TRUTHS=$(count "$S/footprints_gt.geojson" '"type": "Feature"')
@@ -51,9 +51,9 @@ expect_in "$OUT" '"vertices": [0-9]+' "vertex count is an integer"
 expect_rc eval 0 "$CLI" eval-footprints --pred "$OUT" --truth "$S/footprints_gt.geojson" \
   --json "$WORK/eval.json"
 IOU=$(mean_iou "$WORK/eval.json")
-# Measured 0.953 on this scene (docs/delineation.md); the floor leaves a margin for changes of
-# the simulator's textures or of the optimiser that are not regressions.
-above "$IOU" 0.85 || fail "mean IoU $IOU is not above the floor 0.85"
+# Measured 0.873 on this scene (0.953 with --balance-intervals false); the floor leaves a margin
+# for changes of the simulator's textures or of the optimiser that are not regressions.
+above "$IOU" 0.80 || fail "mean IoU $IOU is not above the floor 0.80"
 expect_in "$WORK/eval.json" "\"matched\": $TRUTHS," "every building matched"
 
 # 2. Feature properties override the flags: wrong flag intervals must not change the result.

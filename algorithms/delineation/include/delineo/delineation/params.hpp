@@ -19,7 +19,7 @@ struct DelineationParams {
   int ringWidth = 8;               // px, width of the band outside the init used to estimate ground
   bool edgeMoves = true;           // also translate whole edges (two vertices at once)
   bool courtyards = true;          // look for inner courtyards after convergence (holes)
-  bool balanceIntervals = false;   // compare roof and ground costs over equally many disparities
+  bool balanceIntervals = true;    // compare roof and ground costs over equally many disparities
   double minCourtyardArea = 120.0; // px², smallest courtyard tried
   template <class V>
   void visit(V&& v) {
