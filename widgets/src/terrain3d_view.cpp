@@ -241,23 +241,44 @@ class Terrain3DView::Scene {
     outlineMapper->SetInputData(lineData);
   }
 
-  void resetCamera() {
+  void resetCamera() { frameRegion(cv::Rect2d(0, 0, dem.cols, dem.rows)); }
+
+  // Frames the box of `region` (DEM pixels) between the lowest and highest finite height in it.
+  void frameRegion(cv::Rect2d region) {
     if (dem.empty()) return;
-    const double w = dem.cols * gsd;
-    const double h = dem.rows * gsd;
-    const double zMid = 0.5 * (heightMin + heightMax) * exaggeration;
-    const double cx = w / 2.0;
-    const double cy = -h / 2.0;
-    const double extent = std::max(w, h);
+    region &= cv::Rect2d(0, 0, dem.cols, dem.rows);
+    if (region.width < 1 || region.height < 1) region = cv::Rect2d(0, 0, dem.cols, dem.rows);
+    const cv::Rect pixels = cv::Rect(static_cast<int>(region.x), static_cast<int>(region.y),
+                                     std::max(1, static_cast<int>(std::ceil(region.width))),
+                                     std::max(1, static_cast<int>(std::ceil(region.height)))) &
+                            cv::Rect(0, 0, dem.cols, dem.rows);
+    auto [lo, hi] = finiteRange(dem(pixels));
+    if (std::isnan(lo)) {
+      lo = heightMin;
+      hi = heightMax;
+    }
+    for (const BuildingOutline& b : buildings) {
+      const cv::Rect2d box = core::boundingBox(b.polygon.outer);
+      if ((box & region).area() > 0) hi = std::max(hi, b.topHeight);
+    }
+    const double bounds[6] = {region.x * gsd, (region.x + region.width) * gsd,
+                              -(region.y + region.height) * gsd, -region.y * gsd,
+                              lo * exaggeration, hi * exaggeration};
+    const double cx = 0.5 * (bounds[0] + bounds[1]);
+    const double cy = 0.5 * (bounds[2] + bounds[3]);
+    const double cz = 0.5 * (bounds[4] + bounds[5]);
     vtkCamera* camera = renderer->GetActiveCamera();
     // Looking north from the south, 40° above the horizon: relief reads well with Z up.
-    camera->SetFocalPoint(cx, cy, zMid);
-    camera->SetPosition(cx, cy - 1.1 * extent, zMid + 0.95 * extent);
+    camera->SetFocalPoint(cx, cy, cz);
+    camera->SetPosition(cx, cy - std::cos(kElevation), cz + std::sin(kElevation));
     camera->SetViewUp(0, 0, 1);
-    renderer->ResetCamera();
-    camera->Zoom(1.25);
+    // Fits the box's bounding sphere: the whole region stays visible whatever the aspect ratio;
+    // a sphere is loose around a flat box, so come a little closer.
+    renderer->ResetCamera(bounds);
+    camera->Dolly(1.2);
     renderer->ResetCameraClippingRange();
   }
+  static constexpr double kElevation = 40.0 * 3.14159265358979323846 / 180.0;
 
   vtkNew<vtkRenderer> renderer;
   vtkNew<vtkActor> surfaceActor;
@@ -628,6 +649,35 @@ void Terrain3DView::setVerticalExaggeration(double factor) {
 void Terrain3DView::resetCamera() {
   scene_->resetCamera();
   sceneChanged();
+}
+
+void Terrain3DView::frameRegion(const cv::Rect2d& demPixels) {
+  scene_->frameRegion(demPixels);
+  sceneChanged();
+}
+
+double Terrain3DView::verticalExaggeration() const { return scene_->exaggeration; }
+
+double Terrain3DView::suggestedExaggeration(const cv::Mat& dem, double gsd) {
+  if (dem.empty() || gsd <= 0) return 1.0;
+  cv::Mat heights;
+  dem.convertTo(heights, CV_32F);
+  std::vector<float> values;
+  const int step = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(dem.total()) / 40000.0)));
+  for (int y = 0; y < heights.rows; y += step) {
+    const float* row = heights.ptr<float>(y);
+    for (int x = 0; x < heights.cols; x += step) {
+      if (std::isfinite(row[x])) values.push_back(row[x]);
+    }
+  }
+  if (values.size() < 2) return 1.0;
+  // The full range: a few buildings are a small share of a DEM, but they are the relief.
+  const auto [lowest, highest] = std::minmax_element(values.begin(), values.end());
+  const double relief = *highest - *lowest;
+  const double extent = std::max(dem.cols, dem.rows) * gsd;
+  if (relief <= 0) return 5.0;
+  const double factor = std::clamp(0.1 * extent / relief, 1.0, 5.0);
+  return std::round(factor * 2.0) / 2.0;
 }
 
 cv::Size Terrain3DView::displayedGridSize() const {

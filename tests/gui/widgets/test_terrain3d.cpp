@@ -97,3 +97,58 @@ TEST(Terrain3DView, RendersTheDemWithTheBackendOfThePlatform) {
   delineo::widgets::test::saveImage(textured, offscreen ? QStringLiteral("terrain3d_offscreen_textured")
                                                         : QStringLiteral("terrain3d_glwidget_textured"));
 }
+
+namespace {
+// Share of the image in yellow (the top of the viridis map): neither the purple low end nor the
+// grey-blue background are.
+double yellowShare(const QImage& image) {
+  int n = 0;
+  for (int y = 0; y < image.height(); ++y) {
+    for (int x = 0; x < image.width(); ++x) {
+      const QColor c(image.pixel(x, y));
+      if (c.red() > 110 && c.green() > 110 && c.blue() < 0.6 * std::min(c.red(), c.green())) ++n;
+    }
+  }
+  return static_cast<double>(n) / (image.width() * image.height());
+}
+}  // namespace
+
+TEST(Terrain3DView, FramesARegionAndSuggestsAnExaggeration) {
+  Terrain3DView view;
+  view.resize(400, 300);
+  view.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  // Flat ground at 0 m with one 10 m block in a corner, coloured by height.
+  cv::Mat dem(400, 400, CV_32F, cv::Scalar(0.0f));
+  dem(cv::Rect(300, 40, 40, 40)).setTo(10.0f);
+  view.setDem(dem, 0.25);
+  view.setColourMap(delineo::widgets::ColourMap::Viridis);
+  view.resetCamera();
+  QTest::qWait(50);
+  const QImage whole = view.renderImage().convertToFormat(QImage::Format_RGB32);
+  view.frameRegion(cv::Rect2d(280, 20, 80, 80));
+  QTest::qWait(50);
+  const QImage framed = view.renderImage().convertToFormat(QImage::Format_RGB32);
+  const double wholeShare = yellowShare(whole);
+  const double framedShare = yellowShare(framed);
+  delineo::widgets::test::saveImage(framed, QStringLiteral("terrain3d_framed"));
+  // The block is 1 % of the DEM; framed on it with as much again around, it fills the view.
+  EXPECT_LT(wholeShare, 0.05);
+  EXPECT_GT(framedShare, 0.10);
+  EXPECT_GT(framedShare, 4 * wholeShare);
+  // A region outside the DEM frames the whole DEM again.
+  view.frameRegion(cv::Rect2d(5000, 5000, 10, 10));
+  QTest::qWait(50);
+  EXPECT_LT(countDifferent(view.renderImage().convertToFormat(QImage::Format_RGB32), whole),
+            whole.width() * whole.height() / 100);
+
+  // Town: 10 m over 100 m is readable as it is; gentle terrain gets exaggerated, within 5.
+  EXPECT_DOUBLE_EQ(Terrain3DView::suggestedExaggeration(dem, 0.25), 1.0);
+  EXPECT_DOUBLE_EQ(Terrain3DView::suggestedExaggeration(dem, 0.5), 2.0);
+  cv::Mat gentle(200, 200, CV_32F);
+  for (int y = 0; y < gentle.rows; ++y)
+    for (int x = 0; x < gentle.cols; ++x) gentle.at<float>(y, x) = static_cast<float>(0.02 * x);  // 4 m over 200 m
+  EXPECT_DOUBLE_EQ(Terrain3DView::suggestedExaggeration(gentle, 1.0), 5.0);
+  EXPECT_DOUBLE_EQ(Terrain3DView::suggestedExaggeration(gentle, 0.5), 2.5);
+  EXPECT_DOUBLE_EQ(Terrain3DView::suggestedExaggeration(cv::Mat(), 1.0), 1.0);
+}

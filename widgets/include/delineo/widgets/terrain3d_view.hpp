@@ -50,7 +50,16 @@ class Terrain3DView : public QWidget {
   void setColourMap(ColourMap map);
   void setBuildings(const std::vector<BuildingOutline>& buildings);
   void setVerticalExaggeration(double factor);
+  double verticalExaggeration() const;
+  // A vertical exaggeration that makes the relief readable: 1 when the height range (lowest to
+  // highest finite height) is at least a tenth of the DEM's horizontal extent (towns: buildings
+  // carry the relief), more for flat terrain (up to 5), in steps of 0.5.
+  static double suggestedExaggeration(const cv::Mat& dem, double gsd);
+  // Looks at the whole DEM from the south, 40° above the horizon.
   void resetCamera();
+  // Same viewing direction, framed on a region of the DEM (pixels) and its heights, e.g. the
+  // selected building with some surroundings. An empty or outside region frames the whole DEM.
+  void frameRegion(const cv::Rect2d& demPixels);
 
   // Grid actually displayed (after subsampling); {0, 0} without a DEM.
   cv::Size displayedGridSize() const;
