@@ -122,6 +122,206 @@ __attribute__((target_clones("avx2", "default"))) void shapeSums32(
   shapeSums<32>(b, b2, stride, mask, templ, rows, out);
 }
 
+// The same sums for K consecutive disparities at once (16-float rows, windows ≤ 16): the k-th
+// reads the other image k columns further left (x_other = x - d). The shape rows are loaded
+// once for the K windows, B² is formed on the fly, and the 16 lanes of a row are folded into 8
+// accumulators: K x 3 accumulators stay in registers.
+using Float8 = float __attribute__((vector_size(32)));
+
+// By reference: returning a 32-byte vector from a function built without AVX changes the ABI.
+__attribute__((always_inline)) inline void load8(Float8& v, const float* p) { __builtin_memcpy(&v, p, sizeof v); }
+
+template <int K>
+__attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t stride, const float* mask, const float* templ,
+                           int rows, float out[][3]) {
+  Float8 accB[K], accBB[K], accTB[K];
+  for (int k = 0; k < K; ++k) accB[k] = accBB[k] = accTB[k] = Float8{};
+  for (int v = 0; v < rows; ++v) {
+    const float* bv = b + static_cast<size_t>(v) * stride;
+    const float* m = mask + static_cast<size_t>(v) * 16;
+    const float* t = templ + static_cast<size_t>(v) * 16;
+    Float8 m0, m1, t0, t1;
+    load8(m0, m);
+    load8(m1, m + 8);
+    load8(t0, t);
+    load8(t1, t + 8);
+    for (int k = 0; k < K; ++k) {
+      Float8 b0, b1;
+      load8(b0, bv - k);
+      load8(b1, bv - k + 8);
+      const Float8 mb0 = m0 * b0, mb1 = m1 * b1;
+      accB[k] += mb0 + mb1;
+      accBB[k] += mb0 * b0 + mb1 * b1;
+      accTB[k] += t0 * b0 + t1 * b1;
+    }
+  }
+  for (int k = 0; k < K; ++k) {
+    float sB = 0, sBB = 0, sTB = 0;
+    for (int u = 0; u < 8; ++u) {
+      sB += accB[k][u];
+      sBB += accBB[k][u];
+      sTB += accTB[k][u];
+    }
+    out[k][0] = sB;
+    out[k][1] = sBB;
+    out[k][2] = sTB;
+  }
+}
+
+constexpr int kBatch = 4;
+__attribute__((target_clones("avx2", "default"))) void shapeSums16Batch(
+    const float* b, size_t stride, const float* mask, const float* templ, int rows,
+    float out[][3]) {
+  shapeSumsBatch<kBatch>(b, stride, mask, templ, rows, out);
+}
+
+// Bit count without the library call the baseline x86-64 target makes of __builtin_popcount.
+inline int popcount64(uint64_t v) {
+  v = v - ((v >> 1) & 0x5555555555555555ULL);
+  v = (v & 0x3333333333333333ULL) + ((v >> 2) & 0x3333333333333333ULL);
+  v = (v + (v >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
+  return static_cast<int>((v * 0x0101010101010101ULL) >> 56);
+}
+
+// Dense rows of a shape (16 floats per row): mask M = 1 on S, and the sums Σ_S A, Σ_S A².
+// Fixed-length loops over the row bits, so the whole build vectorises.
+__attribute__((always_inline)) inline void denseMaskRows(const uint32_t* bits, int rows,
+                                                         const float* a, size_t stride,
+                                                         float* mask, float sums[2]) {
+  float acc[16] = {}, acc2[16] = {};
+  for (int v = 0; v < rows; ++v) {
+    const float* av = a + static_cast<size_t>(v) * stride;
+    float* m = mask + static_cast<size_t>(v) * 16;
+    for (int u = 0; u < 16; ++u) {
+      const float mk = (bits[v] >> u) & 1U ? 1.0F : 0.0F;
+      m[u] = mk;
+      const float val = mk * av[u];
+      acc[u] += val;
+      acc2[u] += val * av[u];
+    }
+  }
+  float s0 = 0, s1 = 0;
+  for (int u = 0; u < 16; ++u) {
+    s0 += acc[u];
+    s1 += acc2[u];
+  }
+  sums[0] = s0;
+  sums[1] = s1;
+}
+__attribute__((target_clones("avx2", "default"))) void maskRows16(const uint32_t* bits, int rows,
+                                                                 const float* a, size_t stride,
+                                                                 float* mask, float sums[2]) {
+  denseMaskRows(bits, rows, a, stride, mask, sums);
+}
+// Template rows T = M (A - mean) / sd.
+__attribute__((target_clones("avx2", "default"))) void templateRows16(
+    const float* mask, int rows, const float* a, size_t stride, float mean, float invSd,
+    float* templ) {
+  for (int v = 0; v < rows; ++v) {
+    const float* av = a + static_cast<size_t>(v) * stride;
+    const float* m = mask + static_cast<size_t>(v) * 16;
+    float* t = templ + static_cast<size_t>(v) * 16;
+    for (int u = 0; u < 16; ++u) t[u] = m[u] * ((av[u] - mean) * invSd);
+  }
+}
+
+// A window of ≤ 15 columns as one 256-bit board: row v in bits 16v .. 16v + 14 (of four 64-bit
+// words), bit 16v + 15 always 0. That zero separator stops horizontal shifts at the row ends,
+// so a flood fill runs on the whole window at once: runs along rows by shift-and-mask doubling
+// (shifts 1..8), runs along columns the same way with shifts of 16..128 bits.
+struct Board {
+  uint64_t w[4] = {0, 0, 0, 0};
+
+  friend Board operator&(const Board& a, const Board& b) {
+    Board r;
+    for (int i = 0; i < 4; ++i) r.w[i] = a.w[i] & b.w[i];
+    return r;
+  }
+  friend Board operator|(const Board& a, const Board& b) {
+    Board r;
+    for (int i = 0; i < 4; ++i) r.w[i] = a.w[i] | b.w[i];
+    return r;
+  }
+  friend bool operator==(const Board& a, const Board& b) {
+    return ((a.w[0] ^ b.w[0]) | (a.w[1] ^ b.w[1]) | (a.w[2] ^ b.w[2]) | (a.w[3] ^ b.w[3])) == 0;
+  }
+  // Towards higher columns (within each row; bits leaving a word cross a separator anyway).
+  Board right(int k) const {
+    Board r;
+    for (int i = 0; i < 4; ++i) r.w[i] = w[i] << k;
+    return r;
+  }
+  Board left(int k) const {
+    Board r;
+    for (int i = 0; i < 4; ++i) r.w[i] = w[i] >> k;
+    return r;
+  }
+  // Towards higher rows by n rows (n = 1, 2: inside and across words; 4, 8: whole words).
+  Board down(int n) const {
+    Board r;
+    if (n >= 4) {
+      const int q = n / 4;
+      for (int i = 3; i >= 0; --i) r.w[i] = i >= q ? w[i - q] : 0;
+      return r;
+    }
+    const int b = 16 * n;
+    r.w[0] = w[0] << b;
+    for (int i = 1; i < 4; ++i) r.w[i] = (w[i] << b) | (w[i - 1] >> (64 - b));
+    return r;
+  }
+  Board up(int n) const {
+    Board r;
+    if (n >= 4) {
+      const int q = n / 4;
+      for (int i = 0; i < 4; ++i) r.w[i] = i + q < 4 ? w[i + q] : 0;
+      return r;
+    }
+    const int b = 16 * n;
+    for (int i = 0; i < 3; ++i) r.w[i] = (w[i] >> b) | (w[i + 1] << (64 - b));
+    r.w[3] = w[3] >> b;
+    return r;
+  }
+  int count() const {
+    return popcount64(w[0]) + popcount64(w[1]) + popcount64(w[2]) + popcount64(w[3]);
+  }
+  uint32_t row(int v) const { return static_cast<uint32_t>(w[v >> 2] >> (16 * (v & 3))) & 0xFFFFU; }
+  void setRow(int v, uint32_t bits) { w[v >> 2] |= static_cast<uint64_t>(bits) << (16 * (v & 3)); }
+};
+
+// The 4-connected component of `seed` inside `open` (seed ⊂ open).
+inline Board floodFill(Board seed, const Board& open) {
+  for (;;) {
+    const Board before = seed;
+    // Along rows, both directions, then along columns, both directions (doubling).
+    Board a = seed, g = open;
+    for (int k = 1; k <= 8; k *= 2) {
+      a = a | (g & a.right(k));
+      g = g & g.right(k);
+    }
+    Board b = seed;
+    g = open;
+    for (int k = 1; k <= 8; k *= 2) {
+      b = b | (g & b.left(k));
+      g = g & g.left(k);
+    }
+    seed = a | b;
+    a = seed;
+    g = open;
+    for (int n = 1; n <= 8; n *= 2) {
+      a = a | (g & a.down(n));
+      g = g & g.down(n);
+    }
+    b = seed;
+    g = open;
+    for (int n = 1; n <= 8; n *= 2) {
+      b = b | (g & b.up(n));
+      g = g & g.up(n);
+    }
+    seed = a | b;
+    if (seed == before) return seed;
+  }
+}
+
 // Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
 struct LinePeak {
   float best = kNegInf;
@@ -391,25 +591,11 @@ class LevelMatcher {
 
   // ---- adaptive shapes -------------------------------------------------------------------
 
-  // Window pixels 4-connected to the centre without crossing a contour pixel. Contour pixels
-  // themselves are left out: a step edge's contour pixel usually carries the brighter side's
-  // grey level, and keeping it would let the step dominate the correlation of the other side.
-  // A centre on a contour propagates to both sides (its side is undecidable). Fills the dense
-  // template; returns false when the shape is the full square (the square path serves it),
-  // smaller than minShape, or flat.
-  bool buildShape(int x, int y, ShapeTemplate& t, bool squareServes) const {
+  // Windows wider than 15 columns: the same fill on one word per row (a row's reach grows
+  // from the rows above and below, then along the row by doubling), until no row changes.
+  void fillRows(const uint32_t* free, uint32_t* reach) const {
     const int w = s_.window;
     const uint32_t full = w == 32 ? ~0U : (1U << w) - 1U;
-    // Bit-parallel flood fill on w-bit rows: a row's reach grows from the rows above and below
-    // and is then filled along the row through free pixels (shift-and-mask doubling, the
-    // "occluded fill" of bitboards), until no row changes.
-    uint32_t free[32], reach[32];
-    int blockedCount = 0;
-    for (int v = 0; v < w; ++v) {
-      free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
-      blockedCount += w - __builtin_popcount(free[v]);
-      reach[v] = 0;
-    }
     auto fillRow = [full](uint32_t seeds, uint32_t open) {
       uint32_t up = seeds, g = open;
       up |= g & (up << 1); g &= g << 1;
@@ -441,44 +627,94 @@ class LevelMatcher {
         }
       }
     }
-    t.count = 0;
-    for (int v = 0; v < w; ++v) t.count += __builtin_popcount(reach[v]);
+  }
+
+  // Window pixels 4-connected to the centre without crossing a contour pixel. Contour pixels
+  // themselves are left out: a step edge's contour pixel usually carries the brighter side's
+  // grey level, and keeping it would let the step dominate the correlation of the other side.
+  // A centre on a contour propagates to both sides (its side is undecidable). Fills the dense
+  // template; returns false when the shape is the full square (the square path serves it),
+  // smaller than minShape, or flat.
+  bool buildShape(int x, int y, ShapeTemplate& t, bool squareServes) const {
+    const int w = s_.window;
+    const uint32_t full = w == 32 ? ~0U : (1U << w) - 1U;
+    // Bit-parallel flood fill on w-bit rows: a row's reach grows from the rows above and below
+    // and is then filled along the row through free pixels (shift-and-mask doubling, the
+    // "occluded fill" of bitboards), until no row changes.
+    uint32_t free[32], reach[32];
+    int blockedCount = 0;
+    if (w <= 15) {
+      // The centre belongs to S even on a contour: it is open for the fill.
+      Board open, seed;
+      for (int v = 0; v < w; ++v) {
+        free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
+        open.setRow(v, free[v]);
+      }
+      blockedCount = n_ - open.count();
+      seed.setRow(r_, 1U << r_);
+      const Board s = floodFill(seed, open | seed);
+      for (int v = 0; v < w; ++v) reach[v] = s.row(v);
+      t.count = s.count();
+    } else {
+      for (int v = 0; v < w; ++v) {
+        free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
+        blockedCount += w - __builtin_popcount(free[v]);
+        reach[v] = 0;
+      }
+      fillRows(free, reach);
+      t.count = 0;
+      for (int v = 0; v < w; ++v) t.count += __builtin_popcount(reach[v]);
+    }
     // When S is the whole window minus its contour pixels (no part of the window is cut off)
     // and the square window is usable, the square serves the pixel: the few contour pixels
     // change its NCC little, and the square path is much cheaper.
     const bool cut = t.count + blockedCount - ((free[r_] >> r_) & 1U ? 0 : 1) < n_;
     if (squareServes && !cut) return false;
     if (t.count < s_.minShape || t.count >= n_) return false;
-    // Mask, statistics and template straight from the reach bits (no per-cell tests).
     const int P = rowStride_;
-    t.mask.assign(static_cast<size_t>(w * P), 0.0F);
-    t.templ.assign(static_cast<size_t>(w * P), 0.0F);
+    t.rowFirst = 0;
+    while (reach[t.rowFirst] == 0) ++t.rowFirst;  // the centre row is never empty
+    t.rowLast = w - 1;
+    while (reach[t.rowLast] == 0) --t.rowLast;
+    const int rows = t.rowLast - t.rowFirst + 1;
+    t.mask.resize(static_cast<size_t>(w * P));
+    t.templ.resize(static_cast<size_t>(w * P));
+    float* mask = &t.mask[static_cast<size_t>(t.rowFirst * P)];
+    float* templ = &t.templ[static_cast<size_t>(t.rowFirst * P)];
+    const float* a = in_.ref.ptr<float>(y + t.rowFirst - r_) + x - r_;
+    const size_t stride = in_.ref.step1();
     float sum = 0, sq = 0;  // ≤ 961 values of magnitude ≤ ~128: float is exact enough
-    t.rowFirst = w;
-    t.rowLast = -1;
-    for (int v = 0; v < w; ++v) {
-      if (reach[v] == 0) continue;
-      t.rowFirst = std::min(t.rowFirst, v);
-      t.rowLast = v;
-      const float* a = in_.ref.ptr<float>(y + v - r_) + x - r_;
-      float* m = &t.mask[static_cast<size_t>(v * P)];
-      for (uint32_t bits = reach[v]; bits != 0; bits &= bits - 1) {
-        const int u = __builtin_ctz(bits);
-        m[u] = 1.0F;
-        sum += a[u];
-        sq += a[u] * a[u];
+    if (P == 16) {
+      // Dense, vectorised rows (only rows rowFirst..rowLast are ever read).
+      float sums[2];
+      maskRows16(&reach[t.rowFirst], rows, a, stride, mask, sums);
+      sum = sums[0];
+      sq = sums[1];
+    } else {
+      std::fill(mask, mask + static_cast<size_t>(rows * P), 0.0F);
+      for (int v = 0; v < rows; ++v) {
+        const float* av = a + static_cast<size_t>(v) * stride;
+        float* m = mask + static_cast<size_t>(v * P);
+        for (uint32_t bits = reach[t.rowFirst + v]; bits != 0; bits &= bits - 1) {
+          const int u = __builtin_ctz(bits);
+          m[u] = 1.0F;
+          sum += av[u];
+          sq += av[u] * av[u];
+        }
       }
     }
     const float mean = sum / static_cast<float>(t.count);
     const float var = sq / static_cast<float>(t.count) - mean * mean;
     if (var < static_cast<float>(kFlatVariance)) return false;
     const float invSd = 1.0F / std::sqrt(var);
-    for (int v = t.rowFirst; v <= t.rowLast; ++v) {
-      const float* a = in_.ref.ptr<float>(y + v - r_) + x - r_;
-      float* tt = &t.templ[static_cast<size_t>(v * P)];
-      for (uint32_t bits = reach[v]; bits != 0; bits &= bits - 1) {
-        const int u = __builtin_ctz(bits);
-        tt[u] = (a[u] - mean) * invSd;
+    if (P == 16) {
+      templateRows16(mask, rows, a, stride, mean, invSd, templ);
+    } else {
+      for (int v = 0; v < rows; ++v) {
+        const float* av = a + static_cast<size_t>(v) * stride;
+        const float* m = mask + static_cast<size_t>(v * P);
+        float* tt = templ + static_cast<size_t>(v * P);
+        for (int u = 0; u < P; ++u) tt[u] = m[u] * ((av[u] - mean) * invSd);
       }
     }
     return true;
@@ -507,19 +743,51 @@ class LevelMatcher {
     (rowStride_ == 16 ? shapeSums16 : shapeSums32)(
         in_.other.ptr<float>(top) + xb - r_, otherSq_.ptr<float>(top) + xb - r_,
         in_.other.step1(), &t.mask[first], &t.templ[first], rows, sums);
+    return scoreFromSums(sums, t.count);
+  }
+
+  static float scoreFromSums(const float sums[3], int count) {
     const float sB = sums[0], sBB = sums[1], sTB = sums[2];
-    const float invCount = 1.0F / static_cast<float>(t.count);
+    const float invCount = 1.0F / static_cast<float>(count);
     const float meanB = sB * invCount;
     const float varB = sBB * invCount - meanB * meanB;
     if (varB < static_cast<float>(kFlatVariance)) return kNaN;
     return sTB * invCount / std::sqrt(varB);
   }
 
+  // Main-line scores for d .. d + kBatch - 1 in one pass over the shape; false when one of the
+  // windows is not a plain inside-the-image, nodata-free one (then scored one by one).
+  bool shapeScoresBatch(int x, int y, int d, const ShapeTemplate& t, float* scores) const {
+    if (rowStride_ != 16) return false;
+    const int xb = x - d;
+    if (y < r_ || y >= H_ - r_ || xb - (kBatch - 1) < r_ || xb >= W_ - r_) return false;
+    const uchar* ok = otherStats_.ok.ptr<uchar>(y);
+    for (int k = 0; k < kBatch; ++k) {
+      if (!ok[xb - k]) return false;
+    }
+    const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
+    const int top = y + t.rowFirst - r_;
+    float sums[kBatch][3];
+    shapeSums16Batch(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
+                     &t.templ[first], t.rowLast - t.rowFirst + 1, sums);
+    for (int k = 0; k < kBatch; ++k) scores[k] = scoreFromSums(sums[k], t.count);
+    return true;
+  }
+
   void matchShapePixel(int x, int y, const ShapeTemplate& t) {
     LinePeak peak;
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
-    for (int d = lo; d <= hi; ++d) peak.update(d, shapeScore(x, y, d, 0, t));
-    finish(x, y, peak, [&](int d, int dy) { return shapeScore(x, y, d, dy, t); });
+    int d = lo;
+    float batch[kBatch];
+    for (; d + kBatch - 1 <= hi; d += kBatch) {
+      if (shapeScoresBatch(x, y, d, t, batch)) {
+        for (int k = 0; k < kBatch; ++k) peak.update(d + k, batch[k]);
+      } else {
+        for (int k = 0; k < kBatch; ++k) peak.update(d + k, shapeScore(x, y, d + k, 0, t));
+      }
+    }
+    for (; d <= hi; ++d) peak.update(d, shapeScore(x, y, d, 0, t));
+    finish(x, y, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); });
   }
 
   // ---- peak ------------------------------------------------------------------------------
