@@ -12,6 +12,7 @@
 #include <QWheelEvent>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <vtkActor.h>
 #include <vtkCallbackCommand.h>
@@ -272,10 +273,11 @@ class Terrain3DView::Scene {
     camera->SetFocalPoint(cx, cy, cz);
     camera->SetPosition(cx, cy - std::cos(kElevation), cz + std::sin(kElevation));
     camera->SetViewUp(0, 0, 1);
-    // Fits the box's bounding sphere: the whole region stays visible whatever the aspect ratio;
-    // a sphere is loose around a flat box, so come a little closer.
+    // Fits the box's bounding sphere (VTK accounts for the aspect ratio); the sphere is loose
+    // around a flat box, so come a little closer.
     renderer->ResetCamera(bounds);
     camera->Dolly(1.2);
+    framed = region;
     renderer->ResetCameraClippingRange();
   }
   static constexpr double kElevation = 40.0 * 3.14159265358979323846 / 180.0;
@@ -298,6 +300,9 @@ class Terrain3DView::Scene {
   double heightMax = 1.0;
   double exaggeration = 1.0;
   bool interacting = false;
+  // The region last framed, until the operator moves the camera: a resize frames it again (the
+  // first framing often happens before the widget has its final size).
+  std::optional<cv::Rect2d> framed;
   ColourMap colourMap = ColourMap::Terrain;
   std::vector<BuildingOutline> buildings;
 };
@@ -696,10 +701,21 @@ QImage Terrain3DView::renderImage() {
 void Terrain3DView::setInteracting(bool interacting) {
   if (scene_->interacting == interacting) return;
   scene_->interacting = interacting;
+  if (interacting) scene_->framed.reset();
   scene_->applyMode();
   sceneChanged();
 }
 
-void Terrain3DView::resizeEvent(QResizeEvent* event) { QWidget::resizeEvent(event); }
+void Terrain3DView::resizeEvent(QResizeEvent* event) {
+  QWidget::resizeEvent(event);
+  if (scene_->framed) {
+    // The surface gets its new size in the same layout pass; frame once it has it.
+    QTimer::singleShot(0, this, [this] {
+      if (!scene_->framed) return;
+      scene_->frameRegion(*scene_->framed);
+      sceneChanged();
+    });
+  }
+}
 
 }  // namespace delineo::widgets
