@@ -746,5 +746,53 @@
         <source>Active polygon, building %1</source>
         <translation>Polygone actif, bâtiment %1</translation>
     </message>
+    <message>
+        <source>Left image</source>
+        <translation>Image gauche</translation>
+    </message>
+    <message>
+        <source>Colour the terrain by height, or drape the left image over it</source>
+        <translation>Colorer le terrain selon la hauteur, ou y draper l’image gauche</translation>
+    </message>
+    <message>
+        <source>Vertical exaggeration of the heights</source>
+        <translation>Exagération verticale des hauteurs</translation>
+    </message>
+    <message>
+        <source>Frame</source>
+        <translation>Cadrer</translation>
+    </message>
+    <message>
+        <source>Look at the selected building, or at the whole DEM when none is selected</source>
+        <translation>Regarder le bâtiment sélectionné, ou tout le MNE quand aucun ne l’est</translation>
+    </message>
+    <message>
+        <source>Vertical</source>
+        <translation>Vertical</translation>
+    </message>
+    <message>
+        <source>Snap to right &amp;angles</source>
+        <translation>Aimanter aux &amp;angles droits</translation>
+    </message>
+    <message>
+        <source>While dragging, corners within 6° of a right angle become square</source>
+        <translation>Pendant un déplacement, les coins à moins de 6° d’un angle droit deviennent droits</translation>
+    </message>
+    <message>
+        <source>Snap to image &amp;edges</source>
+        <translation>Aimanter aux &amp;contours de l’image</translation>
+    </message>
+    <message>
+        <source>While dragging, a vertex within 3 px of an edge of the left image lands on it</source>
+        <translation>Pendant un déplacement, un sommet à moins de 3 px d’un contour de l’image gauche s’y pose</translation>
+    </message>
+    <message>
+        <source>Overlay the project&apos;s label raster (only when the project has one)</source>
+        <translation>Superposer le raster d’étiquettes du projet (seulement s’il en a un)</translation>
+    </message>
+    <message>
+        <source>Image edges</source>
+        <translation>Contours de l’image</translation>
+    </message>
 </context>
 </TS>

@@ -7,6 +7,7 @@
 #include <QComboBox>
 #include <QDir>
 #include <QDockWidget>
+#include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
@@ -17,6 +18,8 @@
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QMetaObject>
+#include <QPushButton>
+#include <QSignalBlocker>
 #include <QScrollArea>
 #include <QSettings>
 #include <QStandardPaths>
@@ -34,6 +37,7 @@
 
 #include "buildings_model.hpp"
 #include "delineo/core/error.hpp"
+#include "delineo/project/edge_map.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/widgets/colour_maps.hpp"
 #include "delineo/widgets/disparity_histogram.hpp"
@@ -154,7 +158,19 @@ void MainWindow::createViews() {
   disparityView_->setObjectName(QStringLiteral("disparityView"));
   demView_ = new ImageView;
   demView_->setObjectName(QStringLiteral("demView"));
-  for (ImageView* v : {rightView_, disparityView_, demView_}) widgets::linkViews(leftView_, v);
+  for (ImageView* v : {disparityView_, demView_}) widgets::linkViews(leftView_, v);
+  // The right view follows with the selected roof's disparity as offset, so the roof under the
+  // left view's centre is under the right view's centre too (and the other way round).
+  connect(leftView_, &ImageView::viewChanged, this, [this] { syncRightView(); });
+  connect(rightView_, &ImageView::viewChanged, this, [this](QPointF center, double zoom) {
+    if (linkingRight_) return;
+    linkingRight_ = true;
+    leftView_->setView(center + QPointF(rightShift_, 0.0), zoom);
+    linkingRight_ = false;
+  });
+  // Clicking an outline in the right view selects that building.
+  connect(&rightView_->polygons(), &widgets::PolygonOverlay::selectionChanged, this,
+          &MainWindow::onSelectionFromOverlay);
 
   connect(leftView_, &ImageView::cursorMoved, this, [this](QPointF p) {
     updateReadout(p, true, document_ ? document_->leftGrey() : cv::Mat());
@@ -232,6 +248,36 @@ void MainWindow::createDocks() {
   view3DHost_ = new QWidget;
   auto* host3D = new QVBoxLayout(view3DHost_);
   host3D->setContentsMargins(0, 0, 0, 0);
+  auto* controls3D = new QHBoxLayout;
+  view3DColour_ = new QComboBox;
+  view3DColour_->setObjectName(QStringLiteral("view3DColour"));
+  view3DColour_->addItem(tr("Height colours"));
+  view3DColour_->addItem(tr("Left image"));
+  view3DColour_->setToolTip(tr("Colour the terrain by height, or drape the left image over it"));
+  view3DExaggeration_ = new QDoubleSpinBox;
+  view3DExaggeration_->setObjectName(QStringLiteral("view3DExaggeration"));
+  view3DExaggeration_->setRange(0.5, 20.0);
+  view3DExaggeration_->setSingleStep(0.5);
+  view3DExaggeration_->setDecimals(1);
+  view3DExaggeration_->setPrefix(QStringLiteral("× "));
+  view3DExaggeration_->setValue(1.0);
+  view3DExaggeration_->setToolTip(tr("Vertical exaggeration of the heights"));
+  auto* frameButton = new QPushButton(tr("Frame"));
+  frameButton->setObjectName(QStringLiteral("view3DFrame"));
+  frameButton->setToolTip(tr("Look at the selected building, or at the whole DEM when none is selected"));
+  controls3D->addWidget(view3DColour_);
+  controls3D->addWidget(new QLabel(tr("Vertical")));
+  controls3D->addWidget(view3DExaggeration_);
+  controls3D->addWidget(frameButton);
+  controls3D->addStretch(1);
+  host3D->addLayout(controls3D);
+  connect(view3DColour_, &QComboBox::currentIndexChanged, this, [this] { refresh3D(); });
+  connect(view3DExaggeration_, &QDoubleSpinBox::valueChanged, this, [this](double factor) {
+    if (view3D_ == nullptr) return;
+    view3D_->setVerticalExaggeration(factor);
+    frame3D();
+  });
+  connect(frameButton, &QPushButton::clicked, this, &MainWindow::frame3D);
   view3DPlaceholder_ = new QLabel(tr("The 3D view appears when a DEM is available."));
   view3DPlaceholder_->setAlignment(Qt::AlignCenter);
   view3DPlaceholder_->setWordWrap(true);
@@ -417,10 +463,40 @@ void MainWindow::createActions() {
     if (document_) document_->undoStack()->redo();
   });
 
+  // Snapping while editing outlines: right angles to the neighbouring edges, and the image's
+  // own edges (an edge map of the left image computed when a project opens).
+  auto* snapAngles = make(QStringLiteral("actionSnapRightAngles"), tr("Snap to right &angles"));
+  snapAngles->setCheckable(true);
+  snapAngles->setChecked(QSettings().value(QStringLiteral("edit/snapRightAngles"), true).toBool());
+  snapAngles->setStatusTip(tr("While dragging, corners within 6° of a right angle become square"));
+  leftView_->polygons().setSnapToRightAngles(snapAngles->isChecked());
+  connect(snapAngles, &QAction::toggled, this, [this](bool on) {
+    leftView_->polygons().setSnapToRightAngles(on);
+    QSettings().setValue(QStringLiteral("edit/snapRightAngles"), on);
+  });
+  auto* snapEdges = make(QStringLiteral("actionSnapEdges"), tr("Snap to image &edges"));
+  snapEdges->setCheckable(true);
+  snapEdges->setChecked(QSettings().value(QStringLiteral("edit/snapEdges"), true).toBool());
+  snapEdges->setStatusTip(tr("While dragging, a vertex within 3 px of an edge of the left image lands on it"));
+  leftView_->polygons().setSnapToEdges(snapEdges->isChecked());
+  leftView_->polygons().setEdgeSnapRadius(3.0);
+  connect(snapEdges, &QAction::toggled, this, [this](bool on) {
+    leftView_->polygons().setSnapToEdges(on);
+    QSettings().setValue(QStringLiteral("edit/snapEdges"), on);
+  });
+
+  // A label raster is reference material (ground truth of a simulated scene, a classification):
+  // an operator's project usually has none, and when it has one the outlines should be judged on
+  // the image first. So the overlay is off until asked for, and the choice is remembered.
   auto* labels = make(QStringLiteral("actionShowLabels"), tr("Show &labels"), QKeySequence(QStringLiteral("L")));
   labels->setCheckable(true);
-  labels->setChecked(true);
-  connect(labels, &QAction::toggled, this, [this](bool on) { leftView_->setOverlayVisible(on); });
+  labels->setChecked(QSettings().value(QStringLiteral("view/showLabels"), false).toBool());
+  labels->setEnabled(false);
+  labels->setStatusTip(tr("Overlay the project's label raster (only when the project has one)"));
+  connect(labels, &QAction::toggled, this, [this](bool on) {
+    leftView_->setOverlayVisible(on);
+    QSettings().setValue(QStringLiteral("view/showLabels"), on);
+  });
 }
 
 void MainWindow::createMenus() {
@@ -440,6 +516,9 @@ void MainWindow::createMenus() {
   QMenu* edit = menuBar()->addMenu(tr("&Edit"));
   edit->addAction(action(QStringLiteral("actionUndo")));
   edit->addAction(action(QStringLiteral("actionRedo")));
+  edit->addSeparator();
+  edit->addAction(action(QStringLiteral("actionSnapRightAngles")));
+  edit->addAction(action(QStringLiteral("actionSnapEdges")));
 
   QMenu* building = menuBar()->addMenu(tr("&Building"));
   for (const char* name : {"actionNavigate", "actionPickRectangle", "actionPickPolygon", "actionPickObject", "actionEdit"}) {
@@ -491,7 +570,10 @@ void MainWindow::restoreSettings() {
   QSettings settings;
   resize(1400, 900);
   restoreGeometry(settings.value(QStringLiteral("window/geometry")).toByteArray());
-  restoreState(settings.value(QStringLiteral("window/state")).toByteArray());
+  if (!restoreState(settings.value(QStringLiteral("window/state")).toByteArray())) {
+    // First start: the right image and the 3D view need room as much as the left image.
+    resizeDocks({dock(QStringLiteral("rightDock"))}, {560}, Qt::Horizontal);
+  }
 }
 
 QDockWidget* MainWindow::dock(const QString& objectName) const {
@@ -619,14 +701,20 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   connect(doc, &Document::buildingChanged, this, [this](int id) {
     refreshOverlays();
     if (id == selectedId_) {
-      if (document_->project().find(id) == nullptr) selectBuilding(-1);
-      else refreshHistogram();
+      if (document_->project().find(id) == nullptr) {
+        selectBuilding(-1);
+      } else {
+        refreshHistogram();
+        rightShift_ = roofDisparity(id).value_or(document_->project().height.groundDisparity);
+        syncRightView();
+      }
     }
     refresh3D();
     updateActions();
   });
   connect(doc, &Document::disparityChanged, this, [this] {
     refreshRasters();
+    refreshOverlays();
     refreshHistogram();
     refresh3D();
     updateActions();
@@ -639,13 +727,19 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   });
   leftView_->setImage(doc->leftGrey());
   rightView_->setImage(doc->rightGrey());
+  QAction* showLabels = action(QStringLiteral("actionShowLabels"));
+  showLabels->setEnabled(!doc->labels().empty());
   if (!doc->labels().empty()) {
     leftView_->setOverlay(doc->labels(), 0.25);
-    leftView_->setOverlayVisible(action(QStringLiteral("actionShowLabels"))->isChecked());
+    leftView_->setOverlayVisible(showLabels->isChecked());
   } else {
     leftView_->clearOverlay();
   }
+  edgeMap_ = cv::Mat();
+  leftView_->polygons().setEdgeMap(cv::Mat(), 128.0);
+  rightShift_ = document_->project().height.groundDisparity;
   leftView_->fitToWindow();
+  syncRightView();
   leftView_->polygons().clearEvolvingContour();
   leftView_->polygons().setRoi({});
   loadFormsFromDocument();
@@ -656,6 +750,7 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   refreshTitle();
   updateActions();
   emit documentOpened();
+  startEdgeMap();
   if (doc->disparity().empty() && project::matchingAvailable() &&
       QSettings().value(QStringLiteral("autoMatch"), true).toBool()) {
     statusBar()->showMessage(tr("No disparity yet: computing it in the background."), 8000);
@@ -813,13 +908,63 @@ void MainWindow::refreshOverlays() {
     if (b.status == BuildingStatus::Pending) p.colour = QColor(255, 200, 0);
     polygons.push_back(std::move(p));
   }
-  for (ImageView* v : {leftView_, rightView_, disparityView_, demView_}) {
-    // The right view is in its own geometry: the outlines would be shifted by the roof
-    // disparity, so it shows none rather than misplaced ones.
-    if (v == rightView_) continue;
+  for (ImageView* v : {leftView_, disparityView_, demView_}) {
     v->polygons().setPolygons(polygons);
     v->polygons().setSelectedId(selectedId_);
   }
+  // The right view is in its own geometry: a roof point at x_left is seen at x_left - d. Each
+  // outline is shifted by its roof disparity so the operator can check it on both images (the
+  // walls and the ground then do not line up, by design); editing stays on the left image.
+  std::vector<widgets::OverlayPolygon> shifted;
+  for (widgets::OverlayPolygon p : polygons) {
+    const std::optional<double> d = roofDisparity(p.id);
+    if (!d) continue;
+    auto shift = [&](core::Ring& ring) {
+      for (auto& q : ring) q.x -= *d;
+    };
+    shift(p.polygon.outer);
+    for (auto& hole : p.polygon.holes) shift(hole);
+    shifted.push_back(std::move(p));
+  }
+  rightView_->polygons().setPolygons(std::move(shifted));
+  rightView_->polygons().setSelectedId(selectedId_);
+}
+
+std::optional<double> MainWindow::roofDisparity(int id) const {
+  if (!document_) return std::nullopt;
+  const Building* b = document_->project().find(id);
+  if (b == nullptr) return std::nullopt;
+  std::optional<project::DisparityInterval> interval = b->roofInterval;
+  if (!interval && !document_->disparity().empty()) {
+    interval = project::suggestRoofInterval(document_->disparity(), b->currentPolygon());
+  }
+  if (!interval) return std::nullopt;
+  return 0.5 * (interval->low + interval->high);
+}
+
+void MainWindow::syncRightView() {
+  if (linkingRight_ || !rightView_->hasImage()) return;
+  linkingRight_ = true;
+  rightView_->setView(leftView_->viewCenter() - QPointF(rightShift_, 0.0), leftView_->zoom());
+  linkingRight_ = false;
+}
+
+void MainWindow::startEdgeMap() {
+  if (!document_) return;
+  const cv::Mat grey = document_->leftGrey();
+  QPointer<Document> doc(document_.get());
+  jobs_->run<cv::Mat>(
+      tr("Image edges"),
+      [grey](core::Progress& p) {
+        p.setStage("edges");
+        return project::edgeMap(grey);
+      },
+      [this, doc](cv::Mat edges) {
+        if (!doc || doc != document_.get()) return;
+        edgeMap_ = edges;
+        leftView_->polygons().setEdgeMap(edgeMap_, 128.0);
+      },
+      QStringLiteral("edges"));
 }
 
 void MainWindow::refreshHistogram() {
@@ -864,16 +1009,39 @@ void MainWindow::ensure3DView() {
   }
   view3D_ = new widgets::Terrain3DView;
   view3D_->setObjectName(QStringLiteral("view3D"));
-  view3DHost_->layout()->addWidget(view3D_);
+  static_cast<QVBoxLayout*>(view3DHost_->layout())->addWidget(view3D_, 1);
   view3DPlaceholder_->hide();
   refresh3D();
+  frame3D();
+}
+
+void MainWindow::frame3D() {
+  if (view3D_ == nullptr || !document_) return;
+  const Building* b = selectedId_ > 0 ? document_->project().find(selectedId_) : nullptr;
+  if (b == nullptr) {
+    view3D_->resetCamera();
+    return;
+  }
+  // The building with as much again of its surroundings on each side.
+  const cv::Rect2d box = core::boundingBox(b->currentPolygon().outer);
+  const double margin = 0.5 * std::max(box.width, box.height);
+  view3D_->frameRegion(cv::Rect2d(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin));
 }
 
 void MainWindow::refresh3D() {
   if (view3D_ == nullptr || !document_) return;
   if (document_->dem().empty()) return;
+  const bool newDem = view3DDem_.data != document_->dem().data;
+  if (newDem) {
+    view3DDem_ = document_->dem();
+    const QSignalBlocker block(view3DExaggeration_);
+    view3DExaggeration_->setValue(
+        widgets::Terrain3DView::suggestedExaggeration(view3DDem_, document_->project().height.gsd));
+    view3D_->setVerticalExaggeration(view3DExaggeration_->value());
+  }
   view3D_->setDem(document_->dem(), document_->project().height.gsd);
-  view3D_->setTexture(document_->leftGrey());
+  // Height colours by default: a grey drape is low-contrast and repeats the 2D view.
+  view3D_->setTexture(view3DColour_->currentIndex() == 1 ? document_->leftGrey() : cv::Mat());
   std::vector<widgets::BuildingOutline> outlines;
   for (const Building& b : document_->project().buildings) {
     if (!b.hasOutline() || b.status == BuildingStatus::Rejected || !std::isfinite(b.roofHeight)) continue;
@@ -881,6 +1049,7 @@ void MainWindow::refresh3D() {
     outlines.push_back({b.outline, base, b.roofHeight});
   }
   view3D_->setBuildings(outlines);
+  if (newDem) frame3D();
 }
 
 void MainWindow::updateActions() {
@@ -940,7 +1109,8 @@ void MainWindow::selectBuilding(int id) {
   const bool changed = id != selectedId_;
   selectedId_ = id;
   updatingSelection_ = true;
-  for (ImageView* v : {leftView_, disparityView_, demView_}) v->polygons().setSelectedId(id);
+  for (ImageView* v : {leftView_, rightView_, disparityView_, demView_}) v->polygons().setSelectedId(id);
+  rightShift_ = roofDisparity(id).value_or(document_ ? document_->project().height.groundDisparity : 0.0);
   const int row = buildingsModel_->rowOf(id);
   if (row >= 0) buildingsTable_->selectRow(row);
   else buildingsTable_->clearSelection();
@@ -949,6 +1119,8 @@ void MainWindow::selectBuilding(int id) {
     const cv::Rect2d box = core::boundingBox(document_->project().find(id)->currentPolygon().outer);
     leftView_->setViewCenter(QPointF(box.x + box.width / 2, box.y + box.height / 2));
   }
+  syncRightView();
+  if (changed) frame3D();
   refreshHistogram();
   updateActions();
   if (changed) emit selectedBuildingChanged(id);

@@ -8,6 +8,9 @@
 #include <QTimer>
 #include <functional>
 #include <memory>
+#include <optional>
+
+#include <opencv2/core.hpp>
 
 #include "delineo/project/project.hpp"
 #include "delineo/widgets/job_runner.hpp"
@@ -20,6 +23,7 @@ class QMenu;
 class QTableView;
 class QCheckBox;
 class QComboBox;
+class QDoubleSpinBox;
 class QStackedWidget;
 
 namespace delineo::widgets {
@@ -73,12 +77,21 @@ class MainWindow : public QMainWindow {
   widgets::ImageView* disparityView() const { return disparityView_; }
   widgets::ImageView* demView() const { return demView_; }
   widgets::DisparityHistogramWidget* histogram() const { return histogram_; }
+  widgets::Terrain3DView* view3D() const { return view3D_; }
   widgets::ParameterForm* delineationForm() const { return delineationForm_; }
   widgets::ParameterForm* matchingForm() const { return matchingForm_; }
   QTableView* buildingsTable() const { return buildingsTable_; }
   BuildingsModel* buildingsModel() const { return buildingsModel_; }
   widgets::JobRunner* jobs() const { return jobs_; }
   QLabel* readout() const { return readout_; }
+  // Edge map of the left image used to snap dragged vertices (empty until computed).
+  const cv::Mat& edgeMap() const { return edgeMap_; }
+  // Horizontal offset (px) between the left view's centre and the right view's: the roof
+  // disparity of the selected building, else the ground disparity (x_right = x_left - d).
+  double rightViewShift() const { return rightShift_; }
+  // The roof disparity a building's outline is shifted by in the right view; nullopt when the
+  // building has neither a roof interval nor a disparity map to propose one from.
+  std::optional<double> roofDisparity(int id) const;
   QDockWidget* dock(const QString& objectName) const;
   QAction* action(const QString& objectName) const;
   void showDock(const QString& objectName);
@@ -118,6 +131,9 @@ class MainWindow : public QMainWindow {
   void refreshOverlays();
   void refreshHistogram();
   void refresh3D();
+  void startEdgeMap();
+  void frame3D();
+  void syncRightView();
   void updateActions();
   void updateReadout(QPointF imagePos, bool leftGeometry, const cv::Mat& ownGrey);
   void onPicked(const core::Polygon& polygon);
@@ -144,6 +160,9 @@ class MainWindow : public QMainWindow {
   QWidget* view3DHost_ = nullptr;
   QLabel* view3DPlaceholder_ = nullptr;
   widgets::Terrain3DView* view3D_ = nullptr;
+  QComboBox* view3DColour_ = nullptr;
+  QDoubleSpinBox* view3DExaggeration_ = nullptr;
+  cv::Mat view3DDem_;  // the DEM the 3D view's exaggeration was chosen for
   widgets::DisparityHistogramWidget* histogram_ = nullptr;
   QLabel* intervalLabel_ = nullptr;
   widgets::ParameterForm* delineationForm_ = nullptr;
@@ -162,6 +181,9 @@ class MainWindow : public QMainWindow {
   QString lastMessage_;
   std::function<QString(const QString&)> relocate_;
   widgets::JobId matchingJob_ = 0;
+  cv::Mat edgeMap_;
+  double rightShift_ = 0.0;
+  bool linkingRight_ = false;
 };
 
 }  // namespace delineo::gui

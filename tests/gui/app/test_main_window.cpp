@@ -127,6 +127,20 @@ class MainWindowTest : public QObject {
     QVERIFY(window_->document()->undoStack()->canUndo());
   }
 
+  void labelsOverlayIsOffByDefaultAndRemembered() {
+    // The sample has a label raster (simulated ground truth): available, but not shown.
+    QAction* labels = window_->action(QStringLiteral("actionShowLabels"));
+    QVERIFY(labels->isEnabled());
+    QVERIFY(!labels->isChecked());
+    QVERIFY(!window_->leftView()->overlayVisible());
+    labels->trigger();
+    QVERIFY(window_->leftView()->overlayVisible());
+    QVERIFY(QSettings().value(QStringLiteral("view/showLabels")).toBool());
+    labels->trigger();
+    QVERIFY(!window_->leftView()->overlayVisible());
+    QVERIFY(!QSettings().value(QStringLiteral("view/showLabels")).toBool());
+  }
+
   void picksABuildingWithARectangleDrag() {
     gui::Document* doc = window_->document();
     QVERIFY(doc);
@@ -212,6 +226,59 @@ class MainWindowTest : public QObject {
     QCOMPARE(st(doc->project().find(buildingId_)->status), st(BuildingStatus::Automatic));
   }
 
+  void rightViewShowsOutlinesShiftedByTheRoofDisparity() {
+    gui::Document* doc = window_->document();
+    const project::Building* b = doc->project().find(buildingId_);
+    if (!b->hasOutline() || !b->roofInterval) QSKIP("needs the delineation result");
+    window_->selectBuilding(buildingId_);
+    const double d = 0.5 * (b->roofInterval->low + b->roofInterval->high);
+    QCOMPARE(*window_->roofDisparity(buildingId_), d);
+    QCOMPARE(window_->rightViewShift(), d);
+    const auto& shown = window_->rightView()->polygons().polygons();
+    QCOMPARE(shown.size(), size_t(1));
+    QCOMPARE(shown[0].id, buildingId_);
+    QCOMPARE(shown[0].polygon.outer.size(), b->outline.outer.size());
+    for (size_t i = 0; i < b->outline.outer.size(); ++i) {
+      QCOMPARE(shown[0].polygon.outer[i].x, b->outline.outer[i].x - d);
+      QCOMPARE(shown[0].polygon.outer[i].y, b->outline.outer[i].y);
+    }
+    // The outline really sits on the roof in the right image: the right image under the
+    // shifted roof matches the left image under the outline better than unshifted.
+    const cv::Mat roof = core::rasterize(b->outline, doc->leftGrey().size());
+    cv::Mat leftF, rightF;
+    doc->leftGrey().convertTo(leftF, CV_32F);
+    doc->rightGrey().convertTo(rightF, CV_32F);
+    auto meanAbsDifference = [&](int shift) {
+      double sum = 0;
+      int n = 0;
+      for (int y = 0; y < roof.rows; ++y) {
+        for (int x = 0; x < roof.cols; ++x) {
+          if (roof.at<uchar>(y, x) == 0 || x - shift < 0) continue;
+          sum += std::abs(leftF.at<float>(y, x) - rightF.at<float>(y, x - shift));
+          ++n;
+        }
+      }
+      return n > 0 ? sum / n : 1e9;
+    };
+    const double shifted = meanAbsDifference(static_cast<int>(std::lround(d)));
+    const double unshifted = meanAbsDifference(0);
+    qInfo("right view: roof disparity %.1f px, mean |L - R| on the roof %.1f shifted, %.1f unshifted", d, shifted,
+          unshifted);
+    QVERIFY(shifted < 0.6 * unshifted);
+    // Linked views keep the same roof point at both centres, in both directions.
+    widgets::ImageView* left = window_->leftView();
+    widgets::ImageView* right = window_->rightView();
+    left->setView(QPointF(200, 150), 2.0);
+    QCOMPARE(right->viewCenter(), QPointF(200 - d, 150));
+    QCOMPARE(right->zoom(), 2.0);
+    right->setViewCenter(QPointF(100, 120));
+    QCOMPARE(left->viewCenter(), QPointF(100 + d, 120));
+    // Without a selection the ground disparity is the offset.
+    window_->selectBuilding(-1);
+    QCOMPARE(window_->rightViewShift(), doc->project().height.groundDisparity);
+    window_->selectBuilding(buildingId_);
+  }
+
   void dragsAVertexThenUndoesAndRedoes() {
     gui::Document* doc = window_->document();
     const project::Building* b = doc->project().find(buildingId_);
@@ -220,7 +287,11 @@ class MainWindowTest : public QObject {
     widgets::ImageView* view = window_->leftView();
     window_->selectBuilding(buildingId_);
     window_->action(QStringLiteral("actionEdit"))->trigger();
-    view->polygons().setSnapToRightAngles(false);
+    // A free move: both snaps off (their menu toggles drive the overlay).
+    window_->action(QStringLiteral("actionSnapRightAngles"))->setChecked(false);
+    window_->action(QStringLiteral("actionSnapEdges"))->setChecked(false);
+    QVERIFY(!view->polygons().snapToRightAngles());
+    QVERIFY(!view->polygons().snapToEdges());
     const QPointF vertex(original[0].x, original[0].y);
     const QPoint from = view->imageToWidget(vertex).toPoint();
     const QPoint to = from + QPoint(9, 6);
@@ -240,6 +311,8 @@ class MainWindowTest : public QObject {
     QTest::keyClick(window_.get(), Qt::Key_Y, Qt::ControlModifier);
     QCOMPARE(st(doc->project().find(buildingId_)->status), st(BuildingStatus::Corrected));
     QVERIFY(view->polygons().selectedPolygon()->polygon.outer != original);
+    window_->action(QStringLiteral("actionSnapRightAngles"))->setChecked(true);
+    window_->action(QStringLiteral("actionSnapEdges"))->setChecked(true);
   }
 
   void acceptsSavesReloadsAndExports() {
@@ -324,6 +397,8 @@ class MainWindowTest : public QObject {
     QVERIFY(window_->openProject(QString::fromStdString(path)));
     QVERIFY(asked.endsWith(QStringLiteral("right-renamed.tif")));
     QCOMPARE(window_->document()->project().right, original.right);
+    // No label raster: nothing to show, the toggle is disabled.
+    QVERIFY(!window_->action(QStringLiteral("actionShowLabels"))->isEnabled());
     window_->setRelocateHandler({});
   }
 
@@ -351,6 +426,79 @@ class MainWindowTest : public QObject {
     QVERIFY(declined.openProject(path));
     QCOMPARE(declined.document()->project().buildings.size(), size_t(1));
     doc->undoStack()->undo();
+  }
+
+  void draggedVertexSnapsOntoAnImageEdge() {
+    // A pair whose left image has one bright roof [100, 180) x [60, 120) on a noisy ground.
+    cv::Mat left(200, 260, CV_8U);
+    cv::RNG rng(11);
+    rng.fill(left, cv::RNG::NORMAL, 90, 5);
+    left(cv::Rect(100, 60, 80, 60)) += cv::Scalar(60);
+    cv::Mat right = cv::Mat::zeros(left.size(), CV_8U);
+    left(cv::Rect(12, 0, left.cols - 12, left.rows)).copyTo(right(cv::Rect(0, 0, left.cols - 12, left.rows)));
+    const QString leftPath = dir_.filePath(QStringLiteral("edges_left.tif"));
+    const QString rightPath = dir_.filePath(QStringLiteral("edges_right.tif"));
+    io::writeGeoTiff(leftPath.toStdString(), left);
+    io::writeGeoTiff(rightPath.toStdString(), right);
+    QVERIFY(window_->openPair(leftPath, rightPath));
+    // Both snaps are on by default; the edge map is computed in the background.
+    QVERIFY(window_->action(QStringLiteral("actionSnapEdges"))->isChecked());
+    QVERIFY(window_->action(QStringLiteral("actionSnapRightAngles"))->isChecked());
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->edgeMap().empty(), 10000);
+    const cv::Mat& edges = window_->edgeMap();
+    QCOMPARE(edges.size(), left.size());
+
+    gui::Document* doc = window_->document();
+    core::Polygon rough;
+    rough.outer = {{94, 54}, {186, 54}, {186, 126}, {94, 126}};
+    const int id = doc->addBuilding(rough);
+    window_->selectBuilding(id);
+    window_->action(QStringLiteral("actionEdit"))->trigger();
+    widgets::ImageView* view = window_->leftView();
+    view->setView(QPointF(180, 80), 4.0);
+    auto drag = [&](QPointF fromImage, QPointF toImage) {
+      const QPoint from = view->imageToWidget(fromImage).toPoint();
+      const QPoint to = view->imageToWidget(toImage).toPoint();
+      QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, from);
+      QTest::mouseMove(view, from + (to - from) / 2);
+      QTest::mouseMove(view, to);
+      QTest::mouseRelease(view, Qt::LeftButton, Qt::NoModifier, to);
+      return view->widgetToImage(to);
+    };
+    // Vertex 1 dropped 2 px right of the roof's right wall (x = 180): it lands on the wall.
+    const QPointF dropped = drag(QPointF(186, 54), QPointF(182.1, 75.3));
+    const cv::Point2d moved = doc->project().find(id)->initial.outer[1];
+    qInfo("edge snap: dropped at (%.2f, %.2f), vertex at (%.2f, %.2f)", dropped.x(), dropped.y(), moved.x, moved.y);
+    QVERIFY2(std::abs(moved.x - 180.0) <= 1.0, qPrintable(QString::number(moved.x)));
+    QVERIFY(std::abs(moved.y - dropped.y()) <= 3.0);
+    QCOMPARE(edges.at<uchar>(static_cast<int>(moved.y), static_cast<int>(moved.x)), uchar(255));
+    // With edge snapping off, the same kind of drop stays where the mouse left it.
+    window_->action(QStringLiteral("actionSnapEdges"))->trigger();
+    window_->action(QStringLiteral("actionSnapRightAngles"))->trigger();
+    QVERIFY(!QSettings().value(QStringLiteral("edit/snapEdges")).toBool());
+    const QPointF free = drag(QPointF(186, 126), QPointF(182.1, 104.3));
+    const cv::Point2d unsnapped = doc->project().find(id)->initial.outer[2];
+    QVERIFY(std::abs(unsnapped.x - free.x()) < 1e-6 && std::abs(unsnapped.y - free.y()) < 1e-6);
+    window_->action(QStringLiteral("actionSnapEdges"))->trigger();
+    window_->action(QStringLiteral("actionSnapRightAngles"))->trigger();
+    window_->action(QStringLiteral("actionNavigate"))->trigger();
+  }
+
+  void languageChoicePersistsAndAsksForARestart() {
+    QAction* french = window_->findChild<QAction*>(QStringLiteral("actionLanguage_fr"));
+    QAction* system = window_->findChild<QAction*>(QStringLiteral("actionLanguage_system"));
+    QVERIFY(french && system && window_->findChild<QAction*>(QStringLiteral("actionLanguage_en")));
+    QVERIFY(system->isChecked());
+    QSignalSpy messages(window_.get(), &MainWindow::messageShown);
+    french->trigger();
+    QCOMPARE(QSettings().value(QStringLiteral("language")).toString(), QStringLiteral("fr"));
+    QCOMPARE(messages.count(), 1);
+    QVERIFY(window_->lastMessage().contains(QStringLiteral("next time")));
+    // A new window (the next start) shows the stored choice.
+    MainWindow next;
+    QVERIFY(next.findChild<QAction*>(QStringLiteral("actionLanguage_fr"))->isChecked());
+    system->trigger();
+    QCOMPARE(QSettings().value(QStringLiteral("language")).toString(), QString());
   }
 
   void frenchTranslationIsComplete() {
