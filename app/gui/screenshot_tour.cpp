@@ -14,6 +14,7 @@
 
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
+#include "delineo/widgets/terrain3d_view.hpp"
 #include "document.hpp"
 #include "main_window.hpp"
 
@@ -112,6 +113,8 @@ bool runScreenshotTour(MainWindow& window, const QString& directory) {
   ring[0] += cv::Point2d(-3, -2);
   doc->editRing(id, 0, ring, QStringLiteral("Move vertex 1"));
   window.selectBuilding(id);
+  // The right image with the outline shifted by the roof disparity: the same roof on both.
+  window.showDock(QStringLiteral("rightDock"));
   if (!shoot(window, directory, QStringLiteral("04-corrected"))) return false;
 
   window.acceptSelected();
@@ -120,7 +123,11 @@ bool runScreenshotTour(MainWindow& window, const QString& directory) {
   if (auto* mode = window.findChild<QComboBox*>(QStringLiteral("demMode"))) mode->setCurrentIndex(1);
   if (!shoot(window, directory, QStringLiteral("05-accepted-dem"))) return false;
 
+  // The whole scene in 3D (the view frames the selected building; "Frame" without a selection
+  // and resetCamera() show everything).
   window.showDock(QStringLiteral("view3DDock"));
+  settle();
+  if (window.view3D() != nullptr) window.view3D()->resetCamera();
   if (!shoot(window, directory, QStringLiteral("06-3d-view"))) return false;
   return true;
 }
