@@ -122,8 +122,8 @@ __attribute__((target_clones("avx2", "default"))) void shapeSums32(
   shapeSums<32>(b, b2, stride, mask, templ, rows, out);
 }
 
-// The same sums for K consecutive disparities at once (16-float rows, windows ≤ 16): the k-th
-// reads the other image k columns further left (x_other = x - d). The shape rows are loaded
+// The same sums for K windows of the other image at once (16-float rows, windows ≤ 16), the
+// k-th at b + offsets[k] (consecutive disparities: one column further left each). The shape rows are loaded
 // once for the K windows, B² is formed on the fly, and the 16 lanes of a row are folded into 8
 // accumulators: K x 3 accumulators stay in registers.
 using Float8 = float __attribute__((vector_size(32)));
@@ -132,8 +132,10 @@ using Float8 = float __attribute__((vector_size(32)));
 __attribute__((always_inline)) inline void load8(Float8& v, const float* p) { __builtin_memcpy(&v, p, sizeof v); }
 
 template <int K>
-__attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t stride, const float* mask, const float* templ,
-                           int rows, float out[][3]) {
+__attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t stride,
+                                                          const ptrdiff_t* offsets,
+                                                          const float* mask, const float* templ,
+                                                          int rows, float out[][3]) {
   Float8 accB[K], accBB[K], accTB[K];
   for (int k = 0; k < K; ++k) accB[k] = accBB[k] = accTB[k] = Float8{};
   for (int v = 0; v < rows; ++v) {
@@ -147,8 +149,8 @@ __attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t
     load8(t1, t + 8);
     for (int k = 0; k < K; ++k) {
       Float8 b0, b1;
-      load8(b0, bv - k);
-      load8(b1, bv - k + 8);
+      load8(b0, bv + offsets[k]);
+      load8(b1, bv + offsets[k] + 8);
       const Float8 mb0 = m0 * b0, mb1 = m1 * b1;
       accB[k] += mb0 + mb1;
       accBB[k] += mb0 * b0 + mb1 * b1;
@@ -172,7 +174,15 @@ constexpr int kBatch = 4;
 __attribute__((target_clones("avx2", "default"))) void shapeSums16Batch(
     const float* b, size_t stride, const float* mask, const float* templ, int rows,
     float out[][3]) {
-  shapeSumsBatch<kBatch>(b, stride, mask, templ, rows, out);
+  static constexpr ptrdiff_t kMainLine[kBatch] = {0, -1, -2, -3};  // d, d + 1, ...
+  shapeSumsBatch<kBatch>(b, stride, kMainLine, mask, templ, rows, out);
+}
+// Two windows of the same shape at row offsets -1 and +1 from b (the line-shift probes).
+__attribute__((target_clones("avx2", "default"))) void shapeSums16Pair(
+    const float* b, size_t stride, const float* mask, const float* templ, int rows,
+    float out[][3]) {
+  const ptrdiff_t lines[2] = {-static_cast<ptrdiff_t>(stride), static_cast<ptrdiff_t>(stride)};
+  shapeSumsBatch<2>(b, stride, lines, mask, templ, rows, out);
 }
 
 // Bit count without the library call the baseline x86-64 target makes of __builtin_popcount.
@@ -520,7 +530,8 @@ class LevelMatcher {
     for (const auto& [width, i] : byWidth) {
       const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
       finish(x, y, sc.peaks[static_cast<size_t>(i)],
-             [&](int d, int dy) { return squareScore(x, y, d, dy); });
+             [&](int d, int dy) { return squareScore(x, y, d, dy); },
+             [](int, float&, float&) { return false; });
     }
   }
 
@@ -728,13 +739,13 @@ class LevelMatcher {
     const int w = s_.window;
     if (!otherStats_.ok.at<uchar>(yb, xb)) {
       // Window partly nodata (or flat: the variance test below decides): S must avoid nodata.
+      bool touches = false;  // branch-free inner loop: it vectorises
       for (int v = t.rowFirst; v <= t.rowLast; ++v) {
         const uchar* valid = in_.otherValid.ptr<uchar>(yb + v - r_) + xb - r_;
         const float* m = &t.mask[static_cast<size_t>(v * rowStride_)];
-        for (int u = 0; u < w; ++u) {
-          if (m[u] != 0.0F && !valid[u]) return kNaN;
-        }
+        for (int u = 0; u < w; ++u) touches |= (m[u] != 0.0F) & (valid[u] == 0);
       }
+      if (touches) return kNaN;
     }
     const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     const int rows = t.rowLast - t.rowFirst + 1;
@@ -774,6 +785,23 @@ class LevelMatcher {
     return true;
   }
 
+  // Scores at (d, -1) and (d, +1) in one pass; false when a window is not a plain one.
+  bool shapeScorePair(int x, int y, int d, const ShapeTemplate& t, float& minus,
+                      float& plus) const {
+    if (rowStride_ != 16) return false;
+    const int xb = x - d;
+    if (y - 1 < r_ || y + 1 >= H_ - r_ || xb < r_ || xb >= W_ - r_) return false;
+    if (!otherStats_.ok.at<uchar>(y - 1, xb) || !otherStats_.ok.at<uchar>(y + 1, xb)) return false;
+    const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
+    const int top = y + t.rowFirst - r_;
+    float sums[2][3];
+    shapeSums16Pair(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
+                    &t.templ[first], t.rowLast - t.rowFirst + 1, sums);
+    minus = scoreFromSums(sums[0], t.count);
+    plus = scoreFromSums(sums[1], t.count);
+    return true;
+  }
+
   void matchShapePixel(int x, int y, const ShapeTemplate& t) {
     LinePeak peak;
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
@@ -786,8 +814,13 @@ class LevelMatcher {
         for (int k = 0; k < kBatch; ++k) peak.update(d + k, shapeScore(x, y, d + k, 0, t));
       }
     }
+    // The last 2..3 disparities: one batch ending at hi (its first entries are done already).
+    if (hi - d >= 1 && hi - lo + 1 >= kBatch && shapeScoresBatch(x, y, hi - kBatch + 1, t, batch)) {
+      for (; d <= hi; ++d) peak.update(d, batch[d - (hi - kBatch + 1)]);
+    }
     for (; d <= hi; ++d) peak.update(d, shapeScore(x, y, d, 0, t));
-    finish(x, y, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); });
+    finish(x, y, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); },
+           [&](int dd, float& minus, float& plus) { return shapeScorePair(x, y, dd, t, minus, plus); });
   }
 
   // ---- peak ------------------------------------------------------------------------------
@@ -795,8 +828,9 @@ class LevelMatcher {
   // From the main-line peak: local ascent over the line shifts (3x3 neighbourhoods of the 2D
   // surface, d within the pixel's interval, |dy| <= lineShift), rejection tests, sub-pixel
   // offset, output.
-  template <class Score>
-  void finish(int x, int y, const LinePeak& peak, Score&& score) {
+  // `pair(d, minus, plus)` may give the scores at (d, ∓1) in one go (returns false when not).
+  template <class Score, class Pair>
+  void finish(int x, int y, const LinePeak& peak, Score&& score, Pair&& pair) {
     if (!(peak.best > kNegInf)) return;
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
     int cd = peak.bestD, cdy = 0;
@@ -817,8 +851,10 @@ class LevelMatcher {
         if (step == 0) {
           // The main line is known; the neighbouring lines at the peak's d decide whether the
           // ascent leaves it (and give the sub-pixel line shift when it does not).
-          s[1][0] = at(cd, -1);
-          s[1][2] = at(cd, 1);
+          if (L_ < 1 || cd < lo || cd > hi || !pair(cd, s[1][0], s[1][2])) {
+            s[1][0] = at(cd, -1);
+            s[1][2] = at(cd, 1);
+          }
         } else {
           for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) {

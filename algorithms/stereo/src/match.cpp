@@ -259,6 +259,39 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       intervalsFromCoarse(coarseLeft, lv.left.size(), lv.dmin, lv.dmax, p.margin, inL.lo, inL.hi);
       intervalsFromCoarse(coarseRight, lv.left.size(), lv.dmin, lv.dmax, p.margin, loR, hiR);
     }
+    const double w = weight[static_cast<size_t>(k)] / total;
+    core::Progress::Range leftRange(progress, done, done + 0.5 * w);
+    if (!detail::matchLevel(inL, s, leftOut, progress ? &leftRange : nullptr) ||
+        core::isCanceled(progress)) {
+      result.status = core::RunStatus::Canceled;
+      return result;
+    }
+    if (k == 0) {
+      // At the finest level the right map only validates the left one: only the right pixels
+      // that a left match points to (the floor/ceil neighbours the validation reads) are
+      // matched. The result is the same, at the cost of the unmatched and occluded areas less.
+      cv::Mat needed = cv::Mat::zeros(lv.left.size(), CV_8U);
+      for (int y = 0; y < needed.rows; ++y) {
+        const float* d = leftOut.disparity.ptr<float>(y);
+        const float* dy = leftOut.lineShift.ptr<float>(y);
+        for (int x = 0; x < needed.cols; ++x) {
+          if (!std::isfinite(d[x])) continue;
+          const int fx = static_cast<int>(std::floor(x - d[x]));
+          const int fy = static_cast<int>(std::floor(y + dy[x]));
+          for (int m = 0; m <= 1; ++m) {
+            for (int n = 0; n <= 1; ++n) {
+              const int qx = fx + n, qy = fy + m;
+              if (qx >= 0 && qx < needed.cols && qy >= 0 && qy < needed.rows) {
+                needed.at<uchar>(qy, qx) = 1;
+              }
+            }
+          }
+        }
+      }
+      hiR = hiR.clone();  // may share its data with the left intervals
+      cv::Mat notSearched = loR - 1;
+      notSearched.copyTo(hiR, needed == 0);
+    }
     // Right -> left: mirrored images turn x_left = x_right + d into x'_other = x'_ref - d.
     inR.ref = flipped(lv.right);
     inR.other = flipped(lv.left);
@@ -268,13 +301,6 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     inR.lo = flipped(loR);
     inR.hi = flipped(hiR);
 
-    const double w = weight[static_cast<size_t>(k)] / total;
-    core::Progress::Range leftRange(progress, done, done + 0.5 * w);
-    if (!detail::matchLevel(inL, s, leftOut, progress ? &leftRange : nullptr) ||
-        core::isCanceled(progress)) {
-      result.status = core::RunStatus::Canceled;
-      return result;
-    }
     core::Progress::Range rightRange(progress, done + 0.5 * w, done + w);
     detail::LevelOutput mirrored;
     if (!detail::matchLevel(inR, s, mirrored, progress ? &rightRange : nullptr) ||
