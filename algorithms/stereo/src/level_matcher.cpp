@@ -36,6 +36,8 @@ constexpr int kTileRows = 32;
 constexpr int kTileCols = 64;
 // Steps of the local ascent over line shifts: the dy = ±1 peak lies next to the dy = 0 one.
 constexpr int kMaxAscentSteps = 4;
+// Steps a main-line peak may move outside its guided interval (following a slope).
+constexpr int kMaxIntervalExtension = 1;
 // NCC gain a neighbouring line must bring over the current one for the ascent to move there.
 constexpr float kLineShiftGain = 0.05F;
 // Variance (grey levels², images normalised to ~0..255) under which a window is flat: its NCC
@@ -832,9 +834,48 @@ class LevelMatcher {
   template <class Score, class Pair>
   void finish(int x, int y, const LinePeak& peak, Score&& score, Pair&& pair) {
     if (!(peak.best > kNegInf)) return;
-    const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
+    int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
     int cd = peak.bestD, cdy = 0;
     float best = peak.best;
+    float below = peak.below, above = peak.above;
+    // A maximum on the border of a guided interval may be a slope: the coarser level's
+    // disparities are biased by a px or two next to depth steps, and the interval can stop just
+    // short of the true peak. The score one step outside decides: lower, the border is a peak
+    // and is kept; higher, the peak moves there (at most kMaxIntervalExtension steps); still
+    // rising after that, the pixel is rejected. (Rejecting every border peak, as before, lost
+    // roof pixels along outlines: measured sim 600² edge 55.1 -> 57.3 %, density 85.3 -> 85.7 %;
+    // more steps added errors for little gain.)
+    for (int step = 0; step < kMaxIntervalExtension && cd == lo && lo > in_.dmin; ++step) {
+      const float next = score(cd - 1, 0);
+      if (!(next > best)) {
+        below = next;
+        break;
+      }
+      above = best;
+      best = next;
+      below = kNaN;
+      lo = --cd;
+    }
+    for (int step = 0; step < kMaxIntervalExtension && cd == hi && hi < in_.dmax; ++step) {
+      const float next = score(cd + 1, 0);
+      if (!(next > best)) {
+        above = next;
+        break;
+      }
+      below = best;
+      best = next;
+      above = kNaN;
+      hi = ++cd;
+    }
+    if (cd == lo && lo > in_.dmin && std::isnan(below)) below = score(cd - 1, 0);
+    if (cd == hi && hi < in_.dmax && std::isnan(above)) above = score(cd + 1, 0);
+    // Still rising at the border after the extension: no peak found.
+    const bool slope = (cd == lo && lo > in_.dmin && !(below < best)) ||
+                       (cd == hi && hi < in_.dmax && !(above < best));
+    if (slope) return;
+    // The parabola and the ascent may use the scores just outside the interval.
+    lo = std::max(in_.dmin, std::min(lo, cd - 1));
+    hi = std::min(in_.dmax, std::max(hi, cd + 1));
     float s[3][3];
     auto at = [&](int d, int dy) -> float {
       if (d < lo || d > hi || dy < -L_ || dy > L_) return kNaN;
@@ -843,9 +884,9 @@ class LevelMatcher {
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) s[i][j] = kNaN;
     }
-    s[0][1] = peak.below;
-    s[1][1] = peak.best;
-    s[2][1] = peak.above;
+    s[0][1] = below;
+    s[1][1] = best;
+    s[2][1] = above;
     if (L_ > 0) {
       for (int step = 0;; ++step) {
         if (step == 0) {
@@ -882,8 +923,7 @@ class LevelMatcher {
       }
     }
     if (!(best >= static_cast<float>(s_.minScore))) return;
-    // A peak on the border of a guided interval is a slope, not a peak: the true maximum lies
-    // outside the interval.
+    // The ascent may have ended on the border of the (extended) interval: a slope again.
     if ((cd == lo && lo > in_.dmin) || (cd == hi && hi < in_.dmax)) return;
     float du = 0, dv = 0;
     if (s_.subpixel) {
