@@ -17,6 +17,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <nlohmann/json.hpp>
+
+#include "delineo/core/params.hpp"
 #include "delineo/delineation/delineate.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/cost_service.hpp"
@@ -72,7 +75,7 @@ std::string text(const core::Feature& f, const char* key) {
 }
 
 struct Scores {
-  double iou = 0, p1 = 0, polis = 0, corner = std::nan("");
+  double iou = 0, p1 = 0, polis = 0, hausdorff = std::nan(""), corner = std::nan("");
 };
 
 Scores score(const core::Polygon& pred, const core::Polygon& truth, cv::Size size) {
@@ -82,6 +85,7 @@ Scores score(const core::Polygon& pred, const core::Polygon& truth, cv::Size siz
   s.iou = f.iou;
   s.p1 = f.p1;
   s.polis = f.polis;
+  s.hausdorff = f.hausdorff;
   s.corner = f.cornerRms;
 #else
   const cv::Mat a = core::rasterize(pred, size), b = core::rasterize(truth, size);
@@ -161,8 +165,9 @@ void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& ri
 }  // namespace
 
 int main(int argc, char** argv) {
-  int scenes = 3, referenceRuns = 3;
+  int scenes = 3, referenceRuns = 3, firstSeed = 1;
   std::string dumpDir;  // --dump DIR: one diagnostic PNG per run
+  std::string onlyInit;  // --init box+8|jit6: run one initialisation only
   sim::SceneParams sceneParams;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--tiny")) {
@@ -178,15 +183,29 @@ int main(int argc, char** argv) {
       dumpDir = argv[++i];
     } else if (!std::strcmp(argv[i], "--reference-runs") && i + 1 < argc) {
       referenceRuns = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) {
+      firstSeed = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--size") && i + 1 < argc &&
+               std::sscanf(argv[i + 1], "%dx%d", &sceneParams.width, &sceneParams.height) == 2) {
+      ++i;
+    } else if (!std::strcmp(argv[i], "--buildings") && i + 1 < argc) {
+      sceneParams.buildings = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--trees") && i + 1 < argc) {
+      sceneParams.trees = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--init") && i + 1 < argc) {
+      onlyInit = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: bench_delineation [--tiny] [--scenes N] [--reference-runs N] [--dump DIR]\n");
+      std::fprintf(stderr,
+                   "usage: bench_delineation [--tiny] [--scenes N] [--seed FIRST] [--size WxH] [--buildings N] "
+                   "[--trees N] [--init box+8|jit6] [--reference-runs N] [--dump DIR]\n");
       return 2;
     }
   }
-  const DelineationParams params;
-  std::printf("%-5s %-3s %-9s %-6s %-5s %7s %7s %7s %7s %8s %5s %5s %s\n", "scene", "id", "shape",
-              "roof", "init", "IoU", "p1%", "PoLiS", "cornRMS", "ms", "verts", "holes", "side");
-  std::map<std::string, std::vector<double>> ious, corners;
+  DelineationParams params;
+  if (const char* json = std::getenv("BENCH_PARAMS")) core::fromJson(params, nlohmann::json::parse(json));
+  std::printf("%-5s %-3s %-9s %-6s %-5s %7s %7s %7s %7s %7s %8s %5s %5s\n", "scene", "id", "shape",
+              "roof", "init", "IoU", "p1%", "PoLiS", "Hausd", "cornRMS", "ms", "verts", "holes");
+  std::map<std::string, std::vector<double>> ious, corners, hausdorffs;
   std::vector<double> times;
   int sideOk = 0, sideTotal = 0, failures = 0;
   double fastMs = 0, referenceMs = 0;
@@ -194,7 +213,7 @@ int main(int argc, char** argv) {
   int referenceDone = 0;
   std::mt19937 rng(12345);
   for (int s = 0; s < scenes; ++s) {
-    sceneParams.seed = 1 + s;
+    sceneParams.seed = firstSeed + s;
     const sim::Scene scene = sim::simulateScene(sceneParams);
     cv::Mat left, right;
     scene.left.convertTo(left, CV_32F);
@@ -207,6 +226,7 @@ int main(int argc, char** argv) {
       const int g = static_cast<int>(std::lround(number(fp, "ground_disparity", 0)));
       base.ground = DisparityInterval{g - params.groundTolerance, g + params.groundTolerance};
       for (const char* initName : {"box+8", "jit6"}) {
+        if (!onlyInit.empty() && onlyInit != initName) continue;
         DelineationRequest req = base;
         req.init = std::string(initName) == "box+8" ? grownBox(fp.polygon, 8) : jittered(fp.polygon, rng, 6);
         try {
@@ -216,10 +236,11 @@ int main(int argc, char** argv) {
           const Scores sc = score(r.polygon, fp.polygon, left.size());
           ious[initName].push_back(sc.iou);
           corners[initName].push_back(sc.corner);
+          hausdorffs[initName].push_back(sc.hausdorff);
           times.push_back(ms(t0, t1));
-          std::printf("%-5d %-3d %-9s %-6s %-5s %7.3f %7.2f %7.2f %7.2f %8.1f %5d %5zu\n", sceneParams.seed, id,
-                      text(fp, "shape").c_str(), text(fp, "roof_type").c_str(), initName, sc.iou, sc.p1,
-                      sc.polis, sc.corner, ms(t0, t1), r.vertexCount, r.polygon.holes.size());
+          std::printf("%-5d %-3d %-9s %-6s %-5s %7.3f %7.2f %7.2f %7.2f %7.2f %8.1f %5d %5zu\n", sceneParams.seed,
+                      id, text(fp, "shape").c_str(), text(fp, "roof_type").c_str(), initName, sc.iou, sc.p1,
+                      sc.polis, sc.hausdorff, sc.corner, ms(t0, t1), r.vertexCount, r.polygon.holes.size());
           if (!dumpDir.empty()) {
             dumpPicture(dumpDir + "/s" + std::to_string(sceneParams.seed) + "_b" + std::to_string(id) + "_" +
                             initName + ".png",
@@ -227,6 +248,9 @@ int main(int argc, char** argv) {
           }
           if (std::getenv("BENCH_VERBOSE")) {
             const cv::Rect2d a = core::boundingBox(r.polygon.outer), b = core::boundingBox(fp.polygon.outer);
+            std::printf("      iterations %d energy %.2f vertices:", r.iterations, r.terms.total());
+            for (const auto& v : r.polygon.outer) std::printf(" (%.0f,%.0f)", v.x - r.roi.x, v.y - r.roi.y);
+            std::printf("\n");
             std::printf("      bbox pred %.1f %.1f %.1f %.1f truth %.1f %.1f %.1f %.1f\n", a.x, a.y, a.br().x,
                         a.br().y, b.x, b.y, b.br().x, b.br().y);
           }
@@ -273,8 +297,11 @@ int main(int argc, char** argv) {
   }
   std::printf("\nsummary\n");
   for (const auto& [name, v] : ious) {
-    std::printf("  init %-6s buildings %3zu  mean IoU %.3f  median IoU %.3f  median corner RMS %.2f px\n",
-                name.c_str(), v.size(), mean(v), median(v), median(corners[name]));
+    const auto& h = hausdorffs[name];
+    std::printf("  init %-6s buildings %3zu  mean IoU %.3f  median IoU %.3f  median corner RMS %.2f px  "
+                "Hausdorff mean %.1f median %.1f max %.1f px\n",
+                name.c_str(), v.size(), mean(v), median(v), median(corners[name]), mean(h), median(h),
+                h.empty() ? std::nan("") : *std::max_element(h.begin(), h.end()));
   }
   std::printf("  median time per building %.1f ms (cost service + optimisation, one core)\n", median(times));
   std::printf("  occlusion side from the data agrees with the geometry: %d / %d\n", sideOk, sideTotal);

@@ -22,7 +22,7 @@ class Optimiser {
             const IterationObserver& observer, core::Progress* progress, EnergyMode mode)
       : images_(images),
         params_(params),
-        weights_{params.edgeWeight, params.rigidity},
+        weights_{params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle, params.minGap},
         energy_(images, weights_),
         observer_(observer),
         progress_(progress),
@@ -142,6 +142,37 @@ class Optimiser {
     return changed;
   }
 
+  // Shortcuts: a run of up to `shortcutVertices` consecutive vertices is removed at once (the
+  // ring then goes straight across). A thin spike or finger is a local minimum of vertex and
+  // edge moves: shortening it by 2 px drags its occlusion band along and saves almost nothing,
+  // while the whole protrusion costs more than it earns. The same move closes a thin slit.
+  bool sweepShortcuts() {
+    bool changed = false;
+    for (size_t ring = 0; ring < energy_.polygon().ringCount(); ++ring) {
+      for (size_t i = 0; i < energy_.polygon().ring(ring).size(); ++i) {
+        pollCancel();
+        const IntRing& rg = energy_.polygon().ring(ring);
+        const int n = static_cast<int>(rg.size());
+        std::vector<PolygonEnergy::Change> candidates;
+        // The cut-off piece (vertices i .. i+k+1 closed by the chord) must be thin: its mean
+        // width 2·area / path length at most shortcutWidth. A whole wing of the building is
+        // not a spike, and removing it is the vertex and edge moves' business.
+        double path = 0.0, area2 = 0.0;
+        for (int k = 1; k <= std::min(params_.shortcutVertices, n - 3); ++k) {
+          const cv::Point a = rg[i], p = rg[(i + k) % n], q = rg[(i + k + 1) % n];
+          path += std::hypot(double(q.x - p.x), double(q.y - p.y)) +
+                  (k == 1 ? std::hypot(double(p.x - a.x), double(p.y - a.y)) : 0.0);
+          area2 += static_cast<double>(p.x - a.x) * (q.y - a.y) - static_cast<double>(p.y - a.y) * (q.x - a.x);
+          if (k < 2) continue;
+          if (std::abs(area2) > params_.shortcutWidth * path) continue;
+          candidates.push_back({static_cast<int>(ring), static_cast<int>((i + 1) % n), k, {}});
+        }
+        changed |= applyBest(candidates, -kImprovement);
+      }
+    }
+    return changed;
+  }
+
   // Deletion of a vertex when F does not increase (fewer vertices at equal energy is better).
   bool sweepDeletions() {
     bool changed = false;
@@ -169,6 +200,7 @@ class Optimiser {
         moved = sweepMoves();
         // Edge moves cost as much as vertex moves: only when single vertices are stuck.
         if (!moved && params_.edgeMoves) moved = sweepEdgeMoves();
+        if (!moved && params_.shortcutVertices >= 2) moved = sweepShortcuts();
         endSweep("moves");
         any |= moved;
       }

@@ -54,30 +54,49 @@ float bilinear(const cv::Mat& img, double x, double y) {
                             fy * ((1 - fx) * r1[x0] + fx * r1[x1]));
 }
 
-// Σ along the segment of min(1, |∇I·n|), sampled once per pixel of length.
-double edgeIntegral(const cv::Mat& gx, const cv::Mat& gy, cv::Point a, cv::Point b) {
-  if (gx.empty() || gy.empty()) return 0.0;
+constexpr int kGateDepth = 5;  // px sampled inside the contour by the edge gate
+
+// s(x) of the edge gate: 0 below -contrast, 1 above +contrast, linear in between.
+double gate(double x, double contrast) { return std::clamp(1.0 + x / contrast, 0.0, 1.0); }
+
+// Left and right edge terms of a→b, whose interior side is n = (-dy, dx): λ·unit·Σ along the
+// segment of min(1, |∇I·n|) times the cost-contrast gate, sampled once per pixel of length.
+std::array<double, 2> edgeTermsOf(const EnergyImages& im, const EnergyWeights& w, cv::Point a, cv::Point b) {
+  std::array<double, 2> out{0.0, 0.0};
+  const bool left = !im.leftGradX.empty() && !im.leftGradY.empty();
+  const bool right = !im.rightGradX.empty() && !im.rightGradY.empty();
+  if (!left && !right) return out;
   const double dx = b.x - a.x, dy = b.y - a.y;
   const double len = std::hypot(dx, dy);
-  if (len <= 0) return 0.0;
+  if (len <= 0) return out;
   const double nx = -dy / len, ny = dx / len;
   const int samples = std::max(1, static_cast<int>(std::ceil(len)));
-  double sum = 0.0;
+  const bool gated = w.edgeContrast > 0;
+  auto contrast = [&](double x, double y) {  // D = c_ground - c_roof: > 0 where roof-like
+    return bilinear(im.groundCost, x, y) - bilinear(im.roofCost, x, y);
+  };
   for (int i = 0; i < samples; ++i) {
     const double t = (i + 0.5) / samples;
-    // Pixel centres are at +0.5: sample the gradient images in their index frame.
+    // Pixel centres are at +0.5: sample the images in their index frame.
     const double px = a.x + t * dx - 0.5, py = a.y + t * dy - 0.5;
-    const double g = bilinear(gx, px, py) * nx + bilinear(gy, px, py) * ny;
-    sum += std::min(1.0, std::abs(g));
+    double weight = 1.0;
+    if (gated) {
+      double in = 0.0;
+      for (int k = 1; k <= kGateDepth; ++k) in += contrast(px + k * nx, py + k * ny);
+      weight = gate(in / kGateDepth, w.edgeContrast);
+      if (weight <= 0.0) continue;
+    }
+    if (left) {
+      const double g = bilinear(im.leftGradX, px, py) * nx + bilinear(im.leftGradY, px, py) * ny;
+      out[0] += std::min(1.0, std::abs(g)) * weight;
+    }
+    if (right) {
+      const double g = bilinear(im.rightGradX, px, py) * nx + bilinear(im.rightGradY, px, py) * ny;
+      out[1] += std::min(1.0, std::abs(g)) * weight;
+    }
   }
-  return sum * len / samples;
-}
-
-double edgeTermOf(const EnergyImages& im, const EnergyWeights& w, cv::Point a, cv::Point b,
-                  int which) {
-  const double integral = which == 0 ? edgeIntegral(im.leftGradX, im.leftGradY, a, b)
-                                     : edgeIntegral(im.rightGradX, im.rightGradY, a, b);
-  return -w.edgeWeight * kEdgeUnit * integral;
+  const double scale = -w.edgeWeight * kEdgeUnit * len / samples;
+  return {out[0] * scale, out[1] * scale};
 }
 
 int occlusionAt(const EnergyImages& im, int y, int x) {
@@ -121,6 +140,25 @@ double ringArea2(const IntRing& r) {
   }
   return a;
 }
+double pointSegmentDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
+  const cv::Point2d ab = b - a;
+  const double len2 = ab.dot(ab);
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  const cv::Point2d d = p - (a + t * ab);
+  return std::hypot(d.x, d.y);
+}
+// Segments a-b and p-q that point in nearly opposite directions (more than 135° apart) and come
+// closer than `gap`: the two sides of a finger or slit. They do not cross (checked before).
+bool antiparallelWithin(cv::Point a, cv::Point b, cv::Point p, cv::Point q, double gap) {
+  const cv::Point2d u = b - a, v = q - p;
+  if (u.dot(v) > -std::cos(CV_PI / 4) * std::hypot(u.x, u.y) * std::hypot(v.x, v.y)) return false;
+  const double d = std::min(std::min(pointSegmentDistance(a, p, q), pointSegmentDistance(b, p, q)),
+                            std::min(pointSegmentDistance(p, a, b), pointSegmentDistance(q, a, b)));
+  return d < gap;
+}
+// True when the polygon's interior lies on the (-dy, dx) side of ring r's edges: with y down,
+// a ring of positive ringArea2 has its inside there; a hole's polygon interior is its outside.
+bool interiorOnLeft(const IntRing& ring, bool hole) { return (ringArea2(ring) > 0) != hole; }
 bool insideRing(const IntRing& ring, cv::Point2d p) {
   bool in = false;
   for (size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
@@ -202,10 +240,12 @@ EnergyTerms referenceEnergy(const EnergyImages& im, const EnergyWeights& w,
   for (size_t r = 0; r < polygon.ringCount(); ++r) {
     const IntRing& ring = polygon.ring(r);
     const size_t n = ring.size();
+    const bool inwardLeft = interiorOnLeft(ring, r > 0);
     for (size_t i = 0; i < n; ++i) {
       const cv::Point a = ring[i], b = ring[(i + 1) % n];
-      t.term[3] += edgeTermOf(im, w, a, b, 0);
-      t.term[4] += edgeTermOf(im, w, a, b, 1);
+      const auto e = inwardLeft ? edgeTermsOf(im, w, a, b) : edgeTermsOf(im, w, b, a);
+      t.term[3] += e[0];
+      t.term[4] += e[1];
       t.term[5] += w.rigidity * anglePrior(vertexAngle(ring[(i + n - 1) % n], a, b));
     }
   }
@@ -277,14 +317,15 @@ PolygonEnergy::RowTerms PolygonEnergy::rowTerms(int y, const std::vector<double>
   return t;
 }
 
-const std::array<double, 2>& PolygonEnergy::edgeTerms(cv::Point a, cv::Point b) const {
+const std::array<double, 2>& PolygonEnergy::edgeTerms(cv::Point a, cv::Point b, bool inwardLeft) const {
+  if (!inwardLeft) std::swap(a, b);
   // Vertices lie in [0, W] x [0, H] (validated moves), so 16 bits per coordinate suffice; the key
   // keeps the direction so that results are bit-identical to the reference's.
   const auto coord = [](int v) { return static_cast<std::uint64_t>(static_cast<std::uint16_t>(v)); };
   const std::uint64_t key = coord(a.x) | coord(a.y) << 16 | coord(b.x) << 32 | coord(b.y) << 48;
   if (edgeCache_.size() > (1u << 20)) edgeCache_.clear();  // bounded memory on huge runs
   auto [it, inserted] = edgeCache_.try_emplace(key);
-  if (inserted) it->second = {edgeTermOf(images_, weights_, a, b, 0), edgeTermOf(images_, weights_, a, b, 1)};
+  if (inserted) it->second = edgeTermsOf(images_, weights_, a, b);
   return it->second;
 }
 
@@ -301,9 +342,11 @@ void PolygonEnergy::setPolygon(const IntPolygon& polygon) {
 
 void PolygonEnergy::rebuild() {
   ringOffset_.clear();
+  ringInwardLeft_.clear();
   int total = 0;
   for (size_t r = 0; r < polygon_.ringCount(); ++r) {
     ringOffset_.push_back(total);
+    ringInwardLeft_.push_back(interiorOnLeft(polygon_.ring(r), r > 0));
     total += static_cast<int>(polygon_.ring(r).size());
   }
   edgeTerms_.assign(total, {0.0, 0.0});
@@ -315,7 +358,7 @@ void PolygonEnergy::rebuild() {
     for (int i = 0; i < n; ++i) {
       const int id = ringOffset_[r] + i;
       const cv::Point a = ring[i], b = ring[(i + 1) % n];
-      edgeTerms_[id] = edgeTerms(a, b);
+      edgeTerms_[id] = edgeTerms(a, b, ringInwardLeft_[r]);
       vertexPriors_[id] = vertexPrior(ring, i);
       forEachCrossing(a, b, size_.height,
                       [&](int y, double x) { rowCrossings_[y].push_back({x, id}); });
@@ -397,7 +440,7 @@ double PolygonEnergy::delta(const Change& c) const {
   for (int v : oldVertices) d -= vertexPriors_[v];
   // New edges chain[1]→chain[2] ... chain[m+1]→chain[m+2]; new priors at chain[1..m+2].
   for (int i = 1; i <= m + 1; ++i) {
-    const auto& e = edgeTerms(chain[i], chain[i + 1]);
+    const auto& e = edgeTerms(chain[i], chain[i + 1], ringInwardLeft_[c.ring]);
     d += e[0] + e[1];
   }
   for (int i = 1; i <= m + 2; ++i) {
@@ -475,6 +518,33 @@ bool PolygonEnergy::valid(const Change& c) const {
   }
   const double before = ringArea2(ring), now = ringArea2(nr);
   if (now == 0 || (before > 0) != (now > 0)) return false;
+  // Shape limits: no spike tip sharper than minAngle (unless the change opens a sharper one) and
+  // no finger or slit narrower than minGap.
+  if (weights_.minAngle > 0) {
+    double oldMin = CV_PI, newMin = CV_PI;
+    for (int i = -1; i <= c.removeCount; ++i) {
+      const int k = ((c.first + i) % n + n) % n;
+      oldMin = std::min(oldMin, vertexAngle(ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n]));
+    }
+    for (int i = -1; i <= m; ++i) {
+      const int k = ((start + i) % newN + newN) % newN;
+      newMin = std::min(newMin, vertexAngle(nr[(k + newN - 1) % newN], nr[k], nr[(k + 1) % newN]));
+    }
+    if (newMin < weights_.minAngle * CV_PI / 180.0 && newMin < oldMin) return false;
+  }
+  if (weights_.minGap > 0) {
+    for (int e : changedEdges) {
+      const cv::Point a = nr[e], b = nr[(e + 1) % newN];
+      for (size_t r = 0; r < after.ringCount(); ++r) {
+        const IntRing& other = after.ring(r);
+        const int k = static_cast<int>(other.size());
+        for (int j = 0; j < k; ++j) {
+          if (static_cast<int>(r) == c.ring && (j == e || j == (e + 1) % newN || (j + 1) % newN == e)) continue;
+          if (antiparallelWithin(a, b, other[j], other[(j + 1) % k], weights_.minGap)) return false;
+        }
+      }
+    }
+  }
   // A ring may jump over a whole small ring without crossing it: keep holes inside the outer
   // ring and outside each other.
   if (c.ring == 0) {

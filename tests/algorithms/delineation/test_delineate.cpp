@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <tuple>
 
 #include <opencv2/imgproc.hpp>
@@ -31,8 +33,11 @@ struct Pair {
   core::Polygon truth;
 };
 
-Pair raisedRoof(cv::Size size, cv::Rect roof, int dr, int dg) {
-  const cv::Mat ground = texture(size + cv::Size(64, 0), 100, 25, 1);
+// `lineRow` >= 0 paints a bright 2-row line across the ground, over the whole width (a road
+// marking, a shadow or a wall edge passing by the building).
+Pair raisedRoof(cv::Size size, cv::Rect roof, int dr, int dg, int lineRow = -1) {
+  cv::Mat ground = texture(size + cv::Size(64, 0), 100, 25, 1);
+  if (lineRow >= 0) ground(cv::Rect(0, lineRow, ground.cols, 2)).setTo(230.0f);
   const cv::Mat top = texture(size + cv::Size(64, 0), 160, 25, 2);
   const cv::Mat wall = texture(size + cv::Size(64, 0), 60, 10, 3);
   Pair p;
@@ -85,6 +90,41 @@ TEST(Delineate, ConvergesOnASyntheticPairWithGivenGround) {
   EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.9);
   EXPECT_GT(reports, 0);
   EXPECT_GE(r.vertexCount, 4);
+}
+
+// Largest distance of a polygon vertex outside the rectangle.
+double farthestOutside(const core::Polygon& p, cv::Rect r) {
+  double far = 0;
+  for (const auto& v : p.outer) {
+    const double dx = std::max({r.x - v.x, 0.0, v.x - r.br().x});
+    const double dy = std::max({r.y - v.y, 0.0, v.y - r.br().y});
+    far = std::max(far, std::hypot(dx, dy));
+  }
+  return far;
+}
+
+TEST(Delineate, DoesNotFollowAStrongLineLeavingTheRoof) {
+  // The edge terms reward contour length along any gradient: with the paper's plain terms a
+  // thin finger along the line (both sides on the line; a horizontal line is ambiguous in
+  // disparity, so its area costs nothing) runs to the ROI border.
+  const cv::Rect roof(50, 40, 60, 50);
+  // The line crosses the ROI 10 px above the roof (2 px beyond the init's top edge).
+  const Pair pair = raisedRoof({200, 140}, roof, 14, 4, roof.y - 10);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
+  EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.9);
+  EXPECT_LT(farthestOutside(r.polygon, roof), 4.0);
+  // The same scene with the gate, the shape limits and the shortcuts off: the defect is there.
+  DelineationParams plain;
+  plain.edgeContrast = 0;
+  plain.minAngle = 0;
+  plain.minGap = 0;
+  plain.shortcutVertices = 0;
+  const auto spiky = delineate(pair.left, pair.right, req, plain);
+  EXPECT_GT(farthestOutside(spiky.polygon, roof), 10.0);
 }
 
 TEST(Delineate, EstimatesTheGroundFromTheRing) {

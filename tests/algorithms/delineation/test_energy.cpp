@@ -98,7 +98,9 @@ TEST(Energy, EdgeTermsUseTheNormalComponent) {
   im.leftGradY = cv::Mat(im.roofCost.size(), CV_32F, cv::Scalar(0.0f));
   im.rightGradX = cv::Mat(im.roofCost.size(), CV_32F, cv::Scalar(0.0f));
   im.rightGradY = cv::Mat(im.roofCost.size(), CV_32F, cv::Scalar(0.5f));
-  PolygonEnergy e(im, {5.0, 15.0});
+  EnergyWeights plain{5.0, 15.0};
+  plain.edgeContrast = 0;  // the paper's terms, without the roof/ground gate
+  PolygonEnergy e(im, plain);
   e.setPolygon(rect(2, 3, 10, 5));
   // Left: only the two vertical edges (normal ±x) count, 5 px each.
   EXPECT_NEAR(e.terms().term[3], -5.0 * kEdgeUnit * 10, 1e-9);

@@ -50,6 +50,17 @@ struct EnergyImages {
 struct EnergyWeights {
   double edgeWeight = 5.0;  // λ
   double rigidity = 15.0;   // β
+  // Cost contrast (units of Crit) at which an edge sample counts fully: the gradient across the
+  // contour is weighted by s(D_in) * s(-D_out), D = c_ground - c_roof averaged 1..3 px inside /
+  // outside along the normal, s(x) = clamp(1/2 + x / (2 * contrast), 0, 1). An edge is a roof
+  // edge only where it separates roof-like from ground-like pixels; a thin spike or finger has
+  // ground on both sides and gets (almost) nothing. 0 disables the gate (plain paper terms).
+  double edgeContrast = 0.1;
+  // Shape limits of a change (not of the initial polygon): no new vertex angle below minAngle
+  // degrees unless it opens a sharper one, and no edge closer than minGap px to a non-adjacent,
+  // antiparallel edge (a finger or slit narrower than that). 0 disables each.
+  double minAngle = 20.0;
+  double minGap = 2.0;
 };
 
 // Contour length unit of the edge terms: a full-contrast edge (normalised gradient 1) across the
@@ -115,7 +126,9 @@ class PolygonEnergy {
   RowTerms rowTerms(int y, const std::vector<double>& xs) const;
   // Left and right edge terms of a→b, memoised: the same candidate edges come back sweep after
   // sweep, and sampling them is the most expensive part of a candidate's energy.
-  const std::array<double, 2>& edgeTerms(cv::Point a, cv::Point b) const;
+  // `inwardLeft`: the polygon's interior lies on the side of n = (-dy, dx) (the edge's left in
+  // image coordinates); edges are stored in that normalised direction.
+  const std::array<double, 2>& edgeTerms(cv::Point a, cv::Point b, bool inwardLeft) const;
   double vertexPrior(const IntRing& ring, int i) const;
   void rebuild();
 
@@ -125,6 +138,7 @@ class PolygonEnergy {
   std::vector<double> roofPrefix_, groundPrefix_;  // (W + 1) per row
   IntPolygon polygon_;
   std::vector<int> ringOffset_;
+  std::vector<bool> ringInwardLeft_;  // per ring: the interior is on the (-dy, dx) side
   std::vector<std::vector<Crossing>> rowCrossings_;
   std::vector<RowTerms> rowTerms_;
   std::vector<std::array<double, 2>> edgeTerms_;  // by edge id

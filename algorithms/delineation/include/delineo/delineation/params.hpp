@@ -21,6 +21,11 @@ struct DelineationParams {
   bool courtyards = true;          // look for inner courtyards after convergence (holes)
   bool balanceIntervals = true;    // compare roof and ground costs over equally many disparities
   double minCourtyardArea = 120.0; // px², smallest courtyard tried
+  double edgeContrast = 0.1;       // Crit units: cost contrast gating the edge terms (0 = off)
+  double minAngle = 20.0;          // degrees: sharpest vertex angle a change may create (0 = off)
+  double minGap = 2.0;             // px: narrowest finger or slit a change may create (0 = off)
+  int shortcutVertices = 16;       // most consecutive vertices one shortcut move removes (< 2 = off)
+  double shortcutWidth = 4.0;      // px: widest (mean width) piece a shortcut may cut off
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
@@ -79,6 +84,31 @@ struct DelineationParams {
     v(core::ParamInfo{"min-courtyard-area", "Min courtyard area", "px²",
                       "Smallest interior ground region tried as a courtyard", 16, 1e9},
       minCourtyardArea);
+    v(core::ParamInfo{"edge-contrast", "Edge contrast gate", "",
+                      "Cost contrast (c_ground - c_roof, Crit units) inside vs outside the contour "
+                      "at which an edge sample counts fully; edges with ground-like pixels inside "
+                      "or roof-like pixels outside count less (0 = paper's ungated edge terms)",
+                      0, 1},
+      edgeContrast);
+    v(core::ParamInfo{"min-angle", "Min angle", "deg",
+                      "Sharpest vertex angle an optimisation step may create (spike tips; 0 = off)",
+                      0, 60},
+      minAngle);
+    v(core::ParamInfo{"min-gap", "Min gap", "px",
+                      "Narrowest finger or slit (antiparallel edges) an optimisation step may "
+                      "create (0 = off)",
+                      0, 20},
+      minGap);
+    v(core::ParamInfo{"shortcut-vertices", "Shortcut vertices", "",
+                      "Most consecutive vertices removed by one shortcut move, which cuts off a "
+                      "spike, finger or slit in one step (0 or 1 = off)",
+                      0, 256},
+      shortcutVertices);
+    v(core::ParamInfo{"shortcut-width", "Shortcut width", "px",
+                      "Widest piece a shortcut may cut off, as its mean width 2 * area / path "
+                      "length (thin spikes and fingers, not wings of the building)",
+                      0.5, 100},
+      shortcutWidth);
   }
   void validate() const;
 };
