@@ -518,8 +518,9 @@ bool PolygonEnergy::valid(const Change& c) const {
   }
   const double before = ringArea2(ring), now = ringArea2(nr);
   if (now == 0 || (before > 0) != (now > 0)) return false;
-  // Shape limits: no spike tip sharper than minAngle (unless the change opens a sharper one) and
-  // no finger or slit narrower than minGap.
+  // Shape limits: no spike tip sharper than minAngle (unless the sharpest angle around the
+  // change gets blunter, so that a sharp initial polygon can still improve) and no finger or
+  // slit narrower than minGap.
   if (weights_.minAngle > 0) {
     double oldMin = CV_PI, newMin = CV_PI;
     for (int i = -1; i <= c.removeCount; ++i) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -229,4 +230,61 @@ TEST(Energy, ValidChangesNeverSelfIntersect) {
   }
   EXPECT_GT(accepted, 100);
   EXPECT_GT(rejected, 100);
+}
+
+TEST(Energy, EdgeGateRewardsOnlyContoursWithRoofInside) {
+  // Roof-like pixels (c_roof < c_ground) on x < 15, ground-like on x >= 15; a vertical
+  // gradient line everywhere (|∇I·n| = 1 across vertical edges).
+  auto im = flatImages({40, 20}, 0.4f, 0.1f, 0.0f);
+  im.roofCost(cv::Rect(0, 0, 15, 20)).setTo(0.1f);
+  im.groundCost(cv::Rect(0, 0, 15, 20)).setTo(0.4f);
+  im.leftGradX = cv::Mat(im.roofCost.size(), CV_32F, cv::Scalar(1.0f));
+  im.leftGradY = cv::Mat(im.roofCost.size(), CV_32F, cv::Scalar(0.0f));
+  const EnergyWeights w{5.0, 0.0};
+  PolygonEnergy e(im, w);
+  e.setPolygon(rect(2, 3, 10, 5));  // on the roof: both vertical edges count fully
+  EXPECT_NEAR(e.terms().term[3], -5.0 * kEdgeUnit * 10, 1e-9);
+  e.setPolygon(rect(20, 3, 10, 5));  // on the ground: nothing
+  EXPECT_NEAR(e.terms().term[3], 0.0, 1e-9);
+  // The interior side does not depend on the ring's orientation, and a hole's interior side is
+  // the polygon around it: a hole in the ground part earns nothing, whichever way it turns.
+  IntPolygon withHole = rect(1, 1, 38, 18);
+  withHole.holes.push_back({{22, 6}, {28, 6}, {28, 12}, {22, 12}});
+  e.setPolygon(withHole);
+  const double clockwise = e.terms().term[3];
+  std::reverse(withHole.holes[0].begin(), withHole.holes[0].end());
+  std::reverse(withHole.outer.begin(), withHole.outer.end());
+  e.setPolygon(withHole);
+  EXPECT_NEAR(e.terms().term[3], clockwise, 1e-9);
+  EXPECT_NEAR(referenceEnergy(im, w, withHole).term[3], clockwise, 1e-9);
+  // Only the outer ring's left edge (roof inside) counts: 18 px.
+  EXPECT_NEAR(clockwise, -5.0 * kEdgeUnit * 18, 1e-9);
+}
+
+TEST(Energy, ShapeLimitsRejectSpikeTipsAndFingers) {
+  const auto im = flatImages({40, 40}, 0.0f, 0.0f, 0.0f);
+  EnergyWeights limited{5.0, 15.0};
+  EnergyWeights unlimited = limited;
+  unlimited.minAngle = 0;
+  unlimited.minGap = 0;
+  IntPolygon p;
+  p.outer = {{5, 10}, {13, 10}, {14, 10}, {15, 10}, {16, 10}, {25, 10}, {25, 20}, {5, 20}};
+  PolygonEnergy a(im, limited), b(im, unlimited);
+  a.setPolygon(p);
+  b.setPolygon(p);
+  // Spike: vertex (14, 10) pulled up to (14, 2): its angle is 2·atan(1/8) = 14°.
+  const PolygonEnergy::Change spike{0, 2, 1, {{14, 2}}};
+  EXPECT_FALSE(a.valid(spike));
+  EXPECT_TRUE(b.valid(spike));
+  // A blunter spike (vertex (15, 10) to (15, 6): 2·atan(2/4) = 53°) is allowed.
+  EXPECT_TRUE(a.valid({0, 3, 1, {{15, 6}}}));
+  // Finger: (14, 10) and (15, 10) moved together to (14, 2), (15, 2): its sides are 1 px apart.
+  const PolygonEnergy::Change finger{0, 2, 2, {{14, 2}, {15, 2}}};
+  EXPECT_FALSE(a.valid(finger));
+  EXPECT_TRUE(b.valid(finger));
+  // Parallel neighbours 1 px apart (a staircase) are not a finger.
+  IntPolygon stairs;
+  stairs.outer = {{5, 10}, {15, 10}, {15, 11}, {25, 11}, {25, 20}, {5, 20}};
+  a.setPolygon(stairs);
+  EXPECT_TRUE(a.valid({0, 4, 1, {{26, 20}}}));
 }

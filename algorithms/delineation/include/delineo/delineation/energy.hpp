@@ -56,9 +56,10 @@ struct EnergyWeights {
   // edge only where it separates roof-like from ground-like pixels; a thin spike or finger has
   // ground on both sides and gets (almost) nothing. 0 disables the gate (plain paper terms).
   double edgeContrast = 0.1;
-  // Shape limits of a change (not of the initial polygon): no new vertex angle below minAngle
-  // degrees unless it opens a sharper one, and no edge closer than minGap px to a non-adjacent,
-  // antiparallel edge (a finger or slit narrower than that). 0 disables each.
+  // Shape limits of a change (not of the initial polygon): no vertex angle below minAngle
+  // degrees around the change unless the sharpest one there gets blunter, and no changed edge
+  // closer than minGap px to a non-adjacent edge pointing the opposite way (more than 135°
+  // apart: the two sides of a finger or slit). 0 disables each.
   double minAngle = 20.0;
   double minGap = 2.0;
 };
