@@ -184,6 +184,11 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   for (const auto& v : init.outer) local.emplace_back(v.x - roi.x, v.y - roi.y);
   out.init.outer = polygonise(local, params.initialSpacing, size);
   const cv::Mat initMask = core::rasterize(toPolygon(out.init), size);
+  if (params.maxExcursion < params.roiMargin) {
+    cv::Mat distance;
+    cv::distanceTransform(initMask == 0, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    im.allowed = distance <= params.maxExcursion;
+  }
 
   const cv::Mat bestCost = costs.bestCost();
   im.noMatchCost = static_cast<float>(quantile(bestCost, 1.0 - params.occlusionPercent / 100.0));

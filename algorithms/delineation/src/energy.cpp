@@ -487,6 +487,15 @@ bool PolygonEnergy::valid(const Change& c) const {
   if (newN < 3) return false;
   for (const auto& v : c.inserted) {
     if (v.x < 0 || v.y < 0 || v.x > size_.width || v.y > size_.height) return false;
+    if (!images_.allowed.empty()) {
+      bool near = false;
+      for (int y = std::max(v.y - 1, 0); y <= std::min(v.y, size_.height - 1) && !near; ++y) {
+        for (int x = std::max(v.x - 1, 0); x <= std::min(v.x, size_.width - 1) && !near; ++x) {
+          near = images_.allowed.at<uchar>(y, x) != 0;
+        }
+      }
+      if (!near) return false;
+    }
   }
   const IntPolygon after = changed(c);
   const IntRing& nr = after.ring(c.ring);

@@ -45,6 +45,9 @@ struct EnergyImages {
   // Normalised image gradients (CV_32F, same size); empty pairs disable the term. The right
   // gradients are already resampled at (x - d_xy, y).
   cv::Mat leftGradX, leftGradY, rightGradX, rightGradY;
+  // CV_8U, same size, optional: non-zero where a vertex may go (a vertex at pixel corner (x, y)
+  // is allowed when one of the four pixels around it is). Empty = anywhere in the ROI.
+  cv::Mat allowed;
 };
 
 struct EnergyWeights {

@@ -26,6 +26,7 @@ struct DelineationParams {
   double minGap = 2.0;             // px: narrowest finger or slit a change may create (0 = off)
   int shortcutVertices = 16;       // most consecutive vertices one shortcut move removes (< 2 = off)
   double shortcutWidth = 4.0;      // px: widest (mean width) piece a shortcut may cut off
+  double maxExcursion = 8.0;       // px: farthest a vertex may go outside the initial contour
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
@@ -109,6 +110,12 @@ struct DelineationParams {
                       "length (thin spikes and fingers, not wings of the building)",
                       0.5, 100},
       shortcutWidth);
+    v(core::ParamInfo{"max-excursion", "Max excursion", "px",
+                      "Farthest a vertex may go outside the operator's initial contour (the "
+                      "outline is rough, not wrong: neighbouring roofs and trees at roof height "
+                      "stay out); at least roi-margin = no limit",
+                      0, 10000},
+      maxExcursion);
   }
   void validate() const;
 };
