@@ -292,11 +292,11 @@ TEST(Energy, ShapeLimitsRejectSpikeTipsAndFingers) {
 TEST(Energy, VerticesStayInTheAllowedRegion) {
   auto im = flatImages({40, 40}, 0.0f, 0.0f, 0.0f);
   im.allowed = cv::Mat(im.roofCost.size(), CV_8U, cv::Scalar(0));
-  im.allowed(cv::Rect(5, 5, 20, 20)).setTo(255);  // pixels 5..24: corners 4..25 allowed
+  im.allowed(cv::Rect(5, 5, 20, 20)).setTo(255);  // pixels 5..24: corners 5..25 allowed
   PolygonEnergy e(im, {5.0, 15.0});
   e.setPolygon(rect(10, 10, 10, 10));
-  EXPECT_TRUE(e.valid({0, 0, 1, {{4, 4}}}));
-  EXPECT_FALSE(e.valid({0, 0, 1, {{3, 4}}}));
+  EXPECT_TRUE(e.valid({0, 0, 1, {{5, 5}}}));
+  EXPECT_FALSE(e.valid({0, 0, 1, {{4, 5}}}));
   EXPECT_TRUE(e.valid({0, 2, 1, {{25, 25}}}));
   EXPECT_FALSE(e.valid({0, 2, 1, {{25, 26}}}));
 }
