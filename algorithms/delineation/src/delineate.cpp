@@ -98,6 +98,34 @@ void normaliseBy99(cv::Mat& gx, cv::Mat& gy) {
   }
 }
 
+// Region stage: inside the initial contour, the pixels whose roof interval matches better than
+// the ground's, smoothed (median 5x5, opened 3x3, closed 7x7); the outline of the largest
+// component, simplified (2 px) and polygonised. Carves the notches of concave buildings that
+// a rough (box) contour cannot reach by local moves. Empty when there is no usable component.
+IntPolygon regionStageInit(const EnergyImages& im, const cv::Mat& initMask, const DelineationParams& params) {
+  cv::Mat roofLike = (im.roofCost < im.groundCost) & initMask;
+  cv::medianBlur(roofLike, roofLike, 5);
+  cv::morphologyEx(roofLike, roofLike, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  cv::morphologyEx(roofLike, roofLike, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(roofLike, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  if (contours.empty()) return {};
+  const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+    return cv::contourArea(a) < cv::contourArea(b);
+  });
+  if (cv::contourArea(*largest) < 0.1 * cv::countNonZero(initMask)) return {};
+  std::vector<cv::Point> simplified;
+  cv::approxPolyDP(*largest, simplified, 2.0, true);
+  if (simplified.size() < 3) return {};
+  core::Ring ring;
+  // Contour points are pixel centres of border pixels: their corners are half a pixel out.
+  for (const auto& v : simplified) ring.emplace_back(v.x + 0.5, v.y + 0.5);
+  IntPolygon p;
+  p.outer = polygonise(ring, params.initialSpacing, im.roofCost.size());
+  if (p.outer.size() < 3 || !isValidPolygon(p) || core::area(toPolygon(p)) < 4.0) return {};
+  return p;
+}
+
 }  // namespace
 
 std::pair<DisparityInterval, DisparityInterval> costIntervals(const DisparityInterval& roof,
@@ -298,6 +326,22 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   cv::remap(rgx, im.rightGradX, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   cv::remap(rgy, im.rightGradY, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   normaliseBy99(im.rightGradX, im.rightGradY);
+  if (params.regionInit) {
+    const IntPolygon region = regionStageInit(im, initMask, params);
+    if (!region.outer.empty()) {
+      // The energy decides: the region outline replaces the operator's only when it is lower.
+      const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast,
+                                  params.minAngle, params.minGap};
+      PolygonEnergy energy(im, weights);
+      energy.setPolygon(out.init);
+      const double operatorEnergy = energy.total();
+      energy.setPolygon(region);
+      if (energy.total() < operatorEnergy) {
+        out.init = region;
+        out.regionInit = true;
+      }
+    }
+  }
   return out;
 }
 

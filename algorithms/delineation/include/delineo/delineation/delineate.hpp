@@ -37,7 +37,8 @@ struct DelineationRequest {
 struct PreparedEnergy {
   cv::Rect roi;
   EnergyImages images;
-  IntPolygon init;              // ROI coordinates
+  IntPolygon init;              // ROI coordinates (the region-stage outline when regionInit)
+  bool regionInit = false;      // the region stage's outline had the lower energy
   DisparityInterval ground;     // given or estimated
   double groundDisparity = 0;   // representative ground level used for the occlusion band
   double roofDisparity = 0;     // median roof disparity near the initial contour

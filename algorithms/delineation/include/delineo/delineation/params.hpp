@@ -27,6 +27,7 @@ struct DelineationParams {
   int shortcutVertices = 16;       // most consecutive vertices one shortcut move removes (< 2 = off)
   double shortcutWidth = 4.0;      // px: widest (mean width) piece a shortcut may cut off
   double maxExcursion = 8.0;       // px: farthest a vertex may go outside the initial contour
+  bool regionInit = true;          // start from the roof-like region inside the init when lower F
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
@@ -116,6 +117,11 @@ struct DelineationParams {
                       "stay out); at least roi-margin = no limit",
                       0, 10000},
       maxExcursion);
+    v(core::ParamInfo{"region-init", "Region init", "",
+                      "Start from the outline of the largest roof-like region (c_roof < c_ground) "
+                      "inside the initial contour when its energy is lower (carves notches a "
+                      "rough contour cannot reach)"},
+      regionInit);
   }
   void validate() const;
 };
