@@ -99,12 +99,15 @@ void normaliseBy99(cv::Mat& gx, cv::Mat& gy) {
 }
 
 // Region stage: inside the initial contour, the pixels whose roof interval matches better than
-// the ground's, smoothed (median 5x5, opened 3x3, closed 7x7); the outline of the largest
+// the ground's on average over 9x9 pixels (opened 3x3, closed 7x7); the outline of the largest
 // component, simplified (2 px) and polygonised. Carves the notches of concave buildings that
 // a rough (box) contour cannot reach by local moves. Empty when there is no usable component.
 IntPolygon regionStageInit(const EnergyImages& im, const cv::Mat& initMask, const DelineationParams& params) {
-  cv::Mat roofLike = (im.roofCost < im.groundCost) & initMask;
-  cv::medianBlur(roofLike, roofLike, 5);
+  // Aggregated over 9x9 pixels: on a textureless roof each pixel's difference is noise, but its
+  // mean still leans to the roof (balanced intervals).
+  cv::Mat difference = im.groundCost - im.roofCost;
+  cv::blur(difference, difference, {9, 9}, {-1, -1}, cv::BORDER_REPLICATE);
+  cv::Mat roofLike = (difference > 0) & initMask;
   cv::morphologyEx(roofLike, roofLike, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
   cv::morphologyEx(roofLike, roofLike, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
   std::vector<std::vector<cv::Point>> contours;
