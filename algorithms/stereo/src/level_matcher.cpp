@@ -302,35 +302,37 @@ struct Board {
 
 // The 4-connected component of `seed` inside `open` (seed ⊂ open).
 inline Board floodFill(Board seed, const Board& open) {
-  for (;;) {
-    const Board before = seed;
-    // Along rows, both directions, then along columns, both directions (doubling).
-    Board a = seed, g = open;
-    for (int k = 1; k <= 8; k *= 2) {
-      a = a | (g & a.right(k));
-      g = g & g.right(k);
+  // Runs of open cells 2^i long in each direction: the masks of the doubling steps, which
+  // depend on `open` only.
+  Board gRight[4], gLeft[4], gDown[4], gUp[4];
+  gRight[0] = gLeft[0] = gDown[0] = gUp[0] = open;
+  for (int i = 1; i < 4; ++i) {
+    const int k = 1 << (i - 1);
+    gRight[i] = gRight[i - 1] & gRight[i - 1].right(k);
+    gLeft[i] = gLeft[i - 1] & gLeft[i - 1].left(k);
+    gDown[i] = gDown[i - 1] & gDown[i - 1].down(k);
+    gUp[i] = gUp[i - 1] & gUp[i - 1].up(k);
+  }
+  for (bool first = true;; first = false) {
+    // Along rows, both directions (doubling: shifts 1, 2, 4, 8).
+    Board a = seed, b = seed;
+    for (int i = 0; i < 4; ++i) {
+      a = a | (gRight[i] & a.right(1 << i));
+      b = b | (gLeft[i] & b.left(1 << i));
     }
-    Board b = seed;
-    g = open;
-    for (int k = 1; k <= 8; k *= 2) {
-      b = b | (g & b.left(k));
-      g = g & g.left(k);
-    }
-    seed = a | b;
+    Board filled = a | b;
+    if (!first && filled == seed) return seed;  // closed along both directions
+    seed = filled;
+    // Along columns, both directions.
     a = seed;
-    g = open;
-    for (int n = 1; n <= 8; n *= 2) {
-      a = a | (g & a.down(n));
-      g = g & g.down(n);
-    }
     b = seed;
-    g = open;
-    for (int n = 1; n <= 8; n *= 2) {
-      b = b | (g & b.up(n));
-      g = g & g.up(n);
+    for (int i = 0; i < 4; ++i) {
+      a = a | (gDown[i] & a.down(1 << i));
+      b = b | (gUp[i] & b.up(1 << i));
     }
-    seed = a | b;
-    if (seed == before) return seed;
+    filled = a | b;
+    if (filled == seed) return seed;  // closed along both directions
+    seed = filled;
   }
 }
 
