@@ -286,9 +286,9 @@ int main(int argc, char** argv) {
           fastEvaluations += fast.evaluations;
           referenceEvaluations += ref.evaluations;
           ++referenceDone;
-          std::printf("      speed: ROI %dx%d incremental %.1f ms, reference %.1f ms, same result: %s\n",
+          std::printf("      speed: ROI %dx%d incremental %.1f ms, reference %.1f ms, same result: %s (F %.6f vs %.6f)\n",
                       roi.width, roi.height, ms(t0, t1), ms(t1, t2),
-                      fast.polygon.outer == ref.polygon.outer ? "yes" : "no");
+                      fast.polygon.outer == ref.polygon.outer ? "yes" : "no", fast.terms.total(), ref.terms.total());
         }
       } catch (const std::exception& e) {
         std::printf("      speed run failed: %s\n", e.what());

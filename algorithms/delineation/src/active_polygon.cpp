@@ -84,9 +84,12 @@ class Optimiser {
       const double d = delta(candidates[k]);
       if (d < threshold) scored.emplace_back(d, k);
     }
-    // Stable order: ties keep candidate order, so runs are deterministic.
+    // Stable order: ties keep candidate order, so runs are deterministic. Deltas are compared
+    // at 1e-8 so that exact ties (two moves selecting the same pixels and edge samples) are
+    // broken by candidate order whatever the rounding of the energy mode.
+    const auto key = [](double d) { return std::llround(d * 1e8); };
     std::stable_sort(scored.begin(), scored.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
+                     [&](const auto& a, const auto& b) { return key(a.first) < key(b.first); });
     for (const auto& [d, k] : scored) {
       if (energy_.valid(candidates[k])) {
         apply(candidates[k]);

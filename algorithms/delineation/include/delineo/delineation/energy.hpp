@@ -53,11 +53,11 @@ struct EnergyImages {
 struct EnergyWeights {
   double edgeWeight = 5.0;  // λ
   double rigidity = 15.0;   // β
-  // Cost contrast (units of Crit) at which an edge sample counts fully: the gradient across the
-  // contour is weighted by s(D_in) * s(-D_out), D = c_ground - c_roof averaged 1..3 px inside /
-  // outside along the normal, s(x) = clamp(1/2 + x / (2 * contrast), 0, 1). An edge is a roof
-  // edge only where it separates roof-like from ground-like pixels; a thin spike or finger has
-  // ground on both sides and gets (almost) nothing. 0 disables the gate (plain paper terms).
+  // Edge gate (units of Crit): each edge sample's |∇I·n| is weighted by
+  // clamp(1 + D_in / edgeContrast, 0, 1), D_in = c_ground - c_roof averaged 1..5 px inside the
+  // contour along the normal. An edge is a roof edge only where the roof side is not ground:
+  // a thin spike or finger has ground (or the far side) inside and earns nothing, while a
+  // textureless roof (D_in ~ 0) keeps its edges. 0 disables the gate (the paper's terms).
   double edgeContrast = 0.1;
   // Shape limits of a change (not of the initial polygon): no vertex angle below minAngle
   // degrees around the change unless the sharpest one there gets blunter, and no changed edge

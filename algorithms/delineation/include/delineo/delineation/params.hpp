@@ -21,7 +21,7 @@ struct DelineationParams {
   bool courtyards = true;          // look for inner courtyards after convergence (holes)
   bool balanceIntervals = true;    // compare roof and ground costs over equally many disparities
   double minCourtyardArea = 120.0; // px², smallest courtyard tried
-  double edgeContrast = 0.1;       // Crit units: cost contrast gating the edge terms (0 = off)
+  double edgeContrast = 0.1;       // Crit units: ground-likeness inside that mutes an edge (0 = off)
   double minAngle = 20.0;          // degrees: sharpest vertex angle a change may create (0 = off)
   double minGap = 2.0;             // px: narrowest finger or slit a change may create (0 = off)
   int shortcutVertices = 16;       // most consecutive vertices one shortcut move removes (< 2 = off)
@@ -87,9 +87,9 @@ struct DelineationParams {
                       "Smallest interior ground region tried as a courtyard", 16, 1e9},
       minCourtyardArea);
     v(core::ParamInfo{"edge-contrast", "Edge contrast gate", "",
-                      "Cost contrast (c_ground - c_roof, Crit units) inside vs outside the contour "
-                      "at which an edge sample counts fully; edges with ground-like pixels inside "
-                      "or roof-like pixels outside count less (0 = paper's ungated edge terms)",
+                      "Edge gate: an edge sample counts fully when c_ground - c_roof averaged "
+                      "over 5 px inside the contour is >= 0, not at all when it is <= -X (ground "
+                      "inside: spikes, fingers), linearly between (Crit units; 0 = paper's terms)",
                       0, 1},
       edgeContrast);
     v(core::ParamInfo{"min-angle", "Min angle", "deg",
