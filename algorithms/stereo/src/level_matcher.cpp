@@ -360,6 +360,7 @@ struct LinePeak {
 // the indicator M of S. NCC(d, dy) = sum(T * B) / (|S| sd_S(B)).
 struct ShapeTemplate {
   std::vector<float> templ, mask;
+  uint32_t rowBits[32] = {};       // S as bits: bit u of row v = window cell (u, v)
   int rowFirst = 0, rowLast = -1;  // window rows holding part of S
   int count = 0;
 };
@@ -384,19 +385,10 @@ class LevelMatcher {
     // Pixels a shape never enters: contours and nodata. blockedBits_(y, x): bit u set when
     // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
     blocked_ = (in.refEdges != 0) | (in.refValid == 0);
-    blockedBits_ = cv::Mat(in.ref.size(), CV_32S, cv::Scalar(0));
-    for (int y = 0; y < H_; ++y) {
-      const uchar* b = blocked_.ptr<uchar>(y);
-      int* bits = blockedBits_.ptr<int>(y);
-      uint32_t word = (1U << s.window) - 1U;  // columns left of the image: blocked
-      for (int x = -r_; x < W_; ++x) {
-        // After this step, word covers columns x - r .. x + r (out of the image: blocked).
-        const int incoming = x + r_;
-        const uint32_t entering = incoming >= W_ || b[incoming] ? 1U : 0U;
-        word = (word >> 1) | (entering << (s.window - 1));
-        if (x >= 0) bits[x] = static_cast<int>(word);
-      }
-    }
+    blockedBits_ = rowWindowBits(blocked_);
+    // Nodata of the other image in the same form: a shape window touches nodata when one of its
+    // rows shares a bit with these (one AND per row).
+    otherInvalidBits_ = rowWindowBits(in.otherValid == 0);
     if (s.adaptive) {
       // Shapes also serve pixels whose window holds nodata or leaves the image (the input is
       // padded with nodata): S stops there as it stops at contours.
@@ -408,6 +400,26 @@ class LevelMatcher {
     out.disparity = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN));
     out.lineShift = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN));
     out.score = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN));
+  }
+
+  // Per pixel, the row of its window as one word: bit u set when (x - r + u, y) is marked in
+  // `marked` (CV_8U) or lies outside the image.
+  cv::Mat rowWindowBits(const cv::Mat& marked) const {
+    cv::Mat out(marked.size(), CV_32S, cv::Scalar(0));
+    const int w = s_.window;
+    for (int y = 0; y < H_; ++y) {
+      const uchar* b = marked.ptr<uchar>(y);
+      int* bits = out.ptr<int>(y);
+      uint32_t word = w == 32 ? ~0U : (1U << w) - 1U;  // columns left of the image: marked
+      for (int x = -r_; x < W_; ++x) {
+        // After this step, word covers columns x - r .. x + r.
+        const int incoming = x + r_;
+        const uint32_t entering = incoming >= W_ || b[incoming] ? 1U : 0U;
+        word = (word >> 1) | (entering << (w - 1));
+        if (x >= 0) bits[x] = static_cast<int>(word);
+      }
+    }
+    return out;
   }
 
   bool run(core::Progress* progress) {
@@ -680,6 +692,7 @@ class LevelMatcher {
       t.count = 0;
       for (int v = 0; v < w; ++v) t.count += __builtin_popcount(reach[v]);
     }
+    for (int v = 0; v < w; ++v) t.rowBits[v] = reach[v];
     // When S is the whole window minus its contour pixels (no part of the window is cut off)
     // and the square window is usable, the square serves the pixel: the few contour pixels
     // change its NCC little, and the square path is much cheaper.
@@ -740,16 +753,13 @@ class LevelMatcher {
   float shapeScore(int x, int y, int d, int dy, const ShapeTemplate& t) const {
     const int yb = y + dy, xb = x - d;
     if (yb < r_ || yb >= H_ - r_ || xb < r_ || xb >= W_ - r_) return kNaN;
-    const int w = s_.window;
     if (!otherStats_.ok.at<uchar>(yb, xb)) {
       // Window partly nodata (or flat: the variance test below decides): S must avoid nodata.
-      bool touches = false;  // branch-free inner loop: it vectorises
+      uint32_t touches = 0;
       for (int v = t.rowFirst; v <= t.rowLast; ++v) {
-        const uchar* valid = in_.otherValid.ptr<uchar>(yb + v - r_) + xb - r_;
-        const float* m = &t.mask[static_cast<size_t>(v * rowStride_)];
-        for (int u = 0; u < w; ++u) touches |= (m[u] != 0.0F) & (valid[u] == 0);
+        touches |= static_cast<uint32_t>(otherInvalidBits_.at<int>(yb + v - r_, xb)) & t.rowBits[v];
       }
-      if (touches) return kNaN;
+      if (touches != 0) return kNaN;
     }
     const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     const int rows = t.rowLast - t.rowFirst + 1;
@@ -948,6 +958,7 @@ class LevelMatcher {
   cv::Mat nearEdge_;
   cv::Mat blocked_;      // CV_8U, non-zero on contour and nodata pixels of ref
   cv::Mat blockedBits_;  // CV_32S, blocked pixels of the window row centred on each pixel
+  cv::Mat otherInvalidBits_;  // CV_32S, nodata pixels of the other image's window rows
 };
 
 }  // namespace
