@@ -61,7 +61,12 @@ double gate(double x, double contrast) { return std::clamp(1.0 + x / contrast, 0
 
 // Left and right edge terms of a→b, whose interior side is n = (-dy, dx): λ·unit·Σ along the
 // segment of min(1, |∇I·n|) times the cost-contrast gate, sampled once per pixel of length.
-std::array<double, 2> edgeTermsOf(const EnergyImages& im, const EnergyWeights& w, cv::Point a, cv::Point b) {
+// D = c_ground - c_roof (> 0 where roof-like), the image the edge gate samples.
+cv::Mat costDifference(const EnergyImages& im) { return im.groundCost - im.roofCost; }
+
+// `difference`: costDifference(im), computed once by the caller.
+std::array<double, 2> edgeTermsOf(const EnergyImages& im, const cv::Mat& difference, const EnergyWeights& w,
+                                  cv::Point a, cv::Point b) {
   std::array<double, 2> out{0.0, 0.0};
   const bool left = !im.leftGradX.empty() && !im.leftGradY.empty();
   const bool right = !im.rightGradX.empty() && !im.rightGradY.empty();
@@ -72,9 +77,6 @@ std::array<double, 2> edgeTermsOf(const EnergyImages& im, const EnergyWeights& w
   const double nx = -dy / len, ny = dx / len;
   const int samples = std::max(1, static_cast<int>(std::ceil(len)));
   const bool gated = w.edgeContrast > 0;
-  auto contrast = [&](double x, double y) {  // D = c_ground - c_roof: > 0 where roof-like
-    return bilinear(im.groundCost, x, y) - bilinear(im.roofCost, x, y);
-  };
   for (int i = 0; i < samples; ++i) {
     const double t = (i + 0.5) / samples;
     // Pixel centres are at +0.5: sample the images in their index frame.
@@ -82,7 +84,7 @@ std::array<double, 2> edgeTermsOf(const EnergyImages& im, const EnergyWeights& w
     double weight = 1.0;
     if (gated) {
       double in = 0.0;
-      for (int k = 1; k <= kGateDepth; ++k) in += contrast(px + k * nx, py + k * ny);
+      for (int k = 1; k <= kGateDepth; ++k) in += bilinear(difference, px + k * nx, py + k * ny);
       weight = gate(in / kGateDepth, w.edgeContrast);
       if (weight <= 0.0) continue;
     }
@@ -199,6 +201,7 @@ bool isValidPolygon(const IntPolygon& p) {
 EnergyTerms referenceEnergy(const EnergyImages& im, const EnergyWeights& w,
                             const IntPolygon& polygon) {
   EnergyTerms t;
+  const cv::Mat difference = w.edgeContrast > 0 ? costDifference(im) : cv::Mat();
   const cv::Size size = im.roofCost.size();
   const cv::Mat mask = core::rasterize(toPolygon(polygon), size);
   cv::Mat band(size, CV_8U, cv::Scalar(0));
@@ -243,7 +246,7 @@ EnergyTerms referenceEnergy(const EnergyImages& im, const EnergyWeights& w,
     const bool inwardLeft = interiorOnLeft(ring, r > 0);
     for (size_t i = 0; i < n; ++i) {
       const cv::Point a = ring[i], b = ring[(i + 1) % n];
-      const auto e = inwardLeft ? edgeTermsOf(im, w, a, b) : edgeTermsOf(im, w, b, a);
+      const auto e = inwardLeft ? edgeTermsOf(im, difference, w, a, b) : edgeTermsOf(im, difference, w, b, a);
       t.term[3] += e[0];
       t.term[4] += e[1];
       t.term[5] += w.rigidity * anglePrior(vertexAngle(ring[(i + n - 1) % n], a, b));
@@ -254,6 +257,7 @@ EnergyTerms referenceEnergy(const EnergyImages& im, const EnergyWeights& w,
 
 PolygonEnergy::PolygonEnergy(const EnergyImages& images, const EnergyWeights& weights)
     : images_(images), weights_(weights), size_(images.roofCost.size()) {
+  if (weights.edgeContrast > 0) costDifference_ = costDifference(images);
   CV_Assert(images.roofCost.type() == CV_32F && images.groundCost.type() == CV_32F &&
             images.groundCost.size() == size_);
   const int w = size_.width;
@@ -325,7 +329,7 @@ const std::array<double, 2>& PolygonEnergy::edgeTerms(cv::Point a, cv::Point b, 
   const std::uint64_t key = coord(a.x) | coord(a.y) << 16 | coord(b.x) << 32 | coord(b.y) << 48;
   if (edgeCache_.size() > (1u << 20)) edgeCache_.clear();  // bounded memory on huge runs
   auto [it, inserted] = edgeCache_.try_emplace(key);
-  if (inserted) it->second = edgeTermsOf(images_, weights_, a, b);
+  if (inserted) it->second = edgeTermsOf(images_, costDifference_, weights_, a, b);
   return it->second;
 }
 

@@ -143,6 +143,7 @@ class PolygonEnergy {
   IntPolygon polygon_;
   std::vector<int> ringOffset_;
   std::vector<bool> ringInwardLeft_;  // per ring: the interior is on the (-dy, dx) side
+  cv::Mat costDifference_;            // c_ground - c_roof, sampled by the edge gate
   std::vector<std::vector<Crossing>> rowCrossings_;
   std::vector<RowTerms> rowTerms_;
   std::vector<std::array<double, 2>> edgeTerms_;  // by edge id
