@@ -133,6 +133,16 @@ using Float8 = float __attribute__((vector_size(32)));
 // By reference: returning a 32-byte vector from a function built without AVX changes the ABI.
 __attribute__((always_inline)) inline void load8(Float8& v, const float* p) { __builtin_memcpy(&v, p, sizeof v); }
 
+using Float4 = float __attribute__((vector_size(16)));
+
+// Sum of the 8 lanes by halving (3 vector adds instead of 7 scalar ones).
+__attribute__((always_inline)) inline float laneSum(const Float8& v) {
+  const Float4 h = __builtin_shufflevector(v, v, 0, 1, 2, 3) +
+                   __builtin_shufflevector(v, v, 4, 5, 6, 7);
+  const Float4 q = h + __builtin_shufflevector(h, h, 2, 3, 0, 1);
+  return q[0] + q[1];
+}
+
 template <int K>
 __attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t stride,
                                                           const ptrdiff_t* offsets,
@@ -160,15 +170,9 @@ __attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t
     }
   }
   for (int k = 0; k < K; ++k) {
-    float sB = 0, sBB = 0, sTB = 0;
-    for (int u = 0; u < 8; ++u) {
-      sB += accB[k][u];
-      sBB += accBB[k][u];
-      sTB += accTB[k][u];
-    }
-    out[k][0] = sB;
-    out[k][1] = sBB;
-    out[k][2] = sTB;
+    out[k][0] = laneSum(accB[k]);
+    out[k][1] = laneSum(accBB[k]);
+    out[k][2] = laneSum(accTB[k]);
   }
 }
 
