@@ -245,7 +245,15 @@ class Optimiser {
   void addCourtyards() {
     const IntPolygon before = energy_.polygon();
     const cv::Mat inside = core::rasterize(toPolygon(before), energy_.size());
-    cv::Mat groundLike = (images_.groundCost + 0.1f < images_.roofCost);
+    // Ground-leaning on average over 9x9 px (c_roof - c_ground > 0.05): a shadowed, textureless
+    // courtyard floor is noise pixel by pixel, so the former per-pixel test (c_ground + 0.1 <
+    // c_roof) found no seed there; the final energy decides whether a hole stays. Thresholds
+    // 0 / 0.03 / 0.05 / 0.1 gave box 0.822 / 0.835 / 0.834 / 0.819 and jittered 0.893 / 0.927 /
+    // 0.924 / 0.921 mean IoU on bench_delineation --scenes 2.
+    constexpr float kGroundLean = 0.05f;
+    cv::Mat difference = images_.groundCost - images_.roofCost;
+    cv::blur(difference, difference, {9, 9}, {-1, -1}, cv::BORDER_REPLICATE);
+    cv::Mat groundLike = difference < -kGroundLean;
     groundLike &= inside;
     // Keep away from the outer ring so that the hole starts strictly inside it.
     cv::Mat interior;
