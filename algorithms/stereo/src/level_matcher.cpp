@@ -191,6 +191,25 @@ __attribute__((target_clones("avx2", "default"))) void shapeSums16Pair(
   shapeSumsBatch<2>(b, stride, lines, mask, templ, rows, out);
 }
 
+// Σ A·B over `rows` rows of two windows ≤ 16 columns wide; `lanes` weighs the 16 columns read
+// (1 inside the window, 0 past it).
+__attribute__((target_clones("avx2", "default"))) float windowDot16(
+    const float* a, size_t aStride, const float* b, size_t bStride, int rows, const float* lanes) {
+  Float8 acc0{}, acc1{}, w0, w1;
+  load8(w0, lanes);
+  load8(w1, lanes + 8);
+  for (int v = 0; v < rows; ++v) {
+    Float8 a0, a1, b0, b1;
+    load8(a0, a + static_cast<size_t>(v) * aStride);
+    load8(a1, a + static_cast<size_t>(v) * aStride + 8);
+    load8(b0, b + static_cast<size_t>(v) * bStride);
+    load8(b1, b + static_cast<size_t>(v) * bStride + 8);
+    acc0 += a0 * b0;
+    acc1 += a1 * b1;
+  }
+  return laneSum(acc0 * w0 + acc1 * w1);
+}
+
 // Bit count without the library call the baseline x86-64 target makes of __builtin_popcount.
 inline int popcount64(uint64_t v) {
   v = v - ((v >> 1) & 0x5555555555555555ULL);
@@ -386,6 +405,7 @@ class LevelMatcher {
     refStats_ = windowStats(in.ref, in.refValid, s.window);
     otherStats_ = windowStats(in.other, in.otherValid, s.window);
     cv::multiply(in.other, in.other, otherSq_);
+    for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
     // Pixels a shape never enters: contours and nodata. blockedBits_(y, x): bit u set when
     // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
     blocked_ = (in.refEdges != 0) | (in.refValid == 0);
@@ -482,12 +502,19 @@ class LevelMatcher {
     const int yb = y + dy, xb = x - d;
     if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherStats_.ok.at<uchar>(yb, xb)) return kNaN;
     float sab = 0;
-    for (int v = -r_; v <= r_; ++v) {
-      const float* a = in_.ref.ptr<float>(y + v) + x - r_;
-      const float* b = in_.other.ptr<float>(yb + v) + xb - r_;
-      float acc = 0;
-      for (int u = 0; u < s_.window; ++u) acc += a[u] * b[u];
-      sab += acc;
+    if (s_.window <= 16) {
+      // Reads 16 columns: the inputs are padded on the right.
+      sab = windowDot16(in_.ref.ptr<float>(y - r_) + x - r_, in_.ref.step1(),
+                        in_.other.ptr<float>(yb - r_) + xb - r_, in_.other.step1(), s_.window,
+                        squareLanes_);
+    } else {
+      for (int v = -r_; v <= r_; ++v) {
+        const float* a = in_.ref.ptr<float>(y + v) + x - r_;
+        const float* b = in_.other.ptr<float>(yb + v) + xb - r_;
+        float acc = 0;
+        for (int u = 0; u < s_.window; ++u) acc += a[u] * b[u];
+        sab += acc;
+      }
     }
     return (sab / static_cast<float>(n_) - refStats_.mean.at<float>(y, x) *
                                                otherStats_.mean.at<float>(yb, xb)) /
@@ -959,6 +986,7 @@ class LevelMatcher {
   const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
   WindowStats refStats_, otherStats_;
   cv::Mat otherSq_;
+  float squareLanes_[16] = {};  // 1 for the columns of a square window, 0 past it
   cv::Mat nearEdge_;
   cv::Mat blocked_;      // CV_8U, non-zero on contour and nodata pixels of ref
   cv::Mat blockedBits_;  // CV_32S, blocked pixels of the window row centred on each pixel
