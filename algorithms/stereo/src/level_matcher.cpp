@@ -177,11 +177,23 @@ __attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t
 }
 
 constexpr int kBatch = 4;
+// Main-line windows d, d + 1, ... (one column further left each).
+constexpr ptrdiff_t kMainLine[kBatch] = {0, -1, -2, -3};
 __attribute__((target_clones("avx2", "default"))) void shapeSums16Batch(
     const float* b, size_t stride, const float* mask, const float* templ, int rows,
     float out[][3]) {
-  static constexpr ptrdiff_t kMainLine[kBatch] = {0, -1, -2, -3};  // d, d + 1, ...
   shapeSumsBatch<kBatch>(b, stride, kMainLine, mask, templ, rows, out);
+}
+// The last 1..3 disparities of an interval: as many windows as are left (a full batch there
+// recomputed up to 3 windows already scored).
+__attribute__((target_clones("avx2", "default"))) void shapeSums16Tail(
+    const float* b, size_t stride, const float* mask, const float* templ, int rows, int count,
+    float out[][3]) {
+  switch (count) {
+    case 1: shapeSumsBatch<1>(b, stride, kMainLine, mask, templ, rows, out); break;
+    case 2: shapeSumsBatch<2>(b, stride, kMainLine, mask, templ, rows, out); break;
+    default: shapeSumsBatch<3>(b, stride, kMainLine, mask, templ, rows, out); break;
+  }
 }
 // Two windows of the same shape at row offsets -1 and +1 from b (the line-shift probes).
 __attribute__((target_clones("avx2", "default"))) void shapeSums16Pair(
@@ -813,20 +825,28 @@ class LevelMatcher {
 
   // Main-line scores for d .. d + kBatch - 1 in one pass over the shape; false when one of the
   // windows is not a plain inside-the-image, nodata-free one (then scored one by one).
-  bool shapeScoresBatch(int x, int y, int d, const ShapeTemplate& t, float* scores) const {
+  // `count` (1..kBatch) windows.
+  bool shapeScoresBatch(int x, int y, int d, const ShapeTemplate& t, float* scores,
+                        int count = kBatch) const {
     if (rowStride_ != 16) return false;
     const int xb = x - d;
-    if (y < r_ || y >= H_ - r_ || xb - (kBatch - 1) < r_ || xb >= W_ - r_) return false;
+    if (y < r_ || y >= H_ - r_ || xb - (count - 1) < r_ || xb >= W_ - r_) return false;
     const uchar* ok = otherStats_.ok.ptr<uchar>(y);
-    for (int k = 0; k < kBatch; ++k) {
+    for (int k = 0; k < count; ++k) {
       if (!ok[xb - k]) return false;
     }
     const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     const int top = y + t.rowFirst - r_;
+    const int rows = t.rowLast - t.rowFirst + 1;
     float sums[kBatch][3];
-    shapeSums16Batch(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
-                     &t.templ[first], t.rowLast - t.rowFirst + 1, sums);
-    for (int k = 0; k < kBatch; ++k) scores[k] = scoreFromSums(sums[k], t.count);
+    if (count == kBatch) {
+      shapeSums16Batch(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
+                       &t.templ[first], rows, sums);
+    } else {
+      shapeSums16Tail(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
+                      &t.templ[first], rows, count, sums);
+    }
+    for (int k = 0; k < count; ++k) scores[k] = scoreFromSums(sums[k], t.count);
     return true;
   }
 
@@ -859,9 +879,9 @@ class LevelMatcher {
         for (int k = 0; k < kBatch; ++k) peak.update(d + k, shapeScore(x, y, d + k, 0, t));
       }
     }
-    // The last 2..3 disparities: one batch ending at hi (its first entries are done already).
-    if (hi - d >= 1 && hi - lo + 1 >= kBatch && shapeScoresBatch(x, y, hi - kBatch + 1, t, batch)) {
-      for (; d <= hi; ++d) peak.update(d, batch[d - (hi - kBatch + 1)]);
+    // The last 1..3 disparities in one pass.
+    if (d <= hi && shapeScoresBatch(x, y, d, t, batch, hi - d + 1)) {
+      for (int k = 0; d <= hi; ++d, ++k) peak.update(d, batch[k]);
     }
     for (; d <= hi; ++d) peak.update(d, shapeScore(x, y, d, 0, t));
     finish(x, y, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); },
