@@ -100,9 +100,11 @@ void normaliseBy99(cv::Mat& gx, cv::Mat& gy) {
 
 // Region stage: inside the initial contour, the pixels whose roof interval matches better than
 // the ground's on average over 9x9 pixels (opened 3x3, closed 7x7); the outline of the largest
-// component, simplified (2 px) and polygonised. Carves the notches of concave buildings that
-// a rough (box) contour cannot reach by local moves. Empty when there is no usable component.
-IntPolygon regionStageInit(const EnergyImages& im, const cv::Mat& initMask, const DelineationParams& params) {
+// component, simplified at a few tolerances and polygonised. Carves the notches of concave
+// buildings that a rough (box) contour cannot reach by local moves. Empty when there is no
+// usable component.
+std::vector<IntPolygon> regionStageCandidates(const EnergyImages& im, const cv::Mat& initMask,
+                                              const DelineationParams& params) {
   // Aggregated over 9x9 pixels: on a textureless roof each pixel's difference is noise, but its
   // mean still leans to the roof (balanced intervals).
   cv::Mat difference = im.groundCost - im.roofCost;
@@ -117,16 +119,24 @@ IntPolygon regionStageInit(const EnergyImages& im, const cv::Mat& initMask, cons
     return cv::contourArea(a) < cv::contourArea(b);
   });
   if (cv::contourArea(*largest) < 0.1 * cv::countNonZero(initMask)) return {};
-  std::vector<cv::Point> simplified;
-  cv::approxPolyDP(*largest, simplified, 2.0, true);
-  if (simplified.size() < 3) return {};
-  core::Ring ring;
-  // Contour points are pixel centres of border pixels: their corners are half a pixel out.
-  for (const auto& v : simplified) ring.emplace_back(v.x + 0.5, v.y + 0.5);
-  IntPolygon p;
-  p.outer = polygonise(ring, params.initialSpacing, im.roofCost.size());
-  if (p.outer.size() < 3 || !isValidPolygon(p) || core::area(toPolygon(p)) < 4.0) return {};
-  return p;
+  std::vector<IntPolygon> candidates;
+  // A fine tolerance keeps notches, a coarse one drops the noise of a textureless roof's
+  // outline; the energy picks.
+  std::vector<double> tolerances{std::min(2.0, params.regionTolerance)};
+  while (tolerances.back() * 2 <= params.regionTolerance) tolerances.push_back(tolerances.back() * 2);
+  for (const double tolerance : tolerances) {
+    std::vector<cv::Point> simplified;
+    cv::approxPolyDP(*largest, simplified, tolerance, true);
+    if (simplified.size() < 3) continue;
+    core::Ring ring;
+    // Contour points are pixel centres of border pixels: their corners are half a pixel out.
+    for (const auto& v : simplified) ring.emplace_back(v.x + 0.5, v.y + 0.5);
+    IntPolygon p;
+    p.outer = polygonise(ring, params.initialSpacing, im.roofCost.size());
+    if (p.outer.size() < 3 || !isValidPolygon(p) || core::area(toPolygon(p)) < 4.0) continue;
+    candidates.push_back(std::move(p));
+  }
+  return candidates;
 }
 
 }  // namespace
@@ -258,6 +268,11 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
       costIntervals(request.roof, out.ground, params.balanceIntervals);
   im.roofCost = costs.minCost(out.roofSearched.min, out.roofSearched.max);
   im.groundCost = costs.minCost(out.groundSearched.min, out.groundSearched.max);
+  if (params.costAggregation > 1) {
+    const cv::Size k(params.costAggregation, params.costAggregation);
+    cv::blur(im.roofCost, im.roofCost, k, {-1, -1}, cv::BORDER_REPLICATE);
+    cv::blur(im.groundCost, im.groundCost, k, {-1, -1}, cv::BORDER_REPLICATE);
+  }
 
   // Roof disparity per pixel: argmin of Crit within the roof interval, median-filtered.
   const int d0 = std::max(request.roof.min, costs.dmin()), d1 = std::min(request.roof.max, costs.dmax());
@@ -330,17 +345,17 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   cv::remap(rgy, im.rightGradY, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   normaliseBy99(im.rightGradX, im.rightGradY);
   if (params.regionInit) {
-    const IntPolygon region = regionStageInit(im, initMask, params);
-    if (!region.outer.empty()) {
-      // The energy decides: the region outline replaces the operator's only when it is lower.
-      const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast,
-                                  params.minAngle, params.minGap};
-      PolygonEnergy energy(im, weights);
-      energy.setPolygon(out.init);
-      const double operatorEnergy = energy.total();
+    const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast,
+                                params.minAngle, params.minGap};
+    PolygonEnergy energy(im, weights);
+    energy.setPolygon(out.init);
+    double lowest = energy.total();
+    // The energy decides: a region outline replaces the operator's only when it is lower.
+    for (IntPolygon& region : regionStageCandidates(im, initMask, params)) {
       energy.setPolygon(region);
-      if (energy.total() < operatorEnergy) {
-        out.init = region;
+      if (energy.total() < lowest) {
+        lowest = energy.total();
+        out.init = std::move(region);
         out.regionInit = true;
       }
     }

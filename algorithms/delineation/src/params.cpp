@@ -12,6 +12,10 @@ void DelineationParams::validate() const {
                           " px) must not exceed initial-spacing (" +
                           std::to_string(initialSpacing) + " px)");
   }
+  if (costAggregation % 2 == 0) {
+    throw core::Error(core::ErrorCode::InvalidParameter,
+                      "cost-aggregation must be odd, got " + std::to_string(costAggregation));
+  }
   if (costWindow % 2 == 0) {
     throw core::Error(core::ErrorCode::InvalidParameter,
                       "cost-window must be odd, got " + std::to_string(costWindow));

@@ -129,7 +129,7 @@ TEST(Delineate, DoesNotFollowAStrongLineLeavingTheRoof) {
   unleashed.maxExcursion = unleashed.roiMargin;
   const auto free = delineate(pair.left, pair.right, req, unleashed);
   EXPECT_LT(farthestOutside(free.polygon, roof), 4.0);
-  // The paper's plain terms and moves (no gate, shape limits, shortcuts, leash or region
+  // The paper's plain terms and moves (per-pixel costs; no gate, shape limits, shortcuts, leash or region
   // stage): the defect is there.
   DelineationParams plain = unleashed;
   plain.edgeContrast = 0;
@@ -137,6 +137,7 @@ TEST(Delineate, DoesNotFollowAStrongLineLeavingTheRoof) {
   plain.minGap = 0;
   plain.shortcutVertices = 0;
   plain.regionInit = false;
+  plain.costAggregation = 1;
   const auto spiky = delineate(pair.left, pair.right, req, plain);
   EXPECT_GT(farthestOutside(spiky.polygon, roof), 10.0);
 }

@@ -28,6 +28,8 @@ struct DelineationParams {
   double shortcutWidth = 4.0;      // px: widest (mean width) piece a shortcut may cut off
   double maxExcursion = 8.0;       // px: farthest a vertex may go outside the initial contour
   bool regionInit = true;          // start from the roof-like region inside the init when lower F
+  double regionTolerance = 2.0;    // px: coarsest outline simplification of the region stage
+  int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
@@ -122,6 +124,17 @@ struct DelineationParams {
                       "inside the initial contour when its energy is lower (carves notches a "
                       "rough contour cannot reach)"},
       regionInit);
+    v(core::ParamInfo{"region-tolerance", "Region tolerance", "px",
+                      "Coarsest Douglas-Peucker tolerance of the region stage's outline: 2 px and "
+                      "each doubling up to this are tried, the lowest energy is kept",
+                      0.5, 64},
+      regionTolerance);
+    v(core::ParamInfo{"cost-aggregation", "Cost aggregation", "px",
+                      "Side of the box filter applied to c_roof and c_ground before the area "
+                      "terms (on a textureless roof each pixel's cost is noise, its mean is not; "
+                      "1 = per pixel as in the paper)",
+                      1, 31},
+      costAggregation);
   }
   void validate() const;
 };
