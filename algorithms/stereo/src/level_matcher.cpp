@@ -279,53 +279,9 @@ __attribute__((target_clones("avx2", "default"))) void templateRows16(
 struct Board {
   uint64_t w[4] = {0, 0, 0, 0};
 
-  friend Board operator&(const Board& a, const Board& b) {
-    Board r;
-    for (int i = 0; i < 4; ++i) r.w[i] = a.w[i] & b.w[i];
-    return r;
-  }
   friend Board operator|(const Board& a, const Board& b) {
     Board r;
     for (int i = 0; i < 4; ++i) r.w[i] = a.w[i] | b.w[i];
-    return r;
-  }
-  friend bool operator==(const Board& a, const Board& b) {
-    return ((a.w[0] ^ b.w[0]) | (a.w[1] ^ b.w[1]) | (a.w[2] ^ b.w[2]) | (a.w[3] ^ b.w[3])) == 0;
-  }
-  // Towards higher columns (within each row; bits leaving a word cross a separator anyway).
-  Board right(int k) const {
-    Board r;
-    for (int i = 0; i < 4; ++i) r.w[i] = w[i] << k;
-    return r;
-  }
-  Board left(int k) const {
-    Board r;
-    for (int i = 0; i < 4; ++i) r.w[i] = w[i] >> k;
-    return r;
-  }
-  // Towards higher rows by n rows (n = 1, 2: inside and across words; 4, 8: whole words).
-  Board down(int n) const {
-    Board r;
-    if (n >= 4) {
-      const int q = n / 4;
-      for (int i = 3; i >= 0; --i) r.w[i] = i >= q ? w[i - q] : 0;
-      return r;
-    }
-    const int b = 16 * n;
-    r.w[0] = w[0] << b;
-    for (int i = 1; i < 4; ++i) r.w[i] = (w[i] << b) | (w[i - 1] >> (64 - b));
-    return r;
-  }
-  Board up(int n) const {
-    Board r;
-    if (n >= 4) {
-      const int q = n / 4;
-      for (int i = 0; i < 4; ++i) r.w[i] = i + q < 4 ? w[i + q] : 0;
-      return r;
-    }
-    const int b = 16 * n;
-    for (int i = 0; i < 3; ++i) r.w[i] = (w[i] >> b) | (w[i + 1] << (64 - b));
-    r.w[3] = w[3] >> b;
     return r;
   }
   int count() const {
@@ -335,40 +291,108 @@ struct Board {
   void setRow(int v, uint32_t bits) { w[v >> 2] |= static_cast<uint64_t>(bits) << (16 * (v & 3)); }
 };
 
-// The 4-connected component of `seed` inside `open` (seed ⊂ open).
-inline Board floodFill(Board seed, const Board& open) {
-  // Runs of open cells 2^i long in each direction: the masks of the doubling steps, which
-  // depend on `open` only.
-  Board gRight[4], gLeft[4], gDown[4], gUp[4];
-  gRight[0] = gLeft[0] = gDown[0] = gUp[0] = open;
-  for (int i = 1; i < 4; ++i) {
-    const int k = 1 << (i - 1);
-    gRight[i] = gRight[i - 1] & gRight[i - 1].right(k);
-    gLeft[i] = gLeft[i - 1] & gLeft[i - 1].left(k);
-    gDown[i] = gDown[i - 1] & gDown[i - 1].down(k);
-    gUp[i] = gUp[i - 1] & gUp[i - 1].up(k);
+// The 4-connected component of `seed` inside `open` (seed ⊂ open). The board's four words are
+// one 256-bit vector (one AVX2 register; two SSE registers in the baseline build).
+using Word4 = uint64_t __attribute__((vector_size(32)));
+
+// Helpers take and give vectors by reference: passing a 32-byte vector by value from code built
+// without AVX changes the ABI.
+// Towards higher rows by 16·n bits: n = 1, 2 shift inside and across words, n = 4, 8 move whole
+// words.
+template <int N>
+__attribute__((always_inline)) inline void downRows(Word4& out, const Word4& v) {
+  const Word4 zero{};
+  if constexpr (N == 4) {
+    out = __builtin_shufflevector(v, zero, 4, 0, 1, 2);
+  } else if constexpr (N == 8) {
+    out = __builtin_shufflevector(v, zero, 4, 4, 0, 1);
+  } else {
+    constexpr int kBits = 16 * N;
+    out = (v << kBits) | (__builtin_shufflevector(v, zero, 4, 0, 1, 2) >> (64 - kBits));
   }
+}
+template <int N>
+__attribute__((always_inline)) inline void upRows(Word4& out, const Word4& v) {
+  const Word4 zero{};
+  if constexpr (N == 4) {
+    out = __builtin_shufflevector(v, zero, 1, 2, 3, 4);
+  } else if constexpr (N == 8) {
+    out = __builtin_shufflevector(v, zero, 2, 3, 4, 4);
+  } else {
+    constexpr int kBits = 16 * N;
+    out = (v >> kBits) | (__builtin_shufflevector(v, zero, 1, 2, 3, 4) << (64 - kBits));
+  }
+}
+__attribute__((always_inline)) inline bool sameWords(const Word4& a, const Word4& b) {
+  const Word4 x = a ^ b;
+  return (x[0] | x[1] | x[2] | x[3]) == 0;
+}
+
+__attribute__((target_clones("avx2", "default"))) void floodFillWords(Board& seedBoard,
+                                                                     const Board& openBoard) {
+  Word4 open, seed, t;
+  __builtin_memcpy(&open, openBoard.w, sizeof open);
+  __builtin_memcpy(&seed, seedBoard.w, sizeof seed);
+  // Runs of open cells 2^i long in each direction: the masks of the doubling steps, which
+  // depend on `open` only. Along rows the row-end separator bits (always 0) stop the runs.
+  const Word4 gR1 = open & (open << 1), gR2 = gR1 & (gR1 << 2), gR3 = gR2 & (gR2 << 4);
+  const Word4 gL1 = open & (open >> 1), gL2 = gL1 & (gL1 >> 2), gL3 = gL2 & (gL2 >> 4);
+  Word4 gD1, gD2, gD3, gU1, gU2, gU3;
+  downRows<1>(t, open);
+  gD1 = open & t;
+  downRows<2>(t, gD1);
+  gD2 = gD1 & t;
+  downRows<4>(t, gD2);
+  gD3 = gD2 & t;
+  upRows<1>(t, open);
+  gU1 = open & t;
+  upRows<2>(t, gU1);
+  gU2 = gU1 & t;
+  upRows<4>(t, gU2);
+  gU3 = gU2 & t;
   for (bool first = true;; first = false) {
     // Along rows, both directions (doubling: shifts 1, 2, 4, 8).
-    Board a = seed, b = seed;
-    for (int i = 0; i < 4; ++i) {
-      a = a | (gRight[i] & a.right(1 << i));
-      b = b | (gLeft[i] & b.left(1 << i));
-    }
-    Board filled = a | b;
-    if (!first && filled == seed) return seed;  // closed along both directions
+    Word4 a = seed, b = seed;
+    a |= open & (a << 1);
+    b |= open & (b >> 1);
+    a |= gR1 & (a << 2);
+    b |= gL1 & (b >> 2);
+    a |= gR2 & (a << 4);
+    b |= gL2 & (b >> 4);
+    a |= gR3 & (a << 8);
+    b |= gL3 & (b >> 8);
+    Word4 filled = a | b;
+    if (!first && sameWords(filled, seed)) break;  // closed along both directions
     seed = filled;
     // Along columns, both directions.
     a = seed;
     b = seed;
-    for (int i = 0; i < 4; ++i) {
-      a = a | (gDown[i] & a.down(1 << i));
-      b = b | (gUp[i] & b.up(1 << i));
-    }
+    downRows<1>(t, a);
+    a |= open & t;
+    upRows<1>(t, b);
+    b |= open & t;
+    downRows<2>(t, a);
+    a |= gD1 & t;
+    upRows<2>(t, b);
+    b |= gU1 & t;
+    downRows<4>(t, a);
+    a |= gD2 & t;
+    upRows<4>(t, b);
+    b |= gU2 & t;
+    downRows<8>(t, a);
+    a |= gD3 & t;
+    upRows<8>(t, b);
+    b |= gU3 & t;
     filled = a | b;
-    if (filled == seed) return seed;  // closed along both directions
+    if (sameWords(filled, seed)) break;  // closed along both directions
     seed = filled;
   }
+  __builtin_memcpy(seedBoard.w, &seed, sizeof seed);
+}
+
+inline Board floodFill(Board seed, const Board& open) {
+  floodFillWords(seed, open);
+  return seed;
 }
 
 // Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
