@@ -349,13 +349,25 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
                                 params.minAngle, params.minGap};
     PolygonEnergy energy(im, weights);
     energy.setPolygon(out.init);
-    double lowest = energy.total();
-    // The energy decides: a region outline replaces the operator's only when it is lower.
-    for (IntPolygon& region : regionStageCandidates(im, initMask, params)) {
-      energy.setPolygon(region);
-      if (energy.total() < lowest) {
-        lowest = energy.total();
-        out.init = std::move(region);
+    const double operatorEnergy = energy.total();
+    // The energy decides: the region outline (finest tolerance) replaces the operator's only
+    // when it is lower; then the coarser outlines may replace it when lower still. (Letting a
+    // coarse outline compete with the operator's directly replaced good operator contours by
+    // simpler, lower-F but worse outlines on textureless roofs.)
+    std::vector<IntPolygon> candidates = regionStageCandidates(im, initMask, params);
+    if (!candidates.empty()) {
+      energy.setPolygon(candidates.front());
+      double lowest = energy.total();
+      if (lowest < operatorEnergy) {
+        size_t best = 0;
+        for (size_t i = 1; i < candidates.size(); ++i) {
+          energy.setPolygon(candidates[i]);
+          if (energy.total() < lowest) {
+            lowest = energy.total();
+            best = i;
+          }
+        }
+        out.init = std::move(candidates[best]);
         out.regionInit = true;
       }
     }

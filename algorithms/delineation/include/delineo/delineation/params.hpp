@@ -28,7 +28,7 @@ struct DelineationParams {
   double shortcutWidth = 4.0;      // px: widest (mean width) piece a shortcut may cut off
   double maxExcursion = 8.0;       // px: farthest a vertex may go outside the initial contour
   bool regionInit = true;          // start from the roof-like region inside the init when lower F
-  double regionTolerance = 2.0;    // px: coarsest outline simplification of the region stage
+  double regionTolerance = 8.0;    // px: coarsest outline simplification of the region stage
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
   template <class V>
   void visit(V&& v) {
