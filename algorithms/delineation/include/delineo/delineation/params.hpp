@@ -29,6 +29,7 @@ struct DelineationParams {
   double maxExcursion = 8.0;       // px: farthest a vertex may go outside the initial contour
   bool regionInit = true;          // start from the roof-like region inside the init when lower F
   double regionTolerance = 8.0;    // px: coarsest outline simplification of the region stage
+  bool regionRightAngles = false;  // region stage also tries its outlines with right angles
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
   template <class V>
   void visit(V&& v) {
@@ -129,6 +130,10 @@ struct DelineationParams {
                       "each doubling up to this are tried, the lowest energy is kept",
                       0.5, 64},
       regionTolerance);
+    v(core::ParamInfo{"region-right-angles", "Region right angles", "",
+                      "Region stage also tries each outline with its edges snapped to the dominant "
+                      "orientation or its perpendicular (kept only when its energy is lower)"},
+      regionRightAngles);
     v(core::ParamInfo{"cost-aggregation", "Cost aggregation", "px",
                       "Side of the box filter applied to c_roof and c_ground before the area "
                       "terms (on a textureless roof each pixel's cost is noise, its mean is not; "
