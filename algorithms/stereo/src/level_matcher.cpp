@@ -736,7 +736,7 @@ class LevelMatcher {
     // and is then filled along the row through free pixels (shift-and-mask doubling, the
     // "occluded fill" of bitboards), until no row changes.
     uint32_t free[32], reach[32];
-    int blockedCount = 0;
+    Board shape;  // S as a board (windows ≤ 15 columns)
     if (w <= 15) {
       // The centre belongs to S even on a contour: it is open for the fill.
       Board open, seed;
@@ -744,27 +744,29 @@ class LevelMatcher {
         free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
         open.setRow(v, free[v]);
       }
-      blockedCount = n_ - open.count();
       seed.setRow(r_, 1U << r_);
-      const Board s = floodFill(seed, open | seed);
-      for (int v = 0; v < w; ++v) reach[v] = s.row(v);
-      t.count = s.count();
+      shape = floodFill(seed, open | seed);
+      for (int v = 0; v < w; ++v) reach[v] = shape.row(v);
     } else {
       for (int v = 0; v < w; ++v) {
         free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
-        blockedCount += w - __builtin_popcount(free[v]);
         reach[v] = 0;
       }
       fillRows(free, reach);
-      t.count = 0;
-      for (int v = 0; v < w; ++v) t.count += __builtin_popcount(reach[v]);
     }
+    // When S is the whole window minus its contour pixels (no free pixel left unreached: no
+    // part of the window is cut off) and the square window is usable, the square serves the
+    // pixel: the few contour pixels change its NCC little, and the square path is much cheaper.
+    uint32_t unreached = 0;
+    for (int v = 0; v < w; ++v) unreached |= free[v] & ~reach[v];
+    if (squareServes && unreached == 0) return false;
     for (int v = 0; v < w; ++v) t.rowBits[v] = reach[v];
-    // When S is the whole window minus its contour pixels (no part of the window is cut off)
-    // and the square window is usable, the square serves the pixel: the few contour pixels
-    // change its NCC little, and the square path is much cheaper.
-    const bool cut = t.count + blockedCount - ((free[r_] >> r_) & 1U ? 0 : 1) < n_;
-    if (squareServes && !cut) return false;
+    if (w <= 15) {
+      t.count = shape.count();
+    } else {
+      t.count = 0;
+      for (int v = 0; v < w; ++v) t.count += popcount64(reach[v]);
+    }
     if (t.count < s_.minShape || t.count >= n_) return false;
     const int P = rowStride_;
     t.rowFirst = 0;
