@@ -239,6 +239,12 @@ TEST(Delineate, RejectsBadInputs) {
   expectCode(degenerate, core::ErrorCode::InvalidParameter, pair.right);
   expectCode(ok, core::ErrorCode::MismatchedInputs, pair.right(cv::Rect(0, 0, 100, 100)));
   EXPECT_NO_THROW(regionOfInterest(pair.left, pair.right, ok, params));
+  // The cost box filter is centred: an even side is rejected.
+  DelineationParams even;
+  even.costAggregation = 4;
+  EXPECT_THROW(even.validate(), core::Error);
+  even.costAggregation = 1;
+  EXPECT_NO_THROW(even.validate());
 }
 
 TEST(Delineate, BalancedCostIntervalsHaveEqualWidthsAndGrowAwayFromEachOther) {
