@@ -1,11 +1,13 @@
 #pragma once
-// A fresh directory per test under the system temp dir, removed at the end of the test.
+// Test helpers for io: a fresh directory per test under the system temp dir, removed at the end of the test.
 #include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "delineo/core/error.hpp"
 #include <unistd.h>
 
 namespace delineo::io::testing {
@@ -35,5 +37,17 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+// Runs `action` and returns the core::Error it throws; fails the test when it does not throw.
+template <typename Action>
+core::Error captureError(Action&& action) {
+  try {
+    action();
+  } catch (const core::Error& error) {
+    return error;
+  }
+  ADD_FAILURE() << "expected a core::Error";
+  return core::Error(core::ErrorCode::ProcessingFailed, "no error thrown");
+}
 
 }  // namespace delineo::io::testing

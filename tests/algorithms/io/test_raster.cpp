@@ -19,17 +19,7 @@ namespace {
 using core::ErrorCode;
 using testing::TempDir;
 
-// Runs `action` and returns the core::Error it throws; fails the test when it does not throw.
-template <typename Action>
-core::Error captureError(Action&& action) {
-  try {
-    action();
-  } catch (const core::Error& error) {
-    return error;
-  }
-  ADD_FAILURE() << "expected a core::Error";
-  return core::Error(ErrorCode::ProcessingFailed, "no error thrown");
-}
+using testing::captureError;
 
 std::string utm16Wkt() {
   OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);

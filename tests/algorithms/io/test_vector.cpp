@@ -18,16 +18,7 @@ namespace {
 using core::ErrorCode;
 using testing::TempDir;
 
-template <typename Action>
-core::Error captureError(Action&& action) {
-  try {
-    action();
-  } catch (const core::Error& error) {
-    return error;
-  }
-  ADD_FAILURE() << "expected a core::Error";
-  return core::Error(ErrorCode::ProcessingFailed, "no error thrown");
-}
+using testing::captureError;
 
 void writeText(const std::string& path, const std::string& text) {
   std::ofstream out(path);
