@@ -9,19 +9,8 @@ set -u
 CLI=${1:?usage: e2e_eval.sh DELINEO_CLI WORK_DIR}
 WORK=${2:?usage: e2e_eval.sh DELINEO_CLI WORK_DIR}
 mkdir -p "$WORK"
-failures=0
-fail() { echo "e2e_eval: FAIL: $*" >&2; failures=$((failures + 1)); }
-
-# expect_rc NAME EXPECTED_RC COMMAND...: runs the command, keeps stderr in $WORK/NAME.err.
-expect_rc() {
-  local name=$1 expected=$2
-  shift 2
-  "$@" >"$WORK/$name.out" 2>"$WORK/$name.err"
-  local rc=$?
-  [[ $rc == "$expected" ]] || fail "$name: exit $rc, expected $expected ($(head -c 300 "$WORK/$name.err"))"
-}
-# expect_in FILE PATTERN DESCRIPTION: an extended regular expression must match in FILE.
-expect_in() { grep -Eq -- "$2" "$1" || fail "$3: '$2' not found in $1"; }
+E2E_NAME=e2e_eval
+source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh"
 
 grid() {  # grid FILE NCOLS NROWS VALUES...
   local file=$1 cols=$2 rows=$3
