@@ -27,6 +27,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "level_shape_int.hpp"
+
 namespace delineo::stereo::detail {
 namespace {
 
@@ -111,23 +113,14 @@ inline void shapeSums(const float* b, const float* b2, size_t stride, const floa
   out[2] = sTB;
 }
 
-// The hot loop of the adaptive path, also built for AVX2 (picked at run time when the CPU has
-// it).
-__attribute__((target_clones("avx2", "default"))) void shapeSums16(
-    const float* b, const float* b2, size_t stride, const float* mask, const float* templ,
-    int rows, float out[3]) {
-  shapeSums<16>(b, b2, stride, mask, templ, rows, out);
-}
+// Windows wider than 15 columns (the narrower ones take the integer kernels of
+// level_shape_int.hpp), also built for AVX2 (picked at run time when the CPU has it).
 __attribute__((target_clones("avx2", "default"))) void shapeSums32(
     const float* b, const float* b2, size_t stride, const float* mask, const float* templ,
     int rows, float out[3]) {
   shapeSums<32>(b, b2, stride, mask, templ, rows, out);
 }
 
-// The same sums for K windows of the other image at once (16-float rows, windows ≤ 16), the
-// k-th at b + offsets[k] (consecutive disparities: one column further left each). The shape rows are loaded
-// once for the K windows, B² is formed on the fly, and the 16 lanes of a row are folded into 8
-// accumulators: K x 3 accumulators stay in registers.
 using Float8 = float __attribute__((vector_size(32)));
 
 // By reference: returning a 32-byte vector from a function built without AVX changes the ABI.
@@ -143,65 +136,10 @@ __attribute__((always_inline)) inline float laneSum(const Float8& v) {
   return q[0] + q[1];
 }
 
-template <int K>
-__attribute__((always_inline)) inline void shapeSumsBatch(const float* b, size_t stride,
-                                                          const ptrdiff_t* offsets,
-                                                          const float* mask, const float* templ,
-                                                          int rows, float out[][3]) {
-  Float8 accB[K], accBB[K], accTB[K];
-  for (int k = 0; k < K; ++k) accB[k] = accBB[k] = accTB[k] = Float8{};
-  for (int v = 0; v < rows; ++v) {
-    const float* bv = b + static_cast<size_t>(v) * stride;
-    const float* m = mask + static_cast<size_t>(v) * 16;
-    const float* t = templ + static_cast<size_t>(v) * 16;
-    Float8 m0, m1, t0, t1;
-    load8(m0, m);
-    load8(m1, m + 8);
-    load8(t0, t);
-    load8(t1, t + 8);
-    for (int k = 0; k < K; ++k) {
-      Float8 b0, b1;
-      load8(b0, bv + offsets[k]);
-      load8(b1, bv + offsets[k] + 8);
-      const Float8 mb0 = m0 * b0, mb1 = m1 * b1;
-      accB[k] += mb0 + mb1;
-      accBB[k] += mb0 * b0 + mb1 * b1;
-      accTB[k] += t0 * b0 + t1 * b1;
-    }
-  }
-  for (int k = 0; k < K; ++k) {
-    out[k][0] = laneSum(accB[k]);
-    out[k][1] = laneSum(accBB[k]);
-    out[k][2] = laneSum(accTB[k]);
-  }
-}
-
+// Main-line windows d, d + 1, ... (one column further left each), scored kBatch per pass
+// over the shape.
 constexpr int kBatch = 4;
-// Main-line windows d, d + 1, ... (one column further left each).
 constexpr ptrdiff_t kMainLine[kBatch] = {0, -1, -2, -3};
-__attribute__((target_clones("avx2", "default"))) void shapeSums16Batch(
-    const float* b, size_t stride, const float* mask, const float* templ, int rows,
-    float out[][3]) {
-  shapeSumsBatch<kBatch>(b, stride, kMainLine, mask, templ, rows, out);
-}
-// The last 1..3 disparities of an interval: as many windows as are left (a full batch there
-// recomputed up to 3 windows already scored).
-__attribute__((target_clones("avx2", "default"))) void shapeSums16Tail(
-    const float* b, size_t stride, const float* mask, const float* templ, int rows, int count,
-    float out[][3]) {
-  switch (count) {
-    case 1: shapeSumsBatch<1>(b, stride, kMainLine, mask, templ, rows, out); break;
-    case 2: shapeSumsBatch<2>(b, stride, kMainLine, mask, templ, rows, out); break;
-    default: shapeSumsBatch<3>(b, stride, kMainLine, mask, templ, rows, out); break;
-  }
-}
-// Two windows of the same shape at row offsets -1 and +1 from b (the line-shift probes).
-__attribute__((target_clones("avx2", "default"))) void shapeSums16Pair(
-    const float* b, size_t stride, const float* mask, const float* templ, int rows,
-    float out[][3]) {
-  const ptrdiff_t lines[2] = {-static_cast<ptrdiff_t>(stride), static_cast<ptrdiff_t>(stride)};
-  shapeSumsBatch<2>(b, stride, lines, mask, templ, rows, out);
-}
 
 // Σ A·B over `rows` rows of two windows ≤ 16 columns wide; `lanes` weighs the 16 columns read
 // (1 inside the window, 0 past it).
@@ -228,48 +166,6 @@ inline int popcount64(uint64_t v) {
   v = (v & 0x3333333333333333ULL) + ((v >> 2) & 0x3333333333333333ULL);
   v = (v + (v >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
   return static_cast<int>((v * 0x0101010101010101ULL) >> 56);
-}
-
-// Dense rows of a shape (16 floats per row): mask M = 1 on S, and the sums Σ_S A, Σ_S A².
-// Fixed-length loops over the row bits, so the whole build vectorises.
-__attribute__((always_inline)) inline void denseMaskRows(const uint32_t* bits, int rows,
-                                                         const float* a, size_t stride,
-                                                         float* mask, float sums[2]) {
-  float acc[16] = {}, acc2[16] = {};
-  for (int v = 0; v < rows; ++v) {
-    const float* av = a + static_cast<size_t>(v) * stride;
-    float* m = mask + static_cast<size_t>(v) * 16;
-    for (int u = 0; u < 16; ++u) {
-      const float mk = (bits[v] >> u) & 1U ? 1.0F : 0.0F;
-      m[u] = mk;
-      const float val = mk * av[u];
-      acc[u] += val;
-      acc2[u] += val * av[u];
-    }
-  }
-  float s0 = 0, s1 = 0;
-  for (int u = 0; u < 16; ++u) {
-    s0 += acc[u];
-    s1 += acc2[u];
-  }
-  sums[0] = s0;
-  sums[1] = s1;
-}
-__attribute__((target_clones("avx2", "default"))) void maskRows16(const uint32_t* bits, int rows,
-                                                                 const float* a, size_t stride,
-                                                                 float* mask, float sums[2]) {
-  denseMaskRows(bits, rows, a, stride, mask, sums);
-}
-// Template rows T = M (A - mean) / sd.
-__attribute__((target_clones("avx2", "default"))) void templateRows16(
-    const float* mask, int rows, const float* a, size_t stride, float mean, float invSd,
-    float* templ) {
-  for (int v = 0; v < rows; ++v) {
-    const float* av = a + static_cast<size_t>(v) * stride;
-    const float* m = mask + static_cast<size_t>(v) * 16;
-    float* t = templ + static_cast<size_t>(v) * 16;
-    for (int u = 0; u < 16; ++u) t[u] = m[u] * ((av[u] - mean) * invSd);
-  }
 }
 
 // A window of ≤ 15 columns as one 256-bit board: row v in bits 16v .. 16v + 14 (of four 64-bit
@@ -415,9 +311,17 @@ struct LinePeak {
   }
 };
 
-// Dense w x w template of an adaptive shape: T = (A - mean_S) / sd_S on S and 0 elsewhere, and
-// the indicator M of S. NCC(d, dy) = sum(T * B) / (|S| sd_S(B)).
+// Dense rows of an adaptive shape S.
+//  - Windows ≤ 15 columns: quantised grey levels, rows of 16 int16: mask (−1 on S) and A on S
+//    (0 elsewhere); NCC(d, dy) = (n Σ A·B − Σ A Σ B) / sqrt((n Σ A² − (Σ A)²)(n Σ B² − (Σ B)²))
+//    from exact integer sums (n = |S|).
+//  - Wider windows: float rows of 32, template T = (A - mean_S) / sd_S on S and 0 elsewhere,
+//    and the indicator M of S; NCC(d, dy) = Σ T·B / (|S| sd_S(B)).
 struct ShapeTemplate {
+  alignas(32) int16_t maskQ[16 * 16] = {};
+  alignas(32) int16_t aQ[16 * 16] = {};
+  int32_t sumA = 0;     // Σ_S A (quantised)
+  double invNormA = 0;  // 1 / sqrt(n Σ_S A² − (Σ_S A)²)
   std::vector<float> templ, mask;
   uint32_t rowBits[32] = {};       // S as bits: bit u of row v = window cell (u, v)
   int rowFirst = 0, rowLast = -1;  // window rows holding part of S
@@ -441,6 +345,17 @@ class LevelMatcher {
     refStats_ = windowStats(in.ref, in.refValid, s.window);
     otherStats_ = windowStats(in.other, in.otherValid, s.window);
     cv::multiply(in.other, in.other, otherSq_);
+    // Quantised copies for the integer shape kernels: one scale for both images, the largest
+    // that keeps |q| ≤ kShapeQuantMax (the images are mapped to ~±128: a step of < 0.1 grey).
+    double refMin = 0, refMax = 0, otherMin = 0, otherMax = 0;
+    cv::minMaxLoc(in.ref, &refMin, &refMax);
+    cv::minMaxLoc(in.other, &otherMin, &otherMax);
+    const double maxAbs = std::max({std::abs(refMin), std::abs(refMax), std::abs(otherMin),
+                                    std::abs(otherMax), 1e-6});
+    const double scale = std::floor(kShapeQuantMax / maxAbs * 1e6) / 1e6;  // round(scale·v) ≤ max
+    in.ref.convertTo(refQ_, CV_16S, scale);
+    in.other.convertTo(otherQ_, CV_16S, scale);
+    flatQ_ = kFlatVariance * scale * scale;
     for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
     // Pixels a shape never enters: contours and nodata. blockedBits_(y, x): bit u set when
     // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
@@ -774,6 +689,19 @@ class LevelMatcher {
     t.rowLast = w - 1;
     while (reach[t.rowLast] == 0) --t.rowLast;
     const int rows = t.rowLast - t.rowFirst + 1;
+    if (P == 16) {
+      int32_t sumA = 0, sumAA = 0;
+      shapeRowsInt(&reach[t.rowFirst], rows, refQ_.ptr<int16_t>(y + t.rowFirst - r_) + x - r_,
+                   static_cast<ptrdiff_t>(refQ_.step1()), &t.maskQ[16 * t.rowFirst],
+                   &t.aQ[16 * t.rowFirst], sumA, sumAA);
+      const double n = t.count;
+      // n² var_S(A), exact (< 2^53).
+      const double varN = n * sumAA - static_cast<double>(sumA) * sumA;
+      if (varN < flatQ_ * n * n) return false;
+      t.sumA = sumA;
+      t.invNormA = 1.0 / std::sqrt(varN);
+      return true;
+    }
     t.mask.resize(static_cast<size_t>(w * P));
     t.templ.resize(static_cast<size_t>(w * P));
     float* mask = &t.mask[static_cast<size_t>(t.rowFirst * P)];
@@ -781,38 +709,26 @@ class LevelMatcher {
     const float* a = in_.ref.ptr<float>(y + t.rowFirst - r_) + x - r_;
     const size_t stride = in_.ref.step1();
     float sum = 0, sq = 0;  // ≤ 961 values of magnitude ≤ ~128: float is exact enough
-    if (P == 16) {
-      // Dense, vectorised rows (only rows rowFirst..rowLast are ever read).
-      float sums[2];
-      maskRows16(&reach[t.rowFirst], rows, a, stride, mask, sums);
-      sum = sums[0];
-      sq = sums[1];
-    } else {
-      std::fill(mask, mask + static_cast<size_t>(rows * P), 0.0F);
-      for (int v = 0; v < rows; ++v) {
-        const float* av = a + static_cast<size_t>(v) * stride;
-        float* m = mask + static_cast<size_t>(v * P);
-        for (uint32_t bits = reach[t.rowFirst + v]; bits != 0; bits &= bits - 1) {
-          const int u = __builtin_ctz(bits);
-          m[u] = 1.0F;
-          sum += av[u];
-          sq += av[u] * av[u];
-        }
+    std::fill(mask, mask + static_cast<size_t>(rows * P), 0.0F);
+    for (int v = 0; v < rows; ++v) {
+      const float* av = a + static_cast<size_t>(v) * stride;
+      float* m = mask + static_cast<size_t>(v * P);
+      for (uint32_t bits = reach[t.rowFirst + v]; bits != 0; bits &= bits - 1) {
+        const int u = __builtin_ctz(bits);
+        m[u] = 1.0F;
+        sum += av[u];
+        sq += av[u] * av[u];
       }
     }
     const float mean = sum / static_cast<float>(t.count);
     const float var = sq / static_cast<float>(t.count) - mean * mean;
     if (var < static_cast<float>(kFlatVariance)) return false;
     const float invSd = 1.0F / std::sqrt(var);
-    if (P == 16) {
-      templateRows16(mask, rows, a, stride, mean, invSd, templ);
-    } else {
-      for (int v = 0; v < rows; ++v) {
-        const float* av = a + static_cast<size_t>(v) * stride;
-        const float* m = mask + static_cast<size_t>(v * P);
-        float* tt = templ + static_cast<size_t>(v * P);
-        for (int u = 0; u < P; ++u) tt[u] = m[u] * ((av[u] - mean) * invSd);
-      }
+    for (int v = 0; v < rows; ++v) {
+      const float* av = a + static_cast<size_t>(v) * stride;
+      const float* m = mask + static_cast<size_t>(v * P);
+      float* tt = templ + static_cast<size_t>(v * P);
+      for (int u = 0; u < P; ++u) tt[u] = m[u] * ((av[u] - mean) * invSd);
     }
     return true;
   }
@@ -830,14 +746,30 @@ class LevelMatcher {
       }
       if (touches != 0) return kNaN;
     }
-    const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     const int rows = t.rowLast - t.rowFirst + 1;
     const int top = yb + t.rowFirst - r_;
+    if (rowStride_ == 16) {
+      const ptrdiff_t here = 0;
+      ShapeSumsInt sums;
+      shapeSumsInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
+                   &here, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, 1, &sums);
+      return scoreFromIntSums(sums, t);
+    }
+    const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     float sums[3];
-    (rowStride_ == 16 ? shapeSums16 : shapeSums32)(
-        in_.other.ptr<float>(top) + xb - r_, otherSq_.ptr<float>(top) + xb - r_,
-        in_.other.step1(), &t.mask[first], &t.templ[first], rows, sums);
+    shapeSums32(in_.other.ptr<float>(top) + xb - r_, otherSq_.ptr<float>(top) + xb - r_,
+                in_.other.step1(), &t.mask[first], &t.templ[first], rows, sums);
     return scoreFromSums(sums, t.count);
+  }
+
+  float scoreFromIntSums(const ShapeSumsInt& sums, const ShapeTemplate& t) const {
+    const int64_t n = t.count;
+    const int64_t varN = n * sums.bb - static_cast<int64_t>(sums.b) * sums.b;  // n² var_S(B)
+    const auto nn = static_cast<double>(n * n);
+    if (static_cast<double>(varN) < flatQ_ * nn) return kNaN;
+    const int64_t num = n * sums.ab - static_cast<int64_t>(t.sumA) * sums.b;
+    return static_cast<float>(static_cast<double>(num) * t.invNormA /
+                              std::sqrt(static_cast<double>(varN)));
   }
 
   static float scoreFromSums(const float sums[3], int count) {
@@ -861,18 +793,12 @@ class LevelMatcher {
     for (int k = 0; k < count; ++k) {
       if (!ok[xb - k]) return false;
     }
-    const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     const int top = y + t.rowFirst - r_;
     const int rows = t.rowLast - t.rowFirst + 1;
-    float sums[kBatch][3];
-    if (count == kBatch) {
-      shapeSums16Batch(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
-                       &t.templ[first], rows, sums);
-    } else {
-      shapeSums16Tail(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
-                      &t.templ[first], rows, count, sums);
-    }
-    for (int k = 0; k < count; ++k) scores[k] = scoreFromSums(sums[k], t.count);
+    ShapeSumsInt sums[kBatch];
+    shapeSumsInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
+                 kMainLine, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, count, sums);
+    for (int k = 0; k < count; ++k) scores[k] = scoreFromIntSums(sums[k], t);
     return true;
   }
 
@@ -883,13 +809,14 @@ class LevelMatcher {
     const int xb = x - d;
     if (y - 1 < r_ || y + 1 >= H_ - r_ || xb < r_ || xb >= W_ - r_) return false;
     if (!otherStats_.ok.at<uchar>(y - 1, xb) || !otherStats_.ok.at<uchar>(y + 1, xb)) return false;
-    const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     const int top = y + t.rowFirst - r_;
-    float sums[2][3];
-    shapeSums16Pair(in_.other.ptr<float>(top) + xb - r_, in_.other.step1(), &t.mask[first],
-                    &t.templ[first], t.rowLast - t.rowFirst + 1, sums);
-    minus = scoreFromSums(sums[0], t.count);
-    plus = scoreFromSums(sums[1], t.count);
+    const auto stride = static_cast<ptrdiff_t>(otherQ_.step1());
+    const ptrdiff_t lines[2] = {-stride, stride};
+    ShapeSumsInt sums[2];
+    shapeSumsInt(otherQ_.ptr<int16_t>(top) + xb - r_, stride, lines, &t.maskQ[16 * t.rowFirst],
+                 &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 2, sums);
+    minus = scoreFromIntSums(sums[0], t);
+    plus = scoreFromIntSums(sums[1], t);
     return true;
   }
 
@@ -1032,6 +959,8 @@ class LevelMatcher {
   const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
   WindowStats refStats_, otherStats_;
   cv::Mat otherSq_;
+  cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
+  double flatQ_ = 0;       // kFlatVariance in quantised units
   float squareLanes_[16] = {};  // 1 for the columns of a square window, 0 past it
   cv::Mat nearEdge_;
   cv::Mat blocked_;      // CV_8U, non-zero on contour and nodata pixels of ref
