@@ -71,6 +71,35 @@ struct Row {
 };
 
 constexpr int kOutlineWalk = 7;
+bool gOutlineDiagnosis = false;  // --outline-diag: where the predicted roof starts
+
+// Diagnostic only (not part of the metric): histogram of the predicted roof start relative to
+// the true outline, in px towards the ground (positive: roof fattened), as edge% walks it.
+void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
+  long outside = 0, inside = 0, missed = 0, located = 0;
+  for (const Case::OutlinePixel& o : c.outline) {
+    const float mid = 0.5F * (o.dRoof + o.dGround);
+    const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
+    const float* row = disparity.ptr<float>(o.y);
+    const int xg = o.xb - o.dir;
+    bool found = false;
+    for (int k = -kOutlineWalk; k <= 2 * kOutlineWalk; ++k) {
+      const int x = xg + o.dir * k;
+      if (x < 0 || x >= disparity.cols) break;
+      if (!std::isfinite(row[x]) || (row[x] - mid) * sign <= 0) continue;
+      const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
+      if (std::abs(off) <= 1) ++located;
+      else if (off > 1) ++outside;
+      else ++inside;
+      found = true;
+      break;
+    }
+    if (!found) ++missed;
+  }
+  std::printf("    outline diag: %zu pixels, located %ld, roof starts >=2 px outside %ld, "
+              ">=2 px inside %ld, missed %ld\n", c.outline.size(), located, outside, inside,
+              missed);
+}
 
 double outlineScore(const cv::Mat& disparity, const Case& c) {
   if (c.outline.empty()) return NAN;
@@ -190,6 +219,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
     std::printf("  %-10s %8.1f %8.2f %8.2f %10.2f %9.3f %9.3f %7.1f %8.2f\n", m.c_str(),
                 r.density, r.bad1, r.bad2, r.bad2All, r.roofRms, r.roofRmsInliers, r.edge,
                 r.seconds);
+    if (gOutlineDiagnosis && !c.outline.empty()) outlineDiagnosis(disparity[i], c);
     if (!dump.empty() && !c.outline.empty()) {
       cv::Mat grey;
       c.left.convertTo(grey, CV_8U);
@@ -342,6 +372,8 @@ int main(int argc, char** argv) {
       overrides = nlohmann::json::parse(argv[++i]);
     } else if (a == "--repeat" && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--outline-diag") {
+      gOutlineDiagnosis = true;
     } else if (a == "--cpu") {
       printCpu = true;
     } else if (a == "--no-data") {

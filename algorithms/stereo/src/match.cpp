@@ -13,6 +13,7 @@
 
 #include "delineo/core/error.hpp"
 #include "level_matcher.hpp"
+#include "match_steps.hpp"
 
 namespace delineo::stereo {
 
@@ -94,8 +95,19 @@ cv::Mat flipped(const cv::Mat& m) {
   return out;
 }
 
-// Keeps the matches of `disp` (with line shifts) whose match in the other map points back
-// within `tolerance` for at least one of the four floor/ceil neighbours. `sign`: +1 when disp is
+// True when the other map's match at (qx, qy) points back to (d, dy) within `tolerance`.
+bool consistentAt(const detail::LevelOutput& other, int qx, int qy, float d, float dy,
+                  double tolerance) {
+  if (qx < 0 || qx >= other.disparity.cols || qy < 0 || qy >= other.disparity.rows) return false;
+  const float dq = other.disparity.at<float>(qy, qx);
+  if (!std::isfinite(dq)) return false;
+  const double ex = d - dq;
+  const double ey = dy + other.lineShift.at<float>(qy, qx);
+  return std::hypot(ex, ey) <= tolerance;
+}
+
+// Keeps the matches of `map` (with line shifts) whose match in the other map points back
+// within `tolerance` for at least one of the four floor/ceil neighbours. `sign`: +1 when `map` is
 // the left map (x_other = x - d), -1 for the right map (x_other = x + d).
 cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& other, int sign,
                  double tolerance) {
@@ -112,13 +124,7 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
       bool consistent = false;
       for (int m = 0; m <= 1 && !consistent; ++m) {
         for (int n = 0; n <= 1 && !consistent; ++n) {
-          const int qx = fx + n, qy = fy + m;
-          if (qx < 0 || qx >= W || qy < 0 || qy >= H) continue;
-          const float dq = other.disparity.at<float>(qy, qx);
-          if (!std::isfinite(dq)) continue;
-          const double ex = d[x] - dq;
-          const double ey = dy[x] + other.lineShift.at<float>(qy, qx);
-          consistent = std::hypot(ex, ey) <= tolerance;
+          consistent = consistentAt(other, fx + n, fy + m, d[x], dy[x], tolerance);
         }
       }
       if (!consistent) d[x] = kNaN;
@@ -309,11 +315,31 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       return result;
     }
     done += w;
-    rightOut.disparity = flipped(mirrored.disparity);
-    rightOut.lineShift = flipped(mirrored.lineShift);
-    rightOut.score = flipped(mirrored.score);
+    auto unmirror = [&] {
+      rightOut.disparity = flipped(mirrored.disparity);
+      rightOut.lineShift = flipped(mirrored.lineShift);
+      rightOut.score = flipped(mirrored.score);
+    };
+    unmirror();
     coarseLeft = validate(leftOut, rightOut, +1, p.tolerance);
     coarseRight = validate(rightOut, leftOut, -1, p.tolerance);
+    if (p.adaptive && p.stepCut && k <= p.stepCutLevel) {
+      // Depth steps of the validated maps (most have no image contour): each pixel near one is
+      // given a side and matched again on the window cut at the step (both maps, the right one
+      // mirrored like its matching), then both are validated again. Part of the adaptive shapes:
+      // off with plain square windows.
+      detail::StepRefineSettings rs;
+      rs.window = p.window;
+      rs.minScore = p.minScore;
+      rs.minShape = p.minShape;
+      detail::refineDepthSteps(inL.ref, inL.other, inL.refValid, inL.otherValid, coarseLeft, rs,
+                               leftOut);
+      detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid,
+                               flipped(coarseRight), rs, mirrored);
+      unmirror();
+      coarseLeft = validate(leftOut, rightOut, +1, p.tolerance);
+      coarseRight = validate(rightOut, leftOut, -1, p.tolerance);
+    }
   }
   result.disparity = coarseLeft;
   result.score = leftOut.score.clone();

@@ -191,6 +191,89 @@ TEST(Match, AdaptiveShapesKeepTheOutlineSharperThanSquareWindows) {
   EXPECT_GT(adaptive.matched, adaptive.total * 7 / 10);
 }
 
+// A textured block 12 px above its background with the SAME brightness and texture amplitude
+// (no contour at its outline, as on half of the simulated roof outlines), plus noise.
+testing::SquareScene contourlessBlock() {
+  const cv::Size size(160, 120);
+  const cv::Rect square(60, 30, 60, 60);
+  const int background = 2, foreground = 14;
+  const cv::Mat back = texture(cv::Size(size.width + 64, size.height), 11) * 0.35 + 30.0;
+  const cv::Mat front = texture(cv::Size(size.width + 64, size.height), 12) * 0.35 + 30.0;
+  cv::RNG rng(5);
+  testing::SquareScene s;
+  s.square = square;
+  s.left.create(size, CV_32F);
+  s.right.create(size, CV_32F);
+  s.truth.create(size, CV_32F);
+  s.occluded = cv::Mat::zeros(size, CV_8U);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const bool inSquare = square.contains(cv::Point(x, y));
+      s.left.at<float>(y, x) = (inSquare ? front.at<float>(y, x + 32) : back.at<float>(y, x + 32)) +
+                               static_cast<float>(rng.gaussian(2.0));
+      s.truth.at<float>(y, x) = static_cast<float>(inSquare ? foreground : background);
+      const int xf = x + foreground;
+      const bool seesSquare = y >= square.y && y < square.br().y && xf >= square.x &&
+                              xf < square.br().x;
+      s.right.at<float>(y, x) = (seesSquare ? front.at<float>(y, xf + 32)
+                                            : back.at<float>(y, x + background + 32)) +
+                                static_cast<float>(rng.gaussian(2.0));
+      const int xr = x - background;
+      s.occluded.at<uchar>(y, x) = !inSquare && y >= square.y && y < square.br().y &&
+                                           xr + foreground >= square.x &&
+                                           xr + foreground < square.br().x
+                                       ? 1
+                                       : 0;
+    }
+  }
+  return s;
+}
+
+// Rows whose +x outline (the side whose ground both views see) is located within 1 px: the
+// first pixel walking from the ground towards the block whose disparity is on the block's side
+// of the mid-level is the true outline or its neighbour.
+int locatedOutlineRows(const MatchResult& r, const testing::SquareScene& s) {
+  int located = 0;
+  const int xb = s.square.br().x - 1;  // last block pixel
+  for (int y = s.square.y + 3; y < s.square.br().y - 3; ++y) {
+    for (int x = xb + 8; x >= xb - 8; --x) {
+      const float d = r.disparity.at<float>(y, x);
+      if (!std::isfinite(d) || d < 8.0F) continue;
+      if (std::abs(x - xb) <= 1) ++located;
+      break;
+    }
+  }
+  return located;
+}
+
+TEST(Match, StepCutLocatesAnOutlineWithoutContour) {
+  const auto scene = contourlessBlock();
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 20;
+  const MatchResult cut = matchStereo(scene.left, scene.right, p);
+  p.stepCut = false;
+  const MatchResult plain = matchStereo(scene.left, scene.right, p);
+  const int rows = scene.square.height - 6;
+  const int withCut = locatedOutlineRows(cut, scene);
+  const int without = locatedOutlineRows(plain, scene);
+  // Without a contour the window straddling the step misplaces most of the outline; cut at the
+  // step located along the row, the block keeps its matches up to its true edge.
+  EXPECT_LT(without, rows / 2) << without << " of " << rows;
+  EXPECT_GT(withCut, rows * 6 / 10) << withCut << " of " << rows;
+  EXPECT_GT(withCut, 2 * without) << withCut << " vs " << without;
+  // And the occluded strip on the other side stays rejected.
+  int occluded = 0, occludedRejected = 0;
+  for (int y = 0; y < scene.left.rows; ++y) {
+    for (int x = 0; x < scene.left.cols; ++x) {
+      if (!scene.occluded.at<uchar>(y, x)) continue;
+      ++occluded;
+      if (!std::isfinite(cut.disparity.at<float>(y, x))) ++occludedRejected;
+    }
+  }
+  EXPECT_GT(occludedRejected, occluded * 8 / 10) << occludedRejected << " of " << occluded;
+}
+
 TEST(Match, SgbmFollowsTheSameConventions) {
   const cv::Mat left = texture({200, 120}, 23);
   const cv::Mat right = shiftedRight(left, -6.0);

@@ -22,6 +22,8 @@ struct MatchParams {
   int levels = 0;                    // pyramid levels, 0 = auto: ceil(1 + log2(range / 20))
   int window = 15;                   // px, odd side of the (maximal) template window
   double tolerance = 1.0;            // px, τ of the symmetric left/right validation
+  bool stepCut = true;               // windows cut at the depth steps of the validated map
+  int stepCutLevel = 0;              // coarsest pyramid level (0 = full resolution) it runs on
   double edgeLow = 40.0;             // Canny low threshold on the 0..255-normalised image
   double edgeHigh = 100.0;           // Canny high threshold
   double edgeSigma = 1.0;            // px, Gaussian smoothing before Canny (same at each level)
@@ -54,6 +56,13 @@ struct MatchParams {
     v(core::ParamInfo{"tolerance", "Validation tolerance", "px",
                       "Symmetric left/right consistency tolerance τ", 0, 10},
       tolerance);
+    v(core::ParamInfo{"step-cut", "Cut windows at depth steps", "",
+                      "Near depth steps of the validated map, locate the step along the row and "
+                      "match again on windows cut there"},
+      stepCut);
+    v(core::ParamInfo{"step-cut-level", "Step-cut levels", "",
+                      "Coarsest pyramid level of the step cut (0 = full resolution only)", 0, 10},
+      stepCutLevel);
     v(core::ParamInfo{"edge-low", "Edge low threshold", "",
                       "Canny hysteresis low threshold on the 0..255-normalised image", 0, 1000},
       edgeLow);

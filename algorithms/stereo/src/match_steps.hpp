@@ -1,0 +1,43 @@
+#pragma once
+// Depth steps without an image contour (internal to delineo_stereo): windows cut at the steps.
+#include <opencv2/core.hpp>
+
+#include "level_matcher.hpp"
+
+namespace delineo::stereo::detail {
+
+struct StepRefineSettings {
+  int window = 15;        // px, side of the template window
+  int minStep = 2;        // px, disparity difference between the two sides that makes a step
+  double minScore = 0.3;  // NCC floor of the re-matched (cut) window
+  int minShape = 25;      // px, smallest cut window matched
+  // px, half height of the pixel column whose error locates the boundary. 0 (the pixel alone):
+  // a taller column straddles diagonal outlines (sim 400², edge% 69.5 with 0, 67.2 with 1).
+  int costRadius = 0;
+};
+
+// Depth steps that have no image contour (roof and ground of similar brightness: about half of
+// the roof outlines of the simulated scenes) give the adaptive shape nothing to stop at, and the
+// window straddling the step fattens the surface with the stronger texture. Where a row of
+// `validated` (the reference map after the left/right check) steps by ≥ minStep between two
+// validated pixels p < q, the segment [p − h, q + h] (h = window/2: the fattening reaches half a
+// window) is re-decided:
+//  1. the two sides' disparities da, db are read beyond the segment (first validated pixel);
+//  2. the boundary β minimises Σ_{x≤β} eA(x) + Σ_{x>β} eB(x), e the squared grey difference of
+//     the pixel (column y ± costRadius) under each side's disparity: both hypotheses are
+//     scored on the same pixels, so a stronger texture on one side does not bias the choice (it
+//     does when two windows' NCCs are compared: measured, the roof then grew by 1–3 px);
+//  3. every pixel of a segment is matched again around its side's disparity (±2 px, parabola
+//     sub-pixel) on its window cut at the steps: the pixels of the same side, plus validated
+//     pixels outside the segments within 1.5 px of that side (the step acts as a contour, in
+//     2D, so diagonal outlines are cut along their true direction).
+// Segments holding a validated value on neither side (a third surface) are left alone.
+// `raw` (the reference map before validation) is updated in place: disparity, line shift (that
+// of the side's source pixel), score (NaN disparity when the cut window's NCC < minScore); the
+// caller validates it again. ref/other follow LevelInput: x_other = x_ref − d,
+// y_other = y_ref + dy. Returns the number of pixels whose value changed.
+long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
+                      const cv::Mat& otherValid, const cv::Mat& validated,
+                      const StepRefineSettings& settings, LevelOutput& raw);
+
+}  // namespace delineo::stereo::detail
