@@ -206,6 +206,8 @@ int main(int argc, char** argv) {
   std::printf("%-5s %-3s %-9s %-6s %-5s %7s %7s %7s %7s %7s %8s %5s %5s\n", "scene", "id", "shape",
               "roof", "init", "IoU", "p1%", "PoLiS", "Hausd", "cornRMS", "ms", "verts", "holes");
   std::map<std::string, std::vector<double>> ious, corners, hausdorffs;
+  // Per-group IoU and corner RMS for the breakdown, keyed by "init|group".
+  std::map<std::string, std::vector<double>> groupIous, groupCorners;
   std::vector<double> times;
   int sideOk = 0, sideTotal = 0, failures = 0;
   double fastMs = 0, referenceMs = 0;
@@ -238,6 +240,17 @@ int main(int argc, char** argv) {
           corners[initName].push_back(sc.corner);
           hausdorffs[initName].push_back(sc.hausdorff);
           times.push_back(ms(t0, t1));
+          {
+            const std::string shape = text(fp, "shape"), roofType = text(fp, "roof_type");
+            // Issue #4's wording: flat and gable roofs, rectilinear (right-angled) footprints.
+            const bool issueSubset = (roofType == "flat" || roofType == "gable") && shape != "angled";
+            std::vector<std::string> groups{"roof " + roofType, "shape " + shape};
+            if (issueSubset) groups.push_back("flat+gable, rectilinear");
+            for (const auto& group : groups) {
+              groupIous[std::string(initName) + "|" + group].push_back(sc.iou);
+              groupCorners[std::string(initName) + "|" + group].push_back(sc.corner);
+            }
+          }
           std::printf("%-5d %-3d %-9s %-6s %-5s %7.3f %7.2f %7.2f %7.2f %7.2f %8.1f %5d %5zu\n", sceneParams.seed,
                       id, text(fp, "shape").c_str(), text(fp, "roof_type").c_str(), initName, sc.iou, sc.p1,
                       sc.polis, sc.hausdorff, sc.corner, ms(t0, t1), r.vertexCount, r.polygon.holes.size());
@@ -253,6 +266,29 @@ int main(int argc, char** argv) {
             std::printf("\n");
             std::printf("      bbox pred %.1f %.1f %.1f %.1f truth %.1f %.1f %.1f %.1f\n", a.x, a.y, a.br().x,
                         a.br().y, b.x, b.y, b.br().x, b.br().y);
+            // Energy of the true outline (rounded to pixel corners) on the same prepared energy:
+            // tells an optimisation failure (truth lower) from an energy failure (truth higher).
+            const auto [rsv, gsv] = costIntervals(req.roof, *req.ground, params.balanceIntervals);
+            const auto vc = stereo::CorrelationCostService::compute(left, right, r.roi, std::min(rsv.min, gsv.min),
+                                                                    std::max(rsv.max, gsv.max),
+                                                                    stereo::CostParams{params.costWindow, 1.0});
+            const PreparedEnergy pe = prepareEnergy(*vc, left, right, req, params);
+            auto localRing = [&](const core::Ring& rg) {
+              IntRing out;
+              for (const auto& v : rg) out.emplace_back(int(std::lround(v.x - r.roi.x)), int(std::lround(v.y - r.roi.y)));
+              return out;
+            };
+            IntPolygon truthLocal{localRing(fp.polygon.outer), {}};
+            for (const auto& h : fp.polygon.holes) truthLocal.holes.push_back(localRing(h));
+            IntPolygon resultLocal{localRing(r.polygon.outer), {}};
+            for (const auto& h : r.polygon.holes) resultLocal.holes.push_back(localRing(h));
+            const EnergyWeights w{params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle, params.minGap};
+            for (const auto& [label, poly] : {std::pair{"truth ", truthLocal}, std::pair{"result", resultLocal}}) {
+              const EnergyTerms t = referenceEnergy(pe.images, w, poly);
+              std::printf("      F(%s) %.2f =", label, t.total());
+              for (double v : t.term) std::printf(" %.2f", v);
+              std::printf("\n");
+            }
           }
         } catch (const std::exception& e) {
           ++failures;
@@ -302,6 +338,12 @@ int main(int argc, char** argv) {
                 "Hausdorff mean %.1f median %.1f max %.1f px\n",
                 name.c_str(), v.size(), mean(v), median(v), median(corners[name]), mean(h), median(h),
                 h.empty() ? std::nan("") : *std::max_element(h.begin(), h.end()));
+  }
+  std::printf("  breakdown (mean IoU, median IoU, median corner RMS, runs):\n");
+  for (const auto& [key, v] : groupIous) {
+    const size_t bar = key.find('|');
+    std::printf("    %-6s %-26s %.3f  %.3f  %.2f px  %zu\n", key.substr(0, bar).c_str(), key.substr(bar + 1).c_str(),
+                mean(v), median(v), median(groupCorners[key]), v.size());
   }
   std::printf("  median time per building %.1f ms (cost service + optimisation, one core)\n", median(times));
   std::printf("  occlusion side from the data agrees with the geometry: %d / %d\n", sideOk, sideTotal);
