@@ -12,8 +12,10 @@
 //
 // Built for AVX2 (picked at run time) and for the x86-64 baseline (SSE2); a scalar version
 // elsewhere.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -48,32 +50,50 @@ __attribute__((target("avx2"), always_inline)) inline int32_t laneSumAvx2(__m256
   return _mm_cvtsi128_si32(s);
 }
 
-// K windows of B, the k-th at b + offsets[k]; the shape as rows of 16 int16: mask (−1 on S,
-// 0 elsewhere) and A on S (0 elsewhere). The shape rows are loaded once for the K windows.
+// One row of one window: B on S (A and the mask are 0 off S) into the three accumulators.
+__attribute__((target("avx2"), always_inline)) inline void accumulateRowAvx2(
+    const int16_t* x, __m256i m, __m256i a, __m256i& accB, __m256i& accBB, __m256i& accAB) {
+  const __m256i xm = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(x)), m);
+  accB = _mm256_add_epi16(accB, xm);
+  accBB = _mm256_add_epi32(accBB, _mm256_madd_epi16(xm, xm));
+  accAB = _mm256_add_epi32(accAB, _mm256_madd_epi16(a, xm));
+}
+
+// Lane sums of the accumulators (Σ B widened from its 16-bit column sums).
+__attribute__((target("avx2"), always_inline)) inline void storeSumsAvx2(ShapeSumsInt& out,
+                                                                        __m256i sb, __m256i sbb,
+                                                                        __m256i sab) {
+  out.b = laneSumAvx2(_mm256_madd_epi16(sb, _mm256_set1_epi16(1)));
+  out.bb = laneSumAvx2(sbb);
+  out.ab = laneSumAvx2(sab);
+}
+
+// K (1..4) windows of B, the k-th at b + offsets[k]; the shape as rows of 16 int16: mask (−1
+// on S, 0 elsewhere) and A on S (0 elsewhere). The shape rows are loaded once for the K
+// windows. Named accumulators, not arrays: GCC kept arrays of vectors partly on the stack
+// (a store and a load per accumulator and row).
 template <int K>
 __attribute__((target("avx2"), always_inline)) inline void shapeSumsIntAvx2(
     const int16_t* b, ptrdiff_t stride, const ptrdiff_t* offsets, const int16_t* mask,
     const int16_t* am, int rows, ShapeSumsInt* out) {
-  __m256i accB[K], accBB[K], accAB[K];
-  for (int k = 0; k < K; ++k) accB[k] = accBB[k] = accAB[k] = _mm256_setzero_si256();
+  const __m256i zero = _mm256_setzero_si256();
+  __m256i b0 = zero, bb0 = zero, ab0 = zero, b1 = zero, bb1 = zero, ab1 = zero;
+  __m256i b2 = zero, bb2 = zero, ab2 = zero, b3 = zero, bb3 = zero, ab3 = zero;
+  const ptrdiff_t o0 = offsets[0], o1 = K > 1 ? offsets[1] : 0, o2 = K > 2 ? offsets[2] : 0,
+                  o3 = K > 3 ? offsets[3] : 0;
   for (int v = 0; v < rows; ++v) {
     const int16_t* bv = b + v * stride;
     const __m256i m = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(mask + 16 * v));
     const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(am + 16 * v));
-    for (int k = 0; k < K; ++k) {
-      const __m256i x = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(bv + offsets[k]));
-      const __m256i xm = _mm256_and_si256(x, m);
-      accB[k] = _mm256_add_epi16(accB[k], xm);
-      accBB[k] = _mm256_add_epi32(accBB[k], _mm256_madd_epi16(xm, x));
-      accAB[k] = _mm256_add_epi32(accAB[k], _mm256_madd_epi16(a, x));
-    }
+    accumulateRowAvx2(bv + o0, m, a, b0, bb0, ab0);
+    if constexpr (K > 1) accumulateRowAvx2(bv + o1, m, a, b1, bb1, ab1);
+    if constexpr (K > 2) accumulateRowAvx2(bv + o2, m, a, b2, bb2, ab2);
+    if constexpr (K > 3) accumulateRowAvx2(bv + o3, m, a, b3, bb3, ab3);
   }
-  const __m256i ones = _mm256_set1_epi16(1);
-  for (int k = 0; k < K; ++k) {
-    out[k].b = laneSumAvx2(_mm256_madd_epi16(accB[k], ones));
-    out[k].bb = laneSumAvx2(accBB[k]);
-    out[k].ab = laneSumAvx2(accAB[k]);
-  }
+  storeSumsAvx2(out[0], b0, bb0, ab0);
+  if constexpr (K > 1) storeSumsAvx2(out[1], b1, bb1, ab1);
+  if constexpr (K > 2) storeSumsAvx2(out[2], b2, bb2, ab2);
+  if constexpr (K > 3) storeSumsAvx2(out[3], b3, bb3, ab3);
 }
 
 __attribute__((target("avx2"))) inline void shapeSumsIntAvx2Dispatch(
@@ -88,15 +108,17 @@ __attribute__((target("avx2"))) inline void shapeSumsIntAvx2Dispatch(
 }
 
 // Dense rows of a shape from its row bits (bit u of row v = cell (u, v)): mask, A on S, and
-// Σ_S A, Σ_S A².
+// |S|, Σ_S A, Σ_S A².
 __attribute__((target("avx2"))) inline void shapeRowsIntAvx2(const uint32_t* bits, int rows,
                                                              const int16_t* a, ptrdiff_t stride,
                                                              int16_t* mask, int16_t* am,
-                                                             int32_t& sumA, int32_t& sumAA) {
+                                                             int32_t& count, int32_t& sumA,
+                                                             int32_t& sumAA) {
   const __m256i select = _mm256_setr_epi16(
       0x0001, 0x0002, 0x0004, 0x0008, 0x0010, 0x0020, 0x0040, 0x0080, 0x0100, 0x0200, 0x0400,
       0x0800, 0x1000, 0x2000, 0x4000, static_cast<int16_t>(0x8000));
   __m256i accA = _mm256_setzero_si256(), accAA = _mm256_setzero_si256();
+  __m256i accN = _mm256_setzero_si256();  // − cells of S per column
   for (int v = 0; v < rows; ++v) {
     const __m256i row = _mm256_set1_epi16(static_cast<int16_t>(bits[v] & 0xFFFFU));
     const __m256i m = _mm256_cmpeq_epi16(_mm256_and_si256(row, select), select);
@@ -104,9 +126,11 @@ __attribute__((target("avx2"))) inline void shapeRowsIntAvx2(const uint32_t* bit
     const __m256i xm = _mm256_and_si256(x, m);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(mask + 16 * v), m);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(am + 16 * v), xm);
+    accN = _mm256_add_epi16(accN, m);
     accA = _mm256_add_epi16(accA, xm);
     accAA = _mm256_add_epi32(accAA, _mm256_madd_epi16(xm, xm));
   }
+  count = -laneSumAvx2(_mm256_madd_epi16(accN, _mm256_set1_epi16(1)));
   sumA = laneSumAvx2(_mm256_madd_epi16(accA, _mm256_set1_epi16(1)));
   sumAA = laneSumAvx2(accAA);
 }
@@ -199,15 +223,17 @@ inline void shapeSumsInt(const int16_t* b, ptrdiff_t stride, const ptrdiff_t* of
 #endif
 }
 
-// Dense rows of a shape: mask (−1 on S), A on S, Σ_S A and Σ_S A².
+// Dense rows of a shape: mask (−1 on S), A on S, |S|, Σ_S A and Σ_S A².
 inline void shapeRowsInt(const uint32_t* bits, int rows, const int16_t* a, ptrdiff_t stride,
-                         int16_t* mask, int16_t* am, int32_t& sumA, int32_t& sumAA) {
+                         int16_t* mask, int16_t* am, int32_t& count, int32_t& sumA,
+                         int32_t& sumAA) {
 #ifdef DELINEO_STEREO_X86
   if (cpuHasAvx2()) {
-    shapeRowsIntAvx2(bits, rows, a, stride, mask, am, sumA, sumAA);
+    shapeRowsIntAvx2(bits, rows, a, stride, mask, am, count, sumA, sumAA);
     return;
   }
 #endif
+  count = 0;
   sumA = 0;
   sumAA = 0;
   for (int v = 0; v < rows; ++v) {
@@ -215,11 +241,39 @@ inline void shapeRowsInt(const uint32_t* bits, int rows, const int16_t* a, ptrdi
       const bool in = ((bits[v] >> u) & 1U) != 0;
       const int16_t x = in ? a[v * stride + u] : int16_t{0};
       mask[16 * v + u] = in ? int16_t{-1} : int16_t{0};
+      count += in ? 1 : 0;
       am[16 * v + u] = x;
       sumA += x;
       sumAA += static_cast<int32_t>(x) * x;
     }
   }
+}
+
+// NCC of `count` (1..4) windows from their sums over a shape of n cells with Σ_S A = sumA:
+// (n Σ A·B − Σ A Σ B) · invNormA / sqrt(n Σ B² − (Σ B)²), NaN where B is flat on S
+// (n² var_S(B) < flatN). The integer parts are exact; the rest in float, 4 windows at a time.
+inline void nccFromIntSums(const ShapeSumsInt* sums, int count, int n, int32_t sumA,
+                           float invNormA, float flatN, float* scores) {
+  alignas(16) float num[4] = {0, 0, 0, 0}, var[4] = {1, 1, 1, 1};
+  for (int k = 0; k < count; ++k) {
+    const int64_t b = sums[k].b;
+    var[k] = static_cast<float>(n * static_cast<int64_t>(sums[k].bb) - b * b);
+    num[k] = static_cast<float>(n * static_cast<int64_t>(sums[k].ab) - sumA * b);
+  }
+#ifdef DELINEO_STEREO_X86
+  alignas(16) float out[4];
+  const __m128 v = _mm_load_ps(var);
+  const __m128 r = _mm_div_ps(_mm_mul_ps(_mm_load_ps(num), _mm_set1_ps(invNormA)), _mm_sqrt_ps(v));
+  _mm_store_ps(out, r);
+  for (int k = 0; k < count; ++k) {
+    scores[k] = var[k] < flatN ? std::numeric_limits<float>::quiet_NaN() : out[k];
+  }
+#else
+  for (int k = 0; k < count; ++k) {
+    scores[k] = var[k] < flatN ? std::numeric_limits<float>::quiet_NaN()
+                               : num[k] * invNormA / std::sqrt(var[k]);
+  }
+#endif
 }
 
 }  // namespace delineo::stereo::detail
