@@ -318,9 +318,7 @@ struct LinePeak {
 struct ShapeTemplate {
   alignas(32) int16_t maskQ[16 * 16] = {};
   alignas(32) int16_t aQ[16 * 16] = {};
-  int32_t sumA = 0;    // Σ_S A (quantised)
-  float invNormA = 0;  // 1 / sqrt(n Σ_S A² − (Σ_S A)²)
-  float flatN = 0;     // n² · the flat-window variance (quantised units)
+  ShapeNccTerms terms;  // n, Σ_S A, ... (quantised)
   std::vector<float> templ, mask;
   uint32_t rowBits[32] = {};       // S as bits: bit u of row v = window cell (u, v)
   int rowFirst = 0, rowLast = -1;  // window rows holding part of S
@@ -692,9 +690,10 @@ class LevelMatcher {
       // n² var_S(A), exact (< 2^53).
       const double varN = n * sumAA - static_cast<double>(sumA) * sumA;
       if (varN < flatQ_ * n * n) return false;
-      t.sumA = sumA;
-      t.invNormA = static_cast<float>(1.0 / std::sqrt(varN));
-      t.flatN = static_cast<float>(flatQ_ * n * n);
+      t.terms.n = count;
+      t.terms.sumA = sumA;
+      t.terms.invNormA = static_cast<float>(1.0 / std::sqrt(varN));
+      t.terms.flatN = static_cast<float>(flatQ_ * n * n);
       return true;
     }
     t.count = 0;
@@ -748,10 +747,11 @@ class LevelMatcher {
     const int top = yb + t.rowFirst - r_;
     if (rowStride_ == 16) {
       const ptrdiff_t here = 0;
-      ShapeSumsInt sums;
-      shapeSumsInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
-                   &here, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, 1, &sums);
-      return scoreFromIntSums(sums, t);
+      float score;
+      shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
+                     &here, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, 1, t.terms,
+                     &score);
+      return score;
     }
     const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
     float sums[3];
@@ -760,15 +760,6 @@ class LevelMatcher {
     return scoreFromSums(sums, t.count);
   }
 
-  static float scoreFromIntSums(const ShapeSumsInt& sums, const ShapeTemplate& t) {
-    float score;
-    scoresFromIntSums(&sums, 1, t, &score);
-    return score;
-  }
-  static void scoresFromIntSums(const ShapeSumsInt* sums, int count, const ShapeTemplate& t,
-                                float* scores) {
-    nccFromIntSums(sums, count, t.count, t.sumA, t.invNormA, t.flatN, scores);
-  }
 
   static float scoreFromSums(const float sums[3], int count) {
     const float sB = sums[0], sBB = sums[1], sTB = sums[2];
@@ -793,10 +784,9 @@ class LevelMatcher {
     }
     const int top = y + t.rowFirst - r_;
     const int rows = t.rowLast - t.rowFirst + 1;
-    ShapeSumsInt sums[kBatch];
-    shapeSumsInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
-                 kMainLine, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, count, sums);
-    scoresFromIntSums(sums, count, t, scores);
+    shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
+                   kMainLine, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, count,
+                   t.terms, scores);
     return true;
   }
 
@@ -810,11 +800,9 @@ class LevelMatcher {
     const int top = y + t.rowFirst - r_;
     const auto stride = static_cast<ptrdiff_t>(otherQ_.step1());
     const ptrdiff_t lines[2] = {-stride, stride};
-    ShapeSumsInt sums[2];
-    shapeSumsInt(otherQ_.ptr<int16_t>(top) + xb - r_, stride, lines, &t.maskQ[16 * t.rowFirst],
-                 &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 2, sums);
     float scores[2];
-    scoresFromIntSums(sums, 2, t, scores);
+    shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, stride, lines, &t.maskQ[16 * t.rowFirst],
+                   &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 2, t.terms, scores);
     minus = scores[0];
     plus = scores[1];
     return true;

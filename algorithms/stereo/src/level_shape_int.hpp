@@ -32,6 +32,15 @@ struct ShapeSumsInt {
   int32_t b = 0, bb = 0, ab = 0;
 };
 
+// What the NCC of a window needs from the shape: n = |S|, Σ_S A, 1 / sqrt(n Σ A² − (Σ A)²),
+// and n² times the variance under which a window is flat.
+struct ShapeNccTerms {
+  int n = 0;
+  int32_t sumA = 0;
+  float invNormA = 0;
+  float flatN = 0;
+};
+
 inline bool cpuHasAvx2() {
 #ifdef DELINEO_STEREO_X86
   static const bool has = __builtin_cpu_supports("avx2") != 0;
@@ -59,23 +68,41 @@ __attribute__((target("avx2"), always_inline)) inline void accumulateRowAvx2(
   accAB = _mm256_add_epi32(accAB, _mm256_madd_epi16(a, xm));
 }
 
-// Lane sums of the accumulators (Σ B widened from its 16-bit column sums).
-__attribute__((target("avx2"), always_inline)) inline void storeSumsAvx2(ShapeSumsInt& out,
-                                                                        __m256i sb, __m256i sbb,
-                                                                        __m256i sab) {
-  out.b = laneSumAvx2(_mm256_madd_epi16(sb, _mm256_set1_epi16(1)));
-  out.bb = laneSumAvx2(sbb);
-  out.ab = laneSumAvx2(sab);
-}
-
 // K (1..4) windows of B, the k-th at b + offsets[k]; the shape as rows of 16 int16: mask (−1
 // on S, 0 elsewhere) and A on S (0 elsewhere). The shape rows are loaded once for the K
 // windows. Named accumulators, not arrays: GCC kept arrays of vectors partly on the stack
 // (a store and a load per accumulator and row).
+// The four lane sums of a, b, c, d (8 int32 each) as one vector.
+__attribute__((target("avx2"), always_inline)) inline __m128i laneSums4Avx2(__m256i a, __m256i b,
+                                                                           __m256i c, __m256i d) {
+  const __m256i h = _mm256_hadd_epi32(_mm256_hadd_epi32(a, b), _mm256_hadd_epi32(c, d));
+  return _mm_add_epi32(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+}
+
+// NCC of up to 4 windows from their sums (one per lane): the terms n Σ B² − (Σ B)² and
+// n Σ A·B − Σ A Σ B are exact in double (< 2^53), then rounded to float as in nccFromIntSums.
+__attribute__((target("avx2"), always_inline)) inline void nccAvx2(__m128i sB, __m128i sBB,
+                                                                  __m128i sAB,
+                                                                  const ShapeNccTerms& terms,
+                                                                  int count, float* scores) {
+  const __m256d n = _mm256_set1_pd(terms.n);
+  const __m256d b = _mm256_cvtepi32_pd(sB);
+  const __m256d var = _mm256_sub_pd(_mm256_mul_pd(n, _mm256_cvtepi32_pd(sBB)), _mm256_mul_pd(b, b));
+  const __m256d num = _mm256_sub_pd(_mm256_mul_pd(n, _mm256_cvtepi32_pd(sAB)),
+                                    _mm256_mul_pd(_mm256_set1_pd(terms.sumA), b));
+  const __m128 varF = _mm256_cvtpd_ps(var);
+  const __m128 ncc = _mm_div_ps(_mm_mul_ps(_mm256_cvtpd_ps(num), _mm_set1_ps(terms.invNormA)),
+                                _mm_sqrt_ps(varF));
+  const __m128 flat = _mm_cmplt_ps(varF, _mm_set1_ps(terms.flatN));
+  alignas(16) float out[4];
+  _mm_store_ps(out, _mm_blendv_ps(ncc, _mm_set1_ps(std::numeric_limits<float>::quiet_NaN()), flat));
+  for (int k = 0; k < count; ++k) scores[k] = out[k];
+}
+
 template <int K>
-__attribute__((target("avx2"), always_inline)) inline void shapeSumsIntAvx2(
+__attribute__((target("avx2"), always_inline)) inline void shapeScoresIntAvx2(
     const int16_t* b, ptrdiff_t stride, const ptrdiff_t* offsets, const int16_t* mask,
-    const int16_t* am, int rows, ShapeSumsInt* out) {
+    const int16_t* am, int rows, const ShapeNccTerms& terms, float* scores) {
   const __m256i zero = _mm256_setzero_si256();
   __m256i b0 = zero, bb0 = zero, ab0 = zero, b1 = zero, bb1 = zero, ab1 = zero;
   __m256i b2 = zero, bb2 = zero, ab2 = zero, b3 = zero, bb3 = zero, ab3 = zero;
@@ -90,20 +117,22 @@ __attribute__((target("avx2"), always_inline)) inline void shapeSumsIntAvx2(
     if constexpr (K > 2) accumulateRowAvx2(bv + o2, m, a, b2, bb2, ab2);
     if constexpr (K > 3) accumulateRowAvx2(bv + o3, m, a, b3, bb3, ab3);
   }
-  storeSumsAvx2(out[0], b0, bb0, ab0);
-  if constexpr (K > 1) storeSumsAvx2(out[1], b1, bb1, ab1);
-  if constexpr (K > 2) storeSumsAvx2(out[2], b2, bb2, ab2);
-  if constexpr (K > 3) storeSumsAvx2(out[3], b3, bb3, ab3);
+  // Σ B widened from its 16-bit column sums.
+  const __m256i ones = _mm256_set1_epi16(1);
+  const __m128i sB = laneSums4Avx2(_mm256_madd_epi16(b0, ones), _mm256_madd_epi16(b1, ones),
+                                   _mm256_madd_epi16(b2, ones), _mm256_madd_epi16(b3, ones));
+  nccAvx2(sB, laneSums4Avx2(bb0, bb1, bb2, bb3), laneSums4Avx2(ab0, ab1, ab2, ab3), terms, K,
+          scores);
 }
 
-__attribute__((target("avx2"))) inline void shapeSumsIntAvx2Dispatch(
+__attribute__((target("avx2"))) inline void shapeScoresIntAvx2Dispatch(
     const int16_t* b, ptrdiff_t stride, const ptrdiff_t* offsets, const int16_t* mask,
-    const int16_t* am, int rows, int count, ShapeSumsInt* out) {
+    const int16_t* am, int rows, int count, const ShapeNccTerms& terms, float* scores) {
   switch (count) {
-    case 1: shapeSumsIntAvx2<1>(b, stride, offsets, mask, am, rows, out); break;
-    case 2: shapeSumsIntAvx2<2>(b, stride, offsets, mask, am, rows, out); break;
-    case 3: shapeSumsIntAvx2<3>(b, stride, offsets, mask, am, rows, out); break;
-    default: shapeSumsIntAvx2<4>(b, stride, offsets, mask, am, rows, out); break;
+    case 1: shapeScoresIntAvx2<1>(b, stride, offsets, mask, am, rows, terms, scores); break;
+    case 2: shapeScoresIntAvx2<2>(b, stride, offsets, mask, am, rows, terms, scores); break;
+    case 3: shapeScoresIntAvx2<3>(b, stride, offsets, mask, am, rows, terms, scores); break;
+    default: shapeScoresIntAvx2<4>(b, stride, offsets, mask, am, rows, terms, scores); break;
   }
 }
 
@@ -203,10 +232,6 @@ inline void shapeSumsInt(const int16_t* b, ptrdiff_t stride, const ptrdiff_t* of
                          const int16_t* mask, const int16_t* am, int rows, int count,
                          ShapeSumsInt* out) {
 #ifdef DELINEO_STEREO_X86
-  if (cpuHasAvx2()) {
-    shapeSumsIntAvx2Dispatch(b, stride, offsets, mask, am, rows, count, out);
-    return;
-  }
   switch (count) {
     case 1: shapeSumsIntSse2<1>(b, stride, offsets, mask, am, rows, out); break;
     case 2: shapeSumsIntSse2<2>(b, stride, offsets, mask, am, rows, out); break;
@@ -252,8 +277,11 @@ inline void shapeRowsInt(const uint32_t* bits, int rows, const int16_t* a, ptrdi
 // NCC of `count` (1..4) windows from their sums over a shape of n cells with Σ_S A = sumA:
 // (n Σ A·B − Σ A Σ B) · invNormA / sqrt(n Σ B² − (Σ B)²), NaN where B is flat on S
 // (n² var_S(B) < flatN). The integer parts are exact; the rest in float, 4 windows at a time.
-inline void nccFromIntSums(const ShapeSumsInt* sums, int count, int n, int32_t sumA,
-                           float invNormA, float flatN, float* scores) {
+inline void nccFromIntSums(const ShapeSumsInt* sums, int count, const ShapeNccTerms& terms,
+                           float* scores) {
+  const int64_t n = terms.n;
+  const int64_t sumA = terms.sumA;
+  const float invNormA = terms.invNormA, flatN = terms.flatN;
   alignas(16) float num[4] = {0, 0, 0, 0}, var[4] = {1, 1, 1, 1};
   for (int k = 0; k < count; ++k) {
     const int64_t b = sums[k].b;
@@ -274,6 +302,22 @@ inline void nccFromIntSums(const ShapeSumsInt* sums, int count, int n, int32_t s
                                : num[k] * invNormA / std::sqrt(var[k]);
   }
 #endif
+}
+
+// NCC of `count` (1..4) windows of B at b + offsets[k] over the shape given by its rows
+// (NaN where B is flat on S).
+inline void shapeScoresInt(const int16_t* b, ptrdiff_t stride, const ptrdiff_t* offsets,
+                           const int16_t* mask, const int16_t* am, int rows, int count,
+                           const ShapeNccTerms& terms, float* scores) {
+#ifdef DELINEO_STEREO_X86
+  if (cpuHasAvx2()) {
+    shapeScoresIntAvx2Dispatch(b, stride, offsets, mask, am, rows, count, terms, scores);
+    return;
+  }
+#endif
+  ShapeSumsInt sums[4];
+  shapeSumsInt(b, stride, offsets, mask, am, rows, count, sums);
+  nccFromIntSums(sums, count, terms, scores);
 }
 
 }  // namespace delineo::stereo::detail
