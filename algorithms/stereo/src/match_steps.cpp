@@ -16,38 +16,64 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // Grey levels² (images mapped to ~0..255): below this a half window is flat and not scored.
 constexpr double kFlatVariance = 0.01;
 
-// NCC over the shape {(u, v) in the window of radius r around (x, y) : inShape(u, v)} of ref
-// against other at (u - d, v + dy); NaN when the window leaves either image, the shape touches
-// nodata, is smaller than minPixels, or is flat.
+// A cut window of the reference image: its pixels and their normalised template values
+// (a − mean) / sqrt(Σ (a − mean)²), built once per pixel and scored at every disparity.
+struct CutWindow {
+  std::vector<int> u, v;
+  std::vector<float> t;
+  bool usable = false;
+};
+
 template <class InShape>
-float shapeNcc(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
-               const cv::Mat& otherValid, int x, int y, int r, int d, int dy, int minPixels,
-               const InShape& inShape) {
-  const int W = ref.cols, H = ref.rows;
-  if (x - r < 0 || x + r >= W || y - r < 0 || y + r >= H) return kNaN;
-  if (x - r - d < 0 || x + r - d >= W || y + dy - r < 0 || y + dy + r >= H) return kNaN;
-  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
-  int n = 0;
+void buildCutWindow(const cv::Mat& ref, const cv::Mat& refValid, int x, int y, int r,
+                    int minPixels, const InShape& inShape, CutWindow& w) {
+  w.u.clear();
+  w.v.clear();
+  w.t.clear();
+  w.usable = false;
+  if (x - r < 0 || x + r >= ref.cols || y - r < 0 || y + r >= ref.rows) return;
+  double sa = 0, saa = 0;
   for (int v = y - r; v <= y + r; ++v) {
     const float* a = ref.ptr<float>(v);
-    const float* b = other.ptr<float>(v + dy) - d;
     const uchar* va = refValid.ptr<uchar>(v);
-    const uchar* vb = otherValid.ptr<uchar>(v + dy) - d;
     for (int u = x - r; u <= x + r; ++u) {
       if (!inShape(u, v)) continue;
-      if (!va[u] || !vb[u]) return kNaN;
-      ++n;
+      if (!va[u]) return;
+      w.u.push_back(u);
+      w.v.push_back(v);
+      w.t.push_back(a[u]);
       sa += a[u];
-      sb += b[u];
       saa += static_cast<double>(a[u]) * a[u];
-      sbb += static_cast<double>(b[u]) * b[u];
-      sab += static_cast<double>(a[u]) * b[u];
     }
   }
-  if (n < minPixels) return kNaN;
-  const double vara = saa - sa * sa / n, varb = sbb - sb * sb / n;
-  if (vara < kFlatVariance * n || varb < kFlatVariance * n) return kNaN;
-  return static_cast<float>((sab - sa * sb / n) / std::sqrt(vara * varb));
+  const double n = static_cast<double>(w.t.size());
+  if (static_cast<int>(w.t.size()) < minPixels) return;
+  const double var = saa - sa * sa / n;
+  if (var < kFlatVariance * n) return;
+  const double mean = sa / n, norm = 1.0 / std::sqrt(var);
+  for (float& t : w.t) t = static_cast<float>((t - mean) * norm);
+  w.usable = true;
+}
+
+// NCC of a cut window against other at (u − d, v + dy); NaN when it leaves the image, touches
+// nodata, or the other window is flat.
+float cutWindowNcc(const CutWindow& w, const cv::Mat& other, const cv::Mat& otherValid, int d,
+                   int dy) {
+  if (!w.usable) return kNaN;
+  double sb = 0, sbb = 0, stb = 0;
+  for (size_t i = 0; i < w.t.size(); ++i) {
+    const int u = w.u[i] - d, v = w.v[i] + dy;
+    if (u < 0 || u >= other.cols || v < 0 || v >= other.rows) return kNaN;
+    if (!otherValid.at<uchar>(v, u)) return kNaN;
+    const double b = other.at<float>(v, u);
+    sb += b;
+    sbb += b * b;
+    stb += w.t[i] * b;  // Σ t = 0: Σ t (b − mean_b) = Σ t b
+  }
+  const double n = static_cast<double>(w.t.size());
+  const double varb = sbb - sb * sb / n;
+  if (varb < kFlatVariance * n) return kNaN;
+  return static_cast<float>(stb / std::sqrt(varb));
 }
 
 // Photometric error of ref column x (rows y - r .. y + r) against other at (x - d, y + dy), d
@@ -80,19 +106,20 @@ struct Hypothesis {
   float disparity = kNaN, score = kNaN;
 };
 
-template <class InShape>
-Hypothesis bestNear(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
-                    const cv::Mat& otherValid, int x, int y, int r, float side, int dy,
-                    int minPixels, const InShape& inShape) {
+Hypothesis bestNear(const CutWindow& w, const cv::Mat& other, const cv::Mat& otherValid,
+                    float side, int dy) {
   Hypothesis best;
   const int centre = static_cast<int>(std::lround(side));
-  float sc[5];
+  // Centre ±1 first; ±2 only on the side where the maximum of those three lies on the border.
+  float sc[5] = {kNaN, kNaN, kNaN, kNaN, kNaN};
   int bestK = -1;
-  for (int k = 0; k < 5; ++k) {
-    sc[k] = shapeNcc(ref, other, refValid, otherValid, x, y, r, centre - 2 + k, dy, minPixels,
-                     inShape);
+  auto eval = [&](int k) {
+    sc[k] = cutWindowNcc(w, other, otherValid, centre - 2 + k, dy);
     if (std::isfinite(sc[k]) && (bestK < 0 || sc[k] > sc[bestK])) bestK = k;
-  }
+  };
+  for (int k = 1; k <= 3; ++k) eval(k);
+  if (bestK == 1) eval(0);
+  if (bestK == 3) eval(4);
   if (bestK <= 0 || bestK >= 4) return best;
   const float l = sc[bestK - 1], c = sc[bestK], rr = sc[bestK + 1];
   float offset = 0;
@@ -198,6 +225,7 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
   // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
   // own side (same side value), and the validated pixels off the segments on that surface.
   cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+    CutWindow window;
     for (int y = rows.start; y < rows.end; ++y) {
       float* outD = raw.disparity.ptr<float>(y);
       float* outS = raw.lineShift.ptr<float>(y);
@@ -205,6 +233,10 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
       for (int x = 0; x < W; ++x) {
         const float side = sideD.at<float>(y, x);
         if (!std::isfinite(side)) continue;
+        // A validated value already on this side stays: re-matching it costs the most (most
+        // segment pixels) and changed little.
+        const float kept = validated.at<float>(y, x);
+        if (std::isfinite(kept) && std::abs(kept - side) <= 1.0F) continue;
         const int dy = sideDy.at<schar>(y, x);
         auto inShape = [&](int u, int v) {
           const float su = sideD.at<float>(v, u);
@@ -212,8 +244,8 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
           const float vu = validated.at<float>(v, u);
           return std::isfinite(vu) && std::abs(vu - side) <= 1.5F;
         };
-        const Hypothesis hyp =
-            bestNear(ref, other, refValid, otherValid, x, y, h, side, dy, s.minShape, inShape);
+        buildCutWindow(ref, refValid, x, y, h, s.minShape, inShape, window);
+        const Hypothesis hyp = bestNear(window, other, otherValid, side, dy);
         const float before = outD[x];
         if (hyp.score >= static_cast<float>(s.minScore)) {
           outD[x] = hyp.disparity;

@@ -23,7 +23,7 @@ struct MatchParams {
   int window = 15;                   // px, odd side of the (maximal) template window
   double tolerance = 1.0;            // px, τ of the symmetric left/right validation
   bool stepCut = true;               // windows cut at the depth steps of the validated map
-  int stepCutLevel = 0;              // coarsest pyramid level (0 = full resolution) it runs on
+  int stepCutLevel = 10;             // coarsest pyramid level it runs on (0 = full resolution only)
   double edgeLow = 40.0;             // Canny low threshold on the 0..255-normalised image
   double edgeHigh = 100.0;           // Canny high threshold
   double edgeSigma = 1.0;            // px, Gaussian smoothing before Canny (same at each level)
@@ -61,7 +61,8 @@ struct MatchParams {
                       "match again on windows cut there"},
       stepCut);
     v(core::ParamInfo{"step-cut-level", "Step-cut levels", "",
-                      "Coarsest pyramid level of the step cut (0 = full resolution only)", 0, 10},
+                      "Coarsest pyramid level of the step cut (0 = full resolution only, 10 = all)",
+                      0, 10},
       stepCutLevel);
     v(core::ParamInfo{"edge-low", "Edge low threshold", "",
                       "Canny hysteresis low threshold on the 0..255-normalised image", 0, 1000},
