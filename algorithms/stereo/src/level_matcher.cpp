@@ -173,20 +173,8 @@ inline int popcount64(uint64_t v) {
 // words), bit 16v + 15 always 0. That zero separator stops horizontal shifts at the row ends,
 // so a flood fill runs on the whole window at once: runs along rows by shift-and-mask doubling
 // (shifts 1..8), runs along columns the same way with shifts of 16..128 bits.
-struct Board {
-  uint64_t w[4] = {0, 0, 0, 0};
-
-  friend Board operator|(const Board& a, const Board& b) {
-    Board r;
-    for (int i = 0; i < 4; ++i) r.w[i] = a.w[i] | b.w[i];
-    return r;
-  }
-  uint32_t row(int v) const { return static_cast<uint32_t>(w[v >> 2] >> (16 * (v & 3))) & 0xFFFFU; }
-  void setRow(int v, uint32_t bits) { w[v >> 2] |= static_cast<uint64_t>(bits) << (16 * (v & 3)); }
-};
-
-// The 4-connected component of `seed` inside `open` (seed ⊂ open). The board's four words are
-// one 256-bit vector (one AVX2 register; two SSE registers in the baseline build).
+// The board's four words are one 256-bit vector (one AVX2 register; two SSE registers in the
+// baseline build).
 using Word4 = uint64_t __attribute__((vector_size(32)));
 
 // Helpers take and give vectors by reference: passing a 32-byte vector by value from code built
@@ -222,11 +210,22 @@ __attribute__((always_inline)) inline bool sameWords(const Word4& a, const Word4
   return (x[0] | x[1] | x[2] | x[3]) == 0;
 }
 
-__attribute__((target_clones("avx2", "default"))) void floodFillWords(Board& seedBoard,
-                                                                     const Board& openBoard) {
-  Word4 open, seed, t;
-  __builtin_memcpy(&open, openBoard.w, sizeof open);
-  __builtin_memcpy(&seed, seedBoard.w, sizeof seed);
+// The shape S of a window of ≤ 15 columns: `freeRows` are the window's 16 row words (bit u of
+// row v: cell (u, v) is neither contour nor nodata; bit 15 is 0), `inWindow` keeps the rows
+// v < window. The 4-connected component of the centre (r, r) in the free cells plus the centre
+// (a centre on a contour propagates to both sides) goes to `reach` (16 row words). Returns true
+// when a free cell is left unreached, i.e. S cuts part of the window off. The rows are read
+// from a column-major copy of the row words, so the board is one 32-byte load.
+__attribute__((target_clones("avx2", "default"))) bool fillWindow15(const uint16_t* freeRows,
+                                                                   const uint64_t* inWindow,
+                                                                   int r, uint16_t* reach) {
+  Word4 free, rowMask, t;
+  __builtin_memcpy(&free, freeRows, sizeof free);
+  __builtin_memcpy(&rowMask, inWindow, sizeof rowMask);
+  free &= rowMask;
+  Word4 seed{};
+  seed[r >> 2] = uint64_t{1} << (16 * (r & 3) + r);
+  const Word4 open = free | seed;
   // Runs of open cells 2^i long in each direction: the masks of the doubling steps, which
   // depend on `open` only. Along rows the row-end separator bits (always 0) stop the runs.
   const Word4 gR1 = open & (open << 1), gR2 = gR1 & (gR1 << 2), gR3 = gR2 & (gR2 << 4);
@@ -281,12 +280,9 @@ __attribute__((target_clones("avx2", "default"))) void floodFillWords(Board& see
     if (sameWords(filled, seed)) break;  // closed along both directions
     seed = filled;
   }
-  __builtin_memcpy(seedBoard.w, &seed, sizeof seed);
-}
-
-inline Board floodFill(Board seed, const Board& open) {
-  floodFillWords(seed, open);
-  return seed;
+  __builtin_memcpy(reach, &seed, sizeof seed);
+  const Word4 cut = free & ~seed;
+  return (cut[0] | cut[1] | cut[2] | cut[3]) != 0;
 }
 
 // Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
@@ -358,6 +354,21 @@ class LevelMatcher {
     // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
     blocked_ = (in.refEdges != 0) | (in.refValid == 0);
     blockedBits_ = rowWindowBits(blocked_);
+    if (s.window <= 15) {
+      // Column-major copy of the free (not blocked) row words: the 16 rows of a window are
+      // contiguous, one load for the fill. 16 spare rows keep every window's read inside.
+      const auto full = static_cast<uint32_t>((1U << s.window) - 1U);
+      columnStride_ = static_cast<size_t>(H_) + 16;
+      freeColumns_.assign(static_cast<size_t>(W_) * columnStride_, 0);
+      for (int y = 0; y < H_; ++y) {
+        const int* bits = blockedBits_.ptr<int>(y);
+        for (int x = 0; x < W_; ++x) {
+          freeColumns_[static_cast<size_t>(x) * columnStride_ + static_cast<size_t>(y)] =
+              static_cast<uint16_t>(~static_cast<uint32_t>(bits[x]) & full);
+        }
+      }
+      for (int v = 0; v < s.window; ++v) windowRows_[v >> 2] |= uint64_t{0xFFFF} << (16 * (v & 3));
+    }
     // Nodata of the other image in the same form: a shape window touches nodata when one of its
     // rows shares a bit with these (one AND per row).
     otherInvalidBits_ = rowWindowBits(in.otherValid == 0);
@@ -647,30 +658,27 @@ class LevelMatcher {
     // Bit-parallel flood fill on w-bit rows: a row's reach grows from the rows above and below
     // and is then filled along the row through free pixels (shift-and-mask doubling, the
     // "occluded fill" of bitboards), until no row changes.
-    uint32_t free[32], reach[32];
+    uint32_t reach[32];
+    // When S is the whole window minus its contour pixels (no free pixel left unreached: no
+    // part of the window is cut off) and the square window is usable, the square serves the
+    // pixel: the few contour pixels change its NCC little, and the square path is much cheaper.
     if (w <= 15) {
-      // The centre belongs to S even on a contour: it is open for the fill.
-      Board open, seed;
-      for (int v = 0; v < w; ++v) {
-        free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
-        open.setRow(v, free[v]);
-      }
-      seed.setRow(r_, 1U << r_);
-      const Board shape = floodFill(seed, open | seed);
-      for (int v = 0; v < w; ++v) reach[v] = shape.row(v);
+      alignas(32) uint16_t rows16[16];
+      const bool cut = fillWindow15(&freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)],
+                                    windowRows_, r_, rows16);
+      if (squareServes && !cut) return false;
+      for (int v = 0; v < w; ++v) reach[v] = rows16[v];
     } else {
+      uint32_t free[32];
       for (int v = 0; v < w; ++v) {
         free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
         reach[v] = 0;
       }
       fillRows(free, reach);
+      uint32_t unreached = 0;
+      for (int v = 0; v < w; ++v) unreached |= free[v] & ~reach[v];
+      if (squareServes && unreached == 0) return false;
     }
-    // When S is the whole window minus its contour pixels (no free pixel left unreached: no
-    // part of the window is cut off) and the square window is usable, the square serves the
-    // pixel: the few contour pixels change its NCC little, and the square path is much cheaper.
-    uint32_t unreached = 0;
-    for (int v = 0; v < w; ++v) unreached |= free[v] & ~reach[v];
-    if (squareServes && unreached == 0) return false;
     for (int v = 0; v < w; ++v) t.rowBits[v] = reach[v];
     const int P = rowStride_;
     t.rowFirst = 0;
@@ -953,6 +961,9 @@ class LevelMatcher {
   cv::Mat nearEdge_;
   cv::Mat blocked_;      // CV_8U, non-zero on contour and nodata pixels of ref
   cv::Mat blockedBits_;  // CV_32S, blocked pixels of the window row centred on each pixel
+  std::vector<uint16_t> freeColumns_;  // windows ≤ 15: ~blockedBits_, column-major
+  size_t columnStride_ = 0;
+  uint64_t windowRows_[4] = {0, 0, 0, 0};  // the rows v < window of a 16-row board
   cv::Mat otherInvalidBits_;  // CV_32S, nodata pixels of the other image's window rows
 };
 
