@@ -136,11 +136,9 @@ __attribute__((always_inline)) inline float laneSum(const Float8& v) {
   return q[0] + q[1];
 }
 
-// Main-line windows d, d + 1, ... (one column further left each), scored kBatch per pass
-// over the shape. 3, not 4: the 9 accumulators of 3 windows stay in the 16 vector registers,
-// the 12 of 4 did not (GCC spilled them: 16.5 vs 12.2 ns per window, micro-benchmark).
-constexpr int kBatch = 3;
-constexpr ptrdiff_t kMainLine[kBatch] = {0, -1, -2};
+// Main-line windows d, d + 1, ... (one column further left each), scored several per pass over
+// the shape (shapeBatchWindows(): as many as the vector registers hold).
+constexpr ptrdiff_t kMainLine[kShapeMaxWindows] = {0, -1, -2, -3, -4, -5, -6, -7};
 
 // Σ A·B over `rows` rows of two windows ≤ 16 columns wide; `lanes` weighs the 16 columns read
 // (1 inside the window, 0 past it).
@@ -778,11 +776,11 @@ class LevelMatcher {
     return sTB * invCount / std::sqrt(varB);
   }
 
-  // Main-line scores for d .. d + kBatch - 1 in one pass over the shape; false when one of the
-  // windows is not a plain inside-the-image, nodata-free one (then scored one by one).
-  // `count` (1..kBatch) windows.
+  // Main-line scores for d .. d + count - 1 (count ≤ kShapeMaxWindows) in one pass over the
+  // shape; false when one of the windows is not a plain inside-the-image, nodata-free one (then
+  // scored one by one).
   bool shapeScoresBatch(int x, int y, int d, const ShapeTemplate& t, float* scores,
-                        int count = kBatch) const {
+                        int count) const {
     if (rowStride_ != 16) return false;
     const int xb = x - d;
     if (y < r_ || y >= H_ - r_ || xb - (count - 1) < r_ || xb >= W_ - r_) return false;
@@ -819,20 +817,20 @@ class LevelMatcher {
   void matchShapePixel(int x, int y, const ShapeTemplate& t) {
     LinePeak peak;
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
-    int d = lo;
-    float batch[kBatch];
-    for (; d + kBatch - 1 <= hi; d += kBatch) {
-      if (shapeScoresBatch(x, y, d, t, batch)) {
-        for (int k = 0; k < kBatch; ++k) peak.update(d + k, batch[k]);
+    // As few passes as the batch size allows, of balanced sizes (an interval of 7 with batches
+    // of 6: 4 + 3, not 6 + 1).
+    float batch[kShapeMaxWindows];
+    for (int d = lo; d <= hi;) {
+      const int left = hi - d + 1;
+      const int passes = (left + batchWindows_ - 1) / batchWindows_;
+      const int count = (left + passes - 1) / passes;
+      if (shapeScoresBatch(x, y, d, t, batch, count)) {
+        for (int k = 0; k < count; ++k) peak.update(d + k, batch[k]);
       } else {
-        for (int k = 0; k < kBatch; ++k) peak.update(d + k, shapeScore(x, y, d + k, 0, t));
+        for (int k = 0; k < count; ++k) peak.update(d + k, shapeScore(x, y, d + k, 0, t));
       }
+      d += count;
     }
-    // The last 1..kBatch - 1 disparities in one pass.
-    if (d <= hi && shapeScoresBatch(x, y, d, t, batch, hi - d + 1)) {
-      for (int k = 0; d <= hi; ++d, ++k) peak.update(d, batch[k]);
-    }
-    for (; d <= hi; ++d) peak.update(d, shapeScore(x, y, d, 0, t));
     finish(x, y, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); },
            [&](int dd, float& minus, float& plus) { return shapeScorePair(x, y, dd, t, minus, plus); });
   }
@@ -953,6 +951,7 @@ class LevelMatcher {
   LevelOutput& out_;
   const int W_, H_, r_, n_, L_;
   const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
+  const int batchWindows_ = shapeBatchWindows();  // main-line windows per pass over a shape
   WindowStats refStats_, otherStats_;
   cv::Mat otherSq_;
   cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
