@@ -251,7 +251,8 @@ class Optimiser {
     // 0 / 0.03 / 0.05 / 0.1 gave box 0.822 / 0.835 / 0.834 / 0.819 and jittered 0.893 / 0.927 /
     // 0.924 / 0.921 mean IoU on bench_delineation --scenes 2.
     constexpr float kGroundLean = 0.05f;
-    cv::Mat difference = images_.groundCost - images_.roofCost;
+    cv::Mat difference = images_.uncappedDifference.empty() ? cv::Mat(images_.groundCost - images_.roofCost)
+                                                             : images_.uncappedDifference.clone();
     cv::blur(difference, difference, {9, 9}, {-1, -1}, cv::BORDER_REPLICATE);
     cv::Mat groundLike = difference < -kGroundLean;
     groundLike &= inside;

@@ -163,7 +163,7 @@ std::vector<IntPolygon> regionStageCandidates(const EnergyImages& im, const cv::
                                               const DelineationParams& params) {
   // Aggregated over 9x9 pixels: on a textureless roof each pixel's difference is noise, but its
   // mean still leans to the roof (balanced intervals).
-  cv::Mat difference = im.groundCost - im.roofCost;
+  cv::Mat difference = im.uncappedDifference.empty() ? cv::Mat(im.groundCost - im.roofCost) : im.uncappedDifference.clone();
   cv::blur(difference, difference, {9, 9}, {-1, -1}, cv::BORDER_REPLICATE);
   cv::Mat roofLike = (difference > 0) & initMask;
   cv::morphologyEx(roofLike, roofLike, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
@@ -435,6 +435,15 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
         out.regionInit = true;
       }
     }
+  }
+  if (params.costCap > 0) {
+    // A pixel that matches neither interval (a tree or a neighbour's wall left as ground, a wall
+    // taken as roof) costs no more than the occlusion band. After the region stage, which
+    // compares outlines on the plain costs.
+    im.uncappedDifference = im.groundCost - im.roofCost;
+    const float cap = static_cast<float>(params.costCap * im.noMatchCost);
+    im.roofCost = cv::min(im.roofCost, cap);
+    im.groundCost = cv::min(im.groundCost, cap);
   }
   return out;
 }

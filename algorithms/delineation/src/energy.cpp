@@ -62,7 +62,10 @@ double gate(double x, double contrast) { return std::clamp(1.0 + x / contrast, 0
 // Left and right edge terms of a→b, whose interior side is n = (-dy, dx): λ·unit·Σ along the
 // segment of min(1, |∇I·n|) times the cost-contrast gate, sampled once per pixel of length.
 // D = c_ground - c_roof (> 0 where roof-like), the image the edge gate samples.
-cv::Mat costDifference(const EnergyImages& im) { return im.groundCost - im.roofCost; }
+cv::Mat costDifference(const EnergyImages& im) {
+  if (!im.uncappedDifference.empty()) return im.uncappedDifference.clone();
+  return im.groundCost - im.roofCost;
+}
 
 // `difference`: costDifference(im), computed once by the caller.
 std::array<double, 2> edgeTermsOf(const EnergyImages& im, const cv::Mat& difference, const EnergyWeights& w,

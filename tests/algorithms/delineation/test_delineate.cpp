@@ -269,3 +269,34 @@ TEST(Delineate, BalancedCostIntervalsHaveEqualWidthsAndGrowAwayFromEachOther) {
   EXPECT_EQ(roof.max, 41);
   EXPECT_EQ(ground.min, 5);
 }
+
+TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  DelineationParams plain;
+  const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, plain);
+  const auto costs = stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15);
+  const PreparedEnergy off = prepareEnergy(*costs, pair.left, pair.right, req, plain);
+  EXPECT_TRUE(off.images.uncappedDifference.empty());
+  DelineationParams capped = plain;
+  capped.costCap = 1.0;
+  const PreparedEnergy on = prepareEnergy(*costs, pair.left, pair.right, req, capped);
+  const double cap = on.images.noMatchCost;
+  double maxRoof = 0, maxGround = 0, maxPlain = 0;
+  cv::minMaxLoc(on.images.roofCost, nullptr, &maxRoof);
+  cv::minMaxLoc(on.images.groundCost, nullptr, &maxGround);
+  cv::minMaxLoc(cv::max(off.images.roofCost, off.images.groundCost), nullptr, &maxPlain);
+  EXPECT_GT(maxPlain, cap);  // the wall strip matches neither interval: the cap has work to do
+  EXPECT_LE(maxRoof, cap + 1e-6);
+  EXPECT_LE(maxGround, cap + 1e-6);
+  // Below the cap nothing changes; the gate, region stage and seeds keep the plain difference.
+  const cv::Mat below = (off.images.roofCost < cap) & (off.images.groundCost < cap);
+  EXPECT_EQ(cv::countNonZero((on.images.roofCost != off.images.roofCost) & below), 0);
+  ASSERT_FALSE(on.images.uncappedDifference.empty());
+  EXPECT_EQ(cv::norm(on.images.uncappedDifference, off.images.groundCost - off.images.roofCost, cv::NORM_INF), 0.0);
+  EXPECT_EQ(on.init.outer, off.init.outer);  // the region stage compares outlines on the plain costs
+}

@@ -36,6 +36,10 @@ struct EnergyImages {
   cv::Mat roofCost;       // CV_32F, c_roof = min over the roof interval of Crit
   cv::Mat groundCost;     // CV_32F, c_ground, same size
   float noMatchCost = 1;  // cost of each pixel of the wall/occlusion band
+  // CV_32F, optional: c_ground - c_roof before the costs were capped (`cost-cap`). The edge
+  // gate, the region stage and the courtyard seeds read it (a wall or a shadowed floor is told
+  // apart by values above the cap); empty = groundCost - roofCost.
+  cv::Mat uncappedDifference;
   // CV_32S, same size, >= 0: width in px of the occlusion band next to a roof run whose edge is
   // at this pixel (|roof disparity - ground disparity| there). Empty = no band.
   cv::Mat occlusionWidth;

@@ -31,6 +31,7 @@ struct DelineationParams {
   double regionTolerance = 8.0;    // px: coarsest outline simplification of the region stage
   bool regionRightAngles = false;  // region stage also tries its outlines with right angles
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
+  double costCap = 0.0;            // × NoMatchCost: c_roof and c_ground capped there for the terms (0 = off)
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
@@ -140,6 +141,12 @@ struct DelineationParams {
                       "1 = per pixel as in the paper)",
                       1, 31},
       costAggregation);
+    v(core::ParamInfo{"cost-cap", "Cost cap", "× NoMatchCost",
+                      "Cap c_roof and c_ground at this multiple of NoMatchCost in the area terms "
+                      "(a pixel matching neither interval costs no more than the occlusion band); "
+                      "the edge gate, region stage and courtyard seeds keep the plain costs (0 = off)",
+                      0, 10},
+      costCap);
   }
   void validate() const;
 };
