@@ -95,17 +95,6 @@ cv::Mat flipped(const cv::Mat& m) {
   return out;
 }
 
-// True when the other map's match at (qx, qy) points back to (d, dy) within `tolerance`.
-bool consistentAt(const detail::LevelOutput& other, int qx, int qy, float d, float dy,
-                  double tolerance) {
-  if (qx < 0 || qx >= other.disparity.cols || qy < 0 || qy >= other.disparity.rows) return false;
-  const float dq = other.disparity.at<float>(qy, qx);
-  if (!std::isfinite(dq)) return false;
-  const double ex = d - dq;
-  const double ey = dy + other.lineShift.at<float>(qy, qx);
-  return std::hypot(ex, ey) <= tolerance;
-}
-
 // Keeps the matches of `map` (with line shifts) whose match in the other map points back
 // within `tolerance` for at least one of the four floor/ceil neighbours. `sign`: +1 when `map` is
 // the left map (x_other = x - d), -1 for the right map (x_other = x + d).
@@ -113,6 +102,7 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
                  double tolerance) {
   cv::Mat out = map.disparity.clone();
   const int W = out.cols, H = out.rows;
+  const double tolerance2 = tolerance * tolerance;  // compared with ex² + ey² (hypot's cost)
   for (int y = 0; y < H; ++y) {
     float* d = out.ptr<float>(y);
     const float* dy = map.lineShift.ptr<float>(y);
@@ -122,15 +112,44 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
       const double yo = y + dy[x];
       const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
       bool consistent = false;
-      for (int m = 0; m <= 1 && !consistent; ++m) {
-        for (int n = 0; n <= 1 && !consistent; ++n) {
-          consistent = consistentAt(other, fx + n, fy + m, d[x], dy[x], tolerance);
+      for (int qy = std::max(0, fy); qy <= std::min(H - 1, fy + 1) && !consistent; ++qy) {
+        const float* dq = other.disparity.ptr<float>(qy);
+        const float* sq = other.lineShift.ptr<float>(qy);
+        for (int qx = std::max(0, fx); qx <= std::min(W - 1, fx + 1) && !consistent; ++qx) {
+          if (!std::isfinite(dq[qx])) continue;
+          const double ex = d[x] - dq[qx];
+          const double ey = dy[x] + sq[qx];
+          consistent = ex * ex + ey * ey <= tolerance2;
         }
       }
       if (!consistent) d[x] = kNaN;
     }
   }
   return out;
+}
+
+// Pixels of the other map that the matches of `map` point to (the floor/ceil neighbours the
+// validation reads), CV_8U 0/1; x_other = x − d.
+cv::Mat pointedTo(const detail::LevelOutput& map) {
+  cv::Mat needed = cv::Mat::zeros(map.disparity.size(), CV_8U);
+  for (int y = 0; y < needed.rows; ++y) {
+    const float* d = map.disparity.ptr<float>(y);
+    const float* dy = map.lineShift.ptr<float>(y);
+    for (int x = 0; x < needed.cols; ++x) {
+      if (!std::isfinite(d[x])) continue;
+      const int fx = static_cast<int>(std::floor(x - d[x]));
+      const int fy = static_cast<int>(std::floor(y + dy[x]));
+      for (int m = 0; m <= 1; ++m) {
+        for (int n = 0; n <= 1; ++n) {
+          const int qx = fx + n, qy = fy + m;
+          if (qx >= 0 && qx < needed.cols && qy >= 0 && qy < needed.rows) {
+            needed.at<uchar>(qy, qx) = 1;
+          }
+        }
+      }
+    }
+  }
+  return needed;
 }
 
 // Search intervals of a level from the validated disparities of the next coarser level: the
@@ -276,24 +295,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       // At the finest level the right map only validates the left one: only the right pixels
       // that a left match points to (the floor/ceil neighbours the validation reads) are
       // matched. The result is the same, at the cost of the unmatched and occluded areas less.
-      cv::Mat needed = cv::Mat::zeros(lv.left.size(), CV_8U);
-      for (int y = 0; y < needed.rows; ++y) {
-        const float* d = leftOut.disparity.ptr<float>(y);
-        const float* dy = leftOut.lineShift.ptr<float>(y);
-        for (int x = 0; x < needed.cols; ++x) {
-          if (!std::isfinite(d[x])) continue;
-          const int fx = static_cast<int>(std::floor(x - d[x]));
-          const int fy = static_cast<int>(std::floor(y + dy[x]));
-          for (int m = 0; m <= 1; ++m) {
-            for (int n = 0; n <= 1; ++n) {
-              const int qx = fx + n, qy = fy + m;
-              if (qx >= 0 && qx < needed.cols && qy >= 0 && qy < needed.rows) {
-                needed.at<uchar>(qy, qx) = 1;
-              }
-            }
-          }
-        }
-      }
+      const cv::Mat needed = pointedTo(leftOut);
       hiR = hiR.clone();  // may share its data with the left intervals
       cv::Mat notSearched = loR - 1;
       notSearched.copyTo(hiR, needed == 0);
@@ -332,13 +334,18 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       rs.window = p.window;
       rs.minScore = p.minScore;
       rs.minShape = p.minShape;
+      rs.threads = s.threads;
       detail::refineDepthSteps(inL.ref, inL.other, inL.refValid, inL.otherValid, coarseLeft, rs,
                                leftOut);
+      // At the finest level the right map only validates the left one: its pixels that no left
+      // match points to are not matched again (the result is the same).
+      const cv::Mat rightNeeded = k == 0 ? flipped(pointedTo(leftOut)) : cv::Mat();
       detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid,
-                               flipped(coarseRight), rs, mirrored);
+                               flipped(coarseRight), rs, mirrored, rightNeeded);
       unmirror();
       coarseLeft = validate(leftOut, rightOut, +1, p.tolerance);
-      coarseRight = validate(rightOut, leftOut, -1, p.tolerance);
+      // The validated right map guides the next finer level only.
+      if (k > 0) coarseRight = validate(rightOut, leftOut, -1, p.tolerance);
     }
   }
   result.disparity = coarseLeft;

@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <thread>
 #include <vector>
 
-#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace delineo::stereo::detail {
 namespace {
@@ -16,64 +18,232 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // Grey levels² (images mapped to ~0..255): below this a half window is flat and not scored.
 constexpr double kFlatVariance = 0.01;
 
-// A cut window of the reference image: its pixels and their normalised template values
-// (a − mean) / sqrt(Σ (a − mean)²), built once per pixel and scored at every disparity.
+// A cut window of the reference image, dense over its (2r+1)² bounding square with rows padded
+// to a multiple of 8 columns: template values t = (a − mean) / sqrt(Σ (a − mean)²) on its
+// pixels and 0 elsewhere (padding included), and a 0/1 mask, so that scoring it is a plain
+// multiply-add over contiguous rows of whole vectors (vectorised by the compiler, no tails).
+constexpr int kMaxStride = 32;  // ≥ the padded side of the largest window (31)
+
 struct CutWindow {
-  std::vector<int> u, v;
-  std::vector<float> t;
+  int x = 0, y = 0, r = 0, side = 0, stride = 0;
+  std::vector<float> t, mask;
+  float n = 0;
   bool usable = false;
 };
 
-template <class InShape>
-void buildCutWindow(const cv::Mat& ref, const cv::Mat& refValid, int x, int y, int r,
-                    int minPixels, const InShape& inShape, CutWindow& w) {
-  w.u.clear();
-  w.v.clear();
-  w.t.clear();
-  w.usable = false;
-  if (x - r < 0 || x + r >= ref.cols || y - r < 0 || y + r >= ref.rows) return;
-  double sa = 0, saa = 0;
-  for (int v = y - r; v <= y + r; ++v) {
-    const float* a = ref.ptr<float>(v);
-    const uchar* va = refValid.ptr<uchar>(v);
-    for (int u = x - r; u <= x + r; ++u) {
-      if (!inShape(u, v)) continue;
-      if (!va[u]) return;
-      w.u.push_back(u);
-      w.v.push_back(v);
-      w.t.push_back(a[u]);
-      sa += a[u];
-      saa += static_cast<double>(a[u]) * a[u];
+// Mask and template of one row of a cut window, over Stride columns (a compile-time count, so
+// the loops are whole vectors). Inputs are copies padded beyond the window's `n` columns.
+template <int Stride>
+struct CutRowSums {
+  float a[Stride] = {}, aa[Stride] = {}, n[Stride] = {}, bad[Stride] = {};
+
+  void add(const float* __restrict grey, const float* __restrict valid,
+           const float* __restrict sd, const float* __restrict val, const float* __restrict inWindow,
+           float side, float centre, float* __restrict m) {
+    for (int j = 0; j < Stride; ++j) {
+      // NaN compares false: off the segments (sd NaN) the validated value decides.
+      const bool onSegment = sd[j] == sd[j];
+      const bool nearSide = std::abs(sd[j] - side) <= 1.0F;
+      const bool nearValidated = std::abs(val[j] - side) <= 1.5F;
+      const float mj =
+          (onSegment & nearSide) | (!onSegment & nearValidated) ? inWindow[j] : 0.0F;
+      const float c = grey[j] - centre;
+      m[j] = mj;
+      n[j] += mj;
+      bad[j] += mj * (1.0F - valid[j]);
+      a[j] += mj * c;
+      aa[j] += mj * c * c;
     }
   }
-  const double n = static_cast<double>(w.t.size());
-  if (static_cast<int>(w.t.size()) < minPixels) return;
-  const double var = saa - sa * sa / n;
-  if (var < kFlatVariance * n) return;
-  const double mean = sa / n, norm = 1.0 / std::sqrt(var);
-  for (float& t : w.t) t = static_cast<float>((t - mean) * norm);
+};
+
+// The window of (x, y) cut at the steps: the pixels whose side (sideD, of a step segment) is
+// within 1 px of `side`, or, off the segments, whose validated value is within 1.5 px of it.
+// Unusable when it leaves the image, touches nodata, has fewer than minPixels pixels or is flat.
+template <int Stride>
+__attribute__((target_clones("avx2", "default"))) void buildCutWindowPadded(
+    const cv::Mat& ref, const cv::Mat& refValid, const cv::Mat& sideD, const cv::Mat& validated,
+    float side, int x, int y, int r, int minPixels, CutWindow& w) {
+  const int n = w.side;
+  // Rows copied into padded buffers (values relative to the centre pixel: small sums on flat
+  // windows, where the variance test needs them exact).
+  float grey[Stride], valid[Stride], sd[Stride], val[Stride], inWindow[Stride];
+  for (int j = 0; j < Stride; ++j) {
+    grey[j] = valid[j] = 0.0F;
+    sd[j] = val[j] = kNaN;
+    inWindow[j] = j < n ? 1.0F : 0.0F;
+  }
+  CutRowSums<Stride> sums;
+  const float centre = ref.at<float>(y, x);
+  for (int i = 0; i < n; ++i) {
+    const int v = y - r + i;
+    const float* a = ref.ptr<float>(v) + (x - r);
+    const uchar* va = refValid.ptr<uchar>(v) + (x - r);
+    const float* sdRow = sideD.ptr<float>(v) + (x - r);
+    const float* valRow = validated.ptr<float>(v) + (x - r);
+    for (int j = 0; j < n; ++j) {
+      grey[j] = a[j];
+      valid[j] = va[j];
+      sd[j] = sdRow[j];
+      val[j] = valRow[j];
+    }
+    sums.add(grey, valid, sd, val, inWindow, side, centre,
+             w.mask.data() + static_cast<size_t>(i) * Stride);
+  }
+  float sa = 0, saa = 0, count = 0, bad = 0;
+  for (int j = 0; j < Stride; ++j) {
+    sa += sums.a[j];
+    saa += sums.aa[j];
+    count += sums.n[j];
+    bad += sums.bad[j];
+  }
+  if (bad > 0 || count < static_cast<float>(minPixels)) return;
+  const float var = saa - sa * sa / count;
+  if (var < static_cast<float>(kFlatVariance) * count) return;
+  const float mean = centre + sa / count, norm = 1.0F / std::sqrt(var);
+  for (int i = 0; i < n; ++i) {
+    const float* a = ref.ptr<float>(y - r + i) + (x - r);
+    const size_t row = static_cast<size_t>(i) * Stride;
+    const float* m = w.mask.data() + row;
+    float* t = w.t.data() + row;
+    for (int j = 0; j < n; ++j) t[j] = m[j] * ((a[j] - mean) * norm);
+    for (int j = n; j < Stride; ++j) t[j] = 0.0F;
+  }
+  w.n = count;
   w.usable = true;
 }
 
-// NCC of a cut window against other at (u − d, v + dy); NaN when it leaves the image, touches
-// nodata, or the other window is flat.
-float cutWindowNcc(const CutWindow& w, const cv::Mat& other, const cv::Mat& otherValid, int d,
-                   int dy) {
-  if (!w.usable) return kNaN;
-  double sb = 0, sbb = 0, stb = 0;
-  for (size_t i = 0; i < w.t.size(); ++i) {
-    const int u = w.u[i] - d, v = w.v[i] + dy;
-    if (u < 0 || u >= other.cols || v < 0 || v >= other.rows) return kNaN;
-    if (!otherValid.at<uchar>(v, u)) return kNaN;
-    const double b = other.at<float>(v, u);
-    sb += b;
-    sbb += b * b;
-    stb += w.t[i] * b;  // Σ t = 0: Σ t (b − mean_b) = Σ t b
+void buildCutWindow(const cv::Mat& ref, const cv::Mat& refValid, const cv::Mat& sideD,
+                    const cv::Mat& validated, float side, int x, int y, int r, int minPixels,
+                    CutWindow& w) {
+  w.usable = false;
+  w.x = x;
+  w.y = y;
+  w.r = r;
+  w.side = 2 * r + 1;
+  w.stride = (w.side + 7) / 8 * 8;
+  const size_t area = static_cast<size_t>(w.side) * static_cast<size_t>(w.stride);
+  w.t.resize(area);  // every element written
+  w.mask.resize(area);
+  if (x - r < 0 || x + r >= ref.cols || y - r < 0 || y + r >= ref.rows) return;
+  switch (w.stride) {
+    case 8:
+      return buildCutWindowPadded<8>(ref, refValid, sideD, validated, side, x, y, r, minPixels, w);
+    case 16:
+      return buildCutWindowPadded<16>(ref, refValid, sideD, validated, side, x, y, r, minPixels,
+                                      w);
+    case 24:
+      return buildCutWindowPadded<24>(ref, refValid, sideD, validated, side, x, y, r, minPixels,
+                                      w);
+    default:
+      return buildCutWindowPadded<kMaxStride>(ref, refValid, sideD, validated, side, x, y, r,
+                                              minPixels, w);
   }
-  const double n = static_cast<double>(w.t.size());
-  const double varb = sbb - sb * sb / n;
-  if (varb < kFlatVariance * n) return kNaN;
-  return static_cast<float>(stb / std::sqrt(varb));
+}
+
+// Count of nodata pixels of `valid` in a rectangle, from its integral image (CV_32S).
+int invalidIn(const cv::Mat& invalidSum, int x0, int y0, int x1, int y1) {
+  return invalidSum.at<int>(y1 + 1, x1 + 1) - invalidSum.at<int>(y0, x1 + 1) -
+         invalidSum.at<int>(y1 + 1, x0) + invalidSum.at<int>(y0, x0);
+}
+
+// Σ m·c, Σ m·c², Σ t·c over a window's rows, c = b − offset, with whole rows of Stride columns
+// (compile-time: whole vectors); `rows[i]` points at the other image under row i.
+template <int Stride>
+__attribute__((target_clones("avx2", "default"))) void cutWindowSumsPadded(
+    const CutWindow& w, const float* const* rows, float offset, float& sb, float& sbb,
+    float& stb) {
+  // 8-float vectors (GCC vector extension; two SSE registers in the baseline clone).
+  using Float8 = float __attribute__((vector_size(32)));
+  constexpr int kVectors = Stride / 8;
+  Float8 colB[kVectors] = {}, colBB[kVectors] = {}, colTB[kVectors] = {};
+  const Float8 off = {offset, offset, offset, offset, offset, offset, offset, offset};
+  for (int i = 0; i < w.side; ++i) {
+    const float* b = rows[i];
+    const float* m = w.mask.data() + static_cast<size_t>(i) * Stride;
+    const float* t = w.t.data() + static_cast<size_t>(i) * Stride;
+    for (int k = 0; k < kVectors; ++k) {
+      Float8 bv, mv, tv;
+      std::memcpy(&bv, b + 8 * k, sizeof bv);
+      std::memcpy(&mv, m + 8 * k, sizeof mv);
+      std::memcpy(&tv, t + 8 * k, sizeof tv);
+      const Float8 c = bv - off;
+      const Float8 mc = mv * c;
+      colB[k] += mc;
+      colBB[k] += mc * c;
+      colTB[k] += tv * c;  // Σ t = 0: Σ t (b − mean_b) = Σ t b
+    }
+  }
+  sb = sbb = stb = 0;
+  for (int k = 0; k < kVectors; ++k) {
+    for (int j = 0; j < 8; ++j) {
+      sb += colB[k][j];
+      sbb += colBB[k][j];
+      stb += colTB[k][j];
+    }
+  }
+}
+
+// NCC of a cut window against other at (u − d, v + dy); NaN when it leaves the image, touches
+// nodata, or the other window is flat. Values are taken relative to the other window's centre:
+// the float sums then stay small on flat windows, where the variance test needs them exact.
+float cutWindowNcc(const CutWindow& w, const cv::Mat& other, const cv::Mat& otherValid,
+                   const cv::Mat& otherInvalidSum, int d, int dy) {
+  if (!w.usable) return kNaN;
+  const int r = w.r, side = w.side, stride = w.stride;
+  const int x0 = w.x - r - d, y0 = w.y - r + dy;
+  const float offset = other.at<float>(std::clamp(w.y + dy, 0, other.rows - 1),
+                                       std::clamp(w.x - d, 0, other.cols - 1));
+  float sb = 0, sbb = 0, stb = 0;
+  // Fast path: the padded rows lie inside the image and the window holds no nodata.
+  const bool inside = x0 >= 0 && x0 + stride <= other.cols && y0 >= 0 && y0 + side <= other.rows;
+  if (inside && invalidIn(otherInvalidSum, x0, y0, x0 + side - 1, y0 + side - 1) == 0) {
+    const float* rows[kMaxStride];
+    for (int i = 0; i < side; ++i) rows[i] = other.ptr<float>(y0 + i) + x0;
+    switch (stride) {
+      case 8: cutWindowSumsPadded<8>(w, rows, offset, sb, sbb, stb); break;
+      case 16: cutWindowSumsPadded<16>(w, rows, offset, sb, sbb, stb); break;
+      case 24: cutWindowSumsPadded<24>(w, rows, offset, sb, sbb, stb); break;
+      default: cutWindowSumsPadded<kMaxStride>(w, rows, offset, sb, sbb, stb); break;
+    }
+  } else {
+    // Edge of the image or nodata nearby: only the window's own pixels must be usable.
+    for (int i = 0; i < side; ++i) {
+      const size_t row = static_cast<size_t>(i) * static_cast<size_t>(stride);
+      for (int j = 0; j < side; ++j) {
+        if (w.mask[row + static_cast<size_t>(j)] == 0.0F) continue;
+        const int u = x0 + j, v = y0 + i;
+        if (u < 0 || u >= other.cols || v < 0 || v >= other.rows) return kNaN;
+        if (!otherValid.at<uchar>(v, u)) return kNaN;
+        const float c = other.at<float>(v, u) - offset;
+        sb += c;
+        sbb += c * c;
+        stb += w.t[row + static_cast<size_t>(j)] * c;
+      }
+    }
+  }
+  const float varb = sbb - sb * sb / w.n;
+  if (varb < static_cast<float>(kFlatVariance) * w.n) return kNaN;
+  return stb / std::sqrt(varb);
+}
+
+// Rows 0..rows−1 in bands of 8, handed out to `threads` workers (the calling thread is one of
+// them: threads == 1 runs inline), the worker model of the level matcher.
+template <class BandFn>
+void forRowBands(int rows, int threads, const BandFn& band) {
+  constexpr int kBand = 8;
+  const int bands = (rows + kBand - 1) / kBand;
+  std::atomic<int> next{0};
+  auto worker = [&] {
+    for (int b = next++; b < bands; b = next++) {
+      band(b * kBand, std::min(rows, (b + 1) * kBand));
+    }
+  };
+  const int workers = std::max(1, std::min(threads, bands));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < workers; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
 }
 
 // Photometric error of ref column x (rows y - r .. y + r) against other at (x - d, y + dy), d
@@ -107,14 +277,14 @@ struct Hypothesis {
 };
 
 Hypothesis bestNear(const CutWindow& w, const cv::Mat& other, const cv::Mat& otherValid,
-                    float side, int dy) {
+                    const cv::Mat& otherInvalidSum, float side, int dy) {
   Hypothesis best;
   const int centre = static_cast<int>(std::lround(side));
   // Centre ±1 first; ±2 only on the side where the maximum of those three lies on the border.
   float sc[5] = {kNaN, kNaN, kNaN, kNaN, kNaN};
   int bestK = -1;
   auto eval = [&](int k) {
-    sc[k] = cutWindowNcc(w, other, otherValid, centre - 2 + k, dy);
+    sc[k] = cutWindowNcc(w, other, otherValid, otherInvalidSum, centre - 2 + k, dy);
     if (std::isfinite(sc[k]) && (bestK < 0 || sc[k] > sc[bestK])) bestK = k;
   };
   for (int k = 1; k <= 3; ++k) eval(k);
@@ -136,7 +306,7 @@ Hypothesis bestNear(const CutWindow& w, const cv::Mat& other, const cv::Mat& oth
 
 long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
                       const cv::Mat& otherValid, const cv::Mat& validated,
-                      const StepRefineSettings& s, LevelOutput& raw) {
+                      const StepRefineSettings& s, LevelOutput& raw, const cv::Mat& matchOnly) {
   const int W = ref.cols, H = ref.rows;
   const int h = s.window / 2;
   std::atomic<long> changed{0};
@@ -144,10 +314,10 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
   // Side chosen for each pixel of a step segment: its surface's disparity and line shift.
   cv::Mat sideD(ref.size(), CV_32F, cv::Scalar(kNaN));
   cv::Mat sideDy(ref.size(), CV_8S, cv::Scalar(0));
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+  forRowBands(H, s.threads, [&](int rowStart, int rowEnd) {
     std::vector<int> valid;
     std::vector<float> costA, costB;
-    for (int y = rows.start; y < rows.end; ++y) {
+    for (int y = rowStart; y < rowEnd; ++y) {
       const float* val = validated.ptr<float>(y);
       const float* shift = shifts.ptr<float>(y);
       valid.clear();
@@ -224,28 +394,28 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
   });
   // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
   // own side (same side value), and the validated pixels off the segments on that surface.
-  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+  cv::Mat otherInvalidSum;  // integral image of the other image's nodata pixels
+  cv::integral(1 - otherValid, otherInvalidSum, CV_32S);
+  forRowBands(H, s.threads, [&](int rowStart, int rowEnd) {
     CutWindow window;
-    for (int y = rows.start; y < rows.end; ++y) {
+    for (int y = rowStart; y < rowEnd; ++y) {
       float* outD = raw.disparity.ptr<float>(y);
       float* outS = raw.lineShift.ptr<float>(y);
       float* outScore = raw.score.ptr<float>(y);
+      const float* sides = sideD.ptr<float>(y);
+      const float* val = validated.ptr<float>(y);
+      const schar* sideShift = sideDy.ptr<schar>(y);
+      const uchar* wanted = matchOnly.empty() ? nullptr : matchOnly.ptr<uchar>(y);
       for (int x = 0; x < W; ++x) {
-        const float side = sideD.at<float>(y, x);
-        if (!std::isfinite(side)) continue;
+        const float side = sides[x];
+        if (!std::isfinite(side) || (wanted != nullptr && !wanted[x])) continue;
         // A validated value already on this side stays: re-matching it costs the most (most
         // segment pixels) and changed little.
-        const float kept = validated.at<float>(y, x);
+        const float kept = val[x];
         if (std::isfinite(kept) && std::abs(kept - side) <= 1.0F) continue;
-        const int dy = sideDy.at<schar>(y, x);
-        auto inShape = [&](int u, int v) {
-          const float su = sideD.at<float>(v, u);
-          if (std::isfinite(su)) return std::abs(su - side) <= 1.0F;
-          const float vu = validated.at<float>(v, u);
-          return std::isfinite(vu) && std::abs(vu - side) <= 1.5F;
-        };
-        buildCutWindow(ref, refValid, x, y, h, s.minShape, inShape, window);
-        const Hypothesis hyp = bestNear(window, other, otherValid, side, dy);
+        const int dy = sideShift[x];
+        buildCutWindow(ref, refValid, sideD, validated, side, x, y, h, s.minShape, window);
+        const Hypothesis hyp = bestNear(window, other, otherValid, otherInvalidSum, side, dy);
         const float before = outD[x];
         if (hyp.score >= static_cast<float>(s.minScore)) {
           outD[x] = hyp.disparity;

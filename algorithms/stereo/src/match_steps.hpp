@@ -14,6 +14,7 @@ struct StepRefineSettings {
   // px, half height of the pixel column whose error locates the boundary. 0 (the pixel alone):
   // a taller column straddles diagonal outlines (sim 400², edge% 69.5 with 0, 67.2 with 1).
   int costRadius = 0;
+  int threads = 1;  // worker threads (1: the calling thread only)
 };
 
 // Depth steps that have no image contour (roof and ground of similar brightness: about half of
@@ -35,9 +36,11 @@ struct StepRefineSettings {
 // `raw` (the reference map before validation) is updated in place: disparity, line shift (that
 // of the side's source pixel), score (NaN disparity when the cut window's NCC < minScore); the
 // caller validates it again. ref/other follow LevelInput: x_other = x_ref − d,
-// y_other = y_ref + dy. Returns the number of pixels whose value changed.
+// y_other = y_ref + dy. `matchOnly` (CV_8U, optional): only its non-zero pixels are matched
+// again. Returns the number of pixels whose value changed.
 long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
                       const cv::Mat& otherValid, const cv::Mat& validated,
-                      const StepRefineSettings& settings, LevelOutput& raw);
+                      const StepRefineSettings& settings, LevelOutput& raw,
+                      const cv::Mat& matchOnly = cv::Mat());
 
 }  // namespace delineo::stereo::detail
