@@ -390,6 +390,24 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
         }
         done = s1;
       }
+      if (s.gapFill > 0) {
+        // Gaps of one surface: unmatched pixels between two validated pixels of the same
+        // surface (no step), at most gapFill px apart, matched again around that surface.
+        float* sideRow = sideD.ptr<float>(y);
+        schar* sideDyRow = sideDy.ptr<schar>(y);
+        for (size_t i = 0; i + 1 < valid.size(); ++i) {
+          const int p = valid[i], q = valid[i + 1];
+          if (q - p < 2 || q - p > s.gapFill + 1) continue;
+          if (std::abs(val[p] - val[q]) > s.gapTolerance) continue;
+          const float surface = 0.5F * (val[p] + val[q]);
+          const schar dySurface = static_cast<schar>(std::lround(shift[p]));
+          for (int x = p + 1; x < q; ++x) {
+            if (std::isfinite(sideRow[x])) continue;  // part of a step segment
+            sideRow[x] = surface;
+            sideDyRow[x] = dySurface;
+          }
+        }
+      }
     }
   });
   // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
