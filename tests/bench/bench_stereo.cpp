@@ -77,6 +77,7 @@ bool gOutlineDiagnosis = false;  // --outline-diag: where the predicted roof sta
 // the true outline, in px towards the ground (positive: roof fattened), as edge% walks it.
 void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
   long outside = 0, inside = 0, missed = 0, located = 0;
+  long insideBy[2][2] = {};  // [unmatched only / ground value][ground on −x / on +x]
   for (const Case::OutlinePixel& o : c.outline) {
     const float mid = 0.5F * (o.dRoof + o.dGround);
     const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
@@ -90,7 +91,24 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
       const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
       if (std::abs(off) <= 1) ++located;
       else if (off > 1) ++outside;
-      else ++inside;
+      else {
+        ++inside;
+        // What covers the roof pixels before the start: no match, or the ground's value.
+        bool groundValue = false;
+        for (int u = o.xb; u != x; u += o.dir) {
+          groundValue = groundValue || (std::isfinite(row[u]) && (row[u] - mid) * sign <= 0);
+        }
+        ++insideBy[groundValue ? 1 : 0][o.dir > 0 ? 0 : 1];
+        if (std::getenv("OUTLINE_DUMP") != nullptr && inside % 8 == 1) {
+          std::printf("      y %d xb %d dir %d roof %.1f ground %.1f:", o.y, o.xb, o.dir, o.dRoof,
+                      o.dGround);
+          for (int step = -3; step <= 8; ++step) {
+            const int u = o.xb - o.dir * step;  // < 0: ground, >= 0: roof (inwards)
+            if (u >= 0 && u < disparity.cols) std::printf(" %5.1f", row[u]);
+          }
+          std::printf("\n");
+        }
+      }
       found = true;
       break;
     }
@@ -99,6 +117,9 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
   std::printf("    outline diag: %zu pixels, located %ld, roof starts >=2 px outside %ld, "
               ">=2 px inside %ld, missed %ld\n", c.outline.size(), located, outside, inside,
               missed);
+  std::printf("    inside: unmatched only %ld (ground -x %ld, +x %ld), ground value %ld "
+              "(ground -x %ld, +x %ld)\n", insideBy[0][0] + insideBy[0][1], insideBy[0][0],
+              insideBy[0][1], insideBy[1][0] + insideBy[1][1], insideBy[1][0], insideBy[1][1]);
 }
 
 double outlineScore(const cv::Mat& disparity, const Case& c) {
