@@ -274,6 +274,30 @@ TEST(Match, StepCutLocatesAnOutlineWithoutContour) {
   EXPECT_GT(occludedRejected, occluded * 8 / 10) << occludedRejected << " of " << occluded;
 }
 
+TEST(Match, StepCutGivesTheSameMapOnAnyNumberOfThreads) {
+  // The step cut runs on the matcher's own workers (threads = 1: the calling thread only);
+  // rows are independent, so the map must not depend on how they are shared out.
+  const auto scene = contourlessBlock();
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 20;
+  p.threads = 1;
+  const MatchResult one = matchStereo(scene.left, scene.right, p);
+  p.threads = 3;
+  const MatchResult three = matchStereo(scene.left, scene.right, p);
+  ASSERT_EQ(one.disparity.size(), three.disparity.size());
+  long differing = 0, matched = 0;
+  for (int y = 0; y < one.disparity.rows; ++y) {
+    for (int x = 0; x < one.disparity.cols; ++x) {
+      const float a = one.disparity.at<float>(y, x), b = three.disparity.at<float>(y, x);
+      if (std::isfinite(a)) ++matched;
+      if (std::isfinite(a) != std::isfinite(b) || (std::isfinite(a) && a != b)) ++differing;
+    }
+  }
+  EXPECT_GT(matched, one.disparity.total() / 2);
+  EXPECT_EQ(differing, 0);
+}
+
 TEST(Match, SgbmFollowsTheSameConventions) {
   const cv::Mat left = texture({200, 120}, 23);
   const cv::Mat right = shiftedRight(left, -6.0);
