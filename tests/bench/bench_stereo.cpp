@@ -77,7 +77,8 @@ bool gOutlineDiagnosis = false;  // --outline-diag: where the predicted roof sta
 // the true outline, in px towards the ground (positive: roof fattened), as edge% walks it.
 void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
   long outside = 0, inside = 0, missed = 0, located = 0;
-  long insideBy[2][2] = {};  // [unmatched only / ground value][ground on −x / on +x]
+  long insideBy[2][2] = {};
+  long outsideBy[2] = {}, missedBy[2] = {};  // [ground on −x / on +x]  // [unmatched only / ground value][ground on −x / on +x]
   for (const Case::OutlinePixel& o : c.outline) {
     const float mid = 0.5F * (o.dRoof + o.dGround);
     const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
@@ -90,7 +91,10 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
       if (!std::isfinite(row[x]) || (row[x] - mid) * sign <= 0) continue;
       const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
       if (std::abs(off) <= 1) ++located;
-      else if (off > 1) ++outside;
+      else if (off > 1) {
+        ++outside;
+        ++outsideBy[o.dir > 0 ? 0 : 1];
+      }
       else {
         ++inside;
         // What covers the roof pixels before the start: no match, or the ground's value.
@@ -112,7 +116,10 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
       found = true;
       break;
     }
-    if (!found) ++missed;
+    if (!found) {
+      ++missed;
+      ++missedBy[o.dir > 0 ? 0 : 1];
+    }
   }
   std::printf("    outline diag: %zu pixels, located %ld, roof starts >=2 px outside %ld, "
               ">=2 px inside %ld, missed %ld\n", c.outline.size(), located, outside, inside,
@@ -120,6 +127,8 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
   std::printf("    inside: unmatched only %ld (ground -x %ld, +x %ld), ground value %ld "
               "(ground -x %ld, +x %ld)\n", insideBy[0][0] + insideBy[0][1], insideBy[0][0],
               insideBy[0][1], insideBy[1][0] + insideBy[1][1], insideBy[1][0], insideBy[1][1]);
+  std::printf("    outside: ground -x %ld, +x %ld; missed: ground -x %ld, +x %ld\n", outsideBy[0],
+              outsideBy[1], missedBy[0], missedBy[1]);
 }
 
 double outlineScore(const cv::Mat& disparity, const Case& c) {
