@@ -257,7 +257,6 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) bool fillWin
   const Word4 open = free | seed;
   // Runs of open cells 2^i long in each direction: the masks of the doubling steps, which
   // depend on `open` only. Along rows the row-end separator bits (always 0) stop the runs.
-  const Word4 gR1 = open & (open << 1), gR2 = gR1 & (gR1 << 2), gR3 = gR2 & (gR2 << 4);
   const Word4 gL1 = open & (open >> 1), gL2 = gL1 & (gL1 >> 2), gL3 = gL2 & (gL2 >> 4);
   Word4 gD1, gD2, gD3, gU1, gU2, gU3;
   downRows<1>(t, open);
@@ -273,15 +272,15 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) bool fillWin
   upRows<4>(t, gU2);
   gU3 = gU2 & t;
   for (bool first = true;; first = false) {
-    // Along rows, both directions (doubling: shifts 1, 2, 4, 8).
-    Word4 a = seed, b = seed;
-    a |= open & (a << 1);
+    // Along rows towards higher bits by one addition: adding the seeds to the open cells
+    // carries through each open run from its lowest seed up to the blocked cell ending the run
+    // (the row-end separator bits are 0, so no carry leaves a row or a 64-bit word); the
+    // changed bits are that run. Towards lower bits by doubling (shifts 1, 2, 4, 8).
+    Word4 a = (((open + seed) ^ open) & open) | seed;
+    Word4 b = seed;
     b |= open & (b >> 1);
-    a |= gR1 & (a << 2);
     b |= gL1 & (b >> 2);
-    a |= gR2 & (a << 4);
     b |= gL2 & (b >> 4);
-    a |= gR3 & (a << 8);
     b |= gL3 & (b >> 8);
     Word4 filled = a | b;
     if (!first && sameWords(filled, seed)) break;  // closed along both directions
