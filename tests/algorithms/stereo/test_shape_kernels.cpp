@@ -1,0 +1,164 @@
+// The vector builds of the integer shape kernels (AVX-512VL, AVX2, SSE2) against the portable
+// reference: the machine picks one at run time, so each available one is called directly here
+// and must give the same sums and bit-identical NCC values on random shapes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "level_shape_int.hpp"
+
+namespace {
+
+using namespace delineo::stereo::detail;
+
+constexpr int kStride = 64;
+constexpr int kImageRows = 24;
+
+bool sameFloat(float a, float b) {
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b);
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+struct RandomShape {
+  int rows = 0;
+  std::vector<uint32_t> bits;
+  std::vector<int16_t> mask, am;  // rows of 16: −1 on S / A on S
+  ShapeNccTerms terms;
+};
+
+// Test-local reference of the dense shape rows (mask −1 on S, A on S, 0 elsewhere).
+RandomShape makeShape(std::mt19937& rng, const std::vector<int16_t>& a) {
+  RandomShape s;
+  s.rows = std::uniform_int_distribution<int>(1, 15)(rng);
+  s.bits.resize(s.rows);
+  s.mask.assign(16 * s.rows, 0);
+  s.am.assign(16 * s.rows, 0);
+  int64_t n = 0, sumA = 0, sumAA = 0;
+  for (int v = 0; v < s.rows; ++v) {
+    s.bits[v] = std::uniform_int_distribution<uint32_t>(0, 0x7FFF)(rng);  // 15 columns
+    for (int u = 0; u < 16; ++u) {
+      if (((s.bits[v] >> u) & 1U) == 0) continue;
+      const int16_t x = a[v * kStride + u];
+      s.mask[16 * v + u] = -1;
+      s.am[16 * v + u] = x;
+      ++n;
+      sumA += x;
+      sumAA += static_cast<int64_t>(x) * x;
+    }
+  }
+  s.terms.n = static_cast<int>(n);
+  s.terms.sumA = static_cast<int32_t>(sumA);
+  const double varN = static_cast<double>(n * sumAA - sumA * sumA);
+  s.terms.invNormA = varN > 0 ? static_cast<float>(1.0 / std::sqrt(varN)) : 0.0f;
+  s.terms.flatN = static_cast<float>(4.0 * n * n);  // var_S(B) < 4 quantised units²: flat
+  return s;
+}
+
+std::vector<int16_t> randomImage(std::mt19937& rng, bool flatPatch) {
+  std::vector<int16_t> img(kStride * kImageRows);
+  std::uniform_int_distribution<int> grey(-kShapeQuantMax, kShapeQuantMax);
+  for (auto& v : img) v = static_cast<int16_t>(grey(rng));
+  if (flatPatch) {  // a constant block: windows over it are flat (NaN)
+    for (int y = 0; y < kImageRows; ++y) {
+      for (int x = 0; x < 20; ++x) img[y * kStride + x] = 77;
+    }
+  }
+  return img;
+}
+
+TEST(ShapeKernels, VectorBuildsAgreeWithThePortableReference) {
+  std::mt19937 rng(12345);
+  int compared = 0, flat = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const std::vector<int16_t> a = randomImage(rng, false);
+    const std::vector<int16_t> b = randomImage(rng, trial % 4 == 0);
+    const RandomShape s = makeShape(rng, a);
+    if (s.terms.invNormA == 0.0f) continue;
+    const int count = std::uniform_int_distribution<int>(1, kShapeMaxWindows)(rng);
+    ptrdiff_t offsets[kShapeMaxWindows];
+    for (int k = 0; k < count; ++k) {
+      offsets[k] = std::uniform_int_distribution<int>(0, kStride - 16)(rng);
+    }
+    // Reference: scalar sums and NCC, one window at a time.
+    float expected[kShapeMaxWindows];
+    ShapeSumsInt refSums[kShapeMaxWindows];
+    for (int k = 0; k < count; ++k) {
+      shapeSumsIntScalar<1>(b.data(), kStride, offsets + k, s.mask.data(), s.am.data(), s.rows,
+                            refSums + k);
+      nccFromIntSums(refSums + k, 1, s.terms, expected + k);
+      flat += std::isnan(expected[k]) ? 1 : 0;
+    }
+    // Whatever the machine dispatches to.
+    float got[kShapeMaxWindows];
+    shapeScoresInt(b.data(), kStride, offsets, s.mask.data(), s.am.data(), s.rows, count, s.terms,
+                   got);
+    for (int k = 0; k < count; ++k) {
+      ASSERT_TRUE(sameFloat(expected[k], got[k]))
+          << "dispatched, trial " << trial << " window " << k;
+    }
+#ifdef DELINEO_STEREO_X86
+    for (int k = 0; k < count; k += 4) {
+      const int part = std::min(4, count - k);
+      ShapeSumsInt sums[4];
+      switch (part) {
+        case 1:
+          shapeSumsIntSse2<1>(b.data(), kStride, offsets + k, s.mask.data(), s.am.data(), s.rows,
+                              sums);
+          break;
+        case 2:
+          shapeSumsIntSse2<2>(b.data(), kStride, offsets + k, s.mask.data(), s.am.data(), s.rows,
+                              sums);
+          break;
+        case 3:
+          shapeSumsIntSse2<3>(b.data(), kStride, offsets + k, s.mask.data(), s.am.data(), s.rows,
+                              sums);
+          break;
+        default:
+          shapeSumsIntSse2<4>(b.data(), kStride, offsets + k, s.mask.data(), s.am.data(), s.rows,
+                              sums);
+          break;
+      }
+      for (int j = 0; j < part; ++j) {
+        ASSERT_EQ(sums[j].b, refSums[k + j].b) << "SSE2, trial " << trial;
+        ASSERT_EQ(sums[j].bb, refSums[k + j].bb) << "SSE2, trial " << trial;
+        ASSERT_EQ(sums[j].ab, refSums[k + j].ab) << "SSE2, trial " << trial;
+      }
+    }
+    if (cpuHasAvx2()) {
+      std::fill(got, got + kShapeMaxWindows, 0.0f);
+      shapeScoresIntAvx2Dispatch(b.data(), kStride, offsets, s.mask.data(), s.am.data(), s.rows,
+                                 count, s.terms, got);
+      for (int k = 0; k < count; ++k) {
+        ASSERT_TRUE(sameFloat(expected[k], got[k])) << "AVX2, trial " << trial << " window " << k;
+      }
+      // Dense rows built from the fill bits.
+      std::vector<int16_t> mask(16 * s.rows), am(16 * s.rows);
+      int32_t n = 0, sumA = 0, sumAA = 0;
+      shapeRowsIntAvx2(s.bits.data(), s.rows, a.data(), kStride, mask.data(), am.data(), n, sumA,
+                       sumAA);
+      ASSERT_EQ(mask, s.mask);
+      ASSERT_EQ(am, s.am);
+      ASSERT_EQ(n, s.terms.n);
+      ASSERT_EQ(sumA, s.terms.sumA);
+    }
+    if (cpuHasAvx512Vl()) {
+      std::fill(got, got + kShapeMaxWindows, 0.0f);
+      shapeScoresIntAvx512Dispatch(b.data(), kStride, offsets, s.mask.data(), s.am.data(), s.rows,
+                                   count, s.terms, got);
+      for (int k = 0; k < count; ++k) {
+        ASSERT_TRUE(sameFloat(expected[k], got[k]))
+            << "AVX-512, trial " << trial << " window " << k;
+      }
+    }
+#endif
+    compared += count;
+  }
+  EXPECT_GT(compared, 1000);
+  EXPECT_GT(flat, 10);  // the flat-window rule was exercised
+}
+
+}  // namespace
