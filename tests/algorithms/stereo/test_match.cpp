@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 #include <opencv2/imgproc.hpp>
@@ -296,6 +297,35 @@ TEST(Match, StepCutGivesTheSameMapOnAnyNumberOfThreads) {
   }
   EXPECT_GT(matched, one.disparity.total() / 2);
   EXPECT_EQ(differing, 0);
+}
+
+TEST(Match, MultiLevelMapIsBitIdenticalOnOneAndTwoThreads) {
+  // Every step of the driver (preparation, Canny, validation, intervals, step cut) runs on the
+  // level's threads; each task writes its own rows, so 1 and 2 threads give the same bits.
+  const auto scene = contourlessBlock();
+  cv::Mat left, right;
+  // Several pyramid levels and many row bands: the block scene doubled, range over 20 px.
+  cv::resize(scene.left, left, {}, 2.0, 2.0, cv::INTER_CUBIC);
+  cv::resize(scene.right, right, {}, 2.0, 2.0, cv::INTER_CUBIC);
+  MatchParams p;
+  p.dmin = -8;
+  p.dmax = 48;
+  p.threads = 1;
+  const MatchResult one = matchStereo(left, right, p);
+  p.threads = 2;
+  const MatchResult two = matchStereo(left, right, p);
+  ASSERT_GT(one.levelsUsed, 1);
+  ASSERT_EQ(one.disparity.size(), two.disparity.size());
+  long matched = 0;
+  for (int y = 0; y < one.disparity.rows; ++y) {
+    for (int x = 0; x < one.disparity.cols; ++x) {
+      if (std::isfinite(one.disparity.at<float>(y, x))) ++matched;
+    }
+  }
+  EXPECT_GT(matched, static_cast<long>(one.disparity.total() / 2));
+  const size_t bytes = one.disparity.total() * sizeof(float);
+  EXPECT_EQ(std::memcmp(one.disparity.data, two.disparity.data, bytes), 0);
+  EXPECT_EQ(std::memcmp(one.score.data, two.score.data, bytes), 0);
 }
 
 TEST(Match, SgbmFollowsTheSameConventions) {
