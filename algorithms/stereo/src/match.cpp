@@ -167,26 +167,30 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
 }
 
 // Pixels of the other map that the matches of `map` point to (the floor/ceil neighbours the
-// validation reads), CV_8U 0/1; x_other = x − d.
-cv::Mat pointedTo(const detail::LevelOutput& map) {
+// validation reads), CV_8U 0/1; x_other = x − d. By bands of output rows: a band scans the
+// source rows whose line shift (|dy| < lineShift + 1) can reach it and writes only its own rows.
+cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
   cv::Mat needed = cv::Mat::zeros(map.disparity.size(), CV_8U);
-  for (int y = 0; y < needed.rows; ++y) {
-    const float* d = map.disparity.ptr<float>(y);
-    const float* dy = map.lineShift.ptr<float>(y);
-    for (int x = 0; x < needed.cols; ++x) {
-      if (!std::isfinite(d[x])) continue;
-      const int fx = static_cast<int>(std::floor(x - d[x]));
-      const int fy = static_cast<int>(std::floor(y + dy[x]));
-      for (int m = 0; m <= 1; ++m) {
-        for (int n = 0; n <= 1; ++n) {
-          const int qx = fx + n, qy = fy + m;
-          if (qx >= 0 && qx < needed.cols && qy >= 0 && qy < needed.rows) {
-            needed.at<uchar>(qy, qx) = 1;
+  const int reach = lineShift + 2;
+  forRowBands(needed.rows, threads, [&](int rowStart, int rowEnd) {
+    for (int y = std::max(0, rowStart - reach); y < std::min(needed.rows, rowEnd + reach); ++y) {
+      const float* d = map.disparity.ptr<float>(y);
+      const float* dy = map.lineShift.ptr<float>(y);
+      for (int x = 0; x < needed.cols; ++x) {
+        if (!std::isfinite(d[x])) continue;
+        const int fx = static_cast<int>(std::floor(x - d[x]));
+        const int fy = static_cast<int>(std::floor(y + dy[x]));
+        for (int m = 0; m <= 1; ++m) {
+          const int qy = fy + m;
+          if (qy < rowStart || qy >= rowEnd) continue;
+          for (int n = 0; n <= 1; ++n) {
+            const int qx = fx + n;
+            if (qx >= 0 && qx < needed.cols) needed.at<uchar>(qy, qx) = 1;
           }
         }
       }
     }
-  }
+  });
   return needed;
 }
 
@@ -352,7 +356,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       // At the finest level the right map only validates the left one: only the right pixels
       // that a left match points to (the floor/ceil neighbours the validation reads) are
       // matched. The result is the same, at the cost of the unmatched and occluded areas less.
-      const cv::Mat needed = pointedTo(leftOut);
+      const cv::Mat needed = pointedTo(leftOut, p.lineShift, threads);
       hiR = hiR.clone();  // may share its data with the left intervals
       cv::Mat notSearched = loR - 1;
       notSearched.copyTo(hiR, needed == 0);
@@ -396,7 +400,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                leftOut);
       // At the finest level the right map only validates the left one: its pixels that no left
       // match points to are not matched again (the result is the same).
-      const cv::Mat rightNeeded = k == 0 ? flipped(pointedTo(leftOut)) : cv::Mat();
+      const cv::Mat rightNeeded = k == 0 ? flipped(pointedTo(leftOut, p.lineShift, threads)) : cv::Mat();
       detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid,
                                flipped(coarseRight), rs, mirrored, rightNeeded);
       unmirror();
