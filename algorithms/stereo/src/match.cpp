@@ -168,7 +168,7 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
 
 // Pixels of the other map that the matches of `map` point to (the floor/ceil neighbours the
 // validation reads), CV_8U 0/1; x_other = x − d. By bands of output rows: a band scans the
-// source rows whose line shift (|dy| < lineShift + 1) can reach it and writes only its own rows.
+// source rows whose line shift (|dy| <= lineShift + 1) can reach it and writes only its own rows.
 cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
   cv::Mat needed = cv::Mat::zeros(map.disparity.size(), CV_8U);
   const int reach = lineShift + 2;
