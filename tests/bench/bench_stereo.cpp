@@ -13,7 +13,7 @@
 // 1 px of xb; no roof-side pixel in the walk counts as missed. edge% = located / outline pixels.
 //
 // Usage: bench_stereo [--size N] [--data DIR] [--methods adaptive,square,sgbm] [--no-data]
-//                     [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu]
+//                     [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu] [--seed N]
 //   --size N   side of the simulated scene (default 1000; the ctest smoke run uses a tiny one)
 //   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
 //   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
@@ -260,15 +260,16 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
 }
 
 #ifdef DELINEO_BENCH_HAVE_SIM
-Case simulated(int size) {
+Case simulated(int size, int seed) {
   sim::SceneParams sp;
+  sp.seed = seed;
   sp.width = size;
   sp.height = size;
   sp.buildings = std::max(1, size * size / 40000);
   sp.trees = std::max(1, size * size / 30000);
   const sim::Scene scene = sim::simulateScene(sp);
   Case c;
-  c.name = "simulated scene (seed 1, default noise)";
+  c.name = "simulated scene (seed " + std::to_string(seed) + ", default noise)";
   scene.left.convertTo(c.left, CV_32F);
   scene.right.convertTo(c.right, CV_32F);
   c.truth = scene.disparity;
@@ -385,6 +386,7 @@ int main(int argc, char** argv) {
   std::string dump;
   int range = 0;
   int repeat = 1;
+  int seed = 1;  // simulated scene; other seeds are held-out scenes for the tuned constants
   bool printCpu = false;
   nlohmann::json overrides = nlohmann::json::object();
   std::vector<std::string> methods = {"adaptive", "square", "sgbm"};
@@ -394,6 +396,8 @@ int main(int argc, char** argv) {
       size = std::atoi(argv[++i]);
     } else if (a == "--data" && i + 1 < argc) {
       data = argv[++i];
+    } else if (a == "--seed" && i + 1 < argc) {
+      seed = std::atoi(argv[++i]);
     } else if (a == "--range" && i + 1 < argc) {
       range = std::atoi(argv[++i]);
     } else if (a == "--dump" && i + 1 < argc) {
@@ -420,7 +424,7 @@ int main(int argc, char** argv) {
       }
     } else {
       std::fprintf(stderr, "usage: bench_stereo [--size N] [--data DIR] [--no-data] "
-                           "[--methods adaptive,square,sgbm] [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu]\n");
+                           "[--methods adaptive,square,sgbm] [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu] [--seed N]\n");
       return 2;
     }
   }
@@ -428,7 +432,7 @@ int main(int argc, char** argv) {
   std::printf("bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
               "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
 #ifdef DELINEO_BENCH_HAVE_SIM
-  Case sim = simulated(size);
+  Case sim = simulated(size, seed);
   if (range > sim.dmax - sim.dmin + 1) sim.dmax = sim.dmin + range - 1;
   runCase(sim, methods, dump, overrides, repeat, printCpu);
 #else
