@@ -408,6 +408,14 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   cv::remap(rgx, im.rightGradX, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   cv::remap(rgy, im.rightGradY, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   normaliseBy99(im.rightGradX, im.rightGradY);
+  if (params.bandBestCost) {
+    // The band says "this pixel cannot be matched": that must not make a pixel cheaper than its
+    // best explanation as roof or ground. With the constant NoMatchCost alone, the band is a
+    // sink wherever both costs exceed it (textureless roofs, trees, shadowed or neighbouring
+    // ground): the outline shifts so that its band covers them (docs/delineation.md, "Where the
+    // true outline pays more"). Pre-integrable like the other terms (one more prefix sum).
+    im.bandCost = cv::max(cv::min(im.roofCost, im.groundCost), im.noMatchCost);
+  }
   if (params.regionInit) {
     const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast,
                                 params.minAngle, params.minGap};

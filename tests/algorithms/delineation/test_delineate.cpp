@@ -129,9 +129,10 @@ TEST(Delineate, DoesNotFollowAStrongLineLeavingTheRoof) {
   unleashed.maxExcursion = unleashed.roiMargin;
   const auto free = delineate(pair.left, pair.right, req, unleashed);
   EXPECT_LT(farthestOutside(free.polygon, roof), 4.0);
-  // The paper's plain terms and moves (per-pixel costs; no gate, shape limits, shortcuts, leash or region
-  // stage): the defect is there.
+  // The paper's plain terms and moves (per-pixel costs, constant band cost; no gate, shape limits,
+  // shortcuts, leash or region stage): the defect is there.
   DelineationParams plain = unleashed;
+  plain.bandBestCost = false;
   plain.edgeContrast = 0;
   plain.minAngle = 0;
   plain.minGap = 0;
@@ -299,4 +300,34 @@ TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   ASSERT_FALSE(on.images.uncappedDifference.empty());
   EXPECT_EQ(cv::norm(on.images.uncappedDifference, off.images.groundCost - off.images.roofCost, cv::NORM_INF), 0.0);
   EXPECT_EQ(on.init.outer, off.init.outer);  // the region stage compares outlines on the plain costs
+}
+
+TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  DelineationParams params;
+  ASSERT_TRUE(params.bandBestCost);  // the default
+  const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, params);
+  const auto costs = stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15);
+  const PreparedEnergy on = prepareEnergy(*costs, pair.left, pair.right, req, params);
+  ASSERT_FALSE(on.images.bandCost.empty());
+  const cv::Mat expected = cv::max(cv::min(on.images.roofCost, on.images.groundCost), on.images.noMatchCost);
+  EXPECT_EQ(cv::norm(on.images.bandCost, expected, cv::NORM_INF), 0.0);
+  // The wall strip matches neither interval: there the band costs more than NoMatchCost.
+  double maxBand = 0;
+  cv::minMaxLoc(on.images.bandCost, nullptr, &maxBand);
+  EXPECT_GT(maxBand, on.images.noMatchCost);
+  params.bandBestCost = false;
+  const PreparedEnergy off = prepareEnergy(*costs, pair.left, pair.right, req, params);
+  EXPECT_TRUE(off.images.bandCost.empty());
+  // Both runs still find the roof.
+  for (const bool best : {true, false}) {
+    params.bandBestCost = best;
+    const auto result = delineate(pair.left, pair.right, req, params);
+    EXPECT_GT(iou(result.polygon, pair.truth, pair.left.size()), 0.9) << "band-best-cost " << best;
+  }
 }

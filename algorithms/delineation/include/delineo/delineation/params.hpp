@@ -32,6 +32,7 @@ struct DelineationParams {
   bool regionRightAngles = false;  // region stage also tries its outlines with right angles
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
   double costCap = 0.0;            // × NoMatchCost: c_roof and c_ground capped there for the terms (0 = off)
+  bool bandBestCost = true;        // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost)
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
@@ -147,6 +148,11 @@ struct DelineationParams {
                       "the edge gate, region stage and courtyard seeds keep the plain costs (0 = off)",
                       0, 10},
       costCap);
+    v(core::ParamInfo{"band-best-cost", "Band best cost", "",
+                      "A pixel of the occlusion band costs NoMatchCost or, when higher, the lower of "
+                      "c_roof and c_ground there, so that the band is never cheaper than the pixel's "
+                      "best explanation as roof or ground (false = NoMatchCost everywhere, the paper)"},
+      bandBestCost);
   }
   void validate() const;
 };
