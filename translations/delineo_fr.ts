@@ -198,6 +198,66 @@
         <source>Threads</source>
         <translation>Fils d’exécution</translation>
     </message>
+    <message>
+        <source>Balance intervals</source>
+        <translation>Intervalles équilibrés</translation>
+    </message>
+    <message>
+        <source>Edge contrast gate</source>
+        <translation>Filtre de contraste des bords</translation>
+    </message>
+    <message>
+        <source>Min angle</source>
+        <translation>Angle minimal</translation>
+    </message>
+    <message>
+        <source>Min gap</source>
+        <translation>Écart minimal</translation>
+    </message>
+    <message>
+        <source>Shortcut vertices</source>
+        <translation>Sommets par raccourci</translation>
+    </message>
+    <message>
+        <source>Shortcut width</source>
+        <translation>Largeur de raccourci</translation>
+    </message>
+    <message>
+        <source>Max excursion</source>
+        <translation>Excursion maximale</translation>
+    </message>
+    <message>
+        <source>Region init</source>
+        <translation>Initialisation par région</translation>
+    </message>
+    <message>
+        <source>Region tolerance</source>
+        <translation>Tolérance de la région</translation>
+    </message>
+    <message>
+        <source>Region right angles</source>
+        <translation>Angles droits de la région</translation>
+    </message>
+    <message>
+        <source>Cost aggregation</source>
+        <translation>Agrégation des coûts</translation>
+    </message>
+    <message>
+        <source>Cost cap</source>
+        <translation>Plafond des coûts</translation>
+    </message>
+    <message>
+        <source>Band best cost</source>
+        <translation>Coût de bande selon l’appariement</translation>
+    </message>
+    <message>
+        <source>Cut windows at depth steps</source>
+        <translation>Fenêtres coupées aux sauts de profondeur</translation>
+    </message>
+    <message>
+        <source>Step-cut levels</source>
+        <translation>Niveaux de coupe aux sauts</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::BuildingsModel</name>

@@ -28,6 +28,19 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Edge moves"),
     QT_TRANSLATE_NOOP("Parameters", "Courtyards"),
     QT_TRANSLATE_NOOP("Parameters", "Min courtyard area"),
+    QT_TRANSLATE_NOOP("Parameters", "Balance intervals"),
+    QT_TRANSLATE_NOOP("Parameters", "Edge contrast gate"),
+    QT_TRANSLATE_NOOP("Parameters", "Min angle"),
+    QT_TRANSLATE_NOOP("Parameters", "Min gap"),
+    QT_TRANSLATE_NOOP("Parameters", "Shortcut vertices"),
+    QT_TRANSLATE_NOOP("Parameters", "Shortcut width"),
+    QT_TRANSLATE_NOOP("Parameters", "Max excursion"),
+    QT_TRANSLATE_NOOP("Parameters", "Region init"),
+    QT_TRANSLATE_NOOP("Parameters", "Region tolerance"),
+    QT_TRANSLATE_NOOP("Parameters", "Region right angles"),
+    QT_TRANSLATE_NOOP("Parameters", "Cost aggregation"),
+    QT_TRANSLATE_NOOP("Parameters", "Cost cap"),
+    QT_TRANSLATE_NOOP("Parameters", "Band best cost"),
     // stereo::MatchParams
     QT_TRANSLATE_NOOP("Parameters", "Method"),
     QT_TRANSLATE_NOOP("Parameters", "Minimum disparity"),
@@ -45,5 +58,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Sub-pixel"),
     QT_TRANSLATE_NOOP("Parameters", "Adaptive shapes"),
     QT_TRANSLATE_NOOP("Parameters", "Threads"),
+    QT_TRANSLATE_NOOP("Parameters", "Cut windows at depth steps"),
+    QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),
 };
 }  // namespace

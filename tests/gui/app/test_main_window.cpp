@@ -21,9 +21,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include "buildings_model.hpp"
+#include "delineo/delineation/params.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/stereo/match.hpp"
 #include "delineo/widgets/disparity_histogram.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
@@ -508,6 +510,20 @@ class MainWindowTest : public QObject {
     QCOMPARE(translator.translate("delineo::gui::BuildingsModel", "accepted"), QStringLiteral("accepté"));
     QCOMPARE(translator.translate("ErrorText", "The input files do not match each other."),
              QStringLiteral("Les fichiers d’entrée ne correspondent pas entre eux."));
+    // Every label of the two parameter forms (their strings come from the structs' visit(),
+    // which lupdate cannot see: app/gui/parameter_labels.cpp must list each new one).
+    QStringList untranslated;
+    const auto check = [&](const delineo::core::ParamInfo& info, auto&) {
+      const std::string label(info.label);
+      if (translator.translate("Parameters", label.c_str()).isEmpty()) {
+        untranslated << QString::fromStdString(label);
+      }
+    };
+    delineo::delineation::DelineationParams delineation;
+    delineation.visit(check);
+    delineo::stereo::MatchParams matching;
+    matching.visit(check);
+    QVERIFY2(untranslated.isEmpty(), qPrintable(untranslated.join(QStringLiteral(", "))));
   }
 
   void cleanupTestCase() { window_.reset(); }
