@@ -115,11 +115,17 @@ class MainWindowTest : public QObject {
     QVERIFY(window_->document()->disparity().empty());
     QVERIFY(window_->leftView()->hasImage());
     if (!project::matchingAvailable()) QSKIP("no matcher in this build");
-    const widgets::JobId job = window_->startMatching();
-    QVERIFY(job != 0);
-    const std::vector<double> lateness = measureLatencyWhileRunning(job);
-    QVERIFY(!window_->document()->disparity().empty());
-    QVERIFY(lateness.size() > 20);
+    // Every tick is taken while a matching job runs; the sample's matching now takes about
+    // 0.1 s, so it is run again until the ticks are enough for a 99th percentile.
+    std::vector<double> lateness;
+    for (int run = 0; run < 20 && lateness.size() <= 40; ++run) {
+      const widgets::JobId job = window_->startMatching();
+      QVERIFY(job != 0);
+      const std::vector<double> ticks = measureLatencyWhileRunning(job);
+      lateness.insert(lateness.end(), ticks.begin(), ticks.end());
+      QVERIFY(!window_->document()->disparity().empty());
+    }
+    QVERIFY(lateness.size() > 40);
     const double p99 = percentile99(lateness);
     qInfo("event-loop lateness during matching: %zu ticks, p99 %.2f ms, max %.2f ms", lateness.size(), p99,
           *std::max_element(lateness.begin(), lateness.end()));
