@@ -310,7 +310,8 @@ TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
   req.roof = {13, 15};
   req.ground = DisparityInterval{3, 5};
   DelineationParams params;
-  ASSERT_TRUE(params.bandBestCost);  // the default
+  ASSERT_FALSE(params.bandBestCost);  // the default: the paper's constant band cost
+  params.bandBestCost = true;
   const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, params);
   const auto costs = stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15);
   const PreparedEnergy on = prepareEnergy(*costs, pair.left, pair.right, req, params);

@@ -32,7 +32,7 @@ struct DelineationParams {
   bool regionRightAngles = false;  // region stage also tries its outlines with right angles
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
   double costCap = 0.0;            // × NoMatchCost: c_roof and c_ground capped there for the terms (0 = off)
-  bool bandBestCost = true;        // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost)
+  bool bandBestCost = false;       // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost, the paper)
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
