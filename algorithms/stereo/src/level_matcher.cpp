@@ -29,6 +29,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "level_shape_int.hpp"
+#include "workers.hpp"
 
 namespace delineo::stereo::detail {
 namespace {
@@ -357,20 +358,6 @@ struct Scratch {
   std::vector<uchar> swept;          // 1 where the square pixel is served by the sweep
   std::vector<float> product, cols;  // sweep: product rows of the tile and running column sums
 };
-
-// Runs independent tasks on up to `threads` threads (the caller's included).
-void runTasks(const std::vector<std::function<void()>>& tasks, int threads) {
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i = next++; i < tasks.size(); i = next++) tasks[i]();
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, static_cast<int>(tasks.size())); ++t) {
-    pool.emplace_back(worker);
-  }
-  worker();
-  for (auto& t : pool) t.join();
-}
 
 class LevelMatcher {
  public:

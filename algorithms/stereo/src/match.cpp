@@ -16,6 +16,7 @@
 #include "delineo/core/error.hpp"
 #include "level_matcher.hpp"
 #include "match_steps.hpp"
+#include "workers.hpp"
 
 namespace delineo::stereo {
 
@@ -31,37 +32,9 @@ int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 int ceilDiv(int a, int b) { return -floorDiv(-a, b); }
 
 // The driver's own per-level work (preparation, Canny, validation, intervals) runs on the
-// level's threads, the worker model of the level matcher: independent tasks, or rows in bands,
-// handed out to `threads` workers, the calling thread one of them (threads == 1: all inline).
-// Serial, it was ~0.17 s CPU of the 1000²/128 d run. Every task writes its own outputs, so the
-// results do not depend on the thread count.
-void runTasks(const std::vector<std::function<void()>>& tasks, int threads) {
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i = next++; i < tasks.size(); i = next++) tasks[i]();
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, static_cast<int>(tasks.size())); ++t) {
-    pool.emplace_back(worker);
-  }
-  worker();
-  for (auto& t : pool) t.join();
-}
-
-template <class BandFn>
-void forRowBands(int rows, int threads, const BandFn& band) {
-  constexpr int kBand = 16;
-  const int bands = (rows + kBand - 1) / kBand;
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int b = next++; b < bands; b = next++) band(b * kBand, std::min(rows, (b + 1) * kBand));
-  };
-  const int workers = std::max(1, std::min(threads, bands));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-}
+// level's threads (workers.hpp); serial, it was ~0.17 s CPU of the 1000²/128 d run.
+using detail::forRowBands;
+using detail::runTasks;
 
 // Grey mapping shared by both images: 1st..99th percentile of their valid pixels to 0..255, so
 // Canny thresholds and SGBM penalties mean the same on 8-bit, 16-bit and float inputs.

@@ -11,6 +11,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "workers.hpp"
+
 namespace delineo::stereo::detail {
 namespace {
 
@@ -227,25 +229,6 @@ float cutWindowNcc(const CutWindow& w, const cv::Mat& other, const cv::Mat& othe
   return stb / std::sqrt(varb);
 }
 
-// Rows 0..rows−1 in bands of 8, handed out to `threads` workers (the calling thread is one of
-// them: threads == 1 runs inline), the worker model of the level matcher.
-template <class BandFn>
-void forRowBands(int rows, int threads, const BandFn& band) {
-  constexpr int kBand = 8;
-  const int bands = (rows + kBand - 1) / kBand;
-  std::atomic<int> next{0};
-  auto worker = [&] {
-    for (int b = next++; b < bands; b = next++) {
-      band(b * kBand, std::min(rows, (b + 1) * kBand));
-    }
-  };
-  const int workers = std::max(1, std::min(threads, bands));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-}
-
 // Photometric error of ref column x (rows y - r .. y + r) against other at (x - d, y + dy), d
 // real (linear interpolation along x); NaN when out of the image or on nodata.
 float columnError(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
@@ -409,7 +392,7 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
         }
       }
     }
-  });
+  }, /*bandRows=*/8);
   // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
   // own side (same side value), and the validated pixels off the segments on that surface.
   cv::Mat otherInvalidSum;  // integral image of the other image's nodata pixels
@@ -445,7 +428,7 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
         if (!(before == outD[x])) ++changed;
       }
     }
-  });
+  }, /*bandRows=*/8);
   return changed.load();
 }
 
