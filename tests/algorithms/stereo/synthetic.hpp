@@ -44,30 +44,40 @@ struct SquareScene {
   cv::Rect square;  // in the left image
 };
 
+// `squareLevel` is the square's mean grey level (140: brighter than the background's 30, so its
+// outline is a contour; 30: no contour at all); `noiseSigma` > 0 adds Gaussian noise to both
+// views (one seeded draw per pixel, left then right).
 inline SquareScene squareScene(cv::Size size, cv::Rect square, int background, int foreground,
-                               unsigned seed = 11) {
+                               unsigned seed = 11, double squareLevel = 140.0,
+                               double noiseSigma = 0.0) {
   // Moderate texture on both surfaces and a brighter square: its outline is the strongest
   // contour, as a roof edge is in aerial images.
   const cv::Mat back = texture(cv::Size(size.width + 64, size.height), seed) * 0.35 + 30.0;
-  const cv::Mat front = texture(cv::Size(size.width + 64, size.height), seed + 1) * 0.35 + 140.0;
+  const cv::Mat front = texture(cv::Size(size.width + 64, size.height), seed + 1) * 0.35 + squareLevel;
   SquareScene s;
   s.square = square;
   s.left.create(size, CV_32F);
   s.right.create(size, CV_32F);
   s.truth.create(size, CV_32F);
   s.occluded = cv::Mat::zeros(size, CV_8U);
+  cv::RNG rng(5);
+  const auto noise = [&] {
+    return noiseSigma > 0 ? static_cast<float>(rng.gaussian(noiseSigma)) : 0.0f;
+  };
   for (int y = 0; y < size.height; ++y) {
     for (int x = 0; x < size.width; ++x) {
       const bool inSquare = square.contains(cv::Point(x, y));
       // Textures are indexed by left-image x so both views see the same surface point.
-      s.left.at<float>(y, x) = inSquare ? front.at<float>(y, x + 32) : back.at<float>(y, x + 32);
+      s.left.at<float>(y, x) = (inSquare ? front.at<float>(y, x + 32) : back.at<float>(y, x + 32)) +
+                               noise();
       s.truth.at<float>(y, x) = static_cast<float>(inSquare ? foreground : background);
       // Right pixel xr sees the square if xr + foreground is inside it, else the background.
       const int xf = x + foreground;
       const bool seesSquare = y >= square.y && y < square.br().y && xf >= square.x &&
                               xf < square.br().x;
-      s.right.at<float>(y, x) = seesSquare ? front.at<float>(y, xf + 32)
-                                           : back.at<float>(y, x + background + 32);
+      s.right.at<float>(y, x) = (seesSquare ? front.at<float>(y, xf + 32)
+                                            : back.at<float>(y, x + background + 32)) +
+                                noise();
       const int xr = x - background;
       const bool hidden = !inSquare && y >= square.y && y < square.br().y &&
                           xr + foreground >= square.x && xr + foreground < square.br().x;

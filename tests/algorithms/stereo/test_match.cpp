@@ -195,39 +195,8 @@ TEST(Match, AdaptiveShapesKeepTheOutlineSharperThanSquareWindows) {
 // A textured block 12 px above its background with the SAME brightness and texture amplitude
 // (no contour at its outline, as on half of the simulated roof outlines), plus noise.
 testing::SquareScene contourlessBlock() {
-  const cv::Size size(160, 120);
-  const cv::Rect square(60, 30, 60, 60);
-  const int background = 2, foreground = 14;
-  const cv::Mat back = texture(cv::Size(size.width + 64, size.height), 11) * 0.35 + 30.0;
-  const cv::Mat front = texture(cv::Size(size.width + 64, size.height), 12) * 0.35 + 30.0;
-  cv::RNG rng(5);
-  testing::SquareScene s;
-  s.square = square;
-  s.left.create(size, CV_32F);
-  s.right.create(size, CV_32F);
-  s.truth.create(size, CV_32F);
-  s.occluded = cv::Mat::zeros(size, CV_8U);
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const bool inSquare = square.contains(cv::Point(x, y));
-      s.left.at<float>(y, x) = (inSquare ? front.at<float>(y, x + 32) : back.at<float>(y, x + 32)) +
-                               static_cast<float>(rng.gaussian(2.0));
-      s.truth.at<float>(y, x) = static_cast<float>(inSquare ? foreground : background);
-      const int xf = x + foreground;
-      const bool seesSquare = y >= square.y && y < square.br().y && xf >= square.x &&
-                              xf < square.br().x;
-      s.right.at<float>(y, x) = (seesSquare ? front.at<float>(y, xf + 32)
-                                            : back.at<float>(y, x + background + 32)) +
-                                static_cast<float>(rng.gaussian(2.0));
-      const int xr = x - background;
-      s.occluded.at<uchar>(y, x) = !inSquare && y >= square.y && y < square.br().y &&
-                                           xr + foreground >= square.x &&
-                                           xr + foreground < square.br().x
-                                       ? 1
-                                       : 0;
-    }
-  }
-  return s;
+  return testing::squareScene({160, 120}, {60, 30, 60, 60}, 2, 14, 11, /*squareLevel=*/30.0,
+                              /*noiseSigma=*/2.0);
 }
 
 // Rows whose +x outline (the side whose ground both views see) is located within 1 px: the
