@@ -53,7 +53,8 @@ inline SquareScene squareScene(cv::Size size, cv::Rect square, int background, i
   // Moderate texture on both surfaces and a brighter square: its outline is the strongest
   // contour, as a roof edge is in aerial images.
   const cv::Mat back = texture(cv::Size(size.width + 64, size.height), seed) * 0.35 + 30.0;
-  const cv::Mat front = texture(cv::Size(size.width + 64, size.height), seed + 1) * 0.35 + squareLevel;
+  const cv::Mat front =
+      texture(cv::Size(size.width + 64, size.height), seed + 1) * 0.35 + squareLevel;
   SquareScene s;
   s.square = square;
   s.left.create(size, CV_32F);
@@ -68,16 +69,16 @@ inline SquareScene squareScene(cv::Size size, cv::Rect square, int background, i
     for (int x = 0; x < size.width; ++x) {
       const bool inSquare = square.contains(cv::Point(x, y));
       // Textures are indexed by left-image x so both views see the same surface point.
-      s.left.at<float>(y, x) = (inSquare ? front.at<float>(y, x + 32) : back.at<float>(y, x + 32)) +
-                               noise();
+      s.left.at<float>(y, x) =
+          (inSquare ? front.at<float>(y, x + 32) : back.at<float>(y, x + 32)) + noise();
       s.truth.at<float>(y, x) = static_cast<float>(inSquare ? foreground : background);
       // Right pixel xr sees the square if xr + foreground is inside it, else the background.
       const int xf = x + foreground;
-      const bool seesSquare = y >= square.y && y < square.br().y && xf >= square.x &&
-                              xf < square.br().x;
-      s.right.at<float>(y, x) = (seesSquare ? front.at<float>(y, xf + 32)
-                                            : back.at<float>(y, x + background + 32)) +
-                                noise();
+      const bool seesSquare =
+          y >= square.y && y < square.br().y && xf >= square.x && xf < square.br().x;
+      s.right.at<float>(y, x) =
+          (seesSquare ? front.at<float>(y, xf + 32) : back.at<float>(y, x + background + 32)) +
+          noise();
       const int xr = x - background;
       const bool hidden = !inSquare && y >= square.y && y < square.br().y &&
                           xr + foreground >= square.x && xr + foreground < square.br().x;
