@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <tuple>
 
 #include <opencv2/imgproc.hpp>
@@ -271,16 +272,31 @@ TEST(Delineate, BalancedCostIntervalsHaveEqualWidthsAndGrowAwayFromEachOther) {
   EXPECT_EQ(ground.min, 5);
 }
 
-TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
-  const cv::Rect roof(50, 40, 60, 50);
-  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+// A raised roof (disparity 14 over ground 4) with its grown-box request and the cost service of
+// its ROI: the set-up of the tests that inspect the prepared cost images.
+struct RaisedRoofCosts {
+  Pair pair;
   DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  std::unique_ptr<stereo::CorrelationCostService> costs;
+};
+
+RaisedRoofCosts raisedRoofCosts(const DelineationParams& params) {
+  const cv::Rect roof(50, 40, 60, 50);
+  RaisedRoofCosts c{raisedRoof({170, 140}, roof, 14, 4), {}, nullptr};
+  c.req.init = grownBox(roof, 8);
+  c.req.roof = {13, 15};
+  c.req.ground = DisparityInterval{3, 5};
+  const cv::Rect roi = regionOfInterest(c.pair.left, c.pair.right, c.req, params);
+  c.costs = stereo::CorrelationCostService::compute(c.pair.left, c.pair.right, roi, 3, 15);
+  return c;
+}
+
+TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   DelineationParams plain;
-  const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, plain);
-  const auto costs = stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15);
+  const RaisedRoofCosts c = raisedRoofCosts(plain);
+  const Pair& pair = c.pair;
+  const DelineationRequest& req = c.req;
+  const auto& costs = c.costs;
   const PreparedEnergy off = prepareEnergy(*costs, pair.left, pair.right, req, plain);
   EXPECT_TRUE(off.images.uncappedDifference.empty());
   DelineationParams capped = plain;
@@ -303,17 +319,13 @@ TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
 }
 
 TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
-  const cv::Rect roof(50, 40, 60, 50);
-  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
   DelineationParams params;
   ASSERT_FALSE(params.bandBestCost);  // the default: the paper's constant band cost
   params.bandBestCost = true;
-  const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, params);
-  const auto costs = stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15);
+  const RaisedRoofCosts c = raisedRoofCosts(params);
+  const Pair& pair = c.pair;
+  const DelineationRequest& req = c.req;
+  const auto& costs = c.costs;
   const PreparedEnergy on = prepareEnergy(*costs, pair.left, pair.right, req, params);
   ASSERT_FALSE(on.images.bandCost.empty());
   const cv::Mat expected = cv::max(cv::min(on.images.roofCost, on.images.groundCost), on.images.noMatchCost);
