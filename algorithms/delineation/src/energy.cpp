@@ -436,8 +436,9 @@ double PolygonEnergy::delta(const Change& c) const {
   auto idOf = [&](int i) { return offset + ((c.first + i) % n + n) % n; };
 
   // New local chain: prev2, prev, inserted..., next, next2.
-  std::vector<cv::Point> chain;
-  chain.reserve(m + 4);
+  DeltaScratch& s = scratch_;
+  std::vector<cv::Point>& chain = s.chain;
+  chain.clear();
   chain.push_back(at(-2));
   chain.push_back(at(-1));
   for (const auto& v : c.inserted) chain.push_back(v);
@@ -446,11 +447,13 @@ double PolygonEnergy::delta(const Change& c) const {
 
   double d = 0.0;
   // Old edges: first vertex at -1 .. removeCount-1; old priors at -1 .. removeCount.
-  std::vector<int> oldEdges;
+  std::vector<int>& oldEdges = s.oldEdges;
+  oldEdges.clear();
   for (int i = -1; i < c.removeCount; ++i) oldEdges.push_back(idOf(i));
   std::sort(oldEdges.begin(), oldEdges.end());
   oldEdges.erase(std::unique(oldEdges.begin(), oldEdges.end()), oldEdges.end());
-  std::vector<int> oldVertices;
+  std::vector<int>& oldVertices = s.oldVertices;
+  oldVertices.clear();
   for (int i = -1; i <= c.removeCount; ++i) oldVertices.push_back(idOf(i));
   std::sort(oldVertices.begin(), oldVertices.end());
   oldVertices.erase(std::unique(oldVertices.begin(), oldVertices.end()), oldVertices.end());
@@ -465,30 +468,45 @@ double PolygonEnergy::delta(const Change& c) const {
     d += weights_.rigidity * anglePrior(vertexAngle(chain[i - 1], chain[i], chain[i + 1]));
   }
 
-  // Area terms: rows crossed by an old or a new edge.
-  std::vector<int> rows;
-  std::vector<std::pair<int, double>> added;
-  for (int i = -1; i < c.removeCount; ++i) {
-    forEachCrossing(at(i), at(i + 1), size_.height, [&](int y, double) { rows.push_back(y); });
+  // Area terms: rows crossed by an old or a new edge. Both chains run from at(-1) to
+  // at(removeCount) without a break, so together they cross exactly the rows between the lowest
+  // and the highest of their vertices.
+  int yLow = chain[1].y, yHigh = chain[1].y;
+  for (int i = 0; i <= c.removeCount; ++i) {
+    yLow = std::min(yLow, at(i).y);
+    yHigh = std::max(yHigh, at(i).y);
   }
+  for (int i = 2; i <= m + 2; ++i) {
+    yLow = std::min(yLow, chain[i].y);
+    yHigh = std::max(yHigh, chain[i].y);
+  }
+  yLow = std::max(yLow, 0);
+  yHigh = std::min(yHigh, size_.height);
+  if (yLow >= yHigh) return d;
+  // New crossings bucketed by row (counting sort: start offsets per row, then fill).
+  const int rowCount = yHigh - yLow;
+  std::vector<int>& start = s.addedCount;
+  start.assign(static_cast<size_t>(rowCount) + 1, 0);
+  for (int i = 1; i <= m + 1; ++i) {
+    forEachCrossing(chain[i], chain[i + 1], size_.height, [&](int y, double) { ++start[y - yLow + 1]; });
+  }
+  for (int r = 0; r < rowCount; ++r) start[r + 1] += start[r];
+  std::vector<double>& addedX = s.addedX;
+  addedX.resize(static_cast<size_t>(start[rowCount]));
   for (int i = 1; i <= m + 1; ++i) {
     forEachCrossing(chain[i], chain[i + 1], size_.height, [&](int y, double x) {
-      rows.push_back(y);
-      added.emplace_back(y, x);
+      addedX[static_cast<size_t>(start[y - yLow]++)] = x;
     });
   }
-  std::sort(rows.begin(), rows.end());
-  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-  std::sort(added.begin(), added.end());
-  std::vector<double> xs;
-  size_t a = 0;
-  for (int y : rows) {
+  // start[r] now points past row r's crossings; row r's begin at start[r - 1] (0 for r = 0).
+  std::vector<double>& xs = s.xs;
+  for (int y = yLow; y < yHigh; ++y) {
     xs.clear();
     for (const auto& k : rowCrossings_[y]) {
       if (!std::binary_search(oldEdges.begin(), oldEdges.end(), k.edge)) xs.push_back(k.x);
     }
-    while (a < added.size() && added[a].first < y) ++a;
-    for (size_t j = a; j < added.size() && added[j].first == y; ++j) xs.push_back(added[j].second);
+    const int r = y - yLow;
+    for (int j = r == 0 ? 0 : start[r - 1]; j < start[r]; ++j) xs.push_back(addedX[static_cast<size_t>(j)]);
     std::sort(xs.begin(), xs.end());
     const RowTerms now = rowTerms(y, xs);
     const RowTerms& before = rowTerms_[y];

@@ -153,6 +153,13 @@ class PolygonEnergy {
   cv::Mat costDifference_;            // c_ground - c_roof, sampled by the edge gate
   std::vector<std::vector<Crossing>> rowCrossings_;
   std::vector<RowTerms> rowTerms_;
+  // Scratch of delta(), kept to avoid allocations in the optimiser's inner loop.
+  struct DeltaScratch {
+    std::vector<cv::Point> chain;
+    std::vector<int> oldEdges, oldVertices, addedCount;
+    std::vector<double> addedX, xs;
+  };
+  mutable DeltaScratch scratch_;
   std::vector<std::array<double, 2>> edgeTerms_;  // by edge id
   std::vector<double> vertexPriors_;              // by vertex id (same ids as edges)
   mutable std::unordered_map<std::uint64_t, std::array<double, 2>> edgeCache_;
