@@ -76,6 +76,31 @@ cv::Mat boxSums(const cv::Mat& src, int window) {
   return sums(cv::Rect(r, r, src.cols - 2 * r, src.rows - 2 * r));
 }
 
+// Noise sigma of an image from its response to the difference of two Laplacians, which cancels
+// locally linear intensity (the kernel of Immerkaer 1996, "Fast noise variance estimation"; under
+// pure noise the response has variance 36 sigma^2). Texture adds to the response, so the level
+// is read in the flattest places: the first quartile of the response's mean square over 7x7
+// blocks (on a fully textured image this overestimates sigma, which only weakens the
+// brightness term).
+double noiseSigma(const cv::Mat& image) {
+  if (image.rows < 9 || image.cols < 9) return 1.0;
+  const cv::Mat kernel = (cv::Mat_<double>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
+  cv::Mat response;
+  cv::filter2D(image, response, CV_64F, kernel);
+  const cv::Mat inner = response(cv::Rect(1, 1, image.cols - 2, image.rows - 2));
+  cv::Mat energy;
+  cv::blur(inner.mul(inner), energy, {7, 7});
+  std::vector<double> values;
+  values.reserve(static_cast<size_t>(energy.rows / 7 + 1) * static_cast<size_t>(energy.cols / 7 + 1));
+  for (int y = 3; y < energy.rows - 3; y += 7) {
+    for (int x = 3; x < energy.cols - 3; x += 7) values.push_back(energy.at<double>(y, x));
+  }
+  if (values.empty()) return 1.0;
+  const auto q = values.begin() + static_cast<long>(values.size() / 4);
+  std::nth_element(values.begin(), q, values.end());
+  return std::sqrt(*q / 36.0);
+}
+
 class QuantisedCostVolume final : public CorrelationCostService {
  public:
   QuantisedCostVolume(cv::Rect roi, int dmin, int dmax, double unmatched)
@@ -175,6 +200,98 @@ class QuantisedCostVolume final : public CorrelationCostService {
   cv::Mat bestCost_;               // CV_16U
 };
 
+// Gain and offset mapping the right view's grey levels to the left's, from the moments of the
+// overlapping parts of the whole images (columns seen by both for a typical disparity). The two
+// views see nearly the same scene, so their histograms differ by the exposures; a fit on one
+// building's matches is too noisy (a few percent of gain is many noise sigmas on a bright roof).
+std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& right, int dmin, int dmax) {
+  const int shift = std::clamp((dmin + dmax) / 2, -(left.cols - 1) / 2, (left.cols - 1) / 2);
+  const int width = left.cols - std::abs(shift);
+  // Every 4th row: the moments of a quarter of the image are as good, at a quarter of the time
+  // (this runs for every building).
+  const int rowStep = 4, rows = (left.rows + rowStep - 1) / rowStep;
+  const cv::Mat l(rows, width, CV_32F, const_cast<float*>(left.ptr<float>(0, std::max(0, shift))),
+                  left.step[0] * rowStep);
+  const cv::Mat r(rows, width, CV_32F, const_cast<float*>(right.ptr<float>(0, std::max(0, -shift))),
+                  right.step[0] * rowStep);
+  double sumL = 0, sumLL = 0, sumR = 0, sumRR = 0, count = 0;
+  for (int y = 0; y < rows; ++y) {
+    const float* pl = l.ptr<float>(y);
+    const float* pr = r.ptr<float>(y);
+    for (int x = 0; x < width; ++x) {
+      if (!std::isfinite(pl[x]) || !std::isfinite(pr[x])) continue;
+      sumL += pl[x];
+      sumLL += static_cast<double>(pl[x]) * pl[x];
+      sumR += pr[x];
+      sumRR += static_cast<double>(pr[x]) * pr[x];
+      count += 1;
+    }
+  }
+  if (count < 2) return {1.0, 0.0};
+  const double meanL = sumL / count, meanR = sumR / count;
+  const double varL = sumLL / count - meanL * meanL, varR = sumRR / count - meanR * meanR;
+  if (!(varL > 1e-12) || !(varR > 1e-12)) return {1.0, 0.0};
+  const double gain = std::sqrt(varL / varR);
+  return {gain, meanL - gain * meanR};
+}
+
+// Blends a mean grey level term into the NCC planes of `volume` for windows with little texture:
+// cost = w * ncc_cost + (1 - w) * min(1, |mean_left - (gain * mean_right + offset)| / (scale *
+// sigma)), w = t / (t + sigma^2) with t the left window's variance above the noise's (sigma^2) and sigma the left ROI's
+// noise (radiometricMap gives gain and offset). On a textureless roof NCC is noise at every
+// disparity while the mean grey level still tells the roof's match from the ground's.
+// sums*: box sums of the left (A, ROI positions) and right (B, ROI positions shifted by the
+// plane's offset) windows, as in the NCC pass.
+void addBrightnessTerm(QuantisedCostVolume& volume, const cv::Mat& sumA, const cv::Mat& sumAA,
+                       const cv::Mat& sumB,
+                       const cv::Mat& leftRoi, int window, double scale, double gain,
+                       double shift) {
+  const cv::Rect roi = volume.roi();
+  const int dmin = volume.dmin(), dmax = volume.dmax();
+  const int planes = dmax - dmin + 1;
+  const double n = static_cast<double>(window) * window;
+  const double sigma = std::max(1e-3, noiseSigma(leftRoi));
+  const double flatVariance = sigma * sigma;
+  const uint16_t unmatched = volume.unmatchedQuantised();
+  // NCC counts as much as the left window's variance stands above the noise's. Per pixel:
+  // cost = nccWeight * ncc_cost + min(brightnessWeight, |sa - gain * sb - n * shift| * slope).
+  const double meanScale = scale * sigma;
+  cv::Mat nccWeight(roi.size(), CV_32F), brightnessWeight(roi.size(), CV_32F), slope(roi.size(), CV_32F);
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      const double m = sumA.at<double>(y, x) / n;
+      const double variance = std::max(0.0, sumAA.at<double>(y, x) / n - m * m);
+      // Texture is the variance above the noise's: a flat window's NCC is noise and weighs 0.
+      const double texture = std::max(0.0, variance - flatVariance);
+      const double w = texture / (texture + flatVariance);
+      nccWeight.at<float>(y, x) = static_cast<float>(w / kQuantScale);
+      brightnessWeight.at<float>(y, x) = static_cast<float>(1.0 - w);
+      slope.at<float>(y, x) = static_cast<float>((1.0 - w) / (meanScale * n));
+    }
+  }
+  const float gainF = static_cast<float>(gain), shiftF = static_cast<float>(n * shift);
+  cv::parallel_for_(cv::Range(0, planes), [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      const int offset = dmax - (dmin + k);
+      cv::Mat& plane = volume.plane(k);
+      for (int y = 0; y < roi.height; ++y) {
+        uint16_t* o = plane.ptr<uint16_t>(y);
+        const double* sa = sumA.ptr<double>(y);
+        const double* sb = sumB.ptr<double>(y) + offset;
+        const float* wn = nccWeight.ptr<float>(y);
+        const float* wb = brightnessWeight.ptr<float>(y);
+        const float* sl = slope.ptr<float>(y);
+        for (int x = 0; x < roi.width; ++x) {
+          if (o[x] == unmatched) continue;
+          const float difference = static_cast<float>(sa[x]) - gainF * static_cast<float>(sb[x]) - shiftF;
+          const float cost = wn[x] * o[x] + std::min(wb[x], std::abs(difference) * sl[x]);
+          o[x] = static_cast<uint16_t>(std::min(65535.f, cost * 65535.f + 0.5f));
+        }
+      }
+    }
+  });
+}
+
 }  // namespace
 
 std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
@@ -273,6 +390,11 @@ std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
     }
   });
   if (canceled.load() || core::isCanceled(progress)) return nullptr;
+  if (params.brightnessScale > 0) {
+    const auto [gain, shift] = radiometricMap(left, right, dmin, dmax);
+    addBrightnessTerm(*volume, sumA, sumAA, sumB, leftVals(cv::Rect(r, r, roi.width, roi.height)), window,
+                      params.brightnessScale, gain, shift);
+  }
   volume->finish();
   core::report(progress, 1.0);
   return volume;

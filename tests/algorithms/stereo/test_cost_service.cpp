@@ -124,5 +124,73 @@ TEST(CostService, QueryIsFastFor300x300By256) {
   EXPECT_LT(ms, 20.0);
 }
 
+// A textureless roof (grey 200, disparity 40) on textured ground (disparity 3), noise 2 grey
+// levels in both views, right view with gain 0.9 and offset 8. The roof is narrower than the
+// disparity step, so that the ground's disparity never lands a roof pixel on the roof's image.
+struct FlatRoofPair {
+  cv::Mat left, right;
+  cv::Rect roof{150, 30, 30, 40};
+  int roofDisparity = 40, groundDisparity = 3;
+};
+
+FlatRoofPair flatRoofPair() {
+  FlatRoofPair p;
+  const cv::Mat ground = texture({320, 100}, 5);
+  p.left.create(100, 260, CV_32F);
+  p.right.create(100, 260, CV_32F);
+  for (int y = 0; y < 100; ++y) {
+    for (int x = 0; x < 260; ++x) {
+      p.left.at<float>(y, x) = p.roof.contains({x, y}) ? 200.f : ground.at<float>(y, x);
+      const bool onRoof = p.roof.contains({x + p.roofDisparity, y});
+      const float v = onRoof ? 200.f : ground.at<float>(y, x + p.groundDisparity);
+      p.right.at<float>(y, x) = 0.9f * v + 8.f;
+    }
+  }
+  cv::Mat noise(p.left.size(), CV_32F);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 2.0);
+  p.left += noise;
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 2.0);
+  p.right += noise;
+  return p;
+}
+
+TEST(CostService, BrightnessTermSeparatesATexturelessRoofFromTheGround) {
+  const FlatRoofPair p = flatRoofPair();
+  const cv::Rect roi(90, 20, 150, 60);
+  CostParams nccOnly;
+  CostParams withBrightness;
+  withBrightness.brightnessScale = 20;
+  const auto plain = CorrelationCostService::compute(p.left, p.right, roi, 0, 44, nccOnly);
+  const auto bright = CorrelationCostService::compute(p.left, p.right, roi, 0, 44, withBrightness);
+  ASSERT_NE(plain, nullptr);
+  ASSERT_NE(bright, nullptr);
+  // Inside the roof, 3 px from its edges (flat windows): NCC cannot tell roof from ground; the
+  // mean grey level, mapped through the fitted gain and offset, can.
+  double plainGap = 0, roofCost = 0, groundCost = 0, count = 0;
+  for (int y = p.roof.y + 3; y < p.roof.br().y - 3; ++y) {
+    for (int x = p.roof.x + 3; x < p.roof.br().x - 3; ++x) {
+      plainGap += std::abs(plain->cost(x, y, p.roofDisparity) - plain->cost(x, y, p.groundDisparity));
+      roofCost += bright->cost(x, y, p.roofDisparity);
+      groundCost += bright->cost(x, y, p.groundDisparity);
+      count += 1;
+    }
+  }
+  EXPECT_LT(plainGap / count, 0.15);
+  EXPECT_LT(roofCost / count, 0.1);  // 12 grey levels apart without the gain/offset map: 0.33
+  EXPECT_GT(groundCost / count, 0.5);
+  // Textured ground east of the roof (seen by both views): the term barely changes NCC's verdict.
+  double nccGround = 0, brightGround = 0, n = 0;
+  for (int y = roi.y; y < roi.br().y; ++y) {
+    for (int x = p.roof.br().x + 5; x < roi.br().x; ++x) {
+      nccGround += plain->cost(x, y, p.groundDisparity);
+      brightGround += bright->cost(x, y, p.groundDisparity);
+      n += 1;
+    }
+  }
+  EXPECT_LT(brightGround / n, 0.05);
+  EXPECT_NEAR(brightGround / n, nccGround / n, 0.02);
+}
+
 }  // namespace
 }  // namespace delineo::stereo
