@@ -247,6 +247,14 @@
         <translation>Plafond des coûts</translation>
     </message>
     <message>
+        <source>Cost cap floor</source>
+        <translation>Plancher du plafond des coûts</translation>
+    </message>
+    <message>
+        <source>Cost brightness</source>
+        <translation>Luminosité dans le coût</translation>
+    </message>
+    <message>
         <source>Band best cost</source>
         <translation>Coût de bande selon l’appariement</translation>
     </message>

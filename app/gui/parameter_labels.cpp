@@ -22,6 +22,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Max iterations"),
     QT_TRANSLATE_NOOP("Parameters", "ROI margin"),
     QT_TRANSLATE_NOOP("Parameters", "Cost window"),
+    QT_TRANSLATE_NOOP("Parameters", "Cost brightness"),
     QT_TRANSLATE_NOOP("Parameters", "Ground tolerance"),
     QT_TRANSLATE_NOOP("Parameters", "Ground search"),
     QT_TRANSLATE_NOOP("Parameters", "Ring width"),
@@ -40,6 +41,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Region right angles"),
     QT_TRANSLATE_NOOP("Parameters", "Cost aggregation"),
     QT_TRANSLATE_NOOP("Parameters", "Cost cap"),
+    QT_TRANSLATE_NOOP("Parameters", "Cost cap floor"),
     QT_TRANSLATE_NOOP("Parameters", "Band best cost"),
     // stereo::MatchParams
     QT_TRANSLATE_NOOP("Parameters", "Method"),

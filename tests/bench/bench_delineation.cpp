@@ -117,7 +117,8 @@ core::Polygon jittered(const core::Polygon& p, std::mt19937& rng, double amount)
 // green, the init in blue and the result in red; beside it the same crop of c_roof < c_ground
 // (white: the roof interval matches better).
 void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi,
-                 const DelineationRequest& req, const core::Polygon& truth, const core::Polygon& result) {
+                 const DelineationRequest& req, const core::Polygon& truth, const core::Polygon& result,
+                 const stereo::CostParams& costParams) {
   const int k = 3;
   cv::Mat crop;
   cv::normalize(left(roi), crop, 0, 255, cv::NORM_MINMAX, CV_8U);
@@ -127,7 +128,7 @@ void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& ri
   DelineationRequest r = req;
   const auto [rs, gs] = costIntervals(r.roof, *r.ground, DelineationParams{}.balanceIntervals);
   const auto costs = stereo::CorrelationCostService::compute(left, right, roi, std::min(rs.min, gs.min),
-                                                            std::max(rs.max, gs.max), {});
+                                                            std::max(rs.max, gs.max), costParams);
   if (costs) {
     const cv::Mat cr = costs->minCost(rs.min, rs.max), cg = costs->minCost(gs.min, gs.max);
     roofBetter = cr < cg;
@@ -138,6 +139,13 @@ void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& ri
     std::printf("      diag roof %d:%d ground %d:%d  mean c_roof %.3f c_ground %.3f inside truth; outside %.3f %.3f\n",
                 r.roof.min, r.roof.max, r.ground->min, r.ground->max, cv::mean(cr, inside)[0], cv::mean(cg, inside)[0],
                 cv::mean(cr, ~inside)[0], cv::mean(cg, ~inside)[0]);
+    if (std::getenv("BENCH_DUMP_COSTS")) {
+      cv::Mat grey;
+      cv::hconcat(cr, cg, grey);
+      grey.convertTo(grey, CV_8U, 255.0);
+      cv::resize(grey, grey, {}, k, k, cv::INTER_NEAREST);
+      cv::imwrite(path.substr(0, path.size() - 4) + "_costs.png", grey);
+    }
     cv::resize(roofBetter, roofBetter, {}, k, k, cv::INTER_NEAREST);
     cv::cvtColor(roofBetter, roofBetter, cv::COLOR_GRAY2BGR);
     roofBetter *= 0.6;
@@ -388,7 +396,8 @@ int main(int argc, char** argv) {
           if (!dumpDir.empty()) {
             dumpPicture(dumpDir + "/s" + std::to_string(sceneParams.seed) + "_b" + std::to_string(id) + "_" +
                             initName + ".png",
-                        left, right, r.roi, req, fp.polygon, r.polygon);
+                        left, right, r.roi, req, fp.polygon, r.polygon,
+                        stereo::CostParams{params.costWindow, 1.0, params.costBrightness});
           }
           if (diag || std::getenv("BENCH_VERBOSE")) {
             const cv::Rect2d a = core::boundingBox(r.polygon.outer), b = core::boundingBox(fp.polygon.outer);
@@ -402,7 +411,7 @@ int main(int argc, char** argv) {
             const auto [rsv, gsv] = costIntervals(req.roof, *req.ground, params.balanceIntervals);
             const auto vc = stereo::CorrelationCostService::compute(left, right, r.roi, std::min(rsv.min, gsv.min),
                                                                     std::max(rsv.max, gsv.max),
-                                                                    stereo::CostParams{params.costWindow, 1.0});
+                                                                    stereo::CostParams{params.costWindow, 1.0, params.costBrightness});
             const PreparedEnergy pe = prepareEnergy(*vc, left, right, req, params);
             auto localRing = [&](const core::Ring& rg) {
               IntRing out;
@@ -456,7 +465,7 @@ int main(int argc, char** argv) {
         const auto [roofSearched, groundSearched] = costIntervals(req.roof, *req.ground, params.balanceIntervals);
         const auto costs = stereo::CorrelationCostService::compute(
             left, right, roi, std::min(roofSearched.min, groundSearched.min),
-            std::max(roofSearched.max, groundSearched.max), stereo::CostParams{params.costWindow, 1.0});
+            std::max(roofSearched.max, groundSearched.max), stereo::CostParams{params.costWindow, 1.0, params.costBrightness});
         const PreparedEnergy prepared = prepareEnergy(*costs, left, right, req, params);
         ++sideTotal;
         const int expectedSide = number(fp, "roof_disparity_min", 0) > g ? -1 : +1;

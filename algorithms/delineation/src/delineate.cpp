@@ -449,7 +449,9 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
     // taken as roof) costs no more than the occlusion band. After the region stage, which
     // compares outlines on the plain costs.
     im.uncappedDifference = im.groundCost - im.roofCost;
-    const float cap = static_cast<float>(params.costCap * im.noMatchCost);
+    // The floor keeps the cap meaningful on clean pairs, where NoMatchCost is near 0 and a
+    // multiple of it would flatten every cost (no area evidence left against the edge terms).
+    const float cap = static_cast<float>(std::max(params.costCap * im.noMatchCost, params.costCapFloor));
     im.roofCost = cv::min(im.roofCost, cap);
     im.groundCost = cv::min(im.groundCost, cap);
   }
@@ -479,6 +481,7 @@ DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
   core::Progress::Range costProgress(progress, 0.0, 0.3);
   stereo::CostParams costParams;
   costParams.window = params.costWindow;
+  costParams.brightnessScale = params.costBrightness;
   const auto costs = stereo::CorrelationCostService::compute(toFloat(left), toFloat(right), result.roi,
                                                             search.min, search.max, costParams,
                                                             progress ? &costProgress : nullptr);

@@ -140,6 +140,8 @@ TEST(Delineate, DoesNotFollowAStrongLineLeavingTheRoof) {
   plain.shortcutVertices = 0;
   plain.regionInit = false;
   plain.costAggregation = 1;
+  plain.costCap = 0;
+  plain.costBrightness = 0;
   const auto spiky = delineate(pair.left, pair.right, req, plain);
   EXPECT_GT(farthestOutside(spiky.polygon, roof), 10.0);
 }
@@ -293,6 +295,7 @@ RaisedRoofCosts raisedRoofCosts(const DelineationParams& params) {
 
 TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   DelineationParams plain;
+  plain.costCap = 0;  // off
   const RaisedRoofCosts c = raisedRoofCosts(plain);
   const Pair& pair = c.pair;
   const DelineationRequest& req = c.req;
@@ -301,6 +304,7 @@ TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   EXPECT_TRUE(off.images.uncappedDifference.empty());
   DelineationParams capped = plain;
   capped.costCap = 1.0;
+  capped.costCapFloor = 0;
   const PreparedEnergy on = prepareEnergy(*costs, pair.left, pair.right, req, capped);
   const double cap = on.images.noMatchCost;
   double maxRoof = 0, maxGround = 0, maxPlain = 0;
@@ -316,12 +320,21 @@ TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   ASSERT_FALSE(on.images.uncappedDifference.empty());
   EXPECT_EQ(cv::norm(on.images.uncappedDifference, off.images.groundCost - off.images.roofCost, cv::NORM_INF), 0.0);
   EXPECT_EQ(on.init.outer, off.init.outer);  // the region stage compares outlines on the plain costs
+  // The floor: on this clean pair NoMatchCost is far below it, so the floor sets the cap.
+  capped.costCapFloor = 0.3;
+  ASSERT_LT(cap, capped.costCapFloor);
+  const PreparedEnergy floored = prepareEnergy(*costs, pair.left, pair.right, req, capped);
+  cv::minMaxLoc(floored.images.roofCost, nullptr, &maxRoof);
+  EXPECT_GT(maxRoof, cap + 0.05);
+  EXPECT_LE(maxRoof, 0.3 + 1e-6);
+  EXPECT_EQ(cv::countNonZero((floored.images.roofCost != off.images.roofCost) & (off.images.roofCost < 0.3)), 0);
 }
 
 TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
   DelineationParams params;
   ASSERT_FALSE(params.bandBestCost);  // the default: the paper's constant band cost
   params.bandBestCost = true;
+  params.costCap = 0;  // the band cost is compared with the uncapped costs below
   const RaisedRoofCosts c = raisedRoofCosts(params);
   const Pair& pair = c.pair;
   const DelineationRequest& req = c.req;

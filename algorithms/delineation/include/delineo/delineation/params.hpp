@@ -14,6 +14,7 @@ struct DelineationParams {
   int maxIterations = 400;         // sweeps (moves, edge moves, deletions) over all rounds
   int roiMargin = 24;              // px added around the initial polygon to make the ROI
   int costWindow = 5;              // px, side of the correlation window of Crit
+  double costBrightness = 20.0;    // × noise sigma: Crit's mean grey term for flat windows (0 = NCC only)
   int groundTolerance = 3;         // px, half width of the ground interval estimated from the ring
   int groundSearch = 64;           // px searched below the roof interval when ground is unknown
   int ringWidth = 8;               // px, width of the band outside the init used to estimate ground
@@ -31,7 +32,8 @@ struct DelineationParams {
   double regionTolerance = 8.0;    // px: coarsest outline simplification of the region stage
   bool regionRightAngles = false;  // region stage also tries its outlines with right angles
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
-  double costCap = 0.0;            // × NoMatchCost: c_roof and c_ground capped there for the terms (0 = off)
+  double costCap = 1.6;            // × NoMatchCost: c_roof and c_ground capped there for the terms (0 = off)
+  double costCapFloor = 0.35;      // Crit units: the cap is never below this
   bool bandBestCost = false;       // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost, the paper)
   template <class V>
   void visit(V&& v) {
@@ -65,6 +67,12 @@ struct DelineationParams {
     v(core::ParamInfo{"cost-window", "Cost window", "px",
                       "Side of the correlation window of the per-pixel cost", 3, 31},
       costWindow);
+    v(core::ParamInfo{"cost-brightness", "Cost brightness", "× noise",
+                      "Windows with little texture (where NCC is noise) are also compared by mean "
+                      "grey level after a global gain/offset match of the views; a difference of "
+                      "this many noise sigmas costs 1 (0 = NCC only, as in the paper)",
+                      0, 100},
+      costBrightness);
     v(core::ParamInfo{"ground-tolerance", "Ground tolerance", "px",
                       "Half width of the ground disparity interval estimated around the init", 0,
                       32},
@@ -144,10 +152,17 @@ struct DelineationParams {
       costAggregation);
     v(core::ParamInfo{"cost-cap", "Cost cap", "× NoMatchCost",
                       "Cap c_roof and c_ground at this multiple of NoMatchCost in the area terms "
-                      "(a pixel matching neither interval costs no more than the occlusion band); "
+                      "(a pixel matching neither interval, a tree or a neighbour's wall, weighs the "
+                      "same whichever side of the contour it lies on); "
                       "the edge gate, region stage and courtyard seeds keep the plain costs (0 = off)",
                       0, 10},
       costCap);
+    v(core::ParamInfo{"cost-cap-floor", "Cost cap floor", "",
+                      "Lowest value of the cost cap, in Crit units (0 = perfect match, 0.5 = no "
+                      "correlation): on a clean pair NoMatchCost is near 0 and a multiple of it "
+                      "alone would flatten every cost",
+                      0, 1},
+      costCapFloor);
     v(core::ParamInfo{"band-best-cost", "Band best cost", "",
                       "A pixel of the occlusion band costs NoMatchCost or, when higher, the lower of "
                       "c_roof and c_ground there, so that the band is never cheaper than the pixel's "
