@@ -247,6 +247,10 @@
         <translation>Plafond des coûts</translation>
     </message>
     <message>
+        <source>Notches</source>
+        <translation>Encoches</translation>
+    </message>
+    <message>
         <source>Cost cap floor</source>
         <translation>Plancher du plafond des coûts</translation>
     </message>

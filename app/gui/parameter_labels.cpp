@@ -28,6 +28,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Ring width"),
     QT_TRANSLATE_NOOP("Parameters", "Edge moves"),
     QT_TRANSLATE_NOOP("Parameters", "Courtyards"),
+    QT_TRANSLATE_NOOP("Parameters", "Notches"),
     QT_TRANSLATE_NOOP("Parameters", "Min courtyard area"),
     QT_TRANSLATE_NOOP("Parameters", "Balance intervals"),
     QT_TRANSLATE_NOOP("Parameters", "Edge contrast gate"),

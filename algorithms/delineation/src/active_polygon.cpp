@@ -36,6 +36,7 @@ class Optimiser {
       converge();
       insertVertices(params_.refinedSpacing);
       converge();
+      if (params_.notches) carveNotches();
       if (params_.courtyards) addCourtyards();
     } catch (const CanceledSignal&) {
       result.status = core::RunStatus::Canceled;
@@ -237,6 +238,78 @@ class Optimiser {
     energy_.setPolygon(p);
     refreshReferenceTotal();
     endSweep("insertion");
+  }
+
+  // After convergence, a ground-leaning region inside the polygon that reaches its outer ring
+  // is tried as a notch: the outline of the polygon minus that region is optimised from there
+  // and kept only when the final energy is lower. Local moves cannot carve a notch deeper than
+  // a few pixels from a rough (box) contour; the region stage at the start only sees the init.
+  void carveNotches() {
+    if (!energy_.polygon().holes.empty()) return;
+    const cv::Mat inside = core::rasterize(toPolygon(energy_.polygon()), energy_.size());
+    // Same ground-leaning test as the courtyard seeds (addCourtyards); a region up to
+    // kNotchReach px from the outside counts (the strip between is often a wall or a tree that
+    // matches neither interval).
+    constexpr float kGroundLean = 0.05f;
+    constexpr double kNotchReach = 12.0;
+    cv::Mat difference = images_.uncappedDifference.empty() ? cv::Mat(images_.groundCost - images_.roofCost)
+                                                             : images_.uncappedDifference.clone();
+    cv::blur(difference, difference, {9, 9}, {-1, -1}, cv::BORDER_REPLICATE);
+    cv::Mat groundLike = (difference < -kGroundLean) & inside;
+    cv::morphologyEx(groundLike, groundLike, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
+    cv::Mat depth;  // distance of each inside pixel to the outside
+    cv::distanceTransform(inside, depth, cv::DIST_L2, 3);
+    cv::Mat labels, stats, centroids;
+    const int count = cv::connectedComponentsWithStats(groundLike, labels, stats, centroids, 8, CV_32S);
+    std::vector<std::pair<int, int>> notches;  // (area, label)
+    for (int l = 1; l < count; ++l) {
+      const int area = stats.at<int>(l, cv::CC_STAT_AREA);
+      if (area < params_.minCourtyardArea) continue;
+      double nearest = 0;
+      cv::minMaxLoc(depth, &nearest, nullptr, nullptr, nullptr, labels == l);
+      if (nearest > kNotchReach) continue;  // deep inside: a courtyard candidate, not a notch
+      notches.emplace_back(area, l);
+    }
+    std::stable_sort(notches.begin(), notches.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    constexpr size_t kMostNotches = 3;  // each try is a full convergence
+    for (size_t k = 0; k < notches.size() && k < kMostNotches; ++k) {
+      if (!budgetLeft()) break;
+      // The region grown until it reaches the outside: the strip between them goes too (a wall,
+      // a tree or a neighbour's facade that matches neither interval).
+      double nearest = 0;
+      cv::minMaxLoc(depth, &nearest, nullptr, nullptr, nullptr, labels == notches[k].second);
+      const int reach = static_cast<int>(std::ceil(nearest)) + 1;
+      cv::Mat notch;
+      cv::dilate(labels == notches[k].second, notch,
+                 cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * reach + 1, 2 * reach + 1}));
+      cv::Mat carved = inside & (notch == 0);
+      cv::morphologyEx(carved, carved, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+      std::vector<std::vector<cv::Point>> contours;
+      cv::findContours(carved, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+      if (contours.empty()) continue;
+      const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+        return cv::contourArea(a) < cv::contourArea(b);
+      });
+      std::vector<cv::Point> simplified;
+      cv::approxPolyDP(*largest, simplified, 1.5, true);
+      core::Ring ring;
+      for (const auto& v : simplified) ring.emplace_back(v.x + 0.5, v.y + 0.5);
+      if (ring.size() < 3) continue;
+      IntPolygon trial;
+      trial.outer = polygonise(ring, params_.refinedSpacing, energy_.size());
+      if (trial.outer.size() < 3 || !isValidPolygon(trial)) continue;
+      const IntPolygon keep = energy_.polygon();
+      const double energyBefore = energy_.total();
+      energy_.setPolygon(trial);
+      refreshReferenceTotal();
+      endSweep("notch");
+      converge();
+      if (energy_.total() >= energyBefore - kImprovement) {
+        energy_.setPolygon(keep);
+        refreshReferenceTotal();
+      }
+    }
   }
 
   // After convergence, an interior region where the ground interval matches clearly better

@@ -88,6 +88,43 @@ TEST(ActivePolygon, FindsACourtyard) {
   EXPECT_LT(r.terms.total(), r2.terms.total());
 }
 
+TEST(ActivePolygon, CarvesANotchBehindAStripThatMatchesNeitherInterval) {
+  // An L-shaped roof inside a box init; in the notch an 8 px strip along the box (a wall or a
+  // tree: roof and ground intervals match equally badly) separates the notch's ground from the
+  // outside. Moving the outline across the strip changes nothing, so local moves stop at the
+  // box; the notch search carves the ground region and the strip with it.
+  const core::Polygon l{{{25, 20}, {70, 20}, {70, 70}, {105, 70}, {105, 105}, {25, 105}}, {}};
+  const cv::Mat truth = core::rasterize(l, {130, 130});
+  EnergyImages im = idealImages(truth, 5);
+  const cv::Rect notch(70, 20, 35, 50);
+  cv::Mat strip(truth.size(), CV_8U, cv::Scalar(0));
+  strip(notch).setTo(255);
+  strip(cv::Rect(notch.x, notch.y + 8, notch.width - 8, notch.height - 8)).setTo(0);
+  im.roofCost.setTo(0.5f, strip);
+  im.groundCost.setTo(0.5f, strip);
+  for (cv::Mat* g : {&im.leftGradX, &im.leftGradY, &im.rightGradX, &im.rightGradY}) g->setTo(0.f, strip);
+  const IntPolygon box = rectangle(25, 20, 105, 105);
+  const auto carved = optimiseActivePolygon(im, box, DelineationParams{});
+  DelineationParams without;
+  without.notches = false;
+  const auto kept = optimiseActivePolygon(im, box, without);
+  EXPECT_TRUE(carved.polygon.holes.empty());
+  EXPECT_TRUE(isValidPolygon(carved.polygon));
+  EXPECT_LT(carved.terms.total(), kept.terms.total());
+  // The notch's ground (27 x 42 px) is out of the carved polygon.
+  cv::Mat notchGround(truth.size(), CV_8U, cv::Scalar(0));
+  notchGround(notch).setTo(255);
+  notchGround &= (strip == 0);
+  const double groundPixels = cv::countNonZero(notchGround);
+  const auto share = [&](const IntPolygon& p) {
+    return cv::countNonZero(core::rasterize(toPolygon(p), truth.size()) & notchGround) / groundPixels;
+  };
+  EXPECT_LT(share(carved.polygon), 0.05);
+  EXPECT_GT(iou(carved.polygon, truth), 0.98);
+  // Without the notch search the ground becomes a courtyard and the strip stays roof (0.954).
+  EXPECT_LT(iou(kept.polygon, truth), iou(carved.polygon, truth) - 0.03);
+}
+
 TEST(ActivePolygon, DeterministicAndObservable) {
   cv::Mat truth(100, 100, CV_8U, cv::Scalar(0));
   cv::rectangle(truth, cv::Rect(20, 30, 55, 40), cv::Scalar(255), cv::FILLED);

@@ -20,6 +20,7 @@ struct DelineationParams {
   int ringWidth = 8;               // px, width of the band outside the init used to estimate ground
   bool edgeMoves = true;           // also translate whole edges (two vertices at once)
   bool courtyards = true;          // look for inner courtyards after convergence (holes)
+  bool notches = true;             // carve ground regions reaching the outline after convergence
   bool balanceIntervals = true;    // compare roof and ground costs over equally many disparities
   double minCourtyardArea = 120.0; // px², smallest courtyard tried
   double edgeContrast = 0.1;       // Crit units: ground-likeness inside that mutes an edge (0 = off)
@@ -91,6 +92,11 @@ struct DelineationParams {
     v(core::ParamInfo{"courtyards", "Courtyards", "",
                       "Search for inner courtyards (holes) after convergence"},
       courtyards);
+    v(core::ParamInfo{"notches", "Notches", "",
+                      "After convergence, carve ground-leaning regions inside the polygon that reach "
+                      "(within 12 px) its outline, keeping the carved outline when its optimised "
+                      "energy is lower"},
+      notches);
     v(core::ParamInfo{"balance-intervals", "Balance intervals", "",
                       "Search the narrower of the roof and ground intervals over as many "
                       "disparities as the wider one (extended away from the other), so that "
