@@ -22,7 +22,8 @@ class Optimiser {
             const IterationObserver& observer, core::Progress* progress, EnergyMode mode)
       : images_(images),
         params_(params),
-        weights_{params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle, params.minGap},
+        weights_{params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle,
+                 params.minGap},
         energy_(images, weights_),
         observer_(observer),
         progress_(progress),
@@ -112,7 +113,8 @@ class Optimiser {
         for (int dy = -r; dy <= r; ++dy) {
           for (int dx = -r; dx <= r; ++dx) {
             if (dx == 0 && dy == 0) continue;
-            candidates.push_back({static_cast<int>(ring), static_cast<int>(i), 1, {v + cv::Point(dx, dy)}});
+            candidates.push_back(
+                {static_cast<int>(ring), static_cast<int>(i), 1, {v + cv::Point(dx, dy)}});
           }
         }
         changed |= applyBest(candidates, -kImprovement);
@@ -166,7 +168,8 @@ class Optimiser {
           const cv::Point a = rg[i], p = rg[(i + k) % n], q = rg[(i + k + 1) % n];
           path += std::hypot(double(q.x - p.x), double(q.y - p.y)) +
                   (k == 1 ? std::hypot(double(p.x - a.x), double(p.y - a.y)) : 0.0);
-          area2 += static_cast<double>(p.x - a.x) * (q.y - a.y) - static_cast<double>(p.y - a.y) * (q.x - a.x);
+          area2 += static_cast<double>(p.x - a.x) * (q.y - a.y) -
+                   static_cast<double>(p.y - a.y) * (q.x - a.x);
           if (k < 2) continue;
           if (std::abs(area2) > params_.shortcutWidth * path) continue;
           candidates.push_back({static_cast<int>(ring), static_cast<int>((i + 1) % n), k, {}});
@@ -184,7 +187,8 @@ class Optimiser {
       for (size_t i = 0; i < energy_.polygon().ring(ring).size();) {
         pollCancel();
         if (energy_.polygon().ring(ring).size() <= 3) break;
-        std::vector<PolygonEnergy::Change> candidates{{static_cast<int>(ring), static_cast<int>(i), 1, {}}};
+        std::vector<PolygonEnergy::Change> candidates{
+            {static_cast<int>(ring), static_cast<int>(i), 1, {}}};
         if (applyBest(candidates, kImprovement)) {
           changed = true;  // the next vertex now has index i
         } else {
@@ -252,8 +256,9 @@ class Optimiser {
     // matches neither interval).
     constexpr float kGroundLean = 0.05f;
     constexpr double kNotchReach = 12.0;
-    cv::Mat difference = images_.uncappedDifference.empty() ? cv::Mat(images_.groundCost - images_.roofCost)
-                                                             : images_.uncappedDifference.clone();
+    cv::Mat difference = images_.uncappedDifference.empty()
+                             ? cv::Mat(images_.groundCost - images_.roofCost)
+                             : images_.uncappedDifference.clone();
     cv::blur(difference, difference, {9, 9}, {-1, -1}, cv::BORDER_REPLICATE);
     cv::Mat groundLike = (difference < -kGroundLean) & inside;
     cv::morphologyEx(groundLike, groundLike, cv::MORPH_OPEN,
@@ -261,7 +266,8 @@ class Optimiser {
     cv::Mat depth;  // distance of each inside pixel to the outside
     cv::distanceTransform(inside, depth, cv::DIST_L2, 3);
     cv::Mat labels, stats, centroids;
-    const int count = cv::connectedComponentsWithStats(groundLike, labels, stats, centroids, 8, CV_32S);
+    const int count =
+        cv::connectedComponentsWithStats(groundLike, labels, stats, centroids, 8, CV_32S);
     std::vector<std::pair<int, int>> notches;  // (area, label)
     for (int l = 1; l < count; ++l) {
       const int area = stats.at<int>(l, cv::CC_STAT_AREA);
@@ -271,7 +277,8 @@ class Optimiser {
       if (nearest > kNotchReach) continue;  // deep inside: a courtyard candidate, not a notch
       notches.emplace_back(area, l);
     }
-    std::stable_sort(notches.begin(), notches.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::stable_sort(notches.begin(), notches.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
     constexpr size_t kMostNotches = 3;  // each try is a full convergence
     for (size_t k = 0; k < notches.size() && k < kMostNotches; ++k) {
       if (!budgetLeft()) break;
@@ -284,13 +291,14 @@ class Optimiser {
       cv::dilate(labels == notches[k].second, notch,
                  cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * reach + 1, 2 * reach + 1}));
       cv::Mat carved = inside & (notch == 0);
-      cv::morphologyEx(carved, carved, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+      cv::morphologyEx(carved, carved, cv::MORPH_OPEN,
+                       cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
       std::vector<std::vector<cv::Point>> contours;
       cv::findContours(carved, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
       if (contours.empty()) continue;
-      const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
-        return cv::contourArea(a) < cv::contourArea(b);
-      });
+      const auto largest = std::max_element(
+          contours.begin(), contours.end(),
+          [](const auto& a, const auto& b) { return cv::contourArea(a) < cv::contourArea(b); });
       std::vector<cv::Point> simplified;
       cv::approxPolyDP(*largest, simplified, 1.5, true);
       core::Ring ring;
@@ -324,8 +332,9 @@ class Optimiser {
     // 0 / 0.03 / 0.05 / 0.1 gave box 0.822 / 0.835 / 0.834 / 0.819 and jittered 0.893 / 0.927 /
     // 0.924 / 0.921 mean IoU on bench_delineation --scenes 2.
     constexpr float kGroundLean = 0.05f;
-    cv::Mat difference = images_.uncappedDifference.empty() ? cv::Mat(images_.groundCost - images_.roofCost)
-                                                             : images_.uncappedDifference.clone();
+    cv::Mat difference = images_.uncappedDifference.empty()
+                             ? cv::Mat(images_.groundCost - images_.roofCost)
+                             : images_.uncappedDifference.clone();
     cv::blur(difference, difference, {9, 9}, {-1, -1}, cv::BORDER_REPLICATE);
     cv::Mat groundLike = difference < -kGroundLean;
     groundLike &= inside;

@@ -91,7 +91,8 @@ double noiseSigma(const cv::Mat& image) {
   cv::Mat energy;
   cv::blur(inner.mul(inner), energy, {7, 7});
   std::vector<double> values;
-  values.reserve(static_cast<size_t>(energy.rows / 7 + 1) * static_cast<size_t>(energy.cols / 7 + 1));
+  values.reserve(static_cast<size_t>(energy.rows / 7 + 1) *
+                 static_cast<size_t>(energy.cols / 7 + 1));
   for (int y = 3; y < energy.rows - 3; y += 7) {
     for (int x = 3; x < energy.cols - 3; x += 7) values.push_back(energy.at<double>(y, x));
   }
@@ -124,9 +125,9 @@ class QuantisedCostVolume final : public CorrelationCostService {
 
   float cost(int x, int y, int d) const override {
     if (!roi_.contains(cv::Point(x, y)) || d < dmin_ || d > dmax_) {
-      throw Error(ErrorCode::InvalidParameter,
-                  "cost(" + std::to_string(x) + ", " + std::to_string(y) + ", " +
-                      std::to_string(d) + ") is outside the ROI or the disparity range");
+      throw Error(ErrorCode::InvalidParameter, "cost(" + std::to_string(x) + ", " +
+                                                   std::to_string(y) + ", " + std::to_string(d) +
+                                                   ") is outside the ROI or the disparity range");
     }
     return dequantise(planes_[d - dmin_].at<uint16_t>(y - roi_.y, x - roi_.x));
   }
@@ -194,17 +195,18 @@ class QuantisedCostVolume final : public CorrelationCostService {
   int dmin_, dmax_;
   uint16_t unmatched_;
   std::vector<float> dequantised_;  // quantised level -> cost
-  std::vector<cv::Mat> planes_;    // CV_16U, one per disparity, index d - dmin
-  std::vector<cv::Mat> blockMin_;  // CV_16U, min over disparities [k*kBlock, (k+1)*kBlock)
-  cv::Mat bestDisparity_;          // CV_32S
-  cv::Mat bestCost_;               // CV_16U
+  std::vector<cv::Mat> planes_;     // CV_16U, one per disparity, index d - dmin
+  std::vector<cv::Mat> blockMin_;   // CV_16U, min over disparities [k*kBlock, (k+1)*kBlock)
+  cv::Mat bestDisparity_;           // CV_32S
+  cv::Mat bestCost_;                // CV_16U
 };
 
 // Gain and offset mapping the right view's grey levels to the left's, from the moments of the
 // overlapping parts of the whole images (columns seen by both for a typical disparity). The two
 // views see nearly the same scene, so their histograms differ by the exposures; a fit on one
 // building's matches is too noisy (a few percent of gain is many noise sigmas on a bright roof).
-std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& right, int dmin, int dmax) {
+std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& right, int dmin,
+                                         int dmax) {
   const int shift = std::clamp((dmin + dmax) / 2, -(left.cols - 1) / 2, (left.cols - 1) / 2);
   const int width = left.cols - std::abs(shift);
   // Every 4th row: the moments of a quarter of the image are as good, at a quarter of the time
@@ -237,15 +239,14 @@ std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& rig
 
 // Blends a mean grey level term into the NCC planes of `volume` for windows with little texture:
 // cost = w * ncc_cost + (1 - w) * min(1, |mean_left - (gain * mean_right + offset)| / (scale *
-// sigma)), w = t / (t + sigma^2) with t the left window's variance above the noise's (sigma^2) and sigma the left ROI's
-// noise (radiometricMap gives gain and offset). On a textureless roof NCC is noise at every
-// disparity while the mean grey level still tells the roof's match from the ground's.
-// sums*: box sums of the left (A, ROI positions) and right (B, ROI positions shifted by the
-// plane's offset) windows, as in the NCC pass.
+// sigma)), w = t / (t + sigma^2) with t the left window's variance above the noise's (sigma^2) and
+// sigma the left ROI's noise (radiometricMap gives gain and offset). On a textureless roof NCC is
+// noise at every disparity while the mean grey level still tells the roof's match from the
+// ground's. sums*: box sums of the left (A, ROI positions) and right (B, ROI positions shifted by
+// the plane's offset) windows, as in the NCC pass.
 void addBrightnessTerm(QuantisedCostVolume& volume, const cv::Mat& sumA, const cv::Mat& sumAA,
-                       const cv::Mat& sumB,
-                       const cv::Mat& leftRoi, int window, double scale, double gain,
-                       double shift) {
+                       const cv::Mat& sumB, const cv::Mat& leftRoi, int window, double scale,
+                       double gain, double shift) {
   const cv::Rect roi = volume.roi();
   const int dmin = volume.dmin(), dmax = volume.dmax();
   const int planes = dmax - dmin + 1;
@@ -256,7 +257,8 @@ void addBrightnessTerm(QuantisedCostVolume& volume, const cv::Mat& sumA, const c
   // NCC counts as much as the left window's variance stands above the noise's. Per pixel:
   // cost = nccWeight * ncc_cost + min(brightnessWeight, |sa - gain * sb - n * shift| * slope).
   const double meanScale = scale * sigma;
-  cv::Mat nccWeight(roi.size(), CV_32F), brightnessWeight(roi.size(), CV_32F), slope(roi.size(), CV_32F);
+  cv::Mat nccWeight(roi.size(), CV_32F), brightnessWeight(roi.size(), CV_32F),
+      slope(roi.size(), CV_32F);
   for (int y = 0; y < roi.height; ++y) {
     for (int x = 0; x < roi.width; ++x) {
       const double m = sumA.at<double>(y, x) / n;
@@ -283,7 +285,8 @@ void addBrightnessTerm(QuantisedCostVolume& volume, const cv::Mat& sumA, const c
         const float* sl = slope.ptr<float>(y);
         for (int x = 0; x < roi.width; ++x) {
           if (o[x] == unmatched) continue;
-          const float difference = static_cast<float>(sa[x]) - gainF * static_cast<float>(sb[x]) - shiftF;
+          const float difference =
+              static_cast<float>(sa[x]) - gainF * static_cast<float>(sb[x]) - shiftF;
           const float cost = wn[x] * o[x] + std::min(wb[x], std::abs(difference) * sl[x]);
           o[x] = static_cast<uint16_t>(std::min(65535.f, cost * 65535.f + 0.5f));
         }
@@ -309,9 +312,9 @@ std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
                     std::to_string(right.cols) + "x" + std::to_string(right.rows));
   }
   if (dmin > dmax) {
-    throw Error(ErrorCode::InvalidParameter, "cost service: empty disparity range dmin = " +
-                                                 std::to_string(dmin) + " > dmax = " +
-                                                 std::to_string(dmax));
+    throw Error(ErrorCode::InvalidParameter,
+                "cost service: empty disparity range dmin = " + std::to_string(dmin) +
+                    " > dmax = " + std::to_string(dmax));
   }
   if (roi.area() <= 0 || (roi & cv::Rect(0, 0, left.cols, left.rows)) != roi) {
     throw Error(ErrorCode::InvalidParameter, "cost service: ROI is empty or outside the image");
@@ -392,8 +395,8 @@ std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
   if (canceled.load() || core::isCanceled(progress)) return nullptr;
   if (params.brightnessScale > 0) {
     const auto [gain, shift] = radiometricMap(left, right, dmin, dmax);
-    addBrightnessTerm(*volume, sumA, sumAA, sumB, leftVals(cv::Rect(r, r, roi.width, roi.height)), window,
-                      params.brightnessScale, gain, shift);
+    addBrightnessTerm(*volume, sumA, sumAA, sumB, leftVals(cv::Rect(r, r, roi.width, roi.height)),
+                      window, params.brightnessScale, gain, shift);
   }
   volume->finish();
   core::report(progress, 1.0);

@@ -63,8 +63,9 @@ TEST(ActivePolygon, ConvergesOnAnLShape) {
   std::vector<cv::Point> l{{25, 20}, {70, 20}, {70, 70}, {105, 70}, {105, 105}, {25, 105}};
   cv::fillPoly(truth, std::vector<std::vector<cv::Point>>{l}, cv::Scalar(255));
   // fillPoly paints closed pixel ranges; our polygon covers [x0, x1): match that convention.
-  truth = core::rasterize(core::Polygon{{{25, 20}, {70, 20}, {70, 70}, {105, 70}, {105, 105}, {25, 105}}, {}},
-                          truth.size());
+  truth = core::rasterize(
+      core::Polygon{{{25, 20}, {70, 20}, {70, 70}, {105, 70}, {105, 105}, {25, 105}}, {}},
+      truth.size());
   const auto im = idealImages(truth, 2);
   const auto r = optimiseActivePolygon(im, rectangle(17, 12, 113, 113), DelineationParams{});
   EXPECT_GT(iou(r.polygon, truth), 0.95);
@@ -102,7 +103,8 @@ TEST(ActivePolygon, CarvesANotchBehindAStripThatMatchesNeitherInterval) {
   strip(cv::Rect(notch.x, notch.y + 8, notch.width - 8, notch.height - 8)).setTo(0);
   im.roofCost.setTo(0.5f, strip);
   im.groundCost.setTo(0.5f, strip);
-  for (cv::Mat* g : {&im.leftGradX, &im.leftGradY, &im.rightGradX, &im.rightGradY}) g->setTo(0.f, strip);
+  for (cv::Mat* g : {&im.leftGradX, &im.leftGradY, &im.rightGradX, &im.rightGradY})
+    g->setTo(0.f, strip);
   const IntPolygon box = rectangle(25, 20, 105, 105);
   const auto carved = optimiseActivePolygon(im, box, DelineationParams{});
   DelineationParams without;
@@ -117,7 +119,8 @@ TEST(ActivePolygon, CarvesANotchBehindAStripThatMatchesNeitherInterval) {
   notchGround &= (strip == 0);
   const double groundPixels = cv::countNonZero(notchGround);
   const auto share = [&](const IntPolygon& p) {
-    return cv::countNonZero(core::rasterize(toPolygon(p), truth.size()) & notchGround) / groundPixels;
+    return cv::countNonZero(core::rasterize(toPolygon(p), truth.size()) & notchGround) /
+           groundPixels;
   };
   EXPECT_LT(share(carved.polygon), 0.05);
   EXPECT_GT(iou(carved.polygon, truth), 0.98);
@@ -164,8 +167,8 @@ TEST(ActivePolygon, IncrementalAndReferenceRunsAgree) {
   DelineationParams p;
   p.courtyards = false;
   const auto fast = optimiseActivePolygon(im, rectangle(8, 6, 52, 52), p);
-  const auto ref = optimiseActivePolygon(im, rectangle(8, 6, 52, 52), p, {}, nullptr,
-                                         EnergyMode::Reference);
+  const auto ref =
+      optimiseActivePolygon(im, rectangle(8, 6, 52, 52), p, {}, nullptr, EnergyMode::Reference);
   EXPECT_EQ(fast.polygon.outer, ref.polygon.outer);
   EXPECT_NEAR(fast.terms.total(), ref.terms.total(), 1e-6);
 }

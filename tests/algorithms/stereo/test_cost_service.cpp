@@ -64,19 +64,19 @@ TEST(CostService, UnmatchedCostWhereTheWindowLeavesTheImage) {
   params.window = 5;
   params.unmatchedCost = 0.75;
   // Left window leaves the image at x = 0..1; right window leaves it when x - d < 2.
-  auto service = CorrelationCostService::compute(left, right, cv::Rect(0, 5, 20, 10), 0, 10,
-                                                 params);
+  auto service =
+      CorrelationCostService::compute(left, right, cv::Rect(0, 5, 20, 10), 0, 10, params);
   ASSERT_NE(service, nullptr);
   EXPECT_FLOAT_EQ(service->cost(0, 8, 0), 0.75F);
   EXPECT_FLOAT_EQ(service->cost(1, 8, 0), 0.75F);
-  EXPECT_FLOAT_EQ(service->cost(5, 8, 4), 0.75F);   // x - d = 1: right window leaves
-  EXPECT_LT(service->cost(5, 8, 3), 0.05F);         // x - d = 2: inside, true match
+  EXPECT_FLOAT_EQ(service->cost(5, 8, 4), 0.75F);  // x - d = 1: right window leaves
+  EXPECT_LT(service->cost(5, 8, 3), 0.05F);        // x - d = 2: inside, true match
   EXPECT_FLOAT_EQ(service->minCost(11, 20).at<float>(0, 0), 0.75F);  // empty clipped range
   // NaN in the right image makes the windows covering it unmatched.
   cv::Mat holed = right.clone();
   holed.at<float>(8, 10) = std::numeric_limits<float>::quiet_NaN();
-  auto withHole = CorrelationCostService::compute(left, holed, cv::Rect(0, 5, 20, 10), 0, 10,
-                                                  params);
+  auto withHole =
+      CorrelationCostService::compute(left, holed, cv::Rect(0, 5, 20, 10), 0, 10, params);
   EXPECT_FLOAT_EQ(withHole->cost(13, 8, 3), 0.75F);
   EXPECT_LT(withHole->cost(16, 8, 3), 0.05F);
 }
@@ -100,16 +100,16 @@ TEST(CostService, CancelReturnsNull) {
   const cv::Mat left = texture({100, 100}, 6);
   core::Progress progress;
   progress.cancel();
-  EXPECT_EQ(CorrelationCostService::compute(left, left, cv::Rect(10, 10, 50, 50), 0, 40, {},
-                                            &progress),
-            nullptr);
+  EXPECT_EQ(
+      CorrelationCostService::compute(left, left, cv::Rect(10, 10, 50, 50), 0, 40, {}, &progress),
+      nullptr);
 }
 
 TEST(CostService, QueryIsFastFor300x300By256) {
   const cv::Mat left = texture({600, 340}, 7);
   const cv::Mat right = shiftedRight(left, 20.0);
-  auto service = CorrelationCostService::compute(left, right, cv::Rect(280, 20, 300, 300), -20,
-                                                 235);
+  auto service =
+      CorrelationCostService::compute(left, right, cv::Rect(280, 20, 300, 300), -20, 235);
   ASSERT_NE(service, nullptr);
   const auto start = std::chrono::steady_clock::now();
   const int queries = 10;
@@ -170,7 +170,8 @@ TEST(CostService, BrightnessTermSeparatesATexturelessRoofFromTheGround) {
   double plainGap = 0, roofCost = 0, groundCost = 0, count = 0;
   for (int y = p.roof.y + 3; y < p.roof.br().y - 3; ++y) {
     for (int x = p.roof.x + 3; x < p.roof.br().x - 3; ++x) {
-      plainGap += std::abs(plain->cost(x, y, p.roofDisparity) - plain->cost(x, y, p.groundDisparity));
+      plainGap +=
+          std::abs(plain->cost(x, y, p.roofDisparity) - plain->cost(x, y, p.groundDisparity));
       roofCost += bright->cost(x, y, p.roofDisparity);
       groundCost += bright->cost(x, y, p.groundDisparity);
       count += 1;

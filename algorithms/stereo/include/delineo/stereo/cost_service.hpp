@@ -16,12 +16,13 @@
 namespace delineo::stereo {
 
 struct CostParams {
-  int window = 5;                // px, odd side of the correlation window for Crit
-  double unmatchedCost = 1.0;    // cost where the match falls outside the right image or on NaN
+  int window = 5;              // px, odd side of the correlation window for Crit
+  double unmatchedCost = 1.0;  // cost where the match falls outside the right image or on NaN
   // Mean grey level term for windows with little texture, where NCC is noise: 0 = NCC only.
-  // Else a window whose left variance exceeds the noise's by t gets weight t / (t + sigma^2) on NCC and the rest on
-  // |mean_left - mean_right| / (brightnessScale * sigma), capped at 1, after a global gain/offset
-  // match of the right view to the left (sigma: image noise estimated from the left ROI).
+  // Else a window whose left variance exceeds the noise's by t gets weight t / (t + sigma^2) on NCC
+  // and the rest on |mean_left - mean_right| / (brightnessScale * sigma), capped at 1, after a
+  // global gain/offset match of the right view to the left (sigma: image noise estimated from the
+  // left ROI).
   double brightnessScale = 0.0;  // × noise sigma: mean difference that costs 1 (0 = off)
   template <class V>
   void visit(V&& v) {
