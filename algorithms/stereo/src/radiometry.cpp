@@ -1,0 +1,74 @@
+// Image noise and the grey-level map between the two views (see radiometry.hpp).
+#include "radiometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace delineo::stereo::detail {
+
+// Noise sigma of an image from its response to the difference of two Laplacians, which cancels
+// locally linear intensity (the kernel of Immerkaer 1996, "Fast noise variance estimation"; under
+// pure noise the response has variance 36 sigma^2). Texture adds to the response, so the level
+// is read in the flattest places: the first quartile of the response's mean square over 7x7
+// blocks (on a fully textured image this overestimates sigma, which only weakens the
+// brightness term).
+double noiseSigma(const cv::Mat& image) {
+  if (image.rows < 9 || image.cols < 9) return 1.0;
+  const cv::Mat kernel = (cv::Mat_<double>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
+  cv::Mat response;
+  cv::filter2D(image, response, CV_64F, kernel);
+  const cv::Mat inner = response(cv::Rect(1, 1, image.cols - 2, image.rows - 2));
+  cv::Mat energy;
+  cv::blur(inner.mul(inner), energy, {7, 7});
+  std::vector<double> values;
+  values.reserve(static_cast<size_t>(energy.rows / 7 + 1) *
+                 static_cast<size_t>(energy.cols / 7 + 1));
+  for (int y = 3; y < energy.rows - 3; y += 7) {
+    for (int x = 3; x < energy.cols - 3; x += 7) values.push_back(energy.at<double>(y, x));
+  }
+  if (values.empty()) return 1.0;
+  const auto q = values.begin() + static_cast<long>(values.size() / 4);
+  std::nth_element(values.begin(), q, values.end());
+  return std::sqrt(*q / 36.0);
+}
+
+// Gain and offset mapping the right view's grey levels to the left's, from the moments of the
+// overlapping parts of the whole images (columns seen by both for a typical disparity). The two
+// views see nearly the same scene, so their histograms differ by the exposures; a fit on one
+// building's matches is too noisy (a few percent of gain is many noise sigmas on a bright roof).
+std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& right, int dmin,
+                                         int dmax) {
+  const int shift = std::clamp((dmin + dmax) / 2, -(left.cols - 1) / 2, (left.cols - 1) / 2);
+  const int width = left.cols - std::abs(shift);
+  // Every 4th row: the moments of a quarter of the image are as good, at a quarter of the time
+  // (this runs for every building).
+  const int rowStep = 4, rows = (left.rows + rowStep - 1) / rowStep;
+  const cv::Mat l(rows, width, CV_32F, const_cast<float*>(left.ptr<float>(0, std::max(0, shift))),
+                  left.step[0] * rowStep);
+  const cv::Mat r(rows, width, CV_32F, const_cast<float*>(right.ptr<float>(0, std::max(0, -shift))),
+                  right.step[0] * rowStep);
+  double sumL = 0, sumLL = 0, sumR = 0, sumRR = 0, count = 0;
+  for (int y = 0; y < rows; ++y) {
+    const float* pl = l.ptr<float>(y);
+    const float* pr = r.ptr<float>(y);
+    for (int x = 0; x < width; ++x) {
+      if (!std::isfinite(pl[x]) || !std::isfinite(pr[x])) continue;
+      sumL += pl[x];
+      sumLL += static_cast<double>(pl[x]) * pl[x];
+      sumR += pr[x];
+      sumRR += static_cast<double>(pr[x]) * pr[x];
+      count += 1;
+    }
+  }
+  if (count < 2) return {1.0, 0.0};
+  const double meanL = sumL / count, meanR = sumR / count;
+  const double varL = sumLL / count - meanL * meanL, varR = sumRR / count - meanR * meanR;
+  if (!(varL > 1e-12) || !(varR > 1e-12)) return {1.0, 0.0};
+  const double gain = std::sqrt(varL / varR);
+  return {gain, meanL - gain * meanR};
+}
+
+}  // namespace delineo::stereo::detail

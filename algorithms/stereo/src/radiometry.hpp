@@ -1,0 +1,18 @@
+#pragma once
+// Image noise and the grey-level map between the two views (internal to delineo_stereo).
+#include <utility>
+
+#include <opencv2/core.hpp>
+
+namespace delineo::stereo::detail {
+
+// Noise sigma of a single-channel image (any depth), in its grey levels.
+double noiseSigma(const cv::Mat& image);
+
+// Gain and offset (left ≈ gain · right + offset) mapping the right view's grey levels to the
+// left's, from the moments of the columns both views see for the mid disparity of [dmin, dmax].
+// CV_32F images of the same size; NaN = nodata. {1, 0} when either view is flat.
+std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& right, int dmin,
+                                         int dmax);
+
+}  // namespace delineo::stereo::detail
