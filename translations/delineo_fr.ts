@@ -247,6 +247,10 @@
         <translation>Plafond des coûts</translation>
     </message>
     <message>
+        <source>Fill flat regions</source>
+        <translation>Remplir les régions uniformes</translation>
+    </message>
+    <message>
         <source>Notches</source>
         <translation>Encoches</translation>
     </message>

@@ -60,6 +60,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Minimal score"),
     QT_TRANSLATE_NOOP("Parameters", "Sub-pixel"),
     QT_TRANSLATE_NOOP("Parameters", "Adaptive shapes"),
+    QT_TRANSLATE_NOOP("Parameters", "Fill flat regions"),
     QT_TRANSLATE_NOOP("Parameters", "Threads"),
     QT_TRANSLATE_NOOP("Parameters", "Cut windows at depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),

@@ -16,6 +16,7 @@
 #include "delineo/core/error.hpp"
 #include "level_matcher.hpp"
 #include "match_steps.hpp"
+#include "match_fill.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo {
@@ -385,6 +386,10 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   result.disparity = coarseLeft;
   result.score = leftOut.score.clone();
   result.score.setTo(kNaN, result.disparity != result.disparity);
+  if (p.fillRegions && p.adaptive) {
+    detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
+                            static_cast<float>(p.minScore), result.disparity, result.score);
+  }
   return result;
 }
 

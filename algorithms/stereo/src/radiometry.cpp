@@ -18,8 +18,9 @@ namespace delineo::stereo::detail {
 double noiseSigma(const cv::Mat& image) {
   if (image.rows < 9 || image.cols < 9) return 1.0;
   const cv::Mat kernel = (cv::Mat_<double>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
-  cv::Mat response;
-  cv::filter2D(image, response, CV_64F, kernel);
+  cv::Mat wide, response;
+  image.convertTo(wide, CV_64F);
+  cv::filter2D(wide, response, CV_64F, kernel);
   const cv::Mat inner = response(cv::Rect(1, 1, image.cols - 2, image.rows - 2));
   cv::Mat energy;
   cv::blur(inner.mul(inner), energy, {7, 7});

@@ -216,6 +216,81 @@ int locatedOutlineRows(const MatchResult& r, const testing::SquareScene& s) {
   return located;
 }
 
+// A textureless roof (flat grey 200 with noise sigma 2, 50x40 px, disparity 20) on textured
+// ground (disparity 4). `rightShowsIt` false: the right view shows textured ground where the
+// roof should be (a flat patch only the left image has, e.g. a reflection).
+struct FlatRoofScene {
+  cv::Mat left, right;
+  cv::Rect roof{60, 40, 50, 40};
+};
+
+FlatRoofScene flatRoofScene(bool rightShowsIt) {
+  FlatRoofScene s;
+  const cv::Size size(180, 120);
+  const cv::Mat ground = texture(cv::Size(size.width + 64, size.height), 21) * 0.6 + 20.0;
+  s.left.create(size, CV_32F);
+  s.right.create(size, CV_32F);
+  cv::RNG rng(9);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const bool onRoof = s.roof.contains({x, y});
+      s.left.at<float>(y, x) =
+          (onRoof ? 200.0f : ground.at<float>(y, x + 32)) + static_cast<float>(rng.gaussian(2.0));
+      const bool seesRoof = rightShowsIt && s.roof.contains({x + 20, y});
+      s.right.at<float>(y, x) = (seesRoof ? 200.0f : ground.at<float>(y, x + 4 + 32)) +
+                                static_cast<float>(rng.gaussian(2.0));
+    }
+  }
+  return s;
+}
+
+// Share of the roof's interior (8 px from its outline) with a disparity, and of those within
+// 1 px of `expected`.
+std::pair<double, double> interiorMatches(const MatchResult& r, cv::Rect roof, float expected) {
+  const cv::Rect inner(roof.x + 8, roof.y + 8, roof.width - 16, roof.height - 16);
+  double matched = 0, right = 0;
+  for (int y = inner.y; y < inner.br().y; ++y) {
+    for (int x = inner.x; x < inner.br().x; ++x) {
+      const float d = r.disparity.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      ++matched;
+      if (std::abs(d - expected) <= 1.0f) ++right;
+    }
+  }
+  return {matched / inner.area(), matched > 0 ? right / matched : 0.0};
+}
+
+TEST(Match, FillsATexturelessRoofFromItsOutline) {
+  const auto scene = flatRoofScene(true);
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 32;
+  p.fillRegions = false;
+  const auto [plainShare, plainRight] =
+      interiorMatches(matchStereo(scene.left, scene.right, p), scene.roof, 20);
+  p.fillRegions = true;
+  const MatchResult filled = matchStereo(scene.left, scene.right, p);
+  const auto [share, right] = interiorMatches(filled, scene.roof, 20);
+  // NCC of noise leaves the interior unmatched; the outline's matches and grey levels fix it.
+  EXPECT_LT(plainShare, 0.3) << plainRight;
+  EXPECT_GT(share, 0.95);
+  EXPECT_GT(right, 0.99);
+  // Filled pixels carry the minimum score, not a correlation they did not have.
+  const cv::Point centre(scene.roof.x + 25, scene.roof.y + 20);
+  EXPECT_FLOAT_EQ(filled.score.at<float>(centre), static_cast<float>(p.minScore));
+}
+
+TEST(Match, DoesNotFillAFlatPatchTheRightViewDoesNotShow) {
+  const auto scene = flatRoofScene(false);
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 32;
+  p.fillRegions = true;
+  const auto [share, right] =
+      interiorMatches(matchStereo(scene.left, scene.right, p), scene.roof, 20);
+  EXPECT_LT(share, 0.3) << right;
+}
+
 TEST(Match, StepCutLocatesAnOutlineWithoutContour) {
   const auto scene = contourlessBlock();
   MatchParams p;

@@ -33,6 +33,7 @@ struct MatchParams {
   double minScore = 0.3;             // NCC below this is rejected (flat or unmatched windows)
   bool subpixel = true;              // sub-pixel peak from the 3x3 correlation neighbourhood
   bool adaptive = true;              // contour-adaptive shapes (false: plain square windows)
+  bool fillRegions = true;           // flat regions take the disparity lining up their outline
   int threads = 0;                   // worker threads, 0 = all cores
 
   template <class V>
@@ -90,6 +91,11 @@ struct MatchParams {
     v(core::ParamInfo{"adaptive", "Adaptive shapes", "",
                       "Contour-adaptive template shapes (off: plain square windows)"},
       adaptive);
+    v(core::ParamInfo{"fill-regions", "Fill flat regions", "",
+                      "Unmatched pixels of a flat region (a textureless roof, where NCC is noise) "
+                      "take the disparity of the matches around it that lines up its outline in "
+                      "both views, when that is clear (their score is min-score)"},
+      fillRegions);
     v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
       threads);
   }
@@ -98,7 +104,8 @@ struct MatchParams {
 
 struct MatchResult {
   cv::Mat disparity;  // CV_32F, left-image geometry, NaN = rejected or unmatched
-  cv::Mat score;      // CV_32F, NCC of the retained match, NaN where disparity is NaN
+  cv::Mat score;      // CV_32F, NCC of the retained match (min-score where filled by
+                      // fill-regions), NaN where disparity is NaN
   int levelsUsed = 1;
   core::RunStatus status = core::RunStatus::Completed;
 };

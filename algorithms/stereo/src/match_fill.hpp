@@ -1,0 +1,29 @@
+#pragma once
+// Disparity of flat (textureless) regions from the matches along their outline (internal to
+// delineo_stereo).
+#include <opencv2/core.hpp>
+
+namespace delineo::stereo::detail {
+
+struct RegionFillSettings {
+  double flatSigmas = 2.0;   // × noise sigma: 5x5 standard deviation below this is flat
+  int minUnmatched = 30;     // px: flat regions with fewer unmatched pixels are left alone
+  double maxShare = 0.25;    // flat regions larger than this share of the image are skipped
+  int minMatched = 20;       // px: matches around a region needed to propose a disparity
+  double photometric = 6.0;  // × noise sigma: mean |left − mapped right| allowed on the outline
+  double contrast = 0.5;     // the best candidate's outline error must be below this × the other's
+};
+
+// Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is
+// below flatSigmas noise sigmas (NCC leaves them unmatched: a textureless roof). Candidates for a
+// region: the two largest clusters (±1 px) of the matches within 3 px of it (its edge pixels,
+// matched on windows that reach its outline, and the pixels beyond). Each candidate is scored by
+// the mean |left − (gain · right + offset)| over the region's outline ring (2 px on both sides),
+// where only the right disparity lines the outlines up: inside a flat region every disparity
+// that stays in it matches. The best is kept when below `photometric` noise sigmas and clearly
+// better than the other; the region's unmatched pixels take it, with `fillScore` as score.
+// `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
+int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
+                    int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score);
+
+}  // namespace delineo::stereo::detail
