@@ -260,16 +260,19 @@ std::pair<double, double> interiorMatches(const MatchResult& r, cv::Rect roof, f
   return {matched / inner.area(), matched > 0 ? right / matched : 0.0};
 }
 
-TEST(Match, FillsATexturelessRoofFromItsOutline) {
-  const auto scene = flatRoofScene(true);
+MatchResult matchFlatRoof(const FlatRoofScene& scene, bool fill) {
   MatchParams p;
   p.dmin = 0;
   p.dmax = 32;
-  p.fillRegions = false;
+  p.fillRegions = fill;
+  return matchStereo(scene.left, scene.right, p);
+}
+
+TEST(Match, FillsATexturelessRoofFromItsOutline) {
+  const auto scene = flatRoofScene(true);
   const auto [plainShare, plainRight] =
-      interiorMatches(matchStereo(scene.left, scene.right, p), scene.roof, 20);
-  p.fillRegions = true;
-  const MatchResult filled = matchStereo(scene.left, scene.right, p);
+      interiorMatches(matchFlatRoof(scene, false), scene.roof, 20);
+  const MatchResult filled = matchFlatRoof(scene, true);
   const auto [share, right] = interiorMatches(filled, scene.roof, 20);
   // NCC of noise leaves the interior unmatched; the outline's matches and grey levels fix it.
   EXPECT_LT(plainShare, 0.3) << plainRight;
@@ -277,17 +280,12 @@ TEST(Match, FillsATexturelessRoofFromItsOutline) {
   EXPECT_GT(right, 0.99);
   // Filled pixels carry the minimum score, not a correlation they did not have.
   const cv::Point centre(scene.roof.x + 25, scene.roof.y + 20);
-  EXPECT_FLOAT_EQ(filled.score.at<float>(centre), static_cast<float>(p.minScore));
+  EXPECT_FLOAT_EQ(filled.score.at<float>(centre), static_cast<float>(MatchParams{}.minScore));
 }
 
 TEST(Match, DoesNotFillAFlatPatchTheRightViewDoesNotShow) {
   const auto scene = flatRoofScene(false);
-  MatchParams p;
-  p.dmin = 0;
-  p.dmax = 32;
-  p.fillRegions = true;
-  const auto [share, right] =
-      interiorMatches(matchStereo(scene.left, scene.right, p), scene.roof, 20);
+  const auto [share, right] = interiorMatches(matchFlatRoof(scene, true), scene.roof, 20);
   EXPECT_LT(share, 0.3) << right;
 }
 
