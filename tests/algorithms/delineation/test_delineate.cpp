@@ -280,6 +280,9 @@ struct RaisedRoofCosts {
   Pair pair;
   DelineationRequest req;
   std::unique_ptr<stereo::CorrelationCostService> costs;
+  PreparedEnergy prepare(const DelineationParams& params) const {
+    return prepareEnergy(*costs, pair.left, pair.right, req, params);
+  }
 };
 
 RaisedRoofCosts raisedRoofCosts(const DelineationParams& params) {
@@ -297,15 +300,12 @@ TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   DelineationParams plain;
   plain.costCap = 0;  // off
   const RaisedRoofCosts c = raisedRoofCosts(plain);
-  const Pair& pair = c.pair;
-  const DelineationRequest& req = c.req;
-  const auto& costs = c.costs;
-  const PreparedEnergy off = prepareEnergy(*costs, pair.left, pair.right, req, plain);
+  const PreparedEnergy off = c.prepare(plain);
   EXPECT_TRUE(off.images.uncappedDifference.empty());
   DelineationParams capped = plain;
   capped.costCap = 1.0;
   capped.costCapFloor = 0;
-  const PreparedEnergy on = prepareEnergy(*costs, pair.left, pair.right, req, capped);
+  const PreparedEnergy on = c.prepare(capped);
   const double cap = on.images.noMatchCost;
   double maxRoof = 0, maxGround = 0, maxPlain = 0;
   cv::minMaxLoc(on.images.roofCost, nullptr, &maxRoof);
@@ -323,7 +323,7 @@ TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   // The floor: on this clean pair NoMatchCost is far below it, so the floor sets the cap.
   capped.costCapFloor = 0.3;
   ASSERT_LT(cap, capped.costCapFloor);
-  const PreparedEnergy floored = prepareEnergy(*costs, pair.left, pair.right, req, capped);
+  const PreparedEnergy floored = c.prepare(capped);
   cv::minMaxLoc(floored.images.roofCost, nullptr, &maxRoof);
   EXPECT_GT(maxRoof, cap + 0.05);
   EXPECT_LE(maxRoof, 0.3 + 1e-6);
@@ -336,10 +336,7 @@ TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
   params.bandBestCost = true;
   params.costCap = 0;  // the band cost is compared with the uncapped costs below
   const RaisedRoofCosts c = raisedRoofCosts(params);
-  const Pair& pair = c.pair;
-  const DelineationRequest& req = c.req;
-  const auto& costs = c.costs;
-  const PreparedEnergy on = prepareEnergy(*costs, pair.left, pair.right, req, params);
+  const PreparedEnergy on = c.prepare(params);
   ASSERT_FALSE(on.images.bandCost.empty());
   const cv::Mat expected = cv::max(cv::min(on.images.roofCost, on.images.groundCost), on.images.noMatchCost);
   EXPECT_EQ(cv::norm(on.images.bandCost, expected, cv::NORM_INF), 0.0);
@@ -348,12 +345,12 @@ TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
   cv::minMaxLoc(on.images.bandCost, nullptr, &maxBand);
   EXPECT_GT(maxBand, on.images.noMatchCost);
   params.bandBestCost = false;
-  const PreparedEnergy off = prepareEnergy(*costs, pair.left, pair.right, req, params);
+  const PreparedEnergy off = c.prepare(params);
   EXPECT_TRUE(off.images.bandCost.empty());
   // Both runs still find the roof.
   for (const bool best : {true, false}) {
     params.bandBestCost = best;
-    const auto result = delineate(pair.left, pair.right, req, params);
-    EXPECT_GT(iou(result.polygon, pair.truth, pair.left.size()), 0.9) << "band-best-cost " << best;
+    const auto result = delineate(c.pair.left, c.pair.right, c.req, params);
+    EXPECT_GT(iou(result.polygon, c.pair.truth, c.pair.left.size()), 0.9) << "band-best-cost " << best;
   }
 }
