@@ -303,6 +303,7 @@ int main(int argc, char** argv) {
   int scenes = 3, referenceRuns = 3, firstSeed = 1;
   std::string dumpDir;  // --dump DIR: one diagnostic PNG per run
   std::string onlyInit;  // --init box+8|jit6: run one initialisation only
+  bool oracleVegetation = false;  // --oracle-vegetation: true tree pixels given as excluded
   bool diag = false;     // --diag: spatial decomposition of F(truth) - F(result) (implies BENCH_VERBOSE)
   std::map<std::string, DiagTable> diagTotals;  // by init
   sim::SceneParams sceneParams;
@@ -329,16 +330,25 @@ int main(int argc, char** argv) {
       sceneParams.buildings = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--trees") && i + 1 < argc) {
       sceneParams.trees = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--oracle-vegetation")) {
+      oracleVegetation = true;
     } else if (!std::strcmp(argv[i], "--diag")) {
       diag = true;
     } else if (!std::strcmp(argv[i], "--init") && i + 1 < argc) {
       onlyInit = argv[++i];
     } else {
       std::fprintf(stderr,
-                   "usage: bench_delineation [--tiny] [--scenes N] [--seed FIRST] [--size WxH] [--buildings N] "
-                   "[--trees N] [--init box+8|jit6] [--reference-runs N] [--dump DIR] [--diag]\n");
+                   "usage: bench_delineation [--tiny] [--scenes N] [--seed FIRST] [--size WxH] "
+                   "[--buildings N] "
+                   "[--trees N] [--init box+8|jit6] [--reference-runs N] [--dump DIR] [--diag] "
+                   "[--oracle-vegetation]\n");
       return 2;
     }
+  }
+  if (oracleVegetation) {
+    std::printf(
+        "ORACLE RUN: the true vegetation pixels are given as excluded (what a perfect vegetation "
+        "mask would give; not the method's result)\n");
   }
   DelineationParams params;
   if (const char* json = std::getenv("BENCH_PARAMS")) core::fromJson(params, nlohmann::json::parse(json));
@@ -362,6 +372,8 @@ int main(int argc, char** argv) {
     for (const auto& fp : scene.footprints) {
       const int id = static_cast<int>(number(fp, "id", 0));
       DelineationRequest base;
+      // Oracle run: how much of the remaining error trees at roof height explain.
+      if (oracleVegetation) base.excludeMask = scene.labels == sim::kLabelVegetation;
       base.roof = {static_cast<int>(std::floor(number(fp, "roof_disparity_min", 0))),
                    static_cast<int>(std::ceil(number(fp, "roof_disparity_max", 0)))};
       const int g = static_cast<int>(std::lround(number(fp, "ground_disparity", 0)));

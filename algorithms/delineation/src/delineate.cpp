@@ -253,6 +253,14 @@ cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
                                                    str(*request.searchRange));
     }
   }
+  if (!request.excludeMask.empty() &&
+      (request.excludeMask.size() != left.size() || request.excludeMask.type() != CV_8U)) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "the exclusion mask must be single-band 8-bit of the left image's size (" +
+                    std::to_string(left.cols) + "x" + std::to_string(left.rows) + "), not " +
+                    std::to_string(request.excludeMask.cols) + "x" +
+                    std::to_string(request.excludeMask.rows));
+  }
   const core::Polygon init = initialPolygon(request, left.size());
   if (init.outer.size() < 3 || core::area(init) < 4.0 || !core::isSimple(init.outer)) {
     throw Error(ErrorCode::InvalidParameter,
@@ -338,6 +346,13 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
     cv::blur(im.groundCost, im.groundCost, k, {-1, -1}, cv::BORDER_REPLICATE);
   }
 
+  if (!request.excludeMask.empty()) {
+    // Known non-roof pixels: the worst Crit inside (capped below like every other cost), at
+    // most NoMatchCost outside. Before the region stage, so that its roof-like region skips them.
+    const cv::Mat excluded = request.excludeMask(roi) != 0;
+    im.roofCost.setTo(1.0f, excluded);
+    im.groundCost.setTo(im.noMatchCost, excluded & (im.groundCost > im.noMatchCost));
+  }
   // Roof disparity per pixel: argmin of Crit within the roof interval, median-filtered.
   const int d0 = std::max(request.roof.min, costs.dmin()), d1 = std::min(request.roof.max, costs.dmax());
   cv::Mat roofDisparity(size, CV_32F, cv::Scalar(0.5f * (d0 + d1)));

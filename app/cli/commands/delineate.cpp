@@ -49,13 +49,18 @@ int run(const std::vector<std::string>& args) {
                     "one output polygon per initial polygon (or per --roi rectangle).");
   opts.required("left", "FILE", "left (reference) epipolar image")
       .required("right", "FILE", "right epipolar image")
-      .value("init", "FILE", "initial polygons (GeoJSON/GeoPackage, left-image pixels); may hold many")
+      .value("init", "FILE",
+             "initial polygons (GeoJSON/GeoPackage, left-image pixels); may hold many")
       .value("roi", "X,Y,W,H", "initial rectangle in left-image pixels (instead of --init)")
-      .value("roof-disparity", "A:B", "roof disparity interval (a feature's roof_disparity_min/max override it)")
+      .value("roof-disparity", "A:B",
+             "roof disparity interval (a feature's roof_disparity_min/max override it)")
       .value("ground-disparity", "A:B",
              "ground disparity interval (a feature's ground_disparity overrides it); estimated "
              "around each init when absent")
       .value("disparity-range", "A:B", "full disparity search range, when known")
+      .value("exclude", "FILE",
+             "mask of the left image's size, non-zero where a pixel is known not to be roof "
+             "(vegetation, a neighbour's roof); kept outside every outline")
       .required("out", "FILE", "output polygons (GeoJSON/GeoPackage) with energies and status")
       .params(delineation::DelineationParams{});
   if (!opts.parse(args)) return cli::kExitOk;
@@ -86,6 +91,23 @@ int run(const std::vector<std::string>& args) {
     core::Feature f;
     f.polygon.outer = {{v[0], v[1]}, {v[0] + v[2], v[1]}, {v[0] + v[2], v[1] + v[3]}, {v[0], v[1] + v[3]}};
     inits.push_back(f);
+  }
+  cv::Mat exclude;
+  if (opts.has("exclude")) {
+    io::ReadOptions read;
+    read.type = io::PixelType::Float32;  // nodata becomes NaN
+    cv::Mat mask = io::readRaster(opts.get("exclude"), read).data;
+    if (mask.channels() != 1 || mask.size() != left.size()) {
+      throw core::Error(core::ErrorCode::MismatchedInputs,
+                        "the exclusion mask must be single-band and of the left image's size (" +
+                            std::to_string(left.cols) + "x" + std::to_string(left.rows) +
+                            "), not " + std::to_string(mask.channels()) + "-band " +
+                            std::to_string(mask.cols) + "x" + std::to_string(mask.rows),
+                        opts.get("exclude"));
+    }
+    // Any non-zero value excludes; nodata does not.
+    cv::patchNaNs(mask, 0.0);
+    exclude = mask != 0;
   }
   std::optional<DisparityInterval> roofFlag, groundFlag, searchFlag;
   if (opts.has("roof-disparity")) roofFlag = intervalFlag(opts, "roof-disparity");
@@ -127,6 +149,7 @@ int run(const std::vector<std::string>& args) {
         req.ground = groundFlag;
       }
       req.searchRange = searchFlag;
+      req.excludeMask = exclude;
       const auto r = delineation::delineate(left, right, req, params, {}, &range);
       result.polygon = r.polygon;
       result.attributes["status"] = statusName(r.status);

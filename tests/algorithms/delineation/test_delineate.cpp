@@ -214,6 +214,26 @@ TEST(Delineate, CancelReturnsThePolygonSoFar) {
   EXPECT_TRUE(core::isSimple(r.polygon.outer));
 }
 
+TEST(Delineate, KeepsExcludedPixelsOutEvenWhenTheyMatchTheRoofInterval) {
+  // A 10 px strip south of the roof at the roof's disparity (a tree crown at roof height): the
+  // correlation costs cannot tell it from the roof, an exclusion mask can.
+  const cv::Rect roof(50, 40, 60, 50), strip(50, 90, 60, 10);
+  const Pair pair = raisedRoof({170, 150}, roof | strip, 14, 4);
+  const core::Polygon truth{{{50, 40}, {110, 40}, {110, 90}, {50, 90}}, {}};
+  DelineationRequest req;
+  req.init = grownBox(roof | strip, 6);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  const double without = iou(delineate(pair.left, pair.right, req, DelineationParams{}).polygon,
+                             truth, pair.left.size());
+  req.excludeMask = cv::Mat::zeros(pair.left.size(), CV_8U);
+  req.excludeMask(strip).setTo(255);
+  const double with = iou(delineate(pair.left, pair.right, req, DelineationParams{}).polygon, truth,
+                          pair.left.size());
+  EXPECT_LT(without, 0.88);  // the strip is taken as roof
+  EXPECT_GT(with, 0.95);
+}
+
 TEST(Delineate, RejectsBadInputs) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
@@ -242,6 +262,9 @@ TEST(Delineate, RejectsBadInputs) {
   degenerate.init.outer = {{10, 10}, {20, 20}, {30, 30}};
   expectCode(degenerate, core::ErrorCode::InvalidParameter, pair.right);
   expectCode(ok, core::ErrorCode::MismatchedInputs, pair.right(cv::Rect(0, 0, 100, 100)));
+  DelineationRequest smallMask = ok;
+  smallMask.excludeMask = cv::Mat::zeros(100, 100, CV_8U);
+  expectCode(smallMask, core::ErrorCode::MismatchedInputs, pair.right);
   EXPECT_NO_THROW(regionOfInterest(pair.left, pair.right, ok, params));
   // The cost box filter is centred: an even side is rejected.
   DelineationParams even;

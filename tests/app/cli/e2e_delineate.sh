@@ -71,6 +71,15 @@ expect_rc flag_interval 0 "$CLI" delineate --left "$S/left.tif" --right "$S/righ
 [[ $(count "$WORK/flag_out.geojson" '"roof_disparity_min": 20,') == "$TRUTHS" ]] ||
   fail "the --roof-disparity flag was not used for features without roof properties"
 
+# 4. An exclusion mask of another size is refused with an error naming the file (exit 3).
+expect_rc small_scene 0 "$CLI" simulate --out "$WORK/small" --width 200 --height 150 --buildings 1 --trees 0 --seed 3
+"$CLI" delineate --left "$S/left.tif" --right "$S/right.tif" --init "$WORK/init.geojson" \
+  --exclude "$WORK/small/left.tif" --out "$WORK/excluded.geojson" 2>"$WORK/exclude.err"
+rc=$?
+[[ $rc == 3 ]] || fail "a mis-sized exclusion mask should exit 3, got $rc"
+grep -q "small/left.tif" "$WORK/exclude.err" || fail "the exclusion-mask error does not name the file"
+grep -q "exclusion mask" "$WORK/exclude.err" || fail "the exclusion-mask error does not say what is wrong"
+
 if ((failures > 0)); then
   echo "e2e_delineate: $failures check(s) failed" >&2
   exit 1

@@ -31,6 +31,12 @@ struct DelineationRequest {
   DisparityInterval roof;                     // Δd_b, required
   std::optional<DisparityInterval> ground;    // Δd_g; estimated from a ring around the init when unset
   std::optional<DisparityInterval> searchRange;  // full search range, when the caller knows it
+  // Optional CV_8U mask of the left image's size, non-zero where a pixel is known not to belong
+  // to the roof (vegetation from a classification or a near-infrared band, a neighbour's roof
+  // painted by the operator). Such pixels cost as much as possible inside the outline and no
+  // more than the occlusion band outside it: trees at roof height match the roof interval as
+  // well as a roof does, and the correlation costs alone cannot keep them out.
+  cv::Mat excludeMask;
 };
 
 // The energy inputs of one building, in ROI coordinates, plus what was derived on the way.
