@@ -355,18 +355,28 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
                    std::isfinite(costB[static_cast<size_t>(k)]);
         }
         if (!usable) continue;
+        // Occluded strip: when the +x surface is nearer, the `strip` columns before it are not
+        // seen in the other view; the boundary then has the strip between the two sides, and
+        // every position scores the same number of columns (n - strip).
+        const int strip = s.occlusionStrip && db > da ? static_cast<int>(std::lround(db - da)) : 0;
+        if (n - strip < 2) continue;
         float total = 0;
-        for (float c : costB) total += c;
+        for (int k = strip; k < n; ++k) total += costB[static_cast<size_t>(k)];
         float bestTotal = total;
-        int beta = s0 - 1;
-        for (int k = 0; k < n; ++k) {
-          total += costA[static_cast<size_t>(k)] - costB[static_cast<size_t>(k)];
+        int beta = s0 - 1;  // last column of the −x surface
+        for (int k = 0; k + strip < n; ++k) {
+          total += costA[static_cast<size_t>(k)] - costB[static_cast<size_t>(k + strip)];
           if (total < bestTotal) {
             bestTotal = total;
             beta = s0 + k;
           }
         }
+        float* rawRow = raw.disparity.ptr<float>(y);
         for (int x = s0; x <= s1; ++x) {
+          if (x > beta && x <= beta + strip) {
+            rawRow[x] = kNaN;  // occluded in the other view
+            continue;
+          }
           const bool sideA = x <= beta;
           sideD.at<float>(y, x) = sideA ? da : db;
           sideDy.at<schar>(y, x) = static_cast<schar>(sideA ? dyA : dyB);

@@ -19,6 +19,10 @@ struct StepRefineSettings {
   // gaps along the columns too (sim 600²) raised roofRMS1 to 0.250-0.251 px.
   int gapFill = 5;
   float gapTolerance = 1.0F;  // px
+  // At a step whose +x side is nearer (larger d), the |Δd| columns just before the near surface
+  // are seen by the reference view only (hidden behind it in the other): they are left out of
+  // the boundary's cost and of both sides' windows, and left unmatched.
+  bool occlusionStrip = true;
   int threads = 1;  // worker threads (1: the calling thread only)
 };
 
