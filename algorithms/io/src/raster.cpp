@@ -215,6 +215,22 @@ cv::Mat readGreyFloat(const std::string& path, GeoReference* geo) {
   return raster.data;
 }
 
+cv::Mat readMask(const std::string& path, cv::Size expected) {
+  ReadOptions options;
+  options.type = PixelType::Float32;  // nodata becomes NaN
+  cv::Mat values = readRaster(path, options).data;
+  if (values.channels() != 1 || values.size() != expected) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "a mask must be single-band of the left image's size (" +
+                    std::to_string(expected.width) + "x" + std::to_string(expected.height) +
+                    "), not " + std::to_string(values.channels()) + "-band " +
+                    std::to_string(values.cols) + "x" + std::to_string(values.rows),
+                path);
+  }
+  cv::patchNaNs(values, 0.0);
+  return values != 0;
+}
+
 void writeGeoTiff(const std::string& path, const cv::Mat& image, const GeoReference& geo,
                   const WriteOptions& options) {
   detail::ensureGdalRegistered();

@@ -17,6 +17,7 @@ DelineationOutcome runActivePolygon(const Project& project, const Building& buil
   request.init = building.initial;
   request.roof = {building.roofInterval->low, building.roofInterval->high};
   request.searchRange = delineation::DisparityInterval{project.disparityMin, project.disparityMax};
+  request.excludeMask = pair.exclude;
   // The optimiser reports ROI coordinates; the listener wants left-image pixels.
   const cv::Rect roi = delineation::regionOfInterest(pair.left, pair.right, request, params);
   delineation::IterationObserver observer;

@@ -64,6 +64,7 @@ StereoPair readStereoPair(const Project& project) {
                     "; an epipolar pair must have the same size",
                 project.left);
   }
+  if (!project.exclude.empty()) pair.exclude = io::readMask(project.exclude, pair.left.size());
   return pair;
 }
 

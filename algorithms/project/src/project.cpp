@@ -72,7 +72,7 @@ std::vector<int> Project::pendingBuildings() const {
 
 std::vector<std::string> Project::missingFiles() const {
   std::vector<std::string> missing;
-  for (const std::string* p : {&left, &right, &disparity, &dem, &labels}) {
+  for (const std::string* p : {&left, &right, &disparity, &dem, &labels, &exclude}) {
     std::error_code ec;
     if (!p->empty() && !fs::exists(*p, ec)) missing.push_back(*p);
   }
@@ -177,9 +177,10 @@ T get(const json& object, const char* key, const T& fallback, const std::string&
 bool Project::operator==(const Project& other) const {
   if (!(name == other.name && left == other.left && right == other.right &&
         disparity == other.disparity && dem == other.dem && labels == other.labels &&
-        outputDir == other.outputDir && disparityMin == other.disparityMin &&
-        disparityMax == other.disparityMax && height == other.height &&
-        parameters == other.parameters && buildings.size() == other.buildings.size())) {
+        exclude == other.exclude && outputDir == other.outputDir &&
+        disparityMin == other.disparityMin && disparityMax == other.disparityMax &&
+        height == other.height && parameters == other.parameters &&
+        buildings.size() == other.buildings.size())) {
     return false;
   }
   for (size_t i = 0; i < buildings.size(); ++i) {
@@ -197,7 +198,8 @@ json toJson(const Project& project, const std::string& baseDir) {
                    {"right", relativeTo(project.right, baseDir)},
                    {"disparity", relativeTo(project.disparity, baseDir)},
                    {"dem", relativeTo(project.dem, baseDir)},
-                   {"labels", relativeTo(project.labels, baseDir)}};
+                   {"labels", relativeTo(project.labels, baseDir)},
+                   {"exclude", relativeTo(project.exclude, baseDir)}};
   out["outputDir"] = relativeTo(project.outputDir, baseDir);
   out["disparityRange"] = {project.disparityMin, project.disparityMax};
   out["heightModel"] = {{"groundDisparity", project.height.groundDisparity},
@@ -246,6 +248,7 @@ Project fromJson(const json& in, const std::string& baseDir) {
   p.disparity = resolveAgainst(get<std::string>(images, "disparity", "", "images."), baseDir);
   p.dem = resolveAgainst(get<std::string>(images, "dem", "", "images."), baseDir);
   p.labels = resolveAgainst(get<std::string>(images, "labels", "", "images."), baseDir);
+  p.exclude = resolveAgainst(get<std::string>(images, "exclude", "", "images."), baseDir);
   if (p.left.empty() || p.right.empty()) badField("images", "left and right images are required");
   p.outputDir = resolveAgainst(get<std::string>(in, "outputDir", "output", ""), baseDir);
   if (auto it = in.find("disparityRange"); it != in.end()) {

@@ -93,22 +93,7 @@ int run(const std::vector<std::string>& args) {
     inits.push_back(f);
   }
   cv::Mat exclude;
-  if (opts.has("exclude")) {
-    io::ReadOptions read;
-    read.type = io::PixelType::Float32;  // nodata becomes NaN
-    cv::Mat mask = io::readRaster(opts.get("exclude"), read).data;
-    if (mask.channels() != 1 || mask.size() != left.size()) {
-      throw core::Error(core::ErrorCode::MismatchedInputs,
-                        "the exclusion mask must be single-band and of the left image's size (" +
-                            std::to_string(left.cols) + "x" + std::to_string(left.rows) +
-                            "), not " + std::to_string(mask.channels()) + "-band " +
-                            std::to_string(mask.cols) + "x" + std::to_string(mask.rows),
-                        opts.get("exclude"));
-    }
-    // Any non-zero value excludes; nodata does not.
-    cv::patchNaNs(mask, 0.0);
-    exclude = mask != 0;
-  }
+  if (opts.has("exclude")) exclude = io::readMask(opts.get("exclude"), left.size());
   std::optional<DisparityInterval> roofFlag, groundFlag, searchFlag;
   if (opts.has("roof-disparity")) roofFlag = intervalFlag(opts, "roof-disparity");
   if (opts.has("ground-disparity")) groundFlag = intervalFlag(opts, "ground-disparity");

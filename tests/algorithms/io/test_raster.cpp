@@ -140,6 +140,27 @@ TEST(RasterIo, EightBitNodataMapsToNaNInFloat32) {
   EXPECT_EQ(raster.data.at<float>(0, 0), 200.0f);
 }
 
+TEST(RasterIo, MaskIsNonZeroAndNotNodata) {
+  TempDir dir;
+  cv::Mat values(4, 5, CV_32FC1, cv::Scalar(0.0f));
+  values.at<float>(0, 1) = 2.0f;                                     // a class code
+  values.at<float>(2, 3) = -1.0f;                                    // any non-zero value
+  values.at<float>(3, 4) = std::numeric_limits<float>::quiet_NaN();  // nodata: not masked
+  WriteOptions options;
+  options.nodata = -9999.0;
+  writeGeoTiff(dir.file("mask.tif"), values, {}, options);
+  const cv::Mat mask = readMask(dir.file("mask.tif"), {5, 4});
+  ASSERT_EQ(mask.type(), CV_8UC1);
+  EXPECT_EQ(cv::countNonZero(mask), 2);
+  EXPECT_EQ(mask.at<uchar>(0, 1), 255);
+  EXPECT_EQ(mask.at<uchar>(2, 3), 255);
+  EXPECT_EQ(mask.at<uchar>(3, 4), 0);
+  const core::Error error = captureError([&] { readMask(dir.file("mask.tif"), {6, 4}); });
+  EXPECT_EQ(error.code(), ErrorCode::MismatchedInputs);
+  EXPECT_NE(std::string(error.what()).find("mask.tif"), std::string::npos);
+  EXPECT_NE(std::string(error.what()).find("6x4"), std::string::npos);
+}
+
 TEST(RasterIo, ThreeBandsKeptOrConvertedToGrey) {
   TempDir dir;
   const cv::Mat rgb = randomImage(10, 12, CV_8UC3, 0, 256, 4);

@@ -58,6 +58,7 @@ Project sampleProject(const TempDir& dir) {
   p.left = dir.file("images/left.tif");
   p.right = dir.file("images/right.tif");
   p.disparity = dir.file("output/disparity.tif");
+  p.exclude = dir.file("images/vegetation.tif");
   p.outputDir = dir.file("output");
   p.disparityMin = -4;
   p.disparityMax = 40;
@@ -103,6 +104,7 @@ TEST(ProjectFile, PathsUnderTheProjectFolderAreStoredRelative) {
   p.dem = "/elsewhere/dem.tif";
   const nlohmann::json j = project::toJson(p, dir.path().string());
   EXPECT_EQ(j["images"]["left"], "images/left.tif");
+  EXPECT_EQ(j["images"]["exclude"], "images/vegetation.tif");
   EXPECT_EQ(j["outputDir"], "output");
   EXPECT_EQ(j["images"]["dem"], "/elsewhere/dem.tif");
 }
@@ -128,9 +130,10 @@ TEST(ProjectFile, MissingFilesNamesEachAbsentImage) {
   fs::create_directories(dir.path() / "images");
   touch(p.left);
   const auto missing = p.missingFiles();
-  ASSERT_EQ(missing.size(), 2u);  // right and disparity
+  ASSERT_EQ(missing.size(), 3u);  // right, disparity and the exclusion mask
   EXPECT_EQ(missing[0], p.right);
   EXPECT_EQ(missing[1], p.disparity);
+  EXPECT_EQ(missing[2], p.exclude);
 }
 
 TEST(ProjectFile, SaveIsAtomicAndLeavesNoTemporaryFile) {

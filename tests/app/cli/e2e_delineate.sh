@@ -78,7 +78,7 @@ expect_rc small_scene 0 "$CLI" simulate --out "$WORK/small" --width 200 --height
 rc=$?
 [[ $rc == 3 ]] || fail "a mis-sized exclusion mask should exit 3, got $rc"
 grep -q "small/left.tif" "$WORK/exclude.err" || fail "the exclusion-mask error does not name the file"
-grep -q "exclusion mask" "$WORK/exclude.err" || fail "the exclusion-mask error does not say what is wrong"
+grep -q "mask must be single-band" "$WORK/exclude.err" || fail "the exclusion-mask error does not say what is wrong"
 
 if ((failures > 0)); then
   echo "e2e_delineate: $failures check(s) failed" >&2

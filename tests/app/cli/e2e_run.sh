@@ -110,6 +110,21 @@ cmp -s "$project" "$work/after_first.json" && pass "second run left the project 
 [ "$(stat -c %Y "$site/output/disparity.tif")" = "$disparity_time" ] && pass "disparity not recomputed" \
   || fail "second run rewrote the disparity"
 
+# ---- exclusion mask (images.exclude): an empty one changes nothing; a mis-sized one is refused --
+run_cli simulate_empty 0 "" -- "$cli" simulate --out "$work/empty" --seed 5 --width 256 --height 192 --buildings 0 --trees 0 \
+  || exit 1
+jq --arg mask "$work/empty/labels_gt.tif" \
+  '.images.exclude = $mask | .buildings |= map(.status = "pending" | .outline = [])' \
+  "$work/after_first.json" >"$site/masked.delineo.json"
+run_cli run_masked 0 "disparity already present" -- "$cli" run "$site/masked.delineo.json" --quiet
+expect masked_same_outlines "[.buildings[].outline] == $(jq -c '[.buildings[].outline]' "$work/after_first.json")" \
+  "$site/masked.delineo.json"
+run_cli simulate_small 0 "" -- "$cli" simulate --out "$work/small" --seed 5 --width 128 --height 96 --buildings 0 --trees 0 \
+  || exit 1
+jq --arg mask "$work/small/labels_gt.tif" '.images.exclude = $mask | .buildings[0].status = "pending"' \
+  "$work/after_first.json" >"$site/badmask.delineo.json"
+run_cli run_bad_mask 3 "small/labels_gt.tif" -- "$cli" run "$site/badmask.delineo.json" --quiet
+
 # ---- bad projects: exit 3, the message names the file ----------------------------------------
 printf '{"format": "delineo-project", "version": 1, "images": ' >"$work/corrupt.delineo.json"
 run_cli run_corrupt 3 "corrupt.delineo.json" -- "$cli" run "$work/corrupt.delineo.json" --quiet

@@ -43,6 +43,11 @@ Raster readRaster(const std::string& path, const ReadOptions& options = {});
 // Reads a raster as a single-band float32 image ready for matching (grey, NaN for nodata).
 cv::Mat readGreyFloat(const std::string& path, GeoReference* geo = nullptr);
 
+// Reads a single-band raster as a mask of the given size: CV_8U, 255 where the value is non-zero
+// and not nodata, 0 elsewhere (exclusion masks, classifications). Throws like readRaster, and
+// MismatchedInputs naming the file when it has several bands or another size.
+cv::Mat readMask(const std::string& path, cv::Size expected);
+
 struct WriteOptions {
   std::optional<double> nodata;  // written into the file's band metadata
   bool compress = true;          // DEFLATE

@@ -26,6 +26,7 @@ bool simulationAvailable();
 struct StereoPair {
   cv::Mat left, right;
   io::GeoReference geo;  // of the left image
+  cv::Mat exclude;  // CV_8U, 255 on pixels that are not roof (project's images.exclude), or empty
 };
 StereoPair readStereoPair(const Project& project);
 

@@ -82,6 +82,7 @@ struct Project {
   std::string disparity;   // float32 disparity in left geometry (computed when missing)
   std::string dem;         // float32 heights in left geometry, optional
   std::string labels;      // ground truth / classification labels, optional
+  std::string exclude;     // mask of pixels that are not roof (vegetation...), optional
   std::string outputDir;   // where `run` and exports write; default: "<project dir>/output"
   int disparityMin = 0;    // px, full search range of the pair
   int disparityMax = 64;
