@@ -644,7 +644,8 @@ bool MainWindow::openProject(const QString& path) {
                        "or locate it when opening the project.").arg(missingPath));
         return false;
       }
-      for (std::string* p : {&loaded.left, &loaded.right, &loaded.disparity, &loaded.dem, &loaded.labels}) {
+      for (std::string* p : {&loaded.left, &loaded.right, &loaded.disparity, &loaded.dem, &loaded.labels,
+                             &loaded.exclude}) {
         if (*p == missing) *p = replacement.toStdString();
       }
     }
