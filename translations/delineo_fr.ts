@@ -263,6 +263,14 @@
         <translation>Luminosité dans le coût</translation>
     </message>
     <message>
+        <source>Intermediate height margin</source>
+        <translation>Marge des hauteurs intermédiaires</translation>
+    </message>
+    <message>
+        <source>Intermediate height guard</source>
+        <translation>Garde des hauteurs intermédiaires</translation>
+    </message>
+    <message>
         <source>Band best cost</source>
         <translation>Coût de bande selon l’appariement</translation>
     </message>

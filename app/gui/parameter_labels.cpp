@@ -43,6 +43,8 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Cost aggregation"),
     QT_TRANSLATE_NOOP("Parameters", "Cost cap"),
     QT_TRANSLATE_NOOP("Parameters", "Cost cap floor"),
+    QT_TRANSLATE_NOOP("Parameters", "Intermediate height margin"),
+    QT_TRANSLATE_NOOP("Parameters", "Intermediate height guard"),
     QT_TRANSLATE_NOOP("Parameters", "Band best cost"),
     // stereo::MatchParams
     QT_TRANSLATE_NOOP("Parameters", "Method"),

@@ -216,8 +216,8 @@ using DiagTable = std::map<std::string, DiagCell>;
 
 const char* labelName(int l) { return l == kRoof ? "roof" : l == kBand ? "band" : "ground"; }
 
-void diagnose(const EnergyImages& im, const IntPolygon& truth, const IntPolygon& result, DiagTable& table,
-              cv::Mat* picture) {
+void diagnose(const EnergyImages& im, const cv::Mat& excluded, const IntPolygon& truth,
+              const IntPolygon& result, DiagTable& table, cv::Mat* picture) {
   const cv::Mat lt = labelPixels(im, truth), lr = labelPixels(im, result);
   const cv::Mat inside = core::rasterize(toPolygon(truth), lt.size());
   // Distance to the true outline and the direction to its nearest pixel on the other side.
@@ -231,7 +231,17 @@ void diagnose(const EnergyImages& im, const IntPolygon& truth, const IntPolygon&
       else outsideAt[labIn.at<int>(y, x)] = {x, y};
     }
   }
-  if (picture) *picture = cv::Mat(lt.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+  if (picture) {
+    *picture = cv::Mat(lt.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+    if (!excluded.empty())
+      picture->setTo(cv::Scalar(90, 90, 90), excluded);  // grey: kept out of the roof
+  }
+  if (!excluded.empty()) {
+    std::printf(
+        "      diag excluded pixels (mask, intermediate heights): %d inside the truth, %d "
+        "outside\n",
+        cv::countNonZero(excluded & inside), cv::countNonZero(excluded & ~inside));
+  }
   const float nmc = im.noMatchCost;
   {
     // How the truth's own labels are matched: mean cost and share above NoMatchCost per label.
@@ -444,7 +454,8 @@ int main(int argc, char** argv) {
             if (diag) {
               DiagTable table;
               cv::Mat picture;
-              diagnose(pe.images, truthLocal, resultLocal, table, dumpDir.empty() ? nullptr : &picture);
+              diagnose(pe.images, pe.excluded, truthLocal, resultLocal, table,
+                       dumpDir.empty() ? nullptr : &picture);
               printDiag(table, "      ", false);
               for (const auto& [key, c] : table) {
                 DiagCell& total = diagTotals[initName][key];

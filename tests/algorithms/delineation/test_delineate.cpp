@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <tuple>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -232,6 +233,77 @@ TEST(Delineate, KeepsExcludedPixelsOutEvenWhenTheyMatchTheRoofInterval) {
                           pair.left.size());
   EXPECT_LT(without, 0.88);  // the strip is taken as roof
   EXPECT_GT(with, 0.95);
+}
+
+// Flat textured layers, each at its own disparity, the nearer (larger d) hiding the farther in
+// both views; ground everywhere else. Left view vertical, x_right = x_left - d.
+struct Layer {
+  cv::Rect area;
+  int disparity;
+  cv::Mat texture;  // image size + 64 columns
+};
+Pair layeredPair(cv::Size size, int groundDisparity, std::vector<Layer> layers) {
+  const cv::Mat ground = texture(size + cv::Size(64, 0), 100, 25, 1);
+  std::sort(layers.begin(), layers.end(),
+            [](const Layer& a, const Layer& b) { return a.disparity > b.disparity; });
+  auto sample = [&](int x, int y, int shift) {
+    for (const Layer& l : layers) {
+      if (l.area.contains({x + shift * l.disparity, y}))
+        return l.texture.at<float>(y, x + shift * l.disparity);
+    }
+    return ground.at<float>(y, std::clamp(x + shift * groundDisparity, 0, ground.cols - 1));
+  };
+  Pair p;
+  p.left.create(size, CV_32F);
+  p.right.create(size, CV_32F);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      p.left.at<float>(y, x) = sample(x, y, 0);
+      p.right.at<float>(y, x) = 0.95f * sample(x, y, 1) + 4.0f;
+    }
+  }
+  return p;
+}
+
+TEST(Delineate, KeepsWhatMatchesBetweenTheGroundAndTheRoofOut) {
+  // A crown lower than the roof along its south side, as bright as the roof and textured like
+  // it: the edge between them is weak, the crown's edge on the ground strong. Its pixels match
+  // neither interval (the cost cap makes them neutral) but match a disparity between the two.
+  const cv::Rect roof(50, 40, 60, 50), crown(50, 90, 60, 12);
+  const cv::Size size(170, 150);
+  const Pair pair = layeredPair(size, 4,
+                                {{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
+                                 {crown, 9, texture(size + cv::Size(64, 0), 160, 25, 5)}});
+  const core::Polygon truth{{{50, 40}, {110, 40}, {110, 90}, {50, 90}}, {}};
+  DelineationRequest req;
+  req.init = grownBox(roof | crown, 6);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  DelineationParams off;
+  off.intermediateMargin = 0;
+  const DelineationParams on;
+  const double without = iou(delineate(pair.left, pair.right, req, off).polygon, truth, size);
+  const double with = iou(delineate(pair.left, pair.right, req, on).polygon, truth, size);
+  EXPECT_LT(without, 0.9) << "without the cue the crown is taken as roof";
+  EXPECT_GT(with, 0.95) << "without " << without;
+
+  // The excluded pixels: most of the crown, none of the roof away from its outline.
+  const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, on);
+  stereo::CostParams costParams;
+  costParams.window = on.costWindow;
+  costParams.brightnessScale = on.costBrightness;
+  const auto costs =
+      stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15, costParams);
+  ASSERT_TRUE(costs);
+  const PreparedEnergy prepared = prepareEnergy(*costs, pair.left, pair.right, req, on);
+  const cv::Point o = roi.tl();
+  const cv::Rect crownInside(crown.x + 3 - o.x, crown.y + 3 - o.y, crown.width - 6,
+                             crown.height - 6);
+  const cv::Rect roofInside(roof.x + 3 - o.x, roof.y + 3 - o.y, roof.width - 6, roof.height - 6);
+  EXPECT_GT(cv::countNonZero(prepared.excluded(crownInside)), 0.7 * crownInside.area());
+  EXPECT_EQ(cv::countNonZero(prepared.excluded(roofInside)), 0);
+  const PreparedEnergy plain = prepareEnergy(*costs, pair.left, pair.right, req, off);
+  EXPECT_EQ(cv::countNonZero(plain.excluded), 0);
 }
 
 TEST(Delineate, RejectsBadInputs) {

@@ -50,6 +50,9 @@ struct PreparedEnergy {
   double roofDisparity = 0;     // median roof disparity near the initial contour
   // Intervals the costs c_roof and c_ground were taken over (balanced, see balanceIntervals).
   DisparityInterval roofSearched, groundSearched;
+  // CV_8U, ROI size: pixels kept out of the roof (the request's exclusion mask and the pixels
+  // seen at an intermediate height, see intermediateMargin); 255 = excluded.
+  cv::Mat excluded;
 };
 
 // The intervals over which c_roof and c_ground are computed. With `balance`, the narrower one is

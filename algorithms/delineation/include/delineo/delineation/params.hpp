@@ -35,6 +35,8 @@ struct DelineationParams {
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
   double costCap = 1.6;            // × NoMatchCost: c_roof and c_ground capped there for the terms (0 = off)
   double costCapFloor = 0.35;      // Crit units: the cap is never below this
+  double intermediateMargin = 0.1; // Crit units: in-between match this much better: not roof (0 = off)
+  int intermediateGuard = 1;       // disparities kept off each interval when looking between them
   bool bandBestCost = false;       // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost, the paper)
   template <class V>
   void visit(V&& v) {
@@ -169,6 +171,18 @@ struct DelineationParams {
                       "alone would flatten every cost",
                       0, 1},
       costCapFloor);
+    v(core::ParamInfo{"intermediate-margin", "Intermediate height margin", "",
+                      "A pixel matching no roof disparity (c_roof above NoMatchCost) but a "
+                      "disparity between the ground and roof intervals (below NoMatchCost, this "
+                      "much better than both) shows something at another height, a crown or a "
+                      "wall: it is kept out of the roof like an excluded pixel (0 = off)",
+                      0, 1},
+      intermediateMargin);
+    v(core::ParamInfo{"intermediate-guard", "Intermediate height guard", "px",
+                      "Disparities next to each interval left out of the in-between search (a "
+                      "window straddling a roof edge matches just inside the gap)",
+                      0, 16},
+      intermediateGuard);
     v(core::ParamInfo{"band-best-cost", "Band best cost", "",
                       "A pixel of the occlusion band costs NoMatchCost or, when higher, the lower of "
                       "c_roof and c_ground there, so that the band is never cheaper than the pixel's "
