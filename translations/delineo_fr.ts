@@ -247,6 +247,10 @@
         <translation>Plafond des coûts</translation>
     </message>
     <message>
+        <source>Snap depth steps to contours</source>
+        <translation>Sauts de profondeur calés sur les contours</translation>
+    </message>
+    <message>
         <source>Fill flat regions</source>
         <translation>Remplir les régions uniformes</translation>
     </message>

@@ -111,6 +111,14 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
             if (u >= 0 && u < disparity.cols) std::printf(" %5.1f", row[u]);
           }
           std::printf("\n");
+          if (std::getenv("OUTLINE_DUMP_GREY") != nullptr) {
+            std::printf("        left grey:");
+            for (int step = -3; step <= 8; ++step) {
+              const int u = o.xb - o.dir * step;
+              if (u >= 0 && u < disparity.cols) std::printf(" %5.0f", c.left.at<float>(o.y, u));
+            }
+            std::printf("\n");
+          }
         }
       }
       found = true;

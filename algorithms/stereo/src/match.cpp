@@ -15,8 +15,9 @@
 
 #include "delineo/core/error.hpp"
 #include "level_matcher.hpp"
-#include "match_steps.hpp"
 #include "match_fill.hpp"
+#include "match_snap.hpp"
+#include "match_steps.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo {
@@ -389,6 +390,11 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   if (p.fillRegions && p.adaptive) {
     detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
                             static_cast<float>(p.minScore), result.disparity, result.score);
+  }
+  if (p.snapSteps && p.adaptive) {
+    // Last, after the fill: a filled roof's edges are snapped like matched ones.
+    detail::snapStepsToContours(left, detail::StepSnapSettings{}, static_cast<float>(p.minScore),
+                                result.disparity, result.score);
   }
   return result;
 }

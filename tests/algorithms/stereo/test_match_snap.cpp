@@ -1,0 +1,82 @@
+// Depth steps moved onto the left image's contour (internal snapStepsToContours).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include <opencv2/core.hpp>
+
+#include "match_snap.hpp"
+
+namespace delineo::stereo::detail {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Ground grey 100, a roof [40, 70) grey 160 on every row, noise sigma 1.
+cv::Mat roofImage(bool withContour) {
+  cv::Mat left(20, 120, CV_32F, cv::Scalar(100));
+  if (withContour) left(cv::Rect(40, 0, 30, 20)).setTo(160);
+  cv::Mat noise(left.size(), CV_32F);
+  cv::RNG rng(3);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 1);
+  return left + noise;
+}
+
+// Every row: d on [x0, x1), NaN elsewhere unless already set.
+void setRun(cv::Mat& disparity, int x0, int x1, float d) {
+  disparity(cv::Rect(x0, 0, x1 - x0, disparity.rows)).setTo(d);
+}
+
+TEST(SnapSteps, ExtendsAShortNearSideToTheContour) {
+  // Roof's +x edge at x = 70: the roof is matched up to 65, the ground from 75.
+  cv::Mat disparity(20, 120, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 66, 20.0f);
+  setRun(disparity, 75, 120, 5.0f);
+  const int changed =
+      snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, disparity, score);
+  EXPECT_EQ(changed, 4 * 20);
+  for (int x = 66; x < 70; ++x) EXPECT_FLOAT_EQ(disparity.at<float>(10, x), 20.0f) << x;
+  for (int x = 70; x < 75; ++x) EXPECT_TRUE(std::isnan(disparity.at<float>(10, x))) << x;
+}
+
+TEST(SnapSteps, CutsANearSideThatRunsOverTheContour) {
+  // Roof's -x edge at x = 40 (near side on the right): ground matched up to 34, the roof's value
+  // spread over 37..39 (fattening, within `reach`); its +x edge: roof value on 70..72, ground
+  // from 73.
+  cv::Mat disparity(20, 120, CV_32F, cv::Scalar(kNaN)), score(20, 120, CV_32F, cv::Scalar(0.9));
+  setRun(disparity, 0, 35, 5.0f);
+  setRun(disparity, 37, 73, 20.0f);
+  setRun(disparity, 73, 120, 5.0f);
+  snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, disparity, score);
+  for (int x = 35; x < 40; ++x) EXPECT_TRUE(std::isnan(disparity.at<float>(10, x))) << x;
+  for (int x = 40; x < 70; ++x) EXPECT_FLOAT_EQ(disparity.at<float>(10, x), 20.0f) << x;
+  for (int x = 70; x < 73; ++x) {
+    EXPECT_TRUE(std::isnan(disparity.at<float>(10, x))) << x;
+    EXPECT_TRUE(std::isnan(score.at<float>(10, x))) << x;
+  }
+  EXPECT_FLOAT_EQ(disparity.at<float>(10, 73), 5.0f);  // the far side is left alone
+  EXPECT_FLOAT_EQ(disparity.at<float>(10, 34), 5.0f);
+}
+
+TEST(SnapSteps, LeavesStepsWithoutAContourAndSmallDifferencesAlone) {
+  cv::Mat disparity(20, 120, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 66, 20.0f);
+  setRun(disparity, 75, 120, 5.0f);
+  const cv::Mat before = disparity.clone();
+  // Noise only: no contour strong enough.
+  EXPECT_EQ(snapStepsToContours(roofImage(false), StepSnapSettings{}, 0.3f, disparity, score), 0);
+  // A contour, but 1.5 px of disparity is a slope, not a step.
+  setRun(disparity, 75, 120, 18.5f);
+  EXPECT_EQ(snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, disparity, score), 0);
+  // A gap wider than maxGap.
+  cv::Mat wide(20, 120, CV_32F, cv::Scalar(kNaN));
+  setRun(wide, 40, 50, 20.0f);
+  setRun(wide, 75, 120, 5.0f);
+  EXPECT_EQ(snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, wide, score), 0);
+  EXPECT_EQ(cv::countNonZero(before(cv::Rect(0, 0, 75, 20)) == disparity(cv::Rect(0, 0, 75, 20))),
+            cv::countNonZero(before(cv::Rect(0, 0, 75, 20)) == before(cv::Rect(0, 0, 75, 20))));
+}
+
+}  // namespace
+}  // namespace delineo::stereo::detail
