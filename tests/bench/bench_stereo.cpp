@@ -94,6 +94,20 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
       else if (off > 1) {
         ++outside;
         ++outsideBy[o.dir > 0 ? 0 : 1];
+        if (std::getenv("OUTLINE_DUMP_OUTSIDE") != nullptr && outside % 8 == 1) {
+          std::printf("      outside y %d xb %d dir %d roof %.1f ground %.1f:", o.y, o.xb, o.dir,
+                      o.dRoof, o.dGround);
+          for (int step = -3; step <= 8; ++step) {
+            const int u = o.xb - o.dir * step;
+            if (u >= 0 && u < disparity.cols) std::printf(" %5.1f", row[u]);
+          }
+          std::printf("\n        left grey:");
+          for (int step = -3; step <= 8; ++step) {
+            const int u = o.xb - o.dir * step;
+            if (u >= 0 && u < disparity.cols) std::printf(" %5.0f", c.left.at<float>(o.y, u));
+          }
+          std::printf("\n");
+        }
       }
       else {
         ++inside;

@@ -393,8 +393,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   if (p.snapSteps && p.adaptive) {
     // Last, after the fill: a filled roof's edges are snapped like matched ones.
-    detail::snapStepsToContours(left, detail::StepSnapSettings{}, static_cast<float>(p.minScore),
-                                result.disparity, result.score);
+    detail::snapStepsToContours(left, right, detail::StepSnapSettings{},
+                                static_cast<float>(p.minScore), result.disparity, result.score);
   }
   return result;
 }

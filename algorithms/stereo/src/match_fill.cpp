@@ -55,6 +55,65 @@ std::vector<int> twoLargestClusters(const std::vector<float>& values, int dmin, 
   return centres;
 }
 
+// The cluster candidates of a region can be too close in outline error to pass the contrast
+// test (a roof of nearly the ground's grey). Scanning every integer disparity of the range then
+// confirms `best` when the scan's minimum is within 1 px of it and at most `agreement` × the
+// lowest error found 3 px or more away: the outline lines up there and nowhere else.
+template <typename ErrorAt>
+bool scanConfirms(const ErrorAt& errorAt, int dmin, int dmax, float best, double agreement) {
+  std::vector<double> errors(static_cast<size_t>(dmax - dmin + 1));
+  for (int d = dmin; d <= dmax; ++d)
+    errors[static_cast<size_t>(d - dmin)] = errorAt(static_cast<float>(d));
+  const auto lowest = std::min_element(errors.begin(), errors.end());
+  const int found = dmin + static_cast<int>(lowest - errors.begin());
+  if (std::abs(static_cast<float>(found) - best) > 1.0F || *lowest >= 1e29) return false;
+  double other = 1e30;
+  for (int d = dmin; d <= dmax; ++d) {
+    if (std::abs(d - found) > 2) other = std::min(other, errors[static_cast<size_t>(d - dmin)]);
+  }
+  return *lowest <= agreement * other;
+}
+
+// The flat region stops 2 px short of its contour (its 5x5 windows reach across it): grow it
+// back, 4-connected and at most `growReach` px, over the pixels that look like the region next to
+// them (within growSigmas noise sigmas of the mean of the region pixels in their 7x7
+// neighbourhood) and that match at the region's disparity on their own (|left − mapped right|
+// within growPhotometric noise sigmas). The contour's mixed pixel fails the first test, the
+// surface beyond it both: the fill then ends at the image contour.
+void growToContour(const cv::Mat& left, const cv::Mat& right, const cv::Rect& box,
+                   const cv::Mat& region, int shift, double gain, double offset, double sigma,
+                   const RegionFillSettings& settings, cv::Mat& grown) {
+  cv::Mat leftBox = left(box).clone();
+  cv::patchNaNs(leftBox, 0.0);
+  cv::Mat regionF, sum, count;
+  region.convertTo(regionF, CV_32F, 1.0 / 255.0);
+  cv::boxFilter(leftBox.mul(regionF), sum, CV_32F, {7, 7}, {-1, -1}, false);
+  cv::boxFilter(regionF, count, CV_32F, {7, 7}, {-1, -1}, false);
+  const auto like = [&](int x, int y) {
+    const float a = left.at<float>(box.y + y, box.x + x);
+    const int xr = box.x + x - shift;
+    if (!std::isfinite(a) || xr < 0 || xr >= right.cols) return false;
+    const float b = right.at<float>(box.y + y, xr);
+    const float n = count.at<float>(y, x);
+    if (!std::isfinite(b) || n < 1.0F) return false;
+    return std::abs(a - sum.at<float>(y, x) / n) <= settings.growSigmas * sigma &&
+           std::abs(a - (gain * b + offset)) <= settings.growPhotometric * sigma;
+  };
+  for (int step = 0; step < settings.growReach; ++step) {
+    const cv::Mat before = grown.clone();
+    for (int y = 0; y < box.height; ++y) {
+      for (int x = 0; x < box.width; ++x) {
+        if (before.at<uchar>(y, x)) continue;
+        const bool touches = (x > 0 && before.at<uchar>(y, x - 1)) ||
+                             (x + 1 < box.width && before.at<uchar>(y, x + 1)) ||
+                             (y > 0 && before.at<uchar>(y - 1, x)) ||
+                             (y + 1 < box.height && before.at<uchar>(y + 1, x));
+        if (touches && like(x, y)) grown.at<uchar>(y, x) = 255;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
@@ -108,8 +167,11 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       }
     }
     if (static_cast<int>(matches.size()) < settings.minMatched) continue;
+    // Mean |left − mapped right| over the ring at disparity `value`, the right view read with
+    // linear interpolation (the candidates are sub-pixel means).
     auto ringError = [&](float value) {
-      const int shift = static_cast<int>(std::lround(value));
+      const int whole = static_cast<int>(std::floor(value));
+      const float t = value - static_cast<float>(whole);
       double sum = 0, n = 0;
       for (int y = 0; y < box.height; ++y) {
         const uchar* m = ring.ptr<uchar>(y);
@@ -117,10 +179,11 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
         const float* b = right.ptr<float>(box.y + y);
         for (int x = 0; x < box.width; ++x) {
           if (!m[x]) continue;
-          const int xr = box.x + x - shift;
-          if (xr < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
-          if (!std::isfinite(a[x]) || !std::isfinite(b[xr])) continue;
-          sum += std::abs(a[x] - (gain * b[xr] + offset));
+          const int xr = box.x + x - whole;                 // x − value lies in [xr − 1, xr]
+          if (xr - 1 < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
+          const float bv = (1 - t) * b[xr] + t * b[xr - 1];
+          if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
+          sum += std::abs(a[x] - (gain * bv + offset));
           n += 1;
         }
       }
@@ -139,19 +202,38 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
         otherError = std::min(otherError, e);
       }
     }
-    if (bestError > settings.photometric * sigma || bestError > settings.contrast * otherError) {
+    if (bestError > settings.photometric * sigma) continue;
+    if (bestError > settings.contrast * otherError &&
+        !(settings.scanAgreement > 0 &&
+          scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement))) {
       continue;
     }
     const int shift = static_cast<int>(std::lround(best));
+    cv::Mat grown = region.clone();
+    if (settings.growReach > 0) {
+      growToContour(left, right, box, region, shift, gain, offset, sigma, settings, grown);
+    }
     for (int y = 0; y < box.height; ++y) {
-      const uchar* m = region.ptr<uchar>(y);
+      const uchar* m = grown.ptr<uchar>(y);
+      const uchar* inRegion = region.ptr<uchar>(y);
+      const float* a = left.ptr<float>(box.y + y) + box.x;
       float* d = disparity.ptr<float>(box.y + y) + box.x;
       float* s = score.ptr<float>(box.y + y) + box.x;
       const float* b = right.ptr<float>(box.y + y);
       for (int x = 0; x < box.width; ++x) {
         const int xr = box.x + x - shift;
-        if (!m[x] || std::isfinite(d[x]) || xr < 0 || xr >= right.cols || !std::isfinite(b[xr])) {
-          continue;
+        if (!m[x] || xr < 0 || xr >= right.cols || !std::isfinite(b[xr])) continue;
+        if (std::isfinite(d[x])) {
+          // A grown pixel matched elsewhere (the far side's disparity carried over the outline
+          // by a window that reached across it) is taken when the region's disparity explains
+          // its grey level better than its own.
+          if (inRegion[x] || std::abs(d[x] - best) < 2.0F) continue;
+          const int xo = box.x + x - static_cast<int>(std::lround(d[x]));
+          if (xo < 0 || xo >= right.cols || !std::isfinite(b[xo])) continue;
+          if (!(std::abs(a[x] - (gain * b[xo] + offset)) >
+                std::abs(a[x] - (gain * b[xr] + offset)))) {
+            continue;
+          }
         }
         d[x] = best;
         s[x] = fillScore;

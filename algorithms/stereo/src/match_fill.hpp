@@ -12,6 +12,10 @@ struct RegionFillSettings {
   int minMatched = 20;       // px: matches around a region needed to propose a disparity
   double photometric = 6.0;  // × noise sigma: mean |left − mapped right| allowed on the outline
   double contrast = 0.5;     // the best candidate's outline error must be below this × the other's
+  double scanAgreement = 0.9;    // a full-range scan confirming the best candidate (0 = off)
+  int growReach = 3;             // px: the filled region grows back to its contour by at most this
+  double growSigmas = 3.0;       // × noise sigma: grown pixel vs the region's local mean grey
+  double growPhotometric = 4.0;  // × noise sigma: a grown pixel's |left − mapped right|
 };
 
 // Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is
@@ -21,7 +25,11 @@ struct RegionFillSettings {
 // the mean |left − (gain · right + offset)| over the region's outline ring (2 px on both sides),
 // where only the right disparity lines the outlines up: inside a flat region every disparity
 // that stays in it matches. The best is kept when below `photometric` noise sigmas and clearly
-// better than the other; the region's unmatched pixels take it, with `fillScore` as score.
+// better than the other, or, failing the latter, when a scan of the whole range finds its
+// minimum there too (scanAgreement). The region is then grown back to its image contour (it
+// stops 2 px short: its 5x5 windows straddle it) over pixels that look like it and match at its
+// disparity on their own; its unmatched pixels and the grown ones whose own disparity explains
+// them worse take it, with `fillScore` as score.
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score);

@@ -9,6 +9,7 @@ struct StepSnapSettings {
   int maxGap = 16;          // px: most unmatched pixels between the two sides of a step
   int reach = 3;            // px: how far beyond the matched sides the contour is looked for
   double edgeSigmas = 4.0;  // × noise sigma: weakest contrast taken for the outline
+  double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
 };
 
 // Along each row, two matched pixels a < b with only unmatched pixels between them (at most
@@ -18,9 +19,14 @@ struct StepSnapSettings {
 // edgeSigmas noise sigmas. The near side is then made to end there: near pixels beyond it become
 // unmatched and, when the near side is on the left (a roof's +x edge), the unmatched pixels up
 // to the contour take its disparity (score `fillScore`). The far side is left alone, and so are
-// the unmatched pixels before a near side on the right (seen by the left view only). `left`:
-// the original left image (CV_32F, NaN = nodata). Returns the pixels changed.
-int snapStepsToContours(const cv::Mat& left, const StepSnapSettings& settings, float fillScore,
-                        cv::Mat& disparity, cv::Mat& score);
+// the unmatched pixels before a near side on the right (seen by the left view only).
+// With `right` given and checkSigmas > 0, each change is checked on the pixel and its two
+// vertical neighbours (mean |left − mapped right| in noise sigmas): a near pixel beyond the
+// contour is cut only when the far disparity explains it better, and the extension stops at the
+// first pixel that does not match at the near disparity within checkSigmas — the strongest
+// contrast near a step is often texture, not the outline. `left`, `right`: the original images
+// (CV_32F, NaN = nodata; `right` may be empty: unchecked). Returns the pixels changed.
+int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
+                        float fillScore, cv::Mat& disparity, cv::Mat& score);
 
 }  // namespace delineo::stereo::detail

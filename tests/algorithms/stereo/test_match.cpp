@@ -294,6 +294,7 @@ TEST(Match, StepCutLocatesAnOutlineWithoutContour) {
   MatchParams p;
   p.dmin = 0;
   p.dmax = 20;
+  p.snapSteps = false;  // the step cut alone
   const MatchResult cut = matchStereo(scene.left, scene.right, p);
   p.stepCut = false;
   const MatchResult plain = matchStereo(scene.left, scene.right, p);

@@ -34,7 +34,7 @@ TEST(SnapSteps, ExtendsAShortNearSideToTheContour) {
   setRun(disparity, 40, 66, 20.0f);
   setRun(disparity, 75, 120, 5.0f);
   const int changed =
-      snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, disparity, score);
+      snapStepsToContours(roofImage(true), cv::Mat(), StepSnapSettings{}, 0.3f, disparity, score);
   EXPECT_EQ(changed, 4 * 20);
   for (int x = 66; x < 70; ++x) EXPECT_FLOAT_EQ(disparity.at<float>(10, x), 20.0f) << x;
   for (int x = 70; x < 75; ++x) EXPECT_TRUE(std::isnan(disparity.at<float>(10, x))) << x;
@@ -48,7 +48,7 @@ TEST(SnapSteps, CutsANearSideThatRunsOverTheContour) {
   setRun(disparity, 0, 35, 5.0f);
   setRun(disparity, 37, 73, 20.0f);
   setRun(disparity, 73, 120, 5.0f);
-  snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, disparity, score);
+  snapStepsToContours(roofImage(true), cv::Mat(), StepSnapSettings{}, 0.3f, disparity, score);
   for (int x = 35; x < 40; ++x) EXPECT_TRUE(std::isnan(disparity.at<float>(10, x))) << x;
   for (int x = 40; x < 70; ++x) EXPECT_FLOAT_EQ(disparity.at<float>(10, x), 20.0f) << x;
   for (int x = 70; x < 73; ++x) {
@@ -65,17 +65,78 @@ TEST(SnapSteps, LeavesStepsWithoutAContourAndSmallDifferencesAlone) {
   setRun(disparity, 75, 120, 5.0f);
   const cv::Mat before = disparity.clone();
   // Noise only: no contour strong enough.
-  EXPECT_EQ(snapStepsToContours(roofImage(false), StepSnapSettings{}, 0.3f, disparity, score), 0);
+  EXPECT_EQ(
+      snapStepsToContours(roofImage(false), cv::Mat(), StepSnapSettings{}, 0.3f, disparity, score),
+      0);
   // A contour, but 1.5 px of disparity is a slope, not a step.
   setRun(disparity, 75, 120, 18.5f);
-  EXPECT_EQ(snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, disparity, score), 0);
+  EXPECT_EQ(
+      snapStepsToContours(roofImage(true), cv::Mat(), StepSnapSettings{}, 0.3f, disparity, score),
+      0);
   // A gap wider than maxGap.
   cv::Mat wide(20, 120, CV_32F, cv::Scalar(kNaN));
   setRun(wide, 40, 50, 20.0f);
   setRun(wide, 75, 120, 5.0f);
-  EXPECT_EQ(snapStepsToContours(roofImage(true), StepSnapSettings{}, 0.3f, wide, score), 0);
+  EXPECT_EQ(snapStepsToContours(roofImage(true), cv::Mat(), StepSnapSettings{}, 0.3f, wide, score),
+            0);
   EXPECT_EQ(cv::countNonZero(before(cv::Rect(0, 0, 75, 20)) == disparity(cv::Rect(0, 0, 75, 20))),
             cv::countNonZero(before(cv::Rect(0, 0, 75, 20)) == before(cv::Rect(0, 0, 75, 20))));
+}
+
+// A stereo pair: ground (grey 100, textured with sigma 10 right of the roof) at disparity 5, a
+// uniform roof [40, 70) grey 160 at disparity 20, a bright line on the ground at x = 79 whose
+// contrast beats the roof edge's, and noise sigma 1 in each view.
+struct TexturedPair {
+  cv::Mat left, right;
+};
+
+TexturedPair texturedPair() {
+  cv::Mat ground(20, 160, CV_32F);
+  cv::RNG rng(5);
+  rng.fill(ground, cv::RNG::NORMAL, 100, 10);
+  ground.colRange(0, 60).setTo(100);  // flat left of the roof: where the noise level is read
+  ground.col(79 + 20).setTo(255);     // ground is indexed x + 20 in the left view
+  TexturedPair p;
+  p.left.create(20, 120, CV_32F);
+  p.right.create(20, 120, CV_32F);
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 0; x < 120; ++x) {
+      p.left.at<float>(y, x) = x >= 40 && x < 70 ? 160.0f : ground.at<float>(y, x + 20);
+      const bool roof = x + 20 >= 40 && x + 20 < 70;
+      p.right.at<float>(y, x) = roof ? 160.0f : ground.at<float>(y, x + 5 + 20);
+    }
+  }
+  cv::Mat noise(p.left.size(), CV_32F);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 1);
+  p.left += noise;
+  rng.fill(noise, cv::RNG::NORMAL, 0, 1);
+  p.right += noise;
+  return p;
+}
+
+TEST(SnapSteps, ChecksEachChangedPixelAgainstTheRightView) {
+  const TexturedPair pair = texturedPair();
+  // +x edge at x = 70: roof matched up to 65, ground from 76; the strongest contrast in reach is
+  // the ground's bright line (78|79 and 79|80), not the roof edge.
+  cv::Mat disparity(20, 120, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 66, 20.0f);
+  setRun(disparity, 76, 120, 5.0f);
+  cv::Mat unchecked = disparity.clone();
+  snapStepsToContours(pair.left, cv::Mat(), StepSnapSettings{}, 0.3f, unchecked, score);
+  EXPECT_FLOAT_EQ(unchecked.at<float>(10, 71), 20.0f);  // the roof carried onto the ground
+  snapStepsToContours(pair.left, pair.right, StepSnapSettings{}, 0.3f, disparity, score);
+  // Checked: the roof pixels are taken, the ground ones do not match at the roof's disparity.
+  for (int x = 66; x < 70; ++x) EXPECT_FLOAT_EQ(disparity.at<float>(10, x), 20.0f) << x;
+  for (int x = 70; x < 76; ++x) EXPECT_TRUE(std::isnan(disparity.at<float>(10, x))) << x;
+
+  // Cut (the line out of reach): the roof's value spread over ground pixels 70..72 is cut, the
+  // ground's disparity explaining them better.
+  cv::Mat spread(20, 120, CV_32F, cv::Scalar(kNaN));
+  setRun(spread, 40, 73, 20.0f);
+  setRun(spread, 73, 120, 5.0f);
+  snapStepsToContours(pair.left, pair.right, StepSnapSettings{}, 0.3f, spread, score);
+  for (int x = 40; x < 70; ++x) EXPECT_FLOAT_EQ(spread.at<float>(10, x), 20.0f) << x;
+  for (int x = 70; x < 73; ++x) EXPECT_TRUE(std::isnan(spread.at<float>(10, x))) << x;
 }
 
 }  // namespace

@@ -34,7 +34,7 @@ struct MatchParams {
   bool subpixel = true;              // sub-pixel peak from the 3x3 correlation neighbourhood
   bool adaptive = true;              // contour-adaptive shapes (false: plain square windows)
   bool fillRegions = true;           // flat regions take the disparity lining up their outline
-  bool snapSteps = false;            // the near side of a depth step ends at the image contour
+  bool snapSteps = true;             // the near side of a depth step ends at the image contour
   int threads = 0;                   // worker threads, 0 = all cores
 
   template <class V>
@@ -100,8 +100,8 @@ struct MatchParams {
     v(core::ParamInfo{"snap-steps", "Snap depth steps to contours", "",
                       "Along each row, the near side of a depth step between two matched pixels "
                       "(at most 16 px apart) is made to end at the strongest contour of the left "
-                      "image there (adaptive method only; off: better outlines on simulated "
-                      "scenes, worse on Middlebury)"},
+                      "image there, where the pixels changed match better that way (adaptive "
+                      "method only)"},
       snapSteps);
     v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
       threads);
