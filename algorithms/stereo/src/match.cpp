@@ -393,8 +393,10 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   if (p.snapSteps && p.adaptive) {
     // Last, after the fill: a filled roof's edges are snapped like matched ones.
-    detail::snapStepsToContours(left, right, detail::StepSnapSettings{},
-                                static_cast<float>(p.minScore), result.disparity, result.score);
+    detail::StepSnapSettings snap;
+    snap.threads = threads;
+    detail::snapStepsToContours(left, right, snap, static_cast<float>(p.minScore),
+                                result.disparity, result.score);
   }
   return result;
 }

@@ -10,6 +10,7 @@ struct StepSnapSettings {
   int reach = 3;            // px: how far beyond the matched sides the contour is looked for
   double edgeSigmas = 4.0;  // × noise sigma: weakest contrast taken for the outline
   double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
+  int threads = 1;           // workers over bands of rows (same result on any number)
 };
 
 // Along each row, two matched pixels a < b with only unmatched pixels between them (at most
