@@ -32,6 +32,16 @@ inline cv::Mat shiftedRight(const cv::Mat& left, double d) {
   return out;
 }
 
+// Independent Gaussian sensor noise of `sigma` grey levels added to each view.
+inline void addSensorNoise(cv::Mat& left, cv::Mat& right, double sigma, cv::RNG& rng) {
+  cv::Mat noise(left.size(), CV_32F);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+  left += noise;
+  noise.create(right.size(), CV_32F);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+  right += noise;
+}
+
 }  // namespace delineo::stereo::testing
 
 namespace delineo::stereo::testing {

@@ -146,12 +146,8 @@ FlatRoofPair flatRoofPair() {
       p.right.at<float>(y, x) = 0.9f * v + 8.f;
     }
   }
-  cv::Mat noise(p.left.size(), CV_32F);
   cv::RNG rng(7);
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, 2.0);
-  p.left += noise;
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, 2.0);
-  p.right += noise;
+  testing::addSensorNoise(p.left, p.right, 2.0, rng);
   return p;
 }
 

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "match_snap.hpp"
+#include "synthetic.hpp"
 
 namespace delineo::stereo::detail {
 namespace {
@@ -106,11 +107,7 @@ TexturedPair texturedPair() {
       p.right.at<float>(y, x) = roof ? 160.0f : ground.at<float>(y, x + 5 + 20);
     }
   }
-  cv::Mat noise(p.left.size(), CV_32F);
-  rng.fill(noise, cv::RNG::NORMAL, 0, 1);
-  p.left += noise;
-  rng.fill(noise, cv::RNG::NORMAL, 0, 1);
-  p.right += noise;
+  testing::addSensorNoise(p.left, p.right, 1.0, rng);
   return p;
 }
 
