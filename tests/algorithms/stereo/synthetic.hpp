@@ -32,6 +32,36 @@ inline cv::Mat shiftedRight(const cv::Mat& left, double d) {
   return out;
 }
 
+// A textureless roof (flat `roofGrey` plus noise `noise`, 50x40 px at (60, 40), disparity 20)
+// on textured ground (disparity 4), 180x120. `rightShowsIt` false: the right view shows
+// textured ground where the roof should be (a flat patch only the left image has, e.g. a
+// reflection). `groundSeed` / `noiseSeed` pick the texture and the noise.
+struct FlatRoofPair {
+  cv::Mat left, right;
+  cv::Rect roof{60, 40, 50, 40};
+};
+
+inline FlatRoofPair flatRoofPair(bool rightShowsIt, float roofGrey, double noise,
+                                 unsigned groundSeed, unsigned noiseSeed) {
+  FlatRoofPair s;
+  const cv::Size size(180, 120);
+  const cv::Mat ground = texture(cv::Size(size.width + 64, size.height), groundSeed) * 0.6 + 20.0;
+  s.left.create(size, CV_32F);
+  s.right.create(size, CV_32F);
+  cv::RNG rng(noiseSeed);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const bool onRoof = s.roof.contains({x, y});
+      s.left.at<float>(y, x) = (onRoof ? roofGrey : ground.at<float>(y, x + 32)) +
+                               static_cast<float>(rng.gaussian(noise));
+      const bool seesRoof = rightShowsIt && s.roof.contains({x + 20, y});
+      s.right.at<float>(y, x) = (seesRoof ? roofGrey : ground.at<float>(y, x + 4 + 32)) +
+                                static_cast<float>(rng.gaussian(noise));
+    }
+  }
+  return s;
+}
+
 // Independent Gaussian sensor noise of `sigma` grey levels added to each view.
 inline void addSensorNoise(cv::Mat& left, cv::Mat& right, double sigma, cv::RNG& rng) {
   cv::Mat noise(left.size(), CV_32F);

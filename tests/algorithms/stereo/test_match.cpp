@@ -216,32 +216,12 @@ int locatedOutlineRows(const MatchResult& r, const testing::SquareScene& s) {
   return located;
 }
 
-// A textureless roof (flat grey 200 with noise sigma 2, 50x40 px, disparity 20) on textured
-// ground (disparity 4). `rightShowsIt` false: the right view shows textured ground where the
-// roof should be (a flat patch only the left image has, e.g. a reflection).
-struct FlatRoofScene {
-  cv::Mat left, right;
-  cv::Rect roof{60, 40, 50, 40};
-};
+// A textureless roof (flat grey 200 with noise sigma 2) on textured ground; `rightShowsIt`
+// false: a flat patch only the left image has.
+using FlatRoofScene = testing::FlatRoofPair;
 
 FlatRoofScene flatRoofScene(bool rightShowsIt) {
-  FlatRoofScene s;
-  const cv::Size size(180, 120);
-  const cv::Mat ground = texture(cv::Size(size.width + 64, size.height), 21) * 0.6 + 20.0;
-  s.left.create(size, CV_32F);
-  s.right.create(size, CV_32F);
-  cv::RNG rng(9);
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const bool onRoof = s.roof.contains({x, y});
-      s.left.at<float>(y, x) =
-          (onRoof ? 200.0f : ground.at<float>(y, x + 32)) + static_cast<float>(rng.gaussian(2.0));
-      const bool seesRoof = rightShowsIt && s.roof.contains({x + 20, y});
-      s.right.at<float>(y, x) = (seesRoof ? 200.0f : ground.at<float>(y, x + 4 + 32)) +
-                                static_cast<float>(rng.gaussian(2.0));
-    }
-  }
-  return s;
+  return testing::flatRoofPair(rightShowsIt, 200.0f, 2.0, 21, 9);
 }
 
 // Share of the roof's interior (8 px from its outline) with a disparity, and of those within

@@ -28,21 +28,11 @@ struct Scene {
 
 Scene scene(float roofGrey = 200.0f, double noise = 2.0) {
   Scene s;
-  const cv::Size size(180, 120);
-  const cv::Mat ground = testing::texture(cv::Size(size.width + 64, size.height), 31) * 0.6 + 20.0;
-  s.left.create(size, CV_32F);
-  s.right.create(size, CV_32F);
-  cv::RNG rng(4);
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const bool roof = s.roof.contains({x, y});
-      s.left.at<float>(y, x) =
-          (roof ? roofGrey : ground.at<float>(y, x + 32)) + static_cast<float>(rng.gaussian(noise));
-      const bool seesRoof = s.roof.contains({x + 20, y});
-      s.right.at<float>(y, x) = (seesRoof ? roofGrey : ground.at<float>(y, x + 4 + 32)) +
-                                static_cast<float>(rng.gaussian(noise));
-    }
-  }
+  testing::FlatRoofPair pair = testing::flatRoofPair(true, roofGrey, noise, 31, 4);
+  s.left = pair.left;
+  s.right = pair.right;
+  s.roof = pair.roof;
+  const cv::Size size = s.left.size();
   s.disparity = cv::Mat(size, CV_32F, cv::Scalar(kGround));
   const cv::Rect around(s.roof.x - 3, s.roof.y - 3, s.roof.width + 6, s.roof.height + 6);
   s.disparity(around).setTo(kNaN);
