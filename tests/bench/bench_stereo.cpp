@@ -17,7 +17,8 @@
 //   --size N   side of the simulated scene (default 1000; the ctest smoke run uses a tiny one)
 //   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
 //   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
-//              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored, white outline.
+//              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored; outline pixels
+//              white located, magenta roof found inside, cyan outside, orange not found.
 //   --range N  search at least N disparities on the simulated scene (dmax raised)
 //   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 //   --repeat N run the methods N times round-robin, report each one's fastest run (shared
@@ -41,6 +42,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "delineo/core/nan_mask.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
@@ -153,21 +155,27 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
               outsideBy[1], missedBy[0], missedBy[1]);
 }
 
+// Where edge% finds the predicted start of the roof for outline pixel o: the x of the first
+// matched pixel on the roof side of the mid-level in the walk, or -1 when there is none.
+int predictedRoofStart(const cv::Mat& disparity, const Case::OutlinePixel& o) {
+  const float mid = 0.5F * (o.dRoof + o.dGround);
+  const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
+  const float* row = disparity.ptr<float>(o.y);
+  const int xg = o.xb - o.dir;
+  for (int k = -kOutlineWalk; k <= 2 * kOutlineWalk; ++k) {
+    const int x = xg + o.dir * k;
+    if (x < 0 || x >= disparity.cols) break;
+    if (std::isfinite(row[x]) && (row[x] - mid) * sign > 0) return x;
+  }
+  return -1;
+}
+
 double outlineScore(const cv::Mat& disparity, const Case& c) {
   if (c.outline.empty()) return NAN;
   long located = 0;
   for (const Case::OutlinePixel& o : c.outline) {
-    const float mid = 0.5F * (o.dRoof + o.dGround);
-    const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
-    const float* row = disparity.ptr<float>(o.y);
-    const int xg = o.xb - o.dir;
-    for (int k = -kOutlineWalk; k <= 2 * kOutlineWalk; ++k) {
-      const int x = xg + o.dir * k;
-      if (x < 0 || x >= disparity.cols) break;
-      if (!std::isfinite(row[x]) || (row[x] - mid) * sign <= 0) continue;
-      if (std::abs((x - o.xb) * o.dir) <= 1) ++located;
-      break;
-    }
+    const int x = predictedRoofStart(disparity, o);
+    if (x >= 0 && std::abs(x - o.xb) <= 1) ++located;
   }
   return 100.0 * static_cast<double>(located) / static_cast<double>(c.outline.size());
 }
@@ -189,7 +197,16 @@ void dumpErrors(const cv::Mat& disparity, const Case& c, const std::string& path
       px = e <= 1 ? cv::Vec3b(0, dim, 0) : e <= 2 ? cv::Vec3b(0, 255, 255) : cv::Vec3b(0, 0, 255);
     }
   }
-  for (const Case::OutlinePixel& o : c.outline) img.at<cv::Vec3b>(o.y, o.xb) = {255, 255, 255};
+  // Outline pixels by edge% outcome: white located, magenta roof starts >= 2 px inside,
+  // cyan >= 2 px outside (on the ground), orange no roof start found.
+  for (const Case::OutlinePixel& o : c.outline) {
+    const int x = predictedRoofStart(disparity, o);
+    const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
+    img.at<cv::Vec3b>(o.y, o.xb) = x < 0            ? cv::Vec3b(0, 128, 255)
+                                   : std::abs(off) <= 1 ? cv::Vec3b(255, 255, 255)
+                                   : off > 1          ? cv::Vec3b(255, 255, 0)
+                                                      : cv::Vec3b(255, 0, 255);
+  }
   cv::imwrite(path, img);
 }
 
@@ -302,7 +319,7 @@ Case simulated(int size, int seed) {
   cv::erode(building, building, cv::Mat::ones(5, 5, CV_8U));
   cv::Mat gx, gy;
   cv::Mat truthFilled = scene.disparity.clone();
-  truthFilled.setTo(0, scene.disparity != scene.disparity);
+  truthFilled.setTo(0, core::nanMask(scene.disparity));
   cv::Sobel(truthFilled, gx, CV_32F, 1, 0);
   cv::Sobel(truthFilled, gy, CV_32F, 0, 1);
   cv::Mat flat = (cv::abs(gx) < 1e-3) & (cv::abs(gy) < 1e-3);

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
+#include "delineo/core/nan_mask.hpp"
 #include "gdal_support.hpp"
 
 namespace delineo::io {
@@ -199,8 +200,7 @@ Raster readRaster(const std::string& path, const ReadOptions& options) {
   }
   // Keep the source depth for grey output: nodata pixels get the nodata value back.
   if (raster.nodata && !std::isnan(*raster.nodata)) {
-    cv::Mat nanMask = asFloat != asFloat;
-    asFloat.setTo(*raster.nodata, nanMask);
+    asFloat.setTo(*raster.nodata, core::nanMask(asFloat));
   }
   asFloat.convertTo(raster.data, layout.depth);
   return raster;

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
+#include "delineo/core/nan_mask.hpp"
 #include "level_matcher.hpp"
 #include "match_fill.hpp"
 #include "match_snap.hpp"
@@ -186,45 +187,55 @@ constexpr int kWideExtraMargin = 7;  // px, at the finer level
 void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
                          int threads, cv::Mat& lo, cv::Mat& hi) {
   const int cw = coarse.cols, ch = coarse.rows;
-  cv::Mat clo(coarse.size(), CV_32S), chi(coarse.size(), CV_32S);
-  auto range = [&](int x, int y, int radius, float& mn, float& mx) {
-    mn = std::numeric_limits<float>::infinity();
-    mx = -mn;
-    for (int v = std::max(0, y - radius); v <= std::min(ch - 1, y + radius); ++v) {
-      const float* row = coarse.ptr<float>(v);
-      for (int u = std::max(0, x - radius); u <= std::min(cw - 1, x + radius); ++u) {
-        if (!std::isfinite(row[u])) continue;
-        mn = std::min(mn, row[u]);
-        mx = std::max(mx, row[u]);
-      }
-    }
-    return mn <= mx;
+  // Neighbourhood minima and maxima of the valid coarse disparities as min/max filters (the
+  // morphology's separable float path), rejected pixels at +inf for the minimum and -inf for the
+  // maximum; the border does not extend the neighbourhood (+inf/-inf there too).
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const cv::Mat invalid = core::nanMask(coarse);
+  cv::Mat forMin = coarse.clone(), forMax = coarse.clone();
+  forMin.setTo(kInf, invalid);
+  forMax.setTo(-kInf, invalid);
+  cv::Mat mn1, mx1, mnWide, mxWide;
+  const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
+  const cv::Mat wide = cv::Mat::ones(2 * kWideRadius + 1, 2 * kWideRadius + 1, CV_8U);
+  auto minFilter = [&](const cv::Mat& kernel, cv::Mat& out) {
+    cv::erode(forMin, out, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf);
   };
-  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      for (int x = 0; x < cw; ++x) {
-        float mn = 0, mx = 0;
-        const bool near = range(x, y, 1, mn, mx);
-        if (near || range(x, y, kWideRadius, mn, mx)) {
-          const int m = near ? margin : margin + kWideExtraMargin;
-          clo.at<int>(y, x) = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - m);
-          chi.at<int>(y, x) = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + m);
-        } else {
-          clo.at<int>(y, x) = dmin;
-          chi.at<int>(y, x) = dmax;
-        }
+  auto maxFilter = [&](const cv::Mat& kernel, cv::Mat& out) {
+    cv::dilate(forMax, out, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf);
+  };
+  runTasks({[&] { minFilter(near, mn1); }, [&] { maxFilter(near, mx1); },
+            [&] { minFilter(wide, mnWide); }, [&] { maxFilter(wide, mxWide); }},
+           threads);
+  cv::Mat clo(coarse.size(), CV_32S), chi(coarse.size(), CV_32S);
+  for (int y = 0; y < ch; ++y) {
+    const float *n0 = mn1.ptr<float>(y), *n1 = mx1.ptr<float>(y);
+    const float *w0 = mnWide.ptr<float>(y), *w1 = mxWide.ptr<float>(y);
+    int *l = clo.ptr<int>(y), *h = chi.ptr<int>(y);
+    for (int x = 0; x < cw; ++x) {
+      const bool isNear = n0[x] <= n1[x];
+      if (isNear || w0[x] <= w1[x]) {
+        const float mn = isNear ? n0[x] : w0[x], mx = isNear ? n1[x] : w1[x];
+        const int m = isNear ? margin : margin + kWideExtraMargin;
+        l[x] = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - m);
+        h[x] = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + m);
+      } else {
+        l[x] = dmin;
+        h[x] = dmax;
       }
     }
-  });
+  }
   lo.create(size, CV_32S);
   hi.create(size, CV_32S);
   forRowBands(size.height, threads, [&](int rowStart, int rowEnd) {
     for (int y = rowStart; y < rowEnd; ++y) {
       const int cy = std::min(ch - 1, y / 2);
+      const int *cl = clo.ptr<int>(cy), *chh = chi.ptr<int>(cy);
+      int *l = lo.ptr<int>(y), *h = hi.ptr<int>(y);
       for (int x = 0; x < size.width; ++x) {
         const int cx = std::min(cw - 1, x / 2);
-        lo.at<int>(y, x) = clo.at<int>(cy, cx);
-        hi.at<int>(y, x) = chi.at<int>(cy, cx);
+        l[x] = cl[cx];
+        h[x] = chh[cx];
       }
     }
   });
@@ -386,7 +397,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   result.disparity = coarseLeft;
   result.score = leftOut.score.clone();
-  result.score.setTo(kNaN, result.disparity != result.disparity);
+  result.score.setTo(kNaN, core::nanMask(result.disparity));
   if (p.fillRegions && p.adaptive) {
     detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
                             static_cast<float>(p.minScore), result.disparity, result.score);
@@ -479,7 +490,7 @@ MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchPara
     }
   }
   result.score = squareScore(lv, rv, result.disparity, p.window);
-  result.disparity.setTo(kNaN, result.score != result.score);
+  result.disparity.setTo(kNaN, core::nanMask(result.score));
   core::report(progress, 1.0);
   return result;
 }

@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "delineo/core/nan_mask.hpp"
 #include "radiometry.hpp"
 #include "workers.hpp"
 
@@ -23,7 +24,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
   // Contrast between x and x + 1, summed over the row and its two neighbours: a roof outline is
   // a line across rows, a texture speck is not.
   cv::Mat filled = left.clone();
-  filled.setTo(0.0f, left != left);
+  filled.setTo(0.0f, core::nanMask(left));
   cv::Mat step(h, w - 1, CV_32F);
   for (int y = 0; y < h; ++y) {
     const float* row = filled.ptr<float>(y);

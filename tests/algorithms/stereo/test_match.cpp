@@ -366,6 +366,32 @@ TEST(Match, SgbmFollowsTheSameConventions) {
   EXPECT_GT(r.score.at<float>(60, 100), 0.8F);
 }
 
+// The two maps agree on what is unmatched, for both backends (the NaN masks are taken over
+// whole rows, wide enough for OpenCV's vectorised comparisons).
+TEST(Match, ScoreIsNaNExactlyWhereDisparityIsNaN) {
+  const cv::Mat left = texture({240, 140}, 31);
+  cv::Mat right = shiftedRight(left, 4.0);
+  texture({60, 50}, 32).copyTo(right(cv::Rect(90, 40, 60, 50)));  // seen by the right view only
+  for (const char* method : {"adaptive", "sgbm"}) {
+    MatchParams p;
+    p.method = method;
+    p.dmin = -8;
+    p.dmax = 16;
+    const MatchResult r = matchStereo(left, right, p);
+    ASSERT_EQ(r.status, core::RunStatus::Completed);
+    int unmatched = 0, disagree = 0;
+    for (int y = 0; y < r.disparity.rows; ++y) {
+      for (int x = 0; x < r.disparity.cols; ++x) {
+        const bool noDisparity = std::isnan(r.disparity.at<float>(y, x));
+        unmatched += noDisparity ? 1 : 0;
+        disagree += noDisparity != std::isnan(r.score.at<float>(y, x)) ? 1 : 0;
+      }
+    }
+    EXPECT_GT(unmatched, 500) << method;  // the foreign patch and the borders
+    EXPECT_EQ(disagree, 0) << method;
+  }
+}
+
 TEST(Match, CancelMidRun) {
   const cv::Mat left = texture({200, 160}, 24);
   const cv::Mat right = shiftedRight(left, 5.0);

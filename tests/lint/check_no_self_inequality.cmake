@@ -1,0 +1,30 @@
+# Fails when a source file compares an expression with itself by `!=` (the `m != m` NaN test).
+# On cv::Mat that idiom misses NaNs: OpenCV 4.6's vectorised CMP_NE is ordered on AVX-512
+# machines. Use delineo::core::nanMask / numberMask (delineo/core/nan_mask.hpp), or std::isnan
+# on scalars.
+set(bad "")
+set(n 0)
+foreach(dir ${ROOTS})
+  file(GLOB_RECURSE files ${dir}/*.hpp ${dir}/*.cpp ${dir}/*.h)
+  foreach(f ${files})
+    math(EXPR n "${n} + 1")
+    file(STRINGS ${f} lines REGEX "([A-Za-z_][A-Za-z0-9_.>-]*) != ([A-Za-z_][A-Za-z0-9_.>-]*)")
+    foreach(line ${lines})
+      string(REGEX REPLACE "//.*$" "" code "${line}")  # comments may say it
+      string(REGEX MATCHALL "[A-Za-z_][A-Za-z0-9_.>-]* != [A-Za-z_][A-Za-z0-9_.>-]*" pairs "${code}")
+      foreach(pair ${pairs})
+        string(REGEX REPLACE "^(.*) != (.*)$" "\\1;\\2" sides "${pair}")
+        list(GET sides 0 a)
+        list(GET sides 1 b)
+        if(a STREQUAL b)
+          list(APPEND bad "${f}: ${line}")
+        endif()
+      endforeach()
+    endforeach()
+  endforeach()
+endforeach()
+if(bad)
+  string(REPLACE ";" "\n" bad "${bad}")
+  message(FATAL_ERROR "self-inequality NaN tests (use core::nanMask):\n${bad}")
+endif()
+message(STATUS "checked ${n} files: no `x != x`")
