@@ -15,9 +15,15 @@
 
 namespace delineo::stereo::detail {
 
+namespace {
+// Longest segment a checked cut scores: the near side's reach, the gap and the far pixel.
+constexpr int kMaxCutSpan = 64;
+}  // namespace
+
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
                         float fillScore, cv::Mat& disparity, cv::Mat& score) {
   CV_Assert(left.type() == CV_32F && disparity.type() == CV_32F && left.size() == disparity.size());
+  CV_Assert(settings.cutReach >= 0 && settings.cutReach + settings.maxGap + 4 <= kMaxCutSpan);
   const int w = left.cols, h = left.rows;
   if (w < 3 || h < 1) return 0;
   const float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -64,11 +70,63 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
     }
     return n > 0 ? sum / n / sigma : 1e30;
   };
-  const auto fitsNear = [&](int y, int x, float dNear) {
-    return !checked || error(y, x, dNear) <= settings.checkSigmas;
-  };
   const auto fitsFarBetter = [&](int y, int x, float dNear, float dFar) {
     return !checked || error(y, x, dFar) < error(y, x, dNear);
+  };
+
+  // Checked cut of a near side on the left (a roof's +x edge: both views see the ground there):
+  // the near side's last pixel e over [s0, b - 1] is the one of least total error, near pixels
+  // scored at the near disparity up to e, far ones at the far disparity from e + 2 (pixel e + 1
+  // mixes both surfaces through the blur, and in the right view its roof part is missing: it
+  // biased the cut towards the ground), minus contourWeight × the contrast between e and e + 1.
+  // s0 goes back over the near side's pixels by up to cutReach (fattened roofs). Errors are
+  // capped so that one outlier pixel does not decide. Pixels up to e take the near disparity,
+  // the near pixels after it become unmatched; the far side is left alone.
+  const auto cutNearSide = [&](int y, int a, int b, const float* d, const float* c, float* out,
+                               float* sc) {
+    const float dNear = d[a], dFar = d[b];
+    int s0 = a;
+    while (s0 - 1 >= std::max(0, a - settings.cutReach) && std::isfinite(d[s0 - 1]) &&
+           std::abs(d[s0 - 1] - dNear) <= 1.0F) {
+      --s0;
+    }
+    // Far pixels are scored up to b + 2 whatever they hold: every cut then scores the same
+    // number of pixels (n − 1), and the first far pixel may still turn out to be near.
+    const int s1 = std::min(w - 1, b + 2);
+    const int n = s1 - s0 + 1;
+    // Prefix sums of the capped errors: near[k] over [s0, s0 + k), far likewise.
+    double nearSum[kMaxCutSpan + 1], farSum[kMaxCutSpan + 1];
+    nearSum[0] = farSum[0] = 0;
+    for (int k = 0; k < n; ++k) {
+      nearSum[k + 1] = nearSum[k] + std::min(settings.errorCap, error(y, s0 + k, dNear));
+      farSum[k + 1] = farSum[k] + std::min(settings.errorCap, error(y, s0 + k, dFar));
+    }
+    double bestCost = std::numeric_limits<double>::infinity();
+    int cut = a;
+    for (int e = s0 - 1; e <= std::min(b, s1 - 1); ++e) {
+      const int nearEnd = e - s0 + 1;                 // near pixels: [0, nearEnd)
+      const int farStart = std::min(n, nearEnd + 1);  // far pixels: [farStart, n)
+      const double cost = nearSum[nearEnd] + farSum[n] - farSum[farStart] -
+                          settings.contourWeight * (e >= 0 ? c[e] / sigma : 0.0);
+      if (cost < bestCost) {
+        bestCost = cost;
+        cut = e;
+      }
+    }
+    int changes = 0;
+    for (int x = s0; x <= std::min(b, s1 - 1); ++x) {
+      const bool nearValued = std::isfinite(out[x]) && std::abs(out[x] - dNear) <= 1.0F;
+      if (x <= cut && !nearValued) {
+        out[x] = dNear;
+        if (sc) sc[x] = fillScore;
+        ++changes;
+      } else if (x > cut && nearValued) {
+        out[x] = kNaN;
+        if (sc) sc[x] = kNaN;
+        ++changes;
+      }
+    }
+    return changes;
   };
 
   const cv::Mat source = disparity.clone();
@@ -89,6 +147,10 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
       for (size_t i = 0; i + 1 < matched.size(); ++i) {
         const int a = matched[i], b = matched[i + 1];
         if (b - a - 1 > settings.maxGap || std::abs(d[a] - d[b]) < settings.minStep) continue;
+        if (checked && d[a] > d[b]) {
+          changed += cutNearSide(y, a, b, d, c, out, sc);
+          continue;
+        }
         // Contour position e: between pixels e and e + 1.
         const int e0 = std::max(0, a - settings.reach),
                   e1 = std::min(w - 2, b - 1 + settings.reach);
@@ -102,15 +164,14 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
         }
         if (best < 0) continue;
         if (d[a] > d[b]) {
-          // Near side on the left: it ends at pixel `best`.
+          // Near side on the left, unchecked: it ends at pixel `best`.
           for (int x = a + 1; x <= best && x < b; ++x) {
-            if (!fitsNear(y, x, d[a])) break;
             out[x] = d[a];
             if (sc) sc[x] = fillScore;
             ++changed;
           }
           for (int x = best + 1; x <= a; ++x) {
-            if (std::isfinite(out[x]) && fitsFarBetter(y, x, d[a], d[b])) {
+            if (std::isfinite(out[x])) {
               out[x] = kNaN;
               if (sc) sc[x] = kNaN;
               ++changed;

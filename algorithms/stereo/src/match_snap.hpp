@@ -10,23 +10,31 @@ struct StepSnapSettings {
   int reach = 3;            // px: how far beyond the matched sides the contour is looked for
   double edgeSigmas = 4.0;  // × noise sigma: weakest contrast taken for the outline
   double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
+  // Checked cut of a roof's +x edge (see below).
+  int cutReach = 8;            // px: how far back over the near side the cut may go
+  double contourWeight = 2.0;  // error (noise sigmas) traded for one sigma of contour contrast
+  double errorCap = 6.0;       // noise sigmas: most a single pixel's error counts
   int threads = 1;           // workers over bands of rows (same result on any number)
 };
 
 // Along each row, two matched pixels a < b with only unmatched pixels between them (at most
-// maxGap) and disparities at least minStep apart are the two sides of a depth step. Where the
-// near side (larger disparity: the roof) meets the far one is the strongest contrast of the left
-// image within [a − reach, b + reach] (|I(x+1) − I(x)| over 3 rows), when it is at least
-// edgeSigmas noise sigmas. The near side is then made to end there: near pixels beyond it become
-// unmatched and, when the near side is on the left (a roof's +x edge), the unmatched pixels up
-// to the contour take its disparity (score `fillScore`). The far side is left alone, and so are
-// the unmatched pixels before a near side on the right (seen by the left view only).
-// With `right` given and checkSigmas > 0, each change is checked on the pixel and its two
-// vertical neighbours (mean |left − mapped right| in noise sigmas): a near pixel beyond the
-// contour is cut only when the far disparity explains it better, and the extension stops at the
-// first pixel that does not match at the near disparity within checkSigmas — the strongest
-// contrast near a step is often texture, not the outline. `left`, `right`: the original images
-// (CV_32F, NaN = nodata; `right` may be empty: unchecked). Returns the pixels changed.
+// maxGap) and disparities at least minStep apart are the two sides of a depth step.
+// Near side on the left (larger disparity: a roof's +x edge, where both views see the ground):
+// with `right` given and checkSigmas > 0, the near side's last pixel e is chosen in
+// [a − cutReach, b − 1] (back over the near side's own pixels only) at the least total
+// photometric error (mean |left − mapped right| of the pixel and its two vertical neighbours, in
+// noise sigmas, capped at errorCap): near pixels at the near disparity up to e, far ones at the
+// far disparity from e + 2 — pixel e + 1 mixes both surfaces through the image blur and was seen
+// to pull the cut onto the ground —, less contourWeight × the left image's contrast between e and
+// e + 1 (|I(x+1) − I(x)| over 3 rows, in sigmas). Pixels up to e take the near disparity (score
+// `fillScore`), near pixels after it become unmatched. Unchecked (`right` empty), the near side
+// ends at the strongest contrast within [a − reach, b + reach] when it is at least edgeSigmas
+// sigmas.
+// Near side on the right (the left map's −x edge of a roof): the unmatched pixels before it are
+// mostly ground the right view does not see and stay unmatched; near pixels before the strongest
+// contrast (as above) are cut, checked ones only when the far disparity explains them better.
+// The far side is always left alone. `left`, `right`: the original images (CV_32F, NaN =
+// nodata). Returns the pixels changed.
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
                         float fillScore, cv::Mat& disparity, cv::Mat& score);
 

@@ -136,5 +136,41 @@ TEST(SnapSteps, ChecksEachChangedPixelAgainstTheRightView) {
   for (int x = 70; x < 73; ++x) EXPECT_TRUE(std::isnan(spread.at<float>(10, x))) << x;
 }
 
+// A roof of nearly the ground's grey (110 against textured ground 100 ± 12) at disparity 20
+// over ground at 5, noise sigma 2; its value fattened 5 px onto the ground, as window matching
+// leaves it next to textured ground. Texture contrasts on the ground beat the roof edge's in
+// most rows: the cut must come from the two views, not from the strongest contrast.
+TEST(SnapSteps, CutsAFattenedLowContrastRoofWhereTheViewsDisagree) {
+  const int rows = 40;
+  cv::Mat ground(rows, 200, CV_32F);
+  cv::RNG rng(11);
+  rng.fill(ground, cv::RNG::NORMAL, 100, 12);
+  cv::GaussianBlur(ground, ground, {0, 0}, 0.7);
+  ground.colRange(0, 40).setTo(100);  // flat: where the noise level is read
+  cv::Mat left(rows, 140, CV_32F), right(rows, 140, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < 140; ++x) {
+      left.at<float>(y, x) = x >= 40 && x < 70 ? 110.0f : ground.at<float>(y, x + 20);
+      const bool roof = x + 20 >= 40 && x + 20 < 70;
+      right.at<float>(y, x) = roof ? 110.0f : ground.at<float>(y, x + 5 + 20);
+    }
+  }
+  testing::addSensorNoise(left, right, 2.0, rng);
+  cv::Mat fattened(rows, 140, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(fattened, 40, 75, 20.0f);
+  setRun(fattened, 75, 140, 5.0f);
+  cv::Mat disparity = fattened.clone();
+  snapStepsToContours(left, right, StepSnapSettings{}, 0.3f, disparity, score);
+  int located = 0, onGround = 0;
+  for (int y = 1; y + 1 < rows; ++y) {
+    int end = 39;  // last pixel at the roof's disparity
+    while (end + 1 < 140 && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+    located += std::abs(end - 69) <= 1 ? 1 : 0;
+    for (int x = 71; x < 75; ++x) onGround += disparity.at<float>(y, x) == 20.0f ? 1 : 0;
+  }
+  EXPECT_GE(located, (rows - 2) * 9 / 10);
+  EXPECT_LE(onGround, rows / 4);  // of 4 × 38 ground pixels given the roof's value
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
