@@ -191,6 +191,35 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
           }
         }
       }
+      if (checked) {
+        // Open ends: a matched run followed by more than maxGap unmatched pixels (a roof next
+        // to textureless ground or a shadow) is extended to the strongest contour within
+        // `reach`. A pixel is taken when it matches at the run's disparity, or when its grey is
+        // nearer the run's last pixel than the pixel beyond the contour: the last pixels of a
+        // roof's +x edge mix roof and ground through the blur, and their neighbour in the right
+        // view is another surface, so the photometric test alone stopped 1-2 px short.
+        const float* grey = left.ptr<float>(y);
+        for (size_t i = 0; i < matched.size(); ++i) {
+          const int a = matched[i];
+          const int next = i + 1 < matched.size() ? matched[i + 1] : w;
+          if (next - a - 1 <= settings.maxGap) continue;
+          int best = -1;
+          float bestContrast = minContrast;
+          for (int e = a; e <= std::min(w - 2, a + settings.reach); ++e) {
+            if (c[e] >= bestContrast) {
+              bestContrast = c[e];
+              best = e;
+            }
+          }
+          for (int x = a + 1; x <= best; ++x) {
+            const bool looksNear = std::abs(grey[x] - grey[a]) < std::abs(grey[x] - grey[best + 1]);
+            if (!looksNear && error(y, x, d[a]) > settings.checkSigmas) break;
+            out[x] = d[a];
+            if (sc) sc[x] = fillScore;
+            ++changed;
+          }
+        }
+      }
     }
     changedTotal += changed;
   });

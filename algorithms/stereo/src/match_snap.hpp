@@ -33,6 +33,10 @@ struct StepSnapSettings {
 // Near side on the right (the left map's −x edge of a roof): the unmatched pixels before it are
 // mostly ground the right view does not see and stay unmatched; near pixels before the strongest
 // contrast (as above) are cut, checked ones only when the far disparity explains them better.
+// Open ends (checked only): a matched run followed by more than maxGap unmatched pixels (a roof
+// next to a shadow or textureless ground) is extended to the strongest contrast within `reach`
+// (at least edgeSigmas), over pixels that match at its disparity or whose grey is nearer the
+// run's last pixel than the pixel beyond that contrast.
 // The far side is always left alone. `left`, `right`: the original images (CV_32F, NaN =
 // nodata). Returns the pixels changed.
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,

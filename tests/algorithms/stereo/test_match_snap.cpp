@@ -172,5 +172,37 @@ TEST(SnapSteps, CutsAFattenedLowContrastRoofWhereTheViewsDisagree) {
   EXPECT_LE(onGround, rows / 4);  // of 4 × 38 ground pixels given the roof's value
 }
 
+// A roof (grey 120, disparity 20, [40, 70)) whose +x side is a flat shadow (grey 40) that
+// nothing matches; the right view sees a bright facade (200) beyond the roof instead of the
+// shadow. Both views blurred: the last roof pixel mixes with the shadow in the left view and
+// with the facade in the right one, so it does not match at the roof's disparity.
+TEST(SnapSteps, ExtendsARoofRunEndingInUnmatchedShadowToTheContour) {
+  const int rows = 12, cols = 130;
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = x < 40 ? 90.0f : x < 70 ? 120.0f : 40.0f;
+      right.at<float>(y, x) = x < 20 ? 90.0f : x < 50 ? 120.0f : x < 65 ? 200.0f : 40.0f;
+    }
+  }
+  cv::GaussianBlur(left, left, {0, 0}, 0.8);
+  cv::GaussianBlur(right, right, {0, 0}, 0.8);
+  cv::RNG rng(3);
+  testing::addSensorNoise(left, right, 1.0, rng);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 68, 20.0f);  // matched up to 67: 2 px short of the outline
+  snapStepsToContours(left, right, StepSnapSettings{}, 0.3f, disparity, score);
+  for (int y = 1; y + 1 < rows; ++y) {
+    EXPECT_FLOAT_EQ(disparity.at<float>(y, 69), 20.0f) << y;
+    for (int x = 70; x < cols; ++x)
+      EXPECT_TRUE(std::isnan(disparity.at<float>(y, x))) << y << "," << x;
+  }
+  // Without the right view the run is left as it is (nothing to check an extension against).
+  cv::Mat unchecked(rows, cols, CV_32F, cv::Scalar(kNaN));
+  setRun(unchecked, 40, 68, 20.0f);
+  snapStepsToContours(left, cv::Mat(), StepSnapSettings{}, 0.3f, unchecked, score);
+  EXPECT_TRUE(std::isnan(unchecked.at<float>(5, 68)));
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
