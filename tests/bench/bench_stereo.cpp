@@ -296,6 +296,15 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       dumpErrors(disparity[i], c, dump + "/errors_" + m + ".png");
     }
   }
+  // The speed target is a ratio measured in this run: print it at full precision.
+  const auto at = [&](const char* name) {
+    const auto it = std::find(methods.begin(), methods.end(), name);
+    return it == methods.end() ? -1.0 : best[static_cast<size_t>(it - methods.begin())];
+  };
+  if (at("adaptive") > 0 && at("sgbm") > 0) {
+    std::printf("  time adaptive %.3f s / sgbm %.3f s = %.2fx\n", at("adaptive"), at("sgbm"),
+                at("adaptive") / at("sgbm"));
+  }
 }
 
 #ifdef DELINEO_BENCH_HAVE_SIM

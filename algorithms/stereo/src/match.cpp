@@ -398,15 +398,23 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   result.disparity = coarseLeft;
   result.score = leftOut.score.clone();
   result.score.setTo(kNaN, core::nanMask(result.disparity));
+  // The fill runs on one worker; the snapping's contrast map (left image only) is prepared on
+  // the other meanwhile.
+  detail::StepContrast contrast;
+  std::vector<std::function<void()>> post;
   if (p.fillRegions && p.adaptive) {
-    detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
-                            static_cast<float>(p.minScore), result.disparity, result.score);
+    post.emplace_back([&] {
+      detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
+                              static_cast<float>(p.minScore), result.disparity, result.score);
+    });
   }
+  if (p.snapSteps && p.adaptive) post.emplace_back([&] { contrast = detail::stepContrast(left); });
+  runTasks(post, threads);
   if (p.snapSteps && p.adaptive) {
     // Last, after the fill: a filled roof's edges are snapped like matched ones.
     detail::StepSnapSettings snap;
     snap.threads = threads;
-    detail::snapStepsToContours(left, right, snap, static_cast<float>(p.minScore),
+    detail::snapStepsToContours(left, right, contrast, snap, static_cast<float>(p.minScore),
                                 result.disparity, result.score);
   }
   return result;

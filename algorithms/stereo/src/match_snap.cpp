@@ -20,15 +20,11 @@ namespace {
 constexpr int kMaxCutSpan = 64;
 }  // namespace
 
-int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
-                        float fillScore, cv::Mat& disparity, cv::Mat& score) {
-  CV_Assert(left.type() == CV_32F && disparity.type() == CV_32F && left.size() == disparity.size());
-  CV_Assert(settings.cutReach >= 0 && settings.cutReach + settings.maxGap + 4 <= kMaxCutSpan);
+StepContrast stepContrast(const cv::Mat& left) {
+  CV_Assert(left.type() == CV_32F);
+  StepContrast out;
   const int w = left.cols, h = left.rows;
-  if (w < 3 || h < 1) return 0;
-  const float kNaN = std::numeric_limits<float>::quiet_NaN();
-  // Contrast between x and x + 1, summed over the row and its two neighbours: a roof outline is
-  // a line across rows, a texture speck is not.
+  if (w < 3 || h < 1) return out;
   cv::Mat filled = left.clone();
   filled.setTo(0.0f, core::nanMask(left));
   cv::Mat step(h, w - 1, CV_32F);
@@ -37,9 +33,28 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
     float* s = step.ptr<float>(y);
     for (int x = 0; x + 1 < w; ++x) s[x] = std::abs(row[x + 1] - row[x]);
   }
-  cv::Mat contrast;
-  cv::blur(step, contrast, {1, 3}, {-1, -1}, cv::BORDER_REPLICATE);
-  const double sigma = noiseSigma(left);
+  cv::blur(step, out.contrast, {1, 3}, {-1, -1}, cv::BORDER_REPLICATE);
+  out.sigma = noiseSigma(filled);
+  return out;
+}
+
+int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
+                        float fillScore, cv::Mat& disparity, cv::Mat& score) {
+  return snapStepsToContours(left, right, stepContrast(left), settings, fillScore, disparity,
+                             score);
+}
+
+int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepContrast& prepared,
+                        const StepSnapSettings& settings, float fillScore, cv::Mat& disparity,
+                        cv::Mat& score) {
+  CV_Assert(left.type() == CV_32F && disparity.type() == CV_32F && left.size() == disparity.size());
+  CV_Assert(settings.cutReach >= 0 && settings.cutReach + settings.maxGap + 4 <= kMaxCutSpan);
+  const int w = left.cols, h = left.rows;
+  if (w < 3 || h < 1) return 0;
+  CV_Assert(prepared.contrast.size() == cv::Size(w - 1, h));
+  const float kNaN = std::numeric_limits<float>::quiet_NaN();
+  const cv::Mat& contrast = prepared.contrast;
+  const double sigma = prepared.sigma;
   const float minContrast = static_cast<float>(settings.edgeSigmas * sigma);
   // Photometric check (when `right` is given): mean |left − mapped right| of the pixel and its
   // two vertical neighbours at disparity d, right view read with linear interpolation.

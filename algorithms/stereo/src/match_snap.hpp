@@ -42,4 +42,19 @@ struct StepSnapSettings {
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
                         float fillScore, cv::Mat& disparity, cv::Mat& score);
 
+// What the snapping reads of the left image alone, so that it can be prepared while the
+// disparities are still being filled: the contrast between x and x + 1 averaged over the row and
+// its two neighbours (a roof outline is a line across rows, a texture speck is not; CV_32F,
+// (w − 1) × h, nodata as 0), and the image's noise sigma.
+struct StepContrast {
+  cv::Mat contrast;
+  double sigma = 1.0;
+};
+StepContrast stepContrast(const cv::Mat& left);
+
+// The same with the contrast prepared.
+int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepContrast& prepared,
+                        const StepSnapSettings& settings, float fillScore, cv::Mat& disparity,
+                        cv::Mat& score);
+
 }  // namespace delineo::stereo::detail
