@@ -85,12 +85,25 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     return n > 0 ? sum / n / sigma : 1e30;
   };
+  // Contour position e (between pixels e and e + 1) of the strongest contrast in [e0, e1] of a
+  // row's contrast `c`, when it is at least minContrast; -1 otherwise.
+  const auto strongestContour = [&](const float* c, int e0, int e1) {
+    int best = -1;
+    float bestContrast = minContrast;
+    for (int e = e0; e <= e1; ++e) {
+      if (c[e] >= bestContrast) {
+        bestContrast = c[e];
+        best = e;
+      }
+    }
+    return best;
+  };
   const auto fitsFarBetter = [&](int y, int x, float dNear, float dFar) {
     return !checked || error(y, x, dFar) < error(y, x, dNear);
   };
 
   // Checked cut of a near side on the left (a roof's +x edge: both views see the ground there):
-  // the near side's last pixel e over [s0, b - 1] is the one of least total error, near pixels
+  // the near side's last pixel e over [s0 - 1, b] is the one of least total error, near pixels
   // scored at the near disparity up to e, far ones at the far disparity from e + 2 (pixel e + 1
   // mixes both surfaces through the blur, and in the right view its roof part is missing: it
   // biased the cut towards the ground), minus contourWeight × the contrast between e and e + 1.
@@ -166,17 +179,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
           changed += cutNearSide(y, a, b, d, c, out, sc);
           continue;
         }
-        // Contour position e: between pixels e and e + 1.
-        const int e0 = std::max(0, a - settings.reach),
-                  e1 = std::min(w - 2, b - 1 + settings.reach);
-        int best = -1;
-        float bestContrast = minContrast;
-        for (int e = e0; e <= e1; ++e) {
-          if (c[e] >= bestContrast) {
-            bestContrast = c[e];
-            best = e;
-          }
-        }
+        const int best = strongestContour(c, std::max(0, a - settings.reach),
+                                          std::min(w - 2, b - 1 + settings.reach));
         if (best < 0) continue;
         if (d[a] > d[b]) {
           // Near side on the left, unchecked: it ends at pixel `best`.
@@ -218,14 +222,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
           const int a = matched[i];
           const int next = i + 1 < matched.size() ? matched[i + 1] : w;
           if (next - a - 1 <= settings.maxGap) continue;
-          int best = -1;
-          float bestContrast = minContrast;
-          for (int e = a; e <= std::min(w - 2, a + settings.reach); ++e) {
-            if (c[e] >= bestContrast) {
-              bestContrast = c[e];
-              best = e;
-            }
-          }
+          const int best = strongestContour(c, a, std::min(w - 2, a + settings.reach));
           for (int x = a + 1; x <= best; ++x) {
             const bool looksNear = std::abs(grey[x] - grey[a]) < std::abs(grey[x] - grey[best + 1]);
             if (!looksNear && error(y, x, d[a]) > settings.checkSigmas) break;
