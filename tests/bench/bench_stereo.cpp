@@ -75,6 +75,21 @@ struct Row {
 constexpr int kOutlineWalk = 7;
 bool gOutlineDiagnosis = false;  // --outline-diag: where the predicted roof starts
 
+// Where edge% finds the predicted start of the roof for outline pixel o: the x of the first
+// matched pixel on the roof side of the mid-level in the walk, or -1 when there is none.
+int predictedRoofStart(const cv::Mat& disparity, const Case::OutlinePixel& o) {
+  const float mid = 0.5F * (o.dRoof + o.dGround);
+  const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
+  const float* row = disparity.ptr<float>(o.y);
+  const int xg = o.xb - o.dir;
+  for (int k = -kOutlineWalk; k <= 2 * kOutlineWalk; ++k) {
+    const int x = xg + o.dir * k;
+    if (x < 0 || x >= disparity.cols) break;
+    if (std::isfinite(row[x]) && (row[x] - mid) * sign > 0) return x;
+  }
+  return -1;
+}
+
 // Diagnostic only (not part of the metric): histogram of the predicted roof start relative to
 // the true outline, in px towards the ground (positive: roof fattened), as edge% walks it.
 void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
@@ -85,12 +100,8 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
     const float mid = 0.5F * (o.dRoof + o.dGround);
     const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
     const float* row = disparity.ptr<float>(o.y);
-    const int xg = o.xb - o.dir;
-    bool found = false;
-    for (int k = -kOutlineWalk; k <= 2 * kOutlineWalk; ++k) {
-      const int x = xg + o.dir * k;
-      if (x < 0 || x >= disparity.cols) break;
-      if (!std::isfinite(row[x]) || (row[x] - mid) * sign <= 0) continue;
+    const int x = predictedRoofStart(disparity, o);
+    if (x >= 0) {
       const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
       if (std::abs(off) <= 1) ++located;
       else if (off > 1) {
@@ -137,10 +148,7 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
           }
         }
       }
-      found = true;
-      break;
-    }
-    if (!found) {
+    } else {
       ++missed;
       ++missedBy[o.dir > 0 ? 0 : 1];
     }
@@ -153,21 +161,6 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
               insideBy[0][1], insideBy[1][0] + insideBy[1][1], insideBy[1][0], insideBy[1][1]);
   std::printf("    outside: ground -x %ld, +x %ld; missed: ground -x %ld, +x %ld\n", outsideBy[0],
               outsideBy[1], missedBy[0], missedBy[1]);
-}
-
-// Where edge% finds the predicted start of the roof for outline pixel o: the x of the first
-// matched pixel on the roof side of the mid-level in the walk, or -1 when there is none.
-int predictedRoofStart(const cv::Mat& disparity, const Case::OutlinePixel& o) {
-  const float mid = 0.5F * (o.dRoof + o.dGround);
-  const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
-  const float* row = disparity.ptr<float>(o.y);
-  const int xg = o.xb - o.dir;
-  for (int k = -kOutlineWalk; k <= 2 * kOutlineWalk; ++k) {
-    const int x = xg + o.dir * k;
-    if (x < 0 || x >= disparity.cols) break;
-    if (std::isfinite(row[x]) && (row[x] - mid) * sign > 0) return x;
-  }
-  return -1;
 }
 
 double outlineScore(const cv::Mat& disparity, const Case& c) {
