@@ -251,6 +251,14 @@
         <translation>Sauts de profondeur calés sur les contours</translation>
     </message>
     <message>
+        <source>Speckle size</source>
+        <translation>Taille des îlots</translation>
+    </message>
+    <message>
+        <source>Speckle range</source>
+        <translation>Écart des îlots</translation>
+    </message>
+    <message>
         <source>Fill flat regions</source>
         <translation>Remplir les régions uniformes</translation>
     </message>

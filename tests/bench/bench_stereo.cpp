@@ -18,7 +18,8 @@
 //   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
 //   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
 //              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored; outline pixels
-//              white located, magenta roof found inside, cyan outside, orange not found.
+//              white located, magenta roof found inside, cyan outside, orange not found;
+//              and outline_METHOD.csv, every scored outline pixel with its outcome.
 //   --range N  search at least N disparities on the simulated scene (dmax raised)
 //   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 //   --repeat N run the methods N times round-robin, report each one's fastest run (shared
@@ -203,6 +204,21 @@ void dumpErrors(const cv::Mat& disparity, const Case& c, const std::string& path
   cv::imwrite(path, img);
 }
 
+// Every scored outline pixel with its outcome, for analysis outside the bench: y, xb, dir,
+// true roof and ground disparities, predicted roof start (-1: missed), offset towards the
+// ground (px).
+void dumpOutline(const cv::Mat& disparity, const Case& c, const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) return;
+  std::fprintf(f, "y,xb,dir,d_roof,d_ground,x_start,offset\n");
+  for (const Case::OutlinePixel& o : c.outline) {
+    const int x = predictedRoofStart(disparity, o);
+    std::fprintf(f, "%d,%d,%d,%.2f,%.2f,%d,%d\n", o.y, o.xb, o.dir, o.dRoof, o.dGround, x,
+                 x < 0 ? 0 : (o.xb - x) * o.dir);
+  }
+  std::fclose(f);
+}
+
 Row score(const cv::Mat& disparity, const Case& c, double seconds) {
   Row r;
   r.seconds = seconds;
@@ -287,6 +303,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       c.left.convertTo(grey, CV_8U);
       cv::imwrite(dump + "/left.png", grey);
       dumpErrors(disparity[i], c, dump + "/errors_" + m + ".png");
+      dumpOutline(disparity[i], c, dump + "/outline_" + m + ".csv");
     }
   }
   // The speed target is a ratio measured in this run: print it at full precision.

@@ -19,6 +19,7 @@
 #include "match_fill.hpp"
 #include "match_snap.hpp"
 #include "match_steps.hpp"
+#include "speckles.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo {
@@ -416,6 +417,11 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     snap.threads = threads;
     detail::snapStepsToContours(left, right, contrast, snap, static_cast<float>(p.minScore),
                                 result.disparity, result.score);
+  }
+  // Last: the fill and the snapping start from isolated matches too (removed first, the fill
+  // lost roofs: 600² edge 74.2 -> 66.1 %).
+  if (p.speckleSize > 0) {
+    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
   }
   return result;
 }

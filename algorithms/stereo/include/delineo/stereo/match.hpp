@@ -35,6 +35,8 @@ struct MatchParams {
   bool adaptive = true;              // contour-adaptive shapes (false: plain square windows)
   bool fillRegions = true;           // flat regions take the disparity lining up their outline
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
+  int speckleSize = 20;              // px, matched regions smaller than this are removed (0 = off)
+  int speckleRange = 2;              // px, largest disparity difference within one such region
   int threads = 0;                   // worker threads, 0 = all cores
 
   template <class V>
@@ -103,6 +105,16 @@ struct MatchParams {
                       "image there, where the pixels changed match better that way (adaptive "
                       "method only)"},
       snapSteps);
+    v(core::ParamInfo{"speckle-size", "Speckle size", "px",
+                      "Connected matched regions (8-neighbours within speckle-range) smaller "
+                      "than this are made unmatched, last; 0 = off (adaptive method; SGBM "
+                      "keeps its own filter, 100 px within 2 px)",
+                      0, 100000},
+      speckleSize);
+    v(core::ParamInfo{"speckle-range", "Speckle range", "px",
+                      "Largest disparity difference between neighbours of one speckle region", 1,
+                      1000},
+      speckleRange);
     v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
       threads);
   }
