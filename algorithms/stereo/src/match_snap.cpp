@@ -18,6 +18,121 @@ namespace delineo::stereo::detail {
 namespace {
 // Longest segment a checked cut scores: the near side's reach, the gap and the far pixel.
 constexpr int kMaxCutSpan = 64;
+
+// One checked cut of a near side on the left: the candidate last near pixels e in
+// [eFirst, eFirst + cost.size()) with their costs, and the one chosen.
+struct NearSideCut {
+  int y = 0, b = 0, s0 = 0, s1 = 0;
+  float dNear = 0, dFar = 0;
+  int eFirst = 0;
+  std::vector<float> cost;
+  int chosen = 0;
+  int rowBest = 0;           // argmin of the row's own cost
+  int prev = -1, next = -1;  // the same outline's cut in the rows above and below (index)
+};
+
+// The row's own best cut (the first of equal ones).
+int argminCut(const NearSideCut& cut) {
+  return cut.eFirst +
+         static_cast<int>(std::min_element(cut.cost.begin(), cut.cost.end()) - cut.cost.begin());
+}
+
+// The outline is a line across rows: each cut is linked to the cut of the same step (near and
+// far disparities within linkDisparity, candidate ranges overlapping) in the rows above and
+// below. The row's cut is then the point of the line through rows y ± lineRows of least total
+// cost, each row's cost taken relative to its own best and capped at lineCap (a row that the
+// line misses, at a corner or a notch, costs no more than that).
+void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSettings& settings) {
+  for (auto& row : rows) {
+    for (NearSideCut& cut : row) cut.chosen = cut.rowBest = argminCut(cut);
+  }
+  if (settings.lineRows <= 0) return;
+  const auto overlaps = [](const NearSideCut& p, const NearSideCut& c) {
+    const int pLast = p.eFirst + static_cast<int>(p.cost.size()) - 1;
+    const int cLast = c.eFirst + static_cast<int>(c.cost.size()) - 1;
+    return std::min(pLast, cLast) + 2 >= std::max(p.eFirst, c.eFirst);
+  };
+  const float link = static_cast<float>(settings.linkDisparity);
+  for (size_t y = 1; y < rows.size(); ++y) {
+    for (size_t i = 0; i < rows[y].size(); ++i) {
+      NearSideCut& c = rows[y][i];
+      int bestJ = -1, bestDistance = std::numeric_limits<int>::max();
+      for (size_t j = 0; j < rows[y - 1].size(); ++j) {
+        const NearSideCut& p = rows[y - 1][j];
+        if (p.next >= 0 || std::abs(p.dNear - c.dNear) > link || std::abs(p.dFar - c.dFar) > link ||
+            !overlaps(p, c)) {
+          continue;
+        }
+        const int distance = std::abs(p.rowBest - c.rowBest);
+        if (distance < bestDistance) {
+          bestDistance = distance;
+          bestJ = static_cast<int>(j);
+        }
+      }
+      if (bestJ >= 0) {
+        c.prev = bestJ;
+        rows[y - 1][static_cast<size_t>(bestJ)].next = static_cast<int>(i);
+      }
+    }
+  }
+  // Each row's costs relative to its own best, capped: a row far off the line costs at most
+  // lineCap, whatever its error.
+  for (auto& row : rows) {
+    for (NearSideCut& cut : row) {
+      const float best = *std::min_element(cut.cost.begin(), cut.cost.end());
+      for (float& c : cut.cost) c = std::min(static_cast<float>(settings.lineCap), c - best);
+    }
+  }
+  const float cap = static_cast<float>(settings.lineCap);
+  const int slopes = 2 * settings.slopeSteps + 1;
+  std::vector<const NearSideCut*> chain;
+  for (auto& row : rows) {
+    for (NearSideCut& c : row) {
+      // The chain's cuts in rows y - lineRows .. y + lineRows (nullptr: no cut of this step).
+      chain.assign(static_cast<size_t>(2 * settings.lineRows + 1), nullptr);
+      chain[static_cast<size_t>(settings.lineRows)] = &c;
+      int linked = 0;
+      const NearSideCut* p = &c;
+      for (int k = 1; k <= settings.lineRows && p->prev >= 0; ++k, ++linked) {
+        p = &rows[static_cast<size_t>(p->y - 1)][static_cast<size_t>(p->prev)];
+        chain[static_cast<size_t>(settings.lineRows - k)] = p;
+      }
+      p = &c;
+      for (int k = 1; k <= settings.lineRows && p->next >= 0; ++k, ++linked) {
+        p = &rows[static_cast<size_t>(p->y + 1)][static_cast<size_t>(p->next)];
+        chain[static_cast<size_t>(settings.lineRows + k)] = p;
+      }
+      if (linked < settings.lineRows) continue;  // too short to be a line: the row decides
+      // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost.
+      double bestSum = std::numeric_limits<double>::infinity();
+      int bestE = c.chosen, bestSlope = 0;
+      for (size_t i = 0; i < c.cost.size(); ++i) {
+        const int e0 = c.eFirst + static_cast<int>(i);
+        for (int si = 0; si < slopes; ++si) {
+          const double slope = settings.maxSlope * static_cast<double>(si - settings.slopeSteps) /
+                               settings.slopeSteps;
+          double sum = 0;
+          for (int k = -settings.lineRows; k <= settings.lineRows && sum < bestSum; ++k) {
+            const NearSideCut* q = chain[static_cast<size_t>(k + settings.lineRows)];
+            if (q == nullptr) continue;
+            const int e = e0 + static_cast<int>(std::lround(slope * k));
+            const int j = e - q->eFirst;
+            sum += j >= 0 && j < static_cast<int>(q->cost.size()) ? q->cost[static_cast<size_t>(j)]
+                                                                  : cap;
+          }
+          if (sum < bestSum) {
+            bestSum = sum;
+            bestE = e0;
+            bestSlope = si - settings.slopeSteps;
+          }
+        }
+      }
+      // A line at the steepest slope tried is likely steeper still (a near-horizontal edge,
+      // whose rows the chain links loosely): the row alone decides there.
+      if (std::abs(bestSlope) < settings.slopeSteps) c.chosen = bestE;
+    }
+  }
+}
 }  // namespace
 
 StepContrast stepContrast(const cv::Mat& left) {
@@ -110,45 +225,52 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   // s0 goes back over the near side's pixels by up to cutReach (fattened roofs). Errors are
   // capped so that one outlier pixel does not decide. Pixels up to e take the near disparity,
   // the near pixels after it become unmatched; the far side is left alone.
-  const auto cutNearSide = [&](int y, int a, int b, const float* d, const float* c, float* out,
-                               float* sc) {
-    const float dNear = d[a], dFar = d[b];
+  const auto cutCosts = [&](int y, int a, int b, const float* d, const float* c) {
+    NearSideCut cut;
+    cut.y = y;
+    cut.b = b;
+    cut.dNear = d[a];
+    cut.dFar = d[b];
     int s0 = a;
     while (s0 - 1 >= std::max(0, a - settings.cutReach) && std::isfinite(d[s0 - 1]) &&
-           std::abs(d[s0 - 1] - dNear) <= 1.0F) {
+           std::abs(d[s0 - 1] - cut.dNear) <= 1.0F) {
       --s0;
     }
     // Far pixels are scored up to b + 2 whatever they hold: every cut then scores the same
     // number of pixels (n − 1), and the first far pixel may still turn out to be near.
     const int s1 = std::min(w - 1, b + 2);
     const int n = s1 - s0 + 1;
+    cut.s0 = s0;
+    cut.s1 = s1;
     // Prefix sums of the capped errors: near[k] over [s0, s0 + k), far likewise.
     double nearSum[kMaxCutSpan + 1], farSum[kMaxCutSpan + 1];
     nearSum[0] = farSum[0] = 0;
     for (int k = 0; k < n; ++k) {
-      nearSum[k + 1] = nearSum[k] + std::min(settings.errorCap, error(y, s0 + k, dNear));
-      farSum[k + 1] = farSum[k] + std::min(settings.errorCap, error(y, s0 + k, dFar));
+      nearSum[k + 1] = nearSum[k] + std::min(settings.errorCap, error(y, s0 + k, cut.dNear));
+      farSum[k + 1] = farSum[k] + std::min(settings.errorCap, error(y, s0 + k, cut.dFar));
     }
-    double bestCost = std::numeric_limits<double>::infinity();
-    int cut = a;
-    for (int e = s0 - 1; e <= std::min(b, s1 - 1); ++e) {
+    cut.eFirst = s0 - 1;
+    const int eLast = std::min(b, s1 - 1);
+    cut.cost.clear();
+    for (int e = cut.eFirst; e <= eLast; ++e) {
       const int nearEnd = e - s0 + 1;                 // near pixels: [0, nearEnd)
       const int farStart = std::min(n, nearEnd + 1);  // far pixels: [farStart, n)
-      const double cost = nearSum[nearEnd] + farSum[n] - farSum[farStart] -
-                          settings.contourWeight * (e >= 0 ? c[e] / sigma : 0.0);
-      if (cost < bestCost) {
-        bestCost = cost;
-        cut = e;
-      }
+      cut.cost.push_back(
+          static_cast<float>(nearSum[nearEnd] + farSum[n] - farSum[farStart] -
+                             settings.contourWeight * (e >= 0 ? c[e] / sigma : 0.0)));
     }
+    return cut;
+  };
+  // Pixels up to e take the near disparity, the near pixels after it become unmatched.
+  const auto applyCut = [&](const NearSideCut& cut, int e, float* out, float* sc) {
     int changes = 0;
-    for (int x = s0; x <= std::min(b, s1 - 1); ++x) {
-      const bool nearValued = std::isfinite(out[x]) && std::abs(out[x] - dNear) <= 1.0F;
-      if (x <= cut && !nearValued) {
-        out[x] = dNear;
+    for (int x = cut.s0; x <= std::min(cut.b, cut.s1 - 1); ++x) {
+      const bool nearValued = std::isfinite(out[x]) && std::abs(out[x] - cut.dNear) <= 1.0F;
+      if (x <= e && !nearValued) {
+        out[x] = cut.dNear;
         if (sc) sc[x] = fillScore;
         ++changes;
-      } else if (x > cut && nearValued) {
+      } else if (x > e && nearValued) {
         out[x] = kNaN;
         if (sc) sc[x] = kNaN;
         ++changes;
@@ -158,6 +280,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   };
 
   const cv::Mat source = disparity.clone();
+  // The checked cuts of each row, applied once every row's are known (continuity below).
+  std::vector<std::vector<NearSideCut>> cutsByRow(static_cast<size_t>(h));
   // Rows are independent (each writes only its own): bands of rows on the workers.
   std::atomic<int> changedTotal{0};
   forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
@@ -176,7 +300,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
         const int a = matched[i], b = matched[i + 1];
         if (b - a - 1 > settings.maxGap || std::abs(d[a] - d[b]) < settings.minStep) continue;
         if (checked && d[a] > d[b]) {
-          changed += cutNearSide(y, a, b, d, c, out, sc);
+          cutsByRow[static_cast<size_t>(y)].push_back(cutCosts(y, a, b, d, c));
           continue;
         }
         const int best = strongestContour(c, std::max(0, a - settings.reach),
@@ -235,6 +359,20 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     changedTotal += changed;
   });
+  if (checked) {
+    chooseCuts(cutsByRow, settings);
+    forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
+      int changed = 0;
+      for (int y = rowStart; y < rowEnd; ++y) {
+        float* out = disparity.ptr<float>(y);
+        float* sc = score.empty() ? nullptr : score.ptr<float>(y);
+        for (const NearSideCut& cut : cutsByRow[static_cast<size_t>(y)]) {
+          changed += applyCut(cut, cut.chosen, out, sc);
+        }
+      }
+      changedTotal += changed;
+    });
+  }
   return changedTotal;
 }
 

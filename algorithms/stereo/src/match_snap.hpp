@@ -5,16 +5,22 @@
 namespace delineo::stereo::detail {
 
 struct StepSnapSettings {
-  double minStep = 2.0;     // px of disparity: smaller differences are slopes, not steps
-  int maxGap = 16;          // px: most unmatched pixels between the two sides of a step
-  int reach = 3;            // px: how far beyond the matched sides the contour is looked for
-  double edgeSigmas = 4.0;  // × noise sigma: weakest contrast taken for the outline
+  double minStep = 2.0;      // px of disparity: smaller differences are slopes, not steps
+  int maxGap = 16;           // px: most unmatched pixels between the two sides of a step
+  int reach = 3;             // px: how far beyond the matched sides the contour is looked for
+  double edgeSigmas = 4.0;   // × noise sigma: weakest contrast taken for the outline
   double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
   // Checked cut of a roof's +x edge (see below).
   int cutReach = 8;            // px: how far back over the near side the cut may go
   double contourWeight = 2.0;  // error (noise sigmas) traded for one sigma of contour contrast
   double errorCap = 6.0;       // noise sigmas: most a single pixel's error counts
-  int threads = 1;           // workers over bands of rows (same result on any number)
+  // Continuity of the checked cut across rows (see chooseCuts in match_snap.cpp).
+  int lineRows = 6;            // rows each side of a row's line through the cuts (0 = off)
+  double lineCap = 5.0;        // noise sigmas: most a row off the line adds to its cost
+  double linkDisparity = 1.5;  // px: same step in the next row when both sides are this close
+  double maxSlope = 3.0;       // px per row: steepest line tried
+  int slopeSteps = 12;         // slopes tried on each side of vertical
+  int threads = 1;             // workers over bands of rows (same result on any number)
 };
 
 // Along each row, two matched pixels a < b with only unmatched pixels between them (at most
@@ -26,7 +32,10 @@ struct StepSnapSettings {
 // noise sigmas, capped at errorCap): near pixels at the near disparity up to e, far ones at the
 // far disparity from e + 2 — pixel e + 1 mixes both surfaces through the image blur and was seen
 // to pull the cut onto the ground —, less contourWeight × the left image's contrast between e and
-// e + 1 (|I(x+1) − I(x)| over 3 rows, in sigmas). Pixels up to e take the near disparity (score
+// e + 1 (|I(x+1) − I(x)| over 3 rows, in sigmas). With lineRows > 0 the cut of a row is taken
+// on the line (through rows y ± lineRows of the same step) of least total cost, each row's cost
+// relative to its own best and capped at lineCap: an outline is a line, and the rows whose own
+// evidence is weak follow their neighbours. Pixels up to e take the near disparity (score
 // `fillScore`), near pixels after it become unmatched. Unchecked (`right` empty), the near side
 // ends at the strongest contrast within [a − reach, b + reach] when it is at least edgeSigmas
 // sigmas.

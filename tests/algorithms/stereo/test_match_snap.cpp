@@ -172,6 +172,50 @@ TEST(SnapSteps, CutsAFattenedLowContrastRoofWhereTheViewsDisagree) {
   EXPECT_LE(onGround, rows / 4);  // of 4 × 38 ground pixels given the roof's value
 }
 
+// A roof edge slanted at half a pixel per row, of very low contrast (roof grey 104 over textured
+// ground 100 ± 12, noise sigma 3), its value fattened 5 px onto the ground. Each row alone often
+// cuts at a ground texture edge; the outline's continuity across rows puts the cut back on the
+// line.
+TEST(SnapSteps, ASlantedLowContrastEdgeIsCutAlongALine) {
+  const int rows = 60, cols = 170;
+  cv::Mat ground(rows, cols + 40, CV_32F);
+  cv::RNG rng(5);
+  rng.fill(ground, cv::RNG::NORMAL, 100, 12);
+  cv::GaussianBlur(ground, ground, {0, 0}, 0.7);
+  ground.colRange(0, 30).setTo(100);  // flat: where the noise level is read
+  const auto edge = [](int y) { return 60 + y / 2; };  // last roof pixel + 1
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = x >= 30 && x < edge(y) ? 104.0f : ground.at<float>(y, x + 20);
+      const bool roof = x + 20 >= 30 && x + 20 < edge(y);
+      right.at<float>(y, x) = roof ? 104.0f : ground.at<float>(y, x + 5 + 20);
+    }
+  }
+  testing::addSensorNoise(left, right, 3.0, rng);
+  cv::Mat fattened(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  for (int y = 0; y < rows; ++y) {
+    fattened.row(y).colRange(30, edge(y) + 5).setTo(20.0f);
+    fattened.row(y).colRange(edge(y) + 5, cols).setTo(5.0f);
+  }
+  const auto locatedRows = [&](const StepSnapSettings& settings) {
+    cv::Mat disparity = fattened.clone();
+    snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+    int located = 0;
+    for (int y = 1; y + 1 < rows; ++y) {
+      int end = 29;  // last pixel at the roof's disparity
+      while (end + 1 < cols && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+      located += std::abs(end - (edge(y) - 1)) <= 1 ? 1 : 0;
+    }
+    return located;
+  };
+  StepSnapSettings rowAlone;
+  rowAlone.lineRows = 0;
+  const int alone = locatedRows(rowAlone), alongLine = locatedRows(StepSnapSettings{});
+  EXPECT_GE(alongLine, (rows - 2) * 9 / 10) << alone;
+  EXPECT_GT(alongLine, alone + 5);
+}
+
 // A roof (grey 120, disparity 20, [40, 70)) whose +x side is a flat shadow (grey 40) that
 // nothing matches; the right view sees a bright facade (200) beyond the roof instead of the
 // shadow. Both views blurred: the last roof pixel mixes with the shadow in the left view and
