@@ -19,39 +19,64 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 int removeSpeckles(cv::Mat& disparity, cv::Mat& score, int maxSize, double range) {
   CV_Assert(disparity.type() == CV_32F && (score.empty() || score.size() == disparity.size()));
   const int w = disparity.cols, h = disparity.rows;
+  if (w == 0 || h == 0 || maxSize <= 1) return 0;
   const float tol = static_cast<float>(range);
-  cv::Mat seen(disparity.size(), CV_8U, cv::Scalar(0));
-  std::vector<int> region, stack;
+  // Union-find over pixel indices in one raster pass (each pixel joins its left and three upper
+  // neighbours), then region sizes by root: sequential memory, no per-region lists (a flood
+  // fill was 20 ms at 1 Mpx, most of it walking the large regions).
+  std::vector<int> parent(static_cast<size_t>(w) * static_cast<size_t>(h), -1);
+  const auto root = [&](int i) {
+    while (parent[static_cast<size_t>(i)] != i) {
+      const int up = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+      parent[static_cast<size_t>(i)] = up;  // path halving
+      i = up;
+    }
+    return i;
+  };
+  // The smaller index becomes the root: every pixel's parent precedes it in raster order.
+  const auto join = [&](int a, int b) {
+    const int ra = root(a), rb = root(b);
+    if (ra < rb) {
+      parent[static_cast<size_t>(rb)] = ra;
+    } else if (rb < ra) {
+      parent[static_cast<size_t>(ra)] = rb;
+    }
+  };
+  for (int y = 0; y < h; ++y) {
+    const float* row = disparity.ptr<float>(y);
+    const float* up = y > 0 ? disparity.ptr<float>(y - 1) : nullptr;
+    for (int x = 0; x < w; ++x) {
+      const float d = row[x];
+      if (!std::isfinite(d)) continue;
+      const int i = y * w + x;
+      // NaN fails the comparisons: unmatched pixels never join.
+      const bool left = x > 0 && std::abs(row[x - 1] - d) <= tol;
+      parent[static_cast<size_t>(i)] = left ? parent[static_cast<size_t>(i - 1)] : i;
+      if (up == nullptr) continue;
+      for (int u = std::max(0, x - 1); u <= std::min(w - 1, x + 1); ++u) {
+        if (std::abs(up[u] - d) <= tol) join(i, i - w + (u - x));
+      }
+    }
+  }
+  // Flattened in raster order (a parent precedes its child, so it is flat already), then the
+  // regions' sizes are counted at their roots.
+  std::vector<int> size(parent.size(), 0);
+  for (size_t i = 0; i < parent.size(); ++i) {
+    const int p = parent[i];
+    if (p < 0) continue;
+    parent[i] = parent[static_cast<size_t>(p)];
+    ++size[static_cast<size_t>(parent[i])];
+  }
   int removed = 0;
-  for (int y0 = 0; y0 < h; ++y0) {
-    for (int x0 = 0; x0 < w; ++x0) {
-      if (seen.at<uchar>(y0, x0) || !std::isfinite(disparity.at<float>(y0, x0))) continue;
-      region.clear();
-      stack.assign(1, y0 * w + x0);
-      seen.at<uchar>(y0, x0) = 1;
-      while (!stack.empty()) {
-        const int i = stack.back();
-        stack.pop_back();
-        region.push_back(i);
-        const int y = i / w, x = i % w;
-        const float d = disparity.at<float>(y, x);
-        for (int v = std::max(0, y - 1); v <= std::min(h - 1, y + 1); ++v) {
-          const float* row = disparity.ptr<float>(v);
-          uchar* mark = seen.ptr<uchar>(v);
-          for (int u = std::max(0, x - 1); u <= std::min(w - 1, x + 1); ++u) {
-            // NaN fails the comparison: unmatched pixels never join.
-            if (mark[u] || !(std::abs(row[u] - d) <= tol)) continue;
-            mark[u] = 1;
-            stack.push_back(v * w + u);
-          }
-        }
-      }
-      if (static_cast<int>(region.size()) >= maxSize) continue;
-      removed += static_cast<int>(region.size());
-      for (const int i : region) {
-        disparity.at<float>(i / w, i % w) = kNaN;
-        if (!score.empty()) score.at<float>(i / w, i % w) = kNaN;
-      }
+  for (int y = 0; y < h; ++y) {
+    float* row = disparity.ptr<float>(y);
+    float* sc = score.empty() ? nullptr : score.ptr<float>(y);
+    const int* p = parent.data() + static_cast<size_t>(y) * static_cast<size_t>(w);
+    for (int x = 0; x < w; ++x) {
+      if (p[x] < 0 || size[static_cast<size_t>(p[x])] >= maxSize) continue;
+      row[x] = kNaN;
+      if (sc != nullptr) sc[x] = kNaN;
+      ++removed;
     }
   }
   return removed;
