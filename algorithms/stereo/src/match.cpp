@@ -409,7 +409,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                               static_cast<float>(p.minScore), result.disparity, result.score);
     });
   }
-  if (p.snapSteps && p.adaptive) post.emplace_back([&] { contrast = detail::stepContrast(left); });
+  if (p.snapSteps && p.adaptive) post.emplace_back([&] { contrast = detail::stepContrast(left, right); });
   runTasks(post, threads);
   if (p.snapSteps && p.adaptive) {
     // Last, after the fill: a filled roof's edges are snapped like matched ones.

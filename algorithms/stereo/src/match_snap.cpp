@@ -135,27 +135,41 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
 }
 }  // namespace
 
-StepContrast stepContrast(const cv::Mat& left) {
-  CV_Assert(left.type() == CV_32F);
-  StepContrast out;
-  const int w = left.cols, h = left.rows;
-  if (w < 3 || h < 1) return out;
-  cv::Mat filled = left.clone();
-  filled.setTo(0.0f, core::nanMask(left));
-  cv::Mat step(h, w - 1, CV_32F);
+namespace {
+// |I(x+1) − I(x)| averaged over the row and its two neighbours; nodata as 0. `filled`: no NaN.
+cv::Mat rowContrast(const cv::Mat& filled) {
+  const int w = filled.cols, h = filled.rows;
+  cv::Mat step(h, w - 1, CV_32F), out;
   for (int y = 0; y < h; ++y) {
     const float* row = filled.ptr<float>(y);
     float* s = step.ptr<float>(y);
     for (int x = 0; x + 1 < w; ++x) s[x] = std::abs(row[x + 1] - row[x]);
   }
-  cv::blur(step, out.contrast, {1, 3}, {-1, -1}, cv::BORDER_REPLICATE);
+  cv::blur(step, out, {1, 3}, {-1, -1}, cv::BORDER_REPLICATE);
+  return out;
+}
+
+cv::Mat withoutNaN(const cv::Mat& m) {
+  cv::Mat filled = m.clone();
+  filled.setTo(0.0f, core::nanMask(m));
+  return filled;
+}
+}  // namespace
+
+StepContrast stepContrast(const cv::Mat& left, const cv::Mat& right) {
+  CV_Assert(left.type() == CV_32F && (right.empty() || right.size() == left.size()));
+  StepContrast out;
+  if (left.cols < 3 || left.rows < 1) return out;
+  const cv::Mat filled = withoutNaN(left);
+  out.contrast = rowContrast(filled);
   out.sigma = noiseSigma(filled);
+  if (!right.empty()) out.rightContrast = rowContrast(withoutNaN(right));
   return out;
 }
 
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
                         float fillScore, cv::Mat& disparity, cv::Mat& score) {
-  return snapStepsToContours(left, right, stepContrast(left), settings, fillScore, disparity,
+  return snapStepsToContours(left, right, stepContrast(left, right), settings, fillScore, disparity,
                              score);
 }
 
@@ -225,6 +239,18 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   // s0 goes back over the near side's pixels by up to cutReach (fattened roofs). Errors are
   // capped so that one outlier pixel does not decide. Pixels up to e take the near disparity,
   // the near pixels after it become unmatched; the far side is left alone.
+  // The roof's edge is a contour in the right view too (roof against the wall that view sees),
+  // at x − dNear: its contrast there, in the left view's grey levels and noise sigmas, capped so
+  // that a strong texture line inside the roof does not outweigh the photometric evidence.
+  const cv::Mat& rightContrast = prepared.rightContrast;
+  const bool useRight = checked && settings.rightContourWeight > 0 && !rightContrast.empty();
+  if (useRight) CV_Assert(rightContrast.size() == contrast.size());
+  const auto rightContrastAt = [&](int y, int e, float dNear) -> double {
+    if (!useRight) return 0.0;
+    const int xr = static_cast<int>(std::lround(static_cast<float>(e) - dNear));
+    if (xr < 0 || xr >= rightContrast.cols) return 0.0;
+    return std::min(settings.rightContourCap, gain * rightContrast.at<float>(y, xr) / sigma);
+  };
   const auto cutCosts = [&](int y, int a, int b, const float* d, const float* c) {
     NearSideCut cut;
     cut.y = y;
@@ -257,7 +283,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
       const int farStart = std::min(n, nearEnd + 1);  // far pixels: [farStart, n)
       cut.cost.push_back(
           static_cast<float>(nearSum[nearEnd] + farSum[n] - farSum[farStart] -
-                             settings.contourWeight * (e >= 0 ? c[e] / sigma : 0.0)));
+                             settings.contourWeight * (e >= 0 ? c[e] / sigma : 0.0) -
+                             settings.rightContourWeight * rightContrastAt(y, e, cut.dNear)));
     }
     return cut;
   };

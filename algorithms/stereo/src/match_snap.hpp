@@ -11,9 +11,11 @@ struct StepSnapSettings {
   double edgeSigmas = 4.0;   // × noise sigma: weakest contrast taken for the outline
   double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
   // Checked cut of a roof's +x edge (see below).
-  int cutReach = 8;            // px: how far back over the near side the cut may go
-  double contourWeight = 2.0;  // error (noise sigmas) traded for one sigma of contour contrast
-  double errorCap = 6.0;       // noise sigmas: most a single pixel's error counts
+  int cutReach = 8;                 // px: how far back over the near side the cut may go
+  double contourWeight = 2.0;       // error (noise sigmas) traded for one sigma of contour contrast
+  double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear
+  double rightContourCap = 6.0;     // noise sigmas: most right-view contrast counted
+  double errorCap = 6.0;            // noise sigmas: most a single pixel's error counts
   // Continuity of the checked cut across rows (see chooseCuts in match_snap.cpp).
   int lineRows = 6;            // rows each side of a row's line through the cuts (0 = off)
   double lineCap = 5.0;        // noise sigmas: most a row off the line adds to its cost
@@ -32,7 +34,9 @@ struct StepSnapSettings {
 // noise sigmas, capped at errorCap): near pixels at the near disparity up to e, far ones at the
 // far disparity from e + 2 — pixel e + 1 mixes both surfaces through the image blur and was seen
 // to pull the cut onto the ground —, less contourWeight × the left image's contrast between e and
-// e + 1 (|I(x+1) − I(x)| over 3 rows, in sigmas). With lineRows > 0 the cut of a row is taken
+// e + 1 (|I(x+1) − I(x)| over 3 rows, in sigmas), less rightContourWeight × the right view's
+// contrast where the cut falls in it (x − dNear: roof against the wall that view sees; capped at
+// rightContourCap sigmas). With lineRows > 0 the cut of a row is taken
 // on the line (through rows y ± lineRows of the same step) of least total cost, each row's cost
 // relative to its own best and capped at lineCap: an outline is a line, and the rows whose own
 // evidence is weak follow their neighbours. Pixels up to e take the near disparity (score
@@ -51,15 +55,17 @@ struct StepSnapSettings {
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
                         float fillScore, cv::Mat& disparity, cv::Mat& score);
 
-// What the snapping reads of the left image alone, so that it can be prepared while the
+// What the snapping reads of the images alone, so that it can be prepared while the
 // disparities are still being filled: the contrast between x and x + 1 averaged over the row and
 // its two neighbours (a roof outline is a line across rows, a texture speck is not; CV_32F,
-// (w − 1) × h, nodata as 0), and the image's noise sigma.
+// (w − 1) × h, nodata as 0) of the left image and, when `right` is given, of the right one, and
+// the left image's noise sigma.
 struct StepContrast {
   cv::Mat contrast;
+  cv::Mat rightContrast;
   double sigma = 1.0;
 };
-StepContrast stepContrast(const cv::Mat& left);
+StepContrast stepContrast(const cv::Mat& left, const cv::Mat& right = cv::Mat());
 
 // The same with the contrast prepared.
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepContrast& prepared,

@@ -216,6 +216,38 @@ TEST(SnapSteps, ASlantedLowContrastEdgeIsCutAlongALine) {
   EXPECT_GT(alongLine, alone + 5);
 }
 
+// A roof of the ground's own grey (100 in both views, noise sigma 1): nothing in the left view
+// and nothing photometric tells where it ends. The right view sees the roof's east wall, a dark
+// 2 px band just after the roof (at x − 20): that contour places the cut. The roof's value is
+// fattened 4 px onto the ground.
+TEST(SnapSteps, TheRightViewsContourPlacesTheCutWhereTheLeftViewShowsNone) {
+  const int rows = 16, cols = 140;
+  cv::Mat left(rows, cols, CV_32F, cv::Scalar(100)), right(rows, cols, CV_32F, cv::Scalar(100));
+  right.colRange(50, 52).setTo(60);  // roof [40, 70) at disparity 20 ends at right x 49
+  cv::RNG rng(9);
+  testing::addSensorNoise(left, right, 1.0, rng);
+  cv::Mat fattened(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(fattened, 40, 74, 20.0f);
+  setRun(fattened, 74, cols, 5.0f);
+  const auto locatedRows = [&](const StepSnapSettings& settings) {
+    cv::Mat disparity = fattened.clone();
+    snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+    int located = 0;
+    for (int y = 0; y < rows; ++y) {
+      int end = 39;
+      while (end + 1 < cols && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+      located += std::abs(end - 69) <= 1 ? 1 : 0;
+    }
+    return located;
+  };
+  StepSnapSettings bothViews;
+  bothViews.lineRows = 0;  // each row on its own evidence
+  StepSnapSettings leftOnly = bothViews;
+  leftOnly.rightContourWeight = 0;
+  EXPECT_EQ(locatedRows(bothViews), rows);
+  EXPECT_LT(locatedRows(leftOnly), rows / 2);
+}
+
 // A roof (grey 120, disparity 20, [40, 70)) whose +x side is a flat shadow (grey 40) that
 // nothing matches; the right view sees a bright facade (200) beyond the roof instead of the
 // shadow. Both views blurred: the last roof pixel mixes with the shadow in the left view and
