@@ -19,7 +19,8 @@
 //   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
 //              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored; outline pixels
 //              white located, magenta roof found inside, cyan outside, orange not found;
-//              and outline_METHOD.csv, every scored outline pixel with its outcome.
+//              and outline_METHOD.csv, every scored outline pixel with its outcome;
+//              disparity_METHOD.tif and truth.tif (float32).
 //   --range N  search at least N disparities on the simulated scene (dmax raised)
 //   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 //   --repeat N run the methods N times round-robin, report each one's fastest run (shared
@@ -304,6 +305,8 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       cv::imwrite(dump + "/left.png", grey);
       dumpErrors(disparity[i], c, dump + "/errors_" + m + ".png");
       dumpOutline(disparity[i], c, dump + "/outline_" + m + ".csv");
+      cv::imwrite(dump + "/disparity_" + m + ".tif", disparity[i]);
+      if (i == 0) cv::imwrite(dump + "/truth.tif", c.truth);
     }
   }
   // The speed target is a ratio measured in this run: print it at full precision.
