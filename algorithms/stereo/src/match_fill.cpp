@@ -57,16 +57,19 @@ std::vector<int> twoLargestClusters(const std::vector<float>& values, int dmin, 
 
 // The cluster candidates of a region can be too close in outline error to pass the contrast
 // test (a roof of nearly the ground's grey). Scanning every integer disparity of the range then
-// confirms `best` when the scan's minimum is within 1 px of it and at most `agreement` × the
-// lowest error found 3 px or more away: the outline lines up there and nowhere else.
+// confirms `best` when the scan's minimum is within `reach` px of it and at most `agreement` ×
+// the lowest error found 3 px or more away: the outline lines up there and nowhere else.
+// (`best` is a sub-pixel cluster mean and a large roof's ring error is flat within a pixel of
+// its minimum: the integer minimum can lie 1.4 px away.)
 template <typename ErrorAt>
-bool scanConfirms(const ErrorAt& errorAt, int dmin, int dmax, float best, double agreement) {
+bool scanConfirms(const ErrorAt& errorAt, int dmin, int dmax, float best, double agreement,
+                  double reach) {
   std::vector<double> errors(static_cast<size_t>(dmax - dmin + 1));
   for (int d = dmin; d <= dmax; ++d)
     errors[static_cast<size_t>(d - dmin)] = errorAt(static_cast<float>(d));
   const auto lowest = std::min_element(errors.begin(), errors.end());
   const int found = dmin + static_cast<int>(lowest - errors.begin());
-  if (std::abs(static_cast<float>(found) - best) > 1.0F || *lowest >= 1e29) return false;
+  if (std::abs(static_cast<double>(found) - best) > reach || *lowest >= 1e29) return false;
   double other = 1e30;
   for (int d = dmin; d <= dmax; ++d) {
     if (std::abs(d - found) > 2) other = std::min(other, errors[static_cast<size_t>(d - dmin)]);
@@ -205,7 +208,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
     if (bestError > settings.photometric * sigma) continue;
     if (bestError > settings.contrast * otherError &&
         !(settings.scanAgreement > 0 &&
-          scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement))) {
+          scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement, settings.scanReach))) {
       continue;
     }
     const int shift = static_cast<int>(std::lround(best));

@@ -12,7 +12,8 @@ struct RegionFillSettings {
   int minMatched = 20;       // px: matches around a region needed to propose a disparity
   double photometric = 6.0;  // × noise sigma: mean |left − mapped right| allowed on the outline
   double contrast = 0.5;     // the best candidate's outline error must be below this × the other's
-  double scanAgreement = 0.9;    // a full-range scan confirming the best candidate (0 = off)
+  double scanAgreement = 0.93;   // a full-range scan confirming the best candidate (0 = off)
+  double scanReach = 1.5;        // px: the scan's minimum this close to the candidate confirms it
   int growReach = 3;             // px: the filled region grows back to its contour by at most this
   double growSigmas = 3.0;       // × noise sigma: grown pixel vs the region's local mean grey
   double growPhotometric = 4.0;  // × noise sigma: a grown pixel's |left − mapped right|
