@@ -102,7 +102,9 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
         p = &rows[static_cast<size_t>(p->y + 1)][static_cast<size_t>(p->next)];
         chain[static_cast<size_t>(settings.lineRows + k)] = p;
       }
-      if (linked < settings.lineRows) continue;  // too short to be a line: the row decides
+      // Fewer than lineRows linked rows above and below together: too short to be a line, the
+      // row decides.
+      if (linked < settings.lineRows) continue;
       // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost.
       double bestSum = std::numeric_limits<double>::infinity();
       int bestE = c.chosen, bestSlope = 0;
@@ -288,8 +290,9 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     return cut;
   };
-  // Pixels up to e take the near disparity, the near pixels after it become unmatched.
-  const auto applyCut = [&](const NearSideCut& cut, int e, float* out, float* sc) {
+  // Pixels up to the chosen e take the near disparity, the near pixels after it become unmatched.
+  const auto applyCut = [&](const NearSideCut& cut, float* out, float* sc) {
+    const int e = cut.chosen;
     int changes = 0;
     for (int x = cut.s0; x <= std::min(cut.b, cut.s1 - 1); ++x) {
       const bool nearValued = std::isfinite(out[x]) && std::abs(out[x] - cut.dNear) <= 1.0F;
@@ -394,7 +397,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
         float* out = disparity.ptr<float>(y);
         float* sc = score.empty() ? nullptr : score.ptr<float>(y);
         for (const NearSideCut& cut : cutsByRow[static_cast<size_t>(y)]) {
-          changed += applyCut(cut, cut.chosen, out, sc);
+          changed += applyCut(cut, out, sc);
         }
       }
       changedTotal += changed;

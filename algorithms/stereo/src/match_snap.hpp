@@ -36,10 +36,10 @@ struct StepSnapSettings {
 // to pull the cut onto the ground —, less contourWeight × the left image's contrast between e and
 // e + 1 (|I(x+1) − I(x)| over 3 rows, in sigmas), less rightContourWeight × the right view's
 // contrast where the cut falls in it (x − dNear: roof against the wall that view sees; capped at
-// rightContourCap sigmas). With lineRows > 0 the cut of a row is taken
-// on the line (through rows y ± lineRows of the same step) of least total cost, each row's cost
-// relative to its own best and capped at lineCap: an outline is a line, and the rows whose own
-// evidence is weak follow their neighbours. Pixels up to e take the near disparity (score
+// rightContourCap sigmas). With lineRows > 0 the cut of a row is taken on the line (through
+// rows y ± lineRows of the same step) of least total cost, each row's cost relative to its own
+// best and capped at lineCap: an outline is a line, and the rows whose own evidence is weak
+// follow their neighbours. Pixels up to e take the near disparity (score
 // `fillScore`), near pixels after it become unmatched. Unchecked (`right` empty), the near side
 // ends at the strongest contrast within [a − reach, b + reach] when it is at least edgeSigmas
 // sigmas.
