@@ -13,7 +13,8 @@
 // 1 px of xb; no roof-side pixel in the walk counts as missed. edge% = located / outline pixels.
 //
 // Usage: bench_stereo [--size N] [--data DIR] [--methods adaptive,square,sgbm] [--no-data]
-//                     [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu] [--seed N]
+//                     [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu] [--stages]
+//                     [--seed N]
 //   --size N   side of the simulated scene (default 1000; the ctest smoke run uses a tiny one)
 //   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
 //   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
@@ -27,16 +28,20 @@
 //              machines: the load then hits every method alike).
 //   --cpu      also print the CPU time of every run (process CPU clock: with '{"threads": 1}'
 //              the adaptive matcher's own cost, insensitive to other processes' load).
+//   --stages   print the wall time of each stage the matcher reports (its progress stages),
+//              for every run.
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -46,6 +51,7 @@
 
 #include "delineo/core/nan_mask.hpp"
 #include "delineo/core/params.hpp"
+#include "delineo/core/progress.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
 #ifdef DELINEO_BENCH_HAVE_SIM
@@ -255,6 +261,39 @@ Row score(const cv::Mat& disparity, const Case& c, double seconds) {
   return r;
 }
 
+// Records when the matcher enters each progress stage, to print where its wall time goes.
+class StageClock : public core::Progress {
+ public:
+  using Clock = std::chrono::steady_clock;
+  void setStage(const std::string& stage) override {
+    core::Progress::setStage(stage);
+    const std::lock_guard lock(mutex_);
+    marks_.emplace_back(stage, Clock::now());
+  }
+  // Each stage's seconds, from its start to the next stage's start (the last one to `end`).
+  void print(const std::string& method, Clock::time_point begin, Clock::time_point end) const {
+    const std::lock_guard lock(mutex_);
+    Clock::time_point from = begin;
+    std::string name = "(before the first stage)";
+    for (size_t i = 0; i <= marks_.size(); ++i) {
+      const Clock::time_point to = i < marks_.size() ? marks_[i].second : end;
+      const double seconds = std::chrono::duration<double>(to - from).count();
+      if (i > 0 || seconds > 1e-4)
+        std::printf("    %s %-42s %7.3f s\n", method.c_str(), name.c_str(), seconds);
+      if (i < marks_.size()) {
+        name = marks_[i].first;
+        from = marks_[i].second;
+      }
+    }
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::pair<std::string, Clock::time_point>> marks_;
+};
+
+bool gStageTimes = false;
+
 void runCase(const Case& c, const std::vector<std::string>& methods, const std::string& dump,
              const nlohmann::json& overrides, int repeat, bool printCpu) {
   std::printf("\n%s: %dx%d, range %d..%d\n", c.name.c_str(), c.left.cols, c.left.rows, c.dmin,
@@ -282,9 +321,11 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       const stereo::MatchParams p = paramsFor(methods[i]);
       const auto start = std::chrono::steady_clock::now();
       const std::clock_t cpu0 = std::clock();
-      const stereo::MatchResult result = stereo::matchStereo(c.left, c.right, p);
-      best[i] = std::min(best[i], std::chrono::duration<double>(
-                                      std::chrono::steady_clock::now() - start).count());
+      StageClock stages;
+      const stereo::MatchResult result = stereo::matchStereo(c.left, c.right, p, &stages);
+      const auto end = std::chrono::steady_clock::now();
+      best[i] = std::min(best[i], std::chrono::duration<double>(end - start).count());
+      if (gStageTimes) stages.print(methods[i], start, end);
       disparity[i] = result.disparity;
       if (printCpu) {
         std::printf("  cpu %s %.3f s\n", methods[i].c_str(),
@@ -494,6 +535,8 @@ int main(int argc, char** argv) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--outline-diag") {
       gOutlineDiagnosis = true;
+    } else if (a == "--stages") {
+      gStageTimes = true;
     } else if (a == "--cpu") {
       printCpu = true;
     } else if (a == "--no-data") {
@@ -509,8 +552,10 @@ int main(int argc, char** argv) {
         start = comma + 1;
       }
     } else {
-      std::fprintf(stderr, "usage: bench_stereo [--size N] [--data DIR] [--no-data] "
-                           "[--methods adaptive,square,sgbm] [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu] [--seed N]\n");
+      std::fprintf(stderr,
+                   "usage: bench_stereo [--size N] [--data DIR] [--no-data] "
+                   "[--methods adaptive,square,sgbm] [--dump DIR] [--params JSON] [--range N] "
+                   "[--repeat N] [--cpu] [--stages] [--seed N]\n");
       return 2;
     }
   }
