@@ -117,6 +117,15 @@ void growToContour(const cv::Mat& left, const cv::Mat& right, const cv::Rect& bo
   }
 }
 
+// The 2 px on both sides of a region's outline (CV_8U 0/255 mask in, same size out).
+cv::Mat outlineRing(const cv::Mat& region) {
+  cv::Mat outer, inner;
+  cv::dilate(region, outer, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
+  cv::erode(region, inner, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}), {-1, -1}, 1,
+            cv::BORDER_CONSTANT, 0);
+  return outer & ~inner;
+}
+
 }  // namespace
 
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
@@ -129,6 +138,13 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
   cv::blur(leftFinite.mul(leftFinite), meanSquare, {5, 5});
   const double flatVariance = settings.flatSigmas * settings.flatSigmas * sigma * sigma;
   const cv::Mat flat = (meanSquare - mean.mul(mean) < flatVariance) & (left == left);
+  // The regions without their thin parts (see RegionFillSettings::coreOpening).
+  cv::Mat flatCores;
+  if (settings.coreOpening > 1) {
+    cv::morphologyEx(
+        flat, flatCores, cv::MORPH_OPEN,
+        cv::getStructuringElement(cv::MORPH_RECT, {settings.coreOpening, settings.coreOpening}));
+  }
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(flat, labels, stats, centroids, 4, CV_32S);
   std::vector<int> unmatched(static_cast<size_t>(count), 0);
@@ -154,13 +170,10 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                  stats.at<int>(r, cv::CC_STAT_WIDTH) + 8,
                  stats.at<int>(r, cv::CC_STAT_HEIGHT) + 8) &
         image;
-    const cv::Mat region = labels(box) == r;
-    cv::Mat near, outer, inner;
+    cv::Mat region = labels(box) == r;
+    cv::Mat near;
     cv::dilate(region, near, cv::getStructuringElement(cv::MORPH_RECT, {7, 7}));
-    cv::dilate(region, outer, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
-    cv::erode(region, inner, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}), {-1, -1}, 1,
-              cv::BORDER_CONSTANT, 0);
-    const cv::Mat ring = outer & ~inner;
+    cv::Mat ring = outlineRing(region);
     std::vector<float> matches;
     for (int y = 0; y < box.height; ++y) {
       const uchar* n = near.ptr<uchar>(y);
@@ -194,15 +207,46 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
     };
     float best = 0;
     double bestError = 1e30, otherError = 1e30;
-    for (const int centre : twoLargestClusters(matches, dmin, dmax, settings.minMatched / 2)) {
-      const float value = clusterMean(matches, static_cast<float>(centre));
-      const double e = ringError(value);
-      if (e < bestError) {
-        otherError = bestError;
-        bestError = e;
-        best = value;
-      } else {
-        otherError = std::min(otherError, e);
+    const std::vector<int> centres =
+        twoLargestClusters(matches, dmin, dmax, settings.minMatched / 2);
+    auto rankCandidates = [&] {
+      best = 0;
+      bestError = otherError = 1e30;
+      for (const int centre : centres) {
+        const float value = clusterMean(matches, static_cast<float>(centre));
+        const double e = ringError(value);
+        if (e < bestError) {
+          otherError = bestError;
+          bestError = e;
+          best = value;
+        } else {
+          otherError = std::min(otherError, e);
+        }
+      }
+    };
+    rankCandidates();
+    if (!flatCores.empty() && bestError < 1e29) {
+      // Thin flat parts joined to the region (a facade's plain bands between its window rows,
+      // joined to the roof above) put their own outline, which does not line up at the roof's
+      // disparity, into the ring. When the region's core (without them) lines up clearly better,
+      // the core is the region.
+      const int area = stats.at<int>(r, cv::CC_STAT_AREA);
+      const cv::Mat core = flatCores(box) & region;
+      const int coreArea = cv::countNonZero(core);
+      if (coreArea < area && coreArea >= settings.coreMinShare * area) {
+        const cv::Mat wholeRing = ring;
+        const float wholeBest = best;
+        const double wholeBestError = bestError, wholeOtherError = otherError;
+        ring = outlineRing(core);
+        rankCandidates();
+        if (bestError < settings.coreErrorRatio * wholeBestError) {
+          region = core;
+        } else {
+          ring = wholeRing;
+          best = wholeBest;
+          bestError = wholeBestError;
+          otherError = wholeOtherError;
+        }
       }
     }
     if (bestError > settings.photometric * sigma) continue;

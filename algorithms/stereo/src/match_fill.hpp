@@ -17,6 +17,9 @@ struct RegionFillSettings {
   int growReach = 3;             // px: the filled region grows back to its contour by at most this
   double growSigmas = 3.0;       // × noise sigma: grown pixel vs the region's local mean grey
   double growPhotometric = 4.0;  // × noise sigma: a grown pixel's |left − mapped right|
+  int coreOpening = 5;           // px: square opening that gives a region's core (0 = off)
+  double coreMinShare = 0.5;     // the core replaces the region only when this share of it
+  double coreErrorRatio = 0.85;  //   and when its ring's error is below this × the region's
 };
 
 // Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is
@@ -31,6 +34,11 @@ struct RegionFillSettings {
 // stops 2 px short: its 5x5 windows straddle it) over pixels that look like it and match at its
 // disparity on their own; its unmatched pixels and the grown ones whose own disparity explains
 // them worse take it, with `fillScore` as score.
+// A region's core is the region without its parts thinner than `coreOpening` (a morphological
+// opening): the core takes the region's place when it keeps at least `coreMinShare` of it and
+// its ring's error at the best candidate is below `coreErrorRatio` × the whole region's. Then
+// the thin parts, joined through the roof's grey (a facade's plain bands between its window
+// rows), no longer decide whether the roof is filled, and are not filled with it.
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score);
