@@ -21,7 +21,7 @@
 //              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored; outline pixels
 //              white located, magenta roof found inside, cyan outside, orange not found;
 //              and outline_METHOD.csv, every scored outline pixel with its outcome;
-//              disparity_METHOD.tif and truth.tif (float32).
+//              disparity_METHOD.tif, truth.tif and the views left.tif, right.tif (float32).
 //   --range N  search at least N disparities on the simulated scene (dmax raised)
 //   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 //   --repeat N run the methods N times round-robin, report each one's fastest run (shared
@@ -372,7 +372,11 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       dumpErrors(disparity[i], c, dump + "/errors_" + m + ".png");
       dumpOutline(disparity[i], c, dump + "/outline_" + m + ".csv");
       cv::imwrite(dump + "/disparity_" + m + ".tif", disparity[i]);
-      if (i == 0) cv::imwrite(dump + "/truth.tif", c.truth);
+      if (i == 0) {
+        cv::imwrite(dump + "/truth.tif", c.truth);
+        cv::imwrite(dump + "/left.tif", c.left);
+        cv::imwrite(dump + "/right.tif", c.right);
+      }
     }
   }
   // The speed target is a ratio measured in this run: print it at full precision.
