@@ -12,6 +12,8 @@ struct StepSnapSettings {
   double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
   // Checked cut of a roof's +x edge (see below).
   int cutReach = 8;                 // px: how far back over the near side the cut may go
+  int carriedRuns = 3;              // px of a run on each side of a contour it crosses (0 = off)
+  double carriedMargin = 1.0;       // noise sigmas: a farther disparity's lead over the run's
   double contourWeight = 2.0;       // error (noise sigmas) traded for one sigma of contour contrast
   double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear
   double rightContourCap = 6.0;     // noise sigmas: most right-view contrast counted
@@ -50,6 +52,13 @@ struct StepSnapSettings {
 // next to a shadow or textureless ground) is extended to the strongest contrast within `reach`
 // (at least edgeSigmas), over pixels that match at its disparity or whose grey is nearer the
 // run's last pixel than the pixel beyond that contrast.
+// Runs carried across a contour (checked only; first, on each row): a matched run whose
+// neighbours differ by ≤ 1 px, with the strongest left contour (≥ edgeSigmas) of its last
+// maxGap px at least carriedRuns px from both ends. When an integer disparity at least minStep
+// farther explains the run's pixels after the contour (mean capped error ≤ checkSigmas and
+// carriedMargin below theirs at the run's disparity), those pixels become unmatched: a roof's
+// value spread onto the dark ground beyond its +x edge, which at the roof's disparity falls on
+// the wall the right view sees. The gap left is then snapped like the others.
 // The far side is always left alone. `left`, `right`: the original images (CV_32F, NaN =
 // nodata). Returns the pixels changed.
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,

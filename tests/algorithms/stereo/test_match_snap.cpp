@@ -280,5 +280,51 @@ TEST(SnapSteps, ExtendsARoofRunEndingInUnmatchedShadowToTheContour) {
   EXPECT_TRUE(std::isnan(unchecked.at<float>(5, 68)));
 }
 
+// A roof (grey 140, disparity 20, [40, 70)) whose +x side is a textured shadow on the ground
+// (0.6 × its grey, disparity 5, [70, 90)); at the roof's disparity the right view shows the
+// roof's east wall there, plain (grey 100). The roof's value was carried 12 px onto the shadow,
+// followed by an unmatched gap and the ground's run. Noise sigma 1.5. Wide, so that the views'
+// grey-level map (from their column moments) comes from the ground.
+TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
+  const int rows = 30;
+  cv::Mat ground(rows, 400, CV_32F);
+  cv::RNG rng(17);
+  rng.fill(ground, cv::RNG::NORMAL, 100, 12);
+  cv::GaussianBlur(ground, ground, {0, 0}, 0.7);
+  ground.colRange(0, 60).setTo(100);   // flat: where the noise level is read
+  auto groundAt = [&](int y, int x) {  // left-image column x of the ground, shadowed on [70, 90)
+    const float g = ground.at<float>(y, x + 40);
+    return x >= 70 && x < 90 ? 0.6f * g : g;
+  };
+  cv::Mat left(rows, 360, CV_32F), right(rows, 360, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < 360; ++x) {
+      left.at<float>(y, x) = x >= 40 && x < 70 ? 140.0f : groundAt(y, x);
+      const bool roof = x + 20 >= 40 && x + 20 < 70;
+      const bool wall = x + 20 >= 70 && x + 5 < 70;  // between the roof edge and the ground
+      right.at<float>(y, x) = roof ? 140.0f : wall ? 100.0f : groundAt(y, x + 5);
+    }
+  }
+  testing::addSensorNoise(left, right, 1.5, rng);
+  cv::Mat carried(rows, 360, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(carried, 40, 82, 20.0f);
+  setRun(carried, 100, 360, 5.0f);
+  auto roofEnds = [&](const StepSnapSettings& settings) {
+    cv::Mat disparity = carried.clone();
+    snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+    int located = 0;
+    for (int y = 1; y + 1 < rows; ++y) {
+      int end = 39;  // last pixel at the roof's disparity
+      while (end + 1 < 360 && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+      located += std::abs(end - 69) <= 1 ? 1 : 0;
+    }
+    return located;
+  };
+  StepSnapSettings off;
+  off.carriedRuns = 0;
+  EXPECT_EQ(roofEnds(off), 0);
+  EXPECT_GE(roofEnds(StepSnapSettings{}), (rows - 2) * 9 / 10) << " of " << rows - 2;
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
