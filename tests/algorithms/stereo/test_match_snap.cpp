@@ -24,6 +24,16 @@ cv::Mat roofImage(bool withContour) {
   return left + noise;
 }
 
+// Textured ground (grey 100 ± 12, lightly blurred) of rows × cols, flat (100) on its first
+// `flatCols` columns: where the noise level is read. `rng` goes on to the views' noise.
+cv::Mat texturedGround(int rows, int cols, int flatCols, cv::RNG& rng) {
+  cv::Mat ground(rows, cols, CV_32F);
+  rng.fill(ground, cv::RNG::NORMAL, 100, 12);
+  cv::GaussianBlur(ground, ground, {0, 0}, 0.7);
+  ground.colRange(0, flatCols).setTo(100);
+  return ground;
+}
+
 // Every row: d on [x0, x1), NaN elsewhere unless already set.
 void setRun(cv::Mat& disparity, int x0, int x1, float d) {
   disparity(cv::Rect(x0, 0, x1 - x0, disparity.rows)).setTo(d);
@@ -142,11 +152,8 @@ TEST(SnapSteps, ChecksEachChangedPixelAgainstTheRightView) {
 // most rows: the cut must come from the two views, not from the strongest contrast.
 TEST(SnapSteps, CutsAFattenedLowContrastRoofWhereTheViewsDisagree) {
   const int rows = 40;
-  cv::Mat ground(rows, 200, CV_32F);
   cv::RNG rng(11);
-  rng.fill(ground, cv::RNG::NORMAL, 100, 12);
-  cv::GaussianBlur(ground, ground, {0, 0}, 0.7);
-  ground.colRange(0, 40).setTo(100);  // flat: where the noise level is read
+  const cv::Mat ground = texturedGround(rows, 200, 40, rng);
   cv::Mat left(rows, 140, CV_32F), right(rows, 140, CV_32F);
   for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < 140; ++x) {
@@ -178,11 +185,8 @@ TEST(SnapSteps, CutsAFattenedLowContrastRoofWhereTheViewsDisagree) {
 // line.
 TEST(SnapSteps, ASlantedLowContrastEdgeIsCutAlongALine) {
   const int rows = 60, cols = 170;
-  cv::Mat ground(rows, cols + 40, CV_32F);
   cv::RNG rng(5);
-  rng.fill(ground, cv::RNG::NORMAL, 100, 12);
-  cv::GaussianBlur(ground, ground, {0, 0}, 0.7);
-  ground.colRange(0, 30).setTo(100);  // flat: where the noise level is read
+  const cv::Mat ground = texturedGround(rows, cols + 40, 30, rng);
   const auto edge = [](int y) { return 60 + y / 2; };  // last roof pixel + 1
   cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
   for (int y = 0; y < rows; ++y) {
@@ -287,11 +291,8 @@ TEST(SnapSteps, ExtendsARoofRunEndingInUnmatchedShadowToTheContour) {
 // grey-level map (from their column moments) comes from the ground.
 TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
   const int rows = 30;
-  cv::Mat ground(rows, 400, CV_32F);
   cv::RNG rng(17);
-  rng.fill(ground, cv::RNG::NORMAL, 100, 12);
-  cv::GaussianBlur(ground, ground, {0, 0}, 0.7);
-  ground.colRange(0, 60).setTo(100);   // flat: where the noise level is read
+  const cv::Mat ground = texturedGround(rows, 400, 60, rng);
   auto groundAt = [&](int y, int x) {  // left-image column x of the ground, shadowed on [70, 90)
     const float g = ground.at<float>(y, x + 40);
     return x >= 70 && x < 90 ? 0.6f * g : g;
