@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -409,6 +411,29 @@ TEST(Match, CancelMidRun) {
   EXPECT_EQ(matchStereo(left, right, p, &full).status, core::RunStatus::Completed);
   EXPECT_GT(full.reportCount(), 3);
   EXPECT_DOUBLE_EQ(full.fraction(), 1.0);
+}
+
+TEST(Match, TheStepsAfterTheLevelsReportProgressAndHonourACancel) {
+  const cv::Mat left = texture({200, 160}, 24);
+  const cv::Mat right = shiftedRight(left, 5.0);
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 40;
+  p.threads = 1;
+  std::vector<double> fractions;
+  core::Progress full([&](double fraction, const std::string&) { fractions.push_back(fraction); });
+  ASSERT_EQ(matchStereo(left, right, p, &full).status, core::RunStatus::Completed);
+  // The levels end at 80 %; the fill, speckles and snapping report the rest.
+  int afterLevels = 0;
+  for (const double f : fractions) afterLevels += f > 0.8 && f < 1.0 ? 1 : 0;
+  EXPECT_GE(afterLevels, 3);
+  EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
+  // Canceled on the report that follows the snapping (the last but one): no result.
+  core::Progress late;
+  late.cancelAfterReports(full.reportCount() - 1);
+  const MatchResult r = matchStereo(left, right, p, &late);
+  EXPECT_EQ(r.status, core::RunStatus::Canceled);
+  EXPECT_TRUE(r.disparity.empty());
 }
 
 TEST(Match, BadInputsThrow) {
