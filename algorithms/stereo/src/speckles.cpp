@@ -58,22 +58,33 @@ int removeSpeckles(cv::Mat& disparity, cv::Mat& score, int maxSize, double range
       }
     }
   }
-  // Flattened in raster order (a parent precedes its child, so it is flat already), then the
-  // regions' sizes are counted at their roots.
-  std::vector<int> size(parent.size(), 0);
+  // Flattened in raster order (a parent precedes its child, so it is flat already), counting
+  // each region's size in its root's own entry, as -(1 + size): a region's root is its first
+  // pixel in raster order, so it is met before its other pixels. No second w × h array.
   for (size_t i = 0; i < parent.size(); ++i) {
     const int p = parent[i];
     if (p < 0) continue;
-    parent[i] = parent[static_cast<size_t>(p)];
-    ++size[static_cast<size_t>(parent[i])];
+    if (static_cast<size_t>(p) == i) {
+      parent[i] = -2;  // a root, size 1 so far
+      continue;
+    }
+    // The parent is the root itself (its entry now holds the count) or a flattened pixel.
+    const int r = parent[static_cast<size_t>(p)] <= -2 ? p : parent[static_cast<size_t>(p)];
+    parent[i] = r;
+    --parent[static_cast<size_t>(r)];
   }
+  const auto regionSize = [&](size_t i) {
+    const int p = parent[i];
+    return p <= -2 ? -p - 1 : -parent[static_cast<size_t>(p)] - 1;
+  };
   int removed = 0;
   for (int y = 0; y < h; ++y) {
     float* row = disparity.ptr<float>(y);
     float* sc = score.empty() ? nullptr : score.ptr<float>(y);
-    const int* p = parent.data() + static_cast<size_t>(y) * static_cast<size_t>(w);
+    const size_t first = static_cast<size_t>(y) * static_cast<size_t>(w);
     for (int x = 0; x < w; ++x) {
-      if (p[x] < 0 || size[static_cast<size_t>(p[x])] >= maxSize) continue;
+      const size_t i = first + static_cast<size_t>(x);
+      if (parent[i] == -1 || regionSize(i) >= maxSize) continue;
       row[x] = kNaN;
       if (sc != nullptr) sc[x] = kNaN;
       ++removed;
