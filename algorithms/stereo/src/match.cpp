@@ -417,7 +417,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // The steps after the levels are short but polled too: a cancel is honoured between them.
   const auto canceled = [&] {
     if (!core::isCanceled(progress)) return false;
-    result = MatchResult{};
+    // As when canceled during the levels: no maps.
+    result.disparity.release();
+    result.score.release();
     result.status = core::RunStatus::Canceled;
     return true;
   };

@@ -36,7 +36,8 @@ struct RegionFillSettings {
 // them worse take it, with `fillScore` as score.
 // A region's core is the region without its parts thinner than `coreOpening` (a morphological
 // opening): the core takes the region's place when it keeps at least `coreMinShare` of it and
-// its ring's error at the best candidate is below `coreErrorRatio` × the whole region's. Then
+// the best candidate's error on the core's ring is below `coreErrorRatio` × the best one on the
+// whole region's ring. Then
 // the thin parts, joined through the roof's grey (a facade's plain bands between its window
 // rows), no longer decide whether the roof is filled, and are not filled with it.
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
