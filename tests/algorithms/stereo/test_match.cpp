@@ -394,13 +394,24 @@ TEST(Match, ScoreIsNaNExactlyWhereDisparityIsNaN) {
   }
 }
 
+// A textured pair shifted by 5 px, matched on one thread: the progress reports come in the same
+// order on every run, so a cancel can be aimed at one of them.
+struct CancelCase {
+  cv::Mat left, right;
+  MatchParams params;
+};
+CancelCase cancelCase() {
+  CancelCase c;
+  c.left = texture({200, 160}, 24);
+  c.right = shiftedRight(c.left, 5.0);
+  c.params.dmin = 0;
+  c.params.dmax = 40;
+  c.params.threads = 1;
+  return c;
+}
+
 TEST(Match, CancelMidRun) {
-  const cv::Mat left = texture({200, 160}, 24);
-  const cv::Mat right = shiftedRight(left, 5.0);
-  MatchParams p;
-  p.dmin = 0;
-  p.dmax = 40;
-  p.threads = 1;
+  const auto [left, right, p] = cancelCase();
   core::Progress progress;
   progress.cancelAfterReports(3);
   const MatchResult r = matchStereo(left, right, p, &progress);
@@ -414,12 +425,7 @@ TEST(Match, CancelMidRun) {
 }
 
 TEST(Match, TheStepsAfterTheLevelsReportProgressAndHonourACancel) {
-  const cv::Mat left = texture({200, 160}, 24);
-  const cv::Mat right = shiftedRight(left, 5.0);
-  MatchParams p;
-  p.dmin = 0;
-  p.dmax = 40;
-  p.threads = 1;
+  const auto [left, right, p] = cancelCase();
   std::vector<double> fractions;
   core::Progress full([&](double fraction, const std::string&) { fractions.push_back(fraction); });
   ASSERT_EQ(matchStereo(left, right, p, &full).status, core::RunStatus::Completed);
