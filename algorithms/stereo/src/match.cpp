@@ -257,7 +257,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   result.levelsUsed = levels;
 
   const int threads = threadCount(p);
-  if (progress != nullptr) progress->setStage("preparing pyramids and edges");
+  core::setStage(progress, "preparing pyramids and edges");
   const GreyMapping g = greyMapping(left, right);
   std::vector<Level> pyramid(static_cast<size_t>(levels));
   // Left and right are independent up to the matching: each side's preparation and pyramid is
@@ -314,10 +314,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   detail::LevelOutput leftOut, rightOut;
   for (int k = levels - 1; k >= 0; --k) {
     const Level& lv = pyramid[static_cast<size_t>(k)];
-    if (progress != nullptr) {
-      progress->setStage("matching level " + std::to_string(levels - k) + "/" +
-                         std::to_string(levels));
-    }
+    // "level 1/4" is the coarsest.
+    const std::string level = "level " + std::to_string(levels - k) + "/" + std::to_string(levels);
+    core::setStage(progress, "matching " + level);
     detail::LevelInput inL, inR;
     inL.ref = lv.left;
     inL.other = lv.right;
@@ -345,10 +344,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       result.status = core::RunStatus::Canceled;
       return result;
     }
-    if (progress != nullptr) {
-      progress->setStage("matching level " + std::to_string(levels - k) + "/" +
-                         std::to_string(levels) + ", right view");
-    }
+    core::setStage(progress, "matching " + level + ", right view");
     if (k == 0) {
       // At the finest level the right map only validates the left one: only the right pixels
       // that a left match points to (the floor/ceil neighbours the validation reads) are
@@ -374,10 +370,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       return result;
     }
     done += w;
-    if (progress != nullptr) {
-      progress->setStage("validating level " + std::to_string(levels - k) + "/" +
-                         std::to_string(levels));
-    }
+    core::setStage(progress, "validating " + level);
     auto unmirror = [&] {
       runTasks({[&] { rightOut.disparity = flipped(mirrored.disparity); },
                 [&] { rightOut.lineShift = flipped(mirrored.lineShift); },
@@ -392,10 +385,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       // given a side and matched again on the window cut at the step (both maps, the right one
       // mirrored like its matching), then both are validated again. Part of the adaptive shapes:
       // off with plain square windows.
-      if (progress != nullptr) {
-        progress->setStage("refining depth steps, level " + std::to_string(levels - k) + "/" +
-                           std::to_string(levels));
-      }
+      core::setStage(progress, "refining depth steps, " + level);
       detail::StepRefineSettings rs;
       rs.window = p.window;
       rs.minScore = p.minScore;
@@ -414,8 +404,10 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       if (k > 0) coarseRight = validate(rightOut, leftOut, -1, p.tolerance, threads);
     }
   }
-  // The steps after the levels are short but polled too: a cancel is honoured between them.
-  const auto canceled = [&] {
+  // The steps after the levels report their share and are polled too: a cancel is honoured
+  // between them.
+  const auto reachedButCanceled = [&](double fraction) {
+    core::report(progress, fraction);
     if (!core::isCanceled(progress)) return false;
     // As when canceled during the levels: no maps.
     result.disparity.release();
@@ -423,14 +415,13 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     result.status = core::RunStatus::Canceled;
     return true;
   };
-  core::report(progress, 0.85);
-  if (canceled()) return result;
+  if (reachedButCanceled(0.85)) return result;
   result.disparity = coarseLeft;
   result.score = leftOut.score.clone();
   result.score.setTo(kNaN, core::nanMask(result.disparity));
   // The fill runs on one worker; the snapping's contrast map (left image only) is prepared on
   // the other meanwhile.
-  if (progress != nullptr) progress->setStage("filling flat regions");
+  core::setStage(progress, "filling flat regions");
   detail::StepContrast contrast;
   std::vector<std::function<void()>> post;
   if (p.fillRegions && p.adaptive) {
@@ -441,30 +432,27 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   if (p.snapSteps && p.adaptive) post.emplace_back([&] { contrast = detail::stepContrast(left, right); });
   runTasks(post, threads);
-  core::report(progress, 0.9);
-  if (canceled()) return result;
+  if (reachedButCanceled(0.9)) return result;
   // Speckles are removed after the fill (before it, the fill lost its seeds: 600² edge 66.1 %
   // against 74.7 % removed last) and before the snapping, whose steps a wrong island inside the
   // gap between a roof and the ground split (sim 400² edge 88.1 → 90.7 %, seed 3 600² 76.1 →
   // 79.5 %); and again last, for the islands the snapping's cuts leave.
   if (p.speckleSize > 0) {
-    if (progress != nullptr) progress->setStage("removing speckles");
+    core::setStage(progress, "removing speckles");
     detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
-    core::report(progress, 0.92);
-    if (canceled()) return result;
+    if (reachedButCanceled(0.92)) return result;
   }
   if (p.snapSteps && p.adaptive) {
     // Last, after the fill: a filled roof's edges are snapped like matched ones.
-    if (progress != nullptr) progress->setStage("snapping depth steps to contours");
+    core::setStage(progress, "snapping depth steps to contours");
     detail::StepSnapSettings snap;
     snap.threads = threads;
     detail::snapStepsToContours(left, right, contrast, snap, static_cast<float>(p.minScore),
                                 result.disparity, result.score);
-    core::report(progress, 0.98);
-    if (canceled()) return result;
+    if (reachedButCanceled(0.98)) return result;
   }
   if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {
-    if (progress != nullptr) progress->setStage("removing speckles left by the snapping");
+    core::setStage(progress, "removing speckles left by the snapping");
     detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
   }
   core::report(progress, 1.0);
@@ -509,7 +497,7 @@ cv::Mat squareScore(const cv::Mat& left, const cv::Mat& right, const cv::Mat& di
 MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
                       core::Progress* progress) {
   MatchResult result;
-  if (progress != nullptr) progress->setStage("matching (SGBM)");
+  core::setStage(progress, "matching (SGBM)");
   core::report(progress, 0.0);
   if (core::isCanceled(progress)) {
     result.status = core::RunStatus::Canceled;

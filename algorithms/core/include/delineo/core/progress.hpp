@@ -71,6 +71,9 @@ inline bool isCanceled(const Progress* p) { return p != nullptr && p->canceled()
 inline void report(Progress* p, double fraction) {
   if (p != nullptr) p->report(fraction);
 }
+inline void setStage(Progress* p, const std::string& stage) {
+  if (p != nullptr) p->setStage(stage);
+}
 
 // Outcome of a long operation that can be canceled. Cancel is not an error.
 enum class RunStatus { Completed, Canceled };
