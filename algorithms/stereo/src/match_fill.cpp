@@ -205,27 +205,30 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       }
       return n > 0 ? sum / n : 1e30;
     };
-    float best = 0;
-    double bestError = 1e30, otherError = 1e30;
+    // The cluster candidates ranked by their error on the current ring.
     const std::vector<int> centres =
         twoLargestClusters(matches, dmin, dmax, settings.minMatched / 2);
-    auto rankCandidates = [&] {
-      best = 0;
-      bestError = otherError = 1e30;
+    struct Ranking {
+      float best = 0;
+      double bestError = 1e30, otherError = 1e30;
+    };
+    const auto rankCandidates = [&] {
+      Ranking k;
       for (const int centre : centres) {
         const float value = clusterMean(matches, static_cast<float>(centre));
         const double e = ringError(value);
-        if (e < bestError) {
-          otherError = bestError;
-          bestError = e;
-          best = value;
+        if (e < k.bestError) {
+          k.otherError = k.bestError;
+          k.bestError = e;
+          k.best = value;
         } else {
-          otherError = std::min(otherError, e);
+          k.otherError = std::min(k.otherError, e);
         }
       }
+      return k;
     };
-    rankCandidates();
-    if (!flatCores.empty() && bestError < 1e29) {
+    Ranking ranked = rankCandidates();
+    if (!flatCores.empty() && ranked.bestError < 1e29) {
       // Thin flat parts joined to the region (a facade's plain bands between its window rows,
       // joined to the roof above) put their own outline, which does not line up at the roof's
       // disparity, into the ring. When the region's core (without them) lines up clearly better,
@@ -235,20 +238,17 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       const int coreArea = cv::countNonZero(core);
       if (coreArea < area && coreArea >= settings.coreMinShare * area) {
         const cv::Mat wholeRing = ring;
-        const float wholeBest = best;
-        const double wholeBestError = bestError, wholeOtherError = otherError;
         ring = outlineRing(core);
-        rankCandidates();
-        if (bestError < settings.coreErrorRatio * wholeBestError) {
+        const Ranking onCore = rankCandidates();
+        if (onCore.bestError < settings.coreErrorRatio * ranked.bestError) {
           region = core;
+          ranked = onCore;
         } else {
           ring = wholeRing;
-          best = wholeBest;
-          bestError = wholeBestError;
-          otherError = wholeOtherError;
         }
       }
     }
+    const auto [best, bestError, otherError] = ranked;
     if (bestError > settings.photometric * sigma) continue;
     if (bestError > settings.contrast * otherError &&
         !(settings.scanAgreement > 0 &&
