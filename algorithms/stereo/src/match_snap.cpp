@@ -191,8 +191,9 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   // two vertical neighbours at disparity d, right view read with linear interpolation.
   const bool checked = !right.empty() && settings.checkSigmas > 0;
   double gain = 1, offset = 0;
-  int dlo = 0, dhi = 0;
+  int dlo = 0;  // the smallest disparity of the map (checked only): carried runs search from it
   if (checked) {
+    int dhi = 0;
     double mn = 0, mx = 0;
     cv::minMaxIdx(disparity, &mn, &mx, nullptr, nullptr, disparity == disparity);
     dlo = static_cast<int>(std::floor(mn));
