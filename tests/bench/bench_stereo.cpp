@@ -261,6 +261,34 @@ Row score(const cv::Mat& disparity, const Case& c, double seconds) {
   return r;
 }
 
+// Where roofRMS's gross errors are: flat-roof pixels off by more than 1 and 5 px, and the share
+// of the squared error they carry (ROOF_GROSS set: each one listed).
+void roofErrorDiagnosis(const cv::Mat& disparity, const Case& c) {
+  long roofN = 0, off1 = 0, off5 = 0;
+  double sq = 0, sq5 = 0;
+  for (int y = 0; y < c.roof.rows; ++y) {
+    for (int x = 0; x < c.roof.cols; ++x) {
+      const float d = disparity.at<float>(y, x);
+      if (!c.roof.at<uchar>(y, x) || !std::isfinite(d)) continue;
+      const double e = std::abs(d - c.truth.at<float>(y, x));
+      ++roofN;
+      sq += e * e;
+      off1 += e > 1 ? 1 : 0;
+      if (e > 5) {
+        ++off5;
+        sq5 += e * e;
+        if (std::getenv("ROOF_GROSS") != nullptr) {
+          std::printf("      gross %d %d pred %.1f true %.1f\n", x, y, d, c.truth.at<float>(y, x));
+        }
+      }
+    }
+  }
+  std::printf(
+      "    flat-roof matches: %ld, off > 1 px %ld, off > 5 px %ld (%.0f %% of the squared "
+      "error)\n",
+      roofN, off1, off5, sq > 0 ? 100.0 * sq5 / sq : 0.0);
+}
+
 // Records when the matcher enters each progress stage, to print where its wall time goes.
 class StageClock : public core::Progress {
  public:
@@ -341,29 +369,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
                 r.seconds);
     if (gOutlineDiagnosis && !c.outline.empty()) {
       outlineDiagnosis(disparity[i], c);
-      // Where roofRMS's gross errors are: flat-roof pixels off by more than 1 and 5 px, and the
-      // share of the squared error they carry.
-      long roofN = 0, off1 = 0, off5 = 0;
-      double sq = 0, sq5 = 0;
-      for (int y = 0; y < c.roof.rows; ++y) {
-        for (int x = 0; x < c.roof.cols; ++x) {
-          const float d = disparity[i].at<float>(y, x);
-          if (!c.roof.at<uchar>(y, x) || !std::isfinite(d)) continue;
-          const double e = std::abs(d - c.truth.at<float>(y, x));
-          ++roofN;
-          sq += e * e;
-          off1 += e > 1 ? 1 : 0;
-          if (e > 5) {
-            ++off5;
-            sq5 += e * e;
-            if (std::getenv("ROOF_GROSS") != nullptr) {
-              std::printf("      gross %d %d pred %.1f true %.1f\n", x, y, d, c.truth.at<float>(y, x));
-            }
-          }
-        }
-      }
-      std::printf("    flat-roof matches: %ld, off > 1 px %ld, off > 5 px %ld (%.0f %% of the squared "
-                  "error)\n", roofN, off1, off5, sq > 0 ? 100.0 * sq5 / sq : 0.0);
+      roofErrorDiagnosis(disparity[i], c);
     }
     if (!dump.empty() && !c.outline.empty()) {
       cv::Mat grey;
