@@ -251,14 +251,6 @@
         <translation>Sauts de profondeur calés sur les contours</translation>
     </message>
     <message>
-        <source>Speckle size</source>
-        <translation>Taille des îlots</translation>
-    </message>
-    <message>
-        <source>Speckle range</source>
-        <translation>Écart des îlots</translation>
-    </message>
-    <message>
         <source>Fill flat regions</source>
         <translation>Remplir les régions uniformes</translation>
     </message>
@@ -293,6 +285,105 @@
     <message>
         <source>Step-cut levels</source>
         <translation>Niveaux de coupe aux sauts</translation>
+    </message>
+    <message>
+        <source>Speckle size</source>
+        <translation>Taille des îlots</translation>
+    </message>
+    <message>
+        <source>Speckle range</source>
+        <translation>Écart des îlots</translation>
+    </message>
+</context>
+<context>
+    <name>Stages</name>
+    <message>
+        <source>preparing pyramids and edges</source>
+        <translation>préparation des pyramides et des contours</translation>
+    </message>
+    <message>
+        <source>matching level %1/%2</source>
+        <translation>appariement du niveau %1/%2</translation>
+    </message>
+    <message>
+        <source>matching level %1/%2, right view</source>
+        <translation>appariement du niveau %1/%2, vue droite</translation>
+    </message>
+    <message>
+        <source>validating level %1/%2</source>
+        <translation>validation du niveau %1/%2</translation>
+    </message>
+    <message>
+        <source>refining depth steps, level %1/%2</source>
+        <translation>affinage des sauts de profondeur, niveau %1/%2</translation>
+    </message>
+    <message>
+        <source>filling flat regions</source>
+        <translation>remplissage des régions uniformes</translation>
+    </message>
+    <message>
+        <source>removing speckles</source>
+        <translation>suppression des îlots</translation>
+    </message>
+    <message>
+        <source>snapping depth steps to contours</source>
+        <translation>calage des sauts de profondeur sur les contours</translation>
+    </message>
+    <message>
+        <source>removing speckles left by the snapping</source>
+        <translation>suppression des îlots laissés par le calage</translation>
+    </message>
+    <message>
+        <source>matching (SGBM)</source>
+        <translation>appariement (SGBM)</translation>
+    </message>
+    <message>
+        <source>simulating: layout</source>
+        <translation>simulation : implantation</translation>
+    </message>
+    <message>
+        <source>simulating: rendering</source>
+        <translation>simulation : rendu</translation>
+    </message>
+    <message>
+        <source>simulating: radiometry</source>
+        <translation>simulation : radiométrie</translation>
+    </message>
+    <message>
+        <source>correlation costs</source>
+        <translation>coûts de corrélation</translation>
+    </message>
+    <message>
+        <source>active polygon</source>
+        <translation>polygone actif</translation>
+    </message>
+    <message>
+        <source>active polygon: moves</source>
+        <translation>polygone actif : déplacements</translation>
+    </message>
+    <message>
+        <source>active polygon: deletions</source>
+        <translation>polygone actif : suppressions</translation>
+    </message>
+    <message>
+        <source>active polygon: insertion</source>
+        <translation>polygone actif : insertion</translation>
+    </message>
+    <message>
+        <source>active polygon: notch</source>
+        <translation>polygone actif : encoche</translation>
+    </message>
+    <message>
+        <source>active polygon: courtyard</source>
+        <translation>polygone actif : cour intérieure</translation>
+    </message>
+    <message>
+        <source>dense matching</source>
+        <translation>appariement dense</translation>
+    </message>
+    <message>
+        <source>delineating building %1</source>
+        <translation>délinéation du bâtiment %1</translation>
     </message>
 </context>
 <context>
@@ -889,6 +980,105 @@
     <message>
         <source>Image edges</source>
         <translation>Contours de l’image</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::widgets::ColourLegend</name>
+    <message>
+        <source>no data</source>
+        <translation>sans donnée</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::widgets::DisparityHistogramWidget</name>
+    <message>
+        <source>Disparity %1</source>
+        <translation>Disparité %1</translation>
+    </message>
+    <message>
+        <source>ground</source>
+        <translation>sol</translation>
+    </message>
+    <message>
+        <source>[%1, %2] px</source>
+        <translation>[%1, %2] px</translation>
+    </message>
+    <message>
+        <source>No disparities in the ROI</source>
+        <translation>Aucune disparité dans la zone d’intérêt</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::widgets::ImageView</name>
+    <message>
+        <source>No image</source>
+        <translation>Aucune image</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::widgets::JobProgressWidget</name>
+    <message>
+        <source>Cancel</source>
+        <translation>Annuler</translation>
+    </message>
+    <message>
+        <source>Cancel the running job</source>
+        <translation>Annuler la tâche en cours</translation>
+    </message>
+    <message>
+        <source>Canceling…</source>
+        <translation>Annulation…</translation>
+    </message>
+    <message>
+        <source>Idle</source>
+        <translation>Inactif</translation>
+    </message>
+    <message>
+        <source>%1: %2</source>
+        <comment>job name: stage</comment>
+        <translation>%1 : %2</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::widgets::PolygonOverlay</name>
+    <message>
+        <source>Move vertex</source>
+        <translation>Déplacer le sommet</translation>
+    </message>
+    <message>
+        <source>Move edge</source>
+        <translation>Déplacer l’arête</translation>
+    </message>
+    <message>
+        <source>Insert vertex</source>
+        <translation>Insérer un sommet</translation>
+    </message>
+    <message>
+        <source>Delete vertex</source>
+        <translation>Supprimer le sommet</translation>
+    </message>
+    <message>
+        <source>Insert vertex here</source>
+        <translation>Insérer un sommet ici</translation>
+    </message>
+</context>
+<context>
+    <name>main</name>
+    <message>
+        <source>Building delineation on stereo pairs</source>
+        <translation>Délinéation de bâtiments sur des couples stéréoscopiques</translation>
+    </message>
+    <message>
+        <source>Project file to open</source>
+        <translation>Fichier de projet à ouvrir</translation>
+    </message>
+    <message>
+        <source>Left (reference) image</source>
+        <translation>Image gauche (de référence)</translation>
+    </message>
+    <message>
+        <source>Right image</source>
+        <translation>Image droite</translation>
     </message>
 </context>
 </TS>

@@ -168,8 +168,9 @@ void StderrProgress::report(double fraction) {
   std::fflush(stderr);
 }
 
-void StderrProgress::setStage(const std::string& stage) {
-  core::Progress::setStage(stage);
+void StderrProgress::setStage(const core::Stage& info) {
+  core::Progress::setStage(info);
+  const std::string stage = info.english();
   if (quiet_ || stage == lastStage_) return;
   if (tty_ && !lastStage_.empty()) std::fprintf(stderr, "\n");
   lastStage_ = stage;

@@ -126,7 +126,8 @@ class StderrProgress : public core::Progress {
  public:
   explicit StderrProgress(bool quiet = false);
   void report(double fraction) override;
-  void setStage(const std::string& stage) override;
+  using core::Progress::setStage;
+  void setStage(const core::Stage& stage) override;
   void finish();
   // Commands with a --quiet flag switch the shared progress off (or on) before running.
   void setQuiet(bool quiet) { quiet_ = quiet; }

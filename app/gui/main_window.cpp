@@ -956,10 +956,7 @@ void MainWindow::startEdgeMap() {
   QPointer<Document> doc(document_.get());
   jobs_->run<cv::Mat>(
       tr("Image edges"),
-      [grey](core::Progress& p) {
-        p.setStage("edges");
-        return project::edgeMap(grey);
-      },
+      [grey](core::Progress&) { return project::edgeMap(grey); },
       [this, doc](cv::Mat edges) {
         if (!doc || doc != document_.get()) return;
         edgeMap_ = edges;
@@ -1261,7 +1258,6 @@ widgets::JobId MainWindow::startMatching() {
   matchingJob_ = jobs_->run<project::MatchingOutcome>(
       tr("Dense matching"),
       [projectCopy, pair](core::Progress& p) {
-        p.setStage("matching");
         return project::computeDisparity(projectCopy, pair.left, pair.right, &p);
       },
       [this, doc](project::MatchingOutcome outcome) {
@@ -1328,7 +1324,6 @@ widgets::JobId MainWindow::startDelineation(int id) {
   const widgets::JobId job = jobs_->run<project::DelineationOutcome>(
       tr("Active polygon, building %1").arg(id),
       [projectCopy, building, pair, onContour](core::Progress& p) {
-        p.setStage("active polygon");
         return project::delineateBuilding(projectCopy, building, pair, &p, onContour);
       },
       [this, doc, id](project::DelineationOutcome outcome) {

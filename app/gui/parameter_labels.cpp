@@ -67,5 +67,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Threads"),
     QT_TRANSLATE_NOOP("Parameters", "Cut windows at depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),
+    QT_TRANSLATE_NOOP("Parameters", "Speckle size"),
+    QT_TRANSLATE_NOOP("Parameters", "Speckle range"),
 };
 }  // namespace

@@ -293,10 +293,11 @@ void roofErrorDiagnosis(const cv::Mat& disparity, const Case& c) {
 class StageClock : public core::Progress {
  public:
   using Clock = std::chrono::steady_clock;
-  void setStage(const std::string& stage) override {
+  using core::Progress::setStage;
+  void setStage(const core::Stage& stage) override {
     core::Progress::setStage(stage);
     const std::lock_guard lock(mutex_);
-    marks_.emplace_back(stage, Clock::now());
+    marks_.emplace_back(stage.english(), Clock::now());
   }
   // Each stage's seconds, from its start to the next stage's start (the last one to `end`).
   void print(const std::string& method, Clock::time_point begin, Clock::time_point end) const {

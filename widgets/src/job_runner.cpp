@@ -1,5 +1,7 @@
 #include "delineo/widgets/job_runner.hpp"
 
+#include "delineo/widgets/stage_text.hpp"
+
 #include <QCoreApplication>
 #include <QElapsedTimer>
 #include <QFutureWatcher>
@@ -128,7 +130,7 @@ void JobRunner::pollProgress() {
   const auto jobs = jobs_.values();
   for (const auto& job : jobs) {
     const double fraction = job->progress.fraction();
-    const QString stage = QString::fromStdString(job->progress.stage());
+    const QString stage = stageText(job->progress.stageInfo());
     if (fraction != job->shownFraction || stage != job->shownStage) {
       job->shownFraction = fraction;
       job->shownStage = stage;
@@ -212,7 +214,8 @@ JobProgressWidget::JobProgressWidget(JobRunner* runner, QWidget* parent)
             if (id != job_) return;
             bar_->setValue(static_cast<int>(fraction * 1000.0 + 0.5));
             const QString name = runner_->jobName(id);
-            stage_->setText(stage.isEmpty() ? name : name + QStringLiteral(": ") + stage);
+            // The separator is translatable: French puts a space before the colon.
+            stage_->setText(stage.isEmpty() ? name : tr("%1: %2", "job name: stage").arg(name, stage));
           });
   connect(runner_, &JobRunner::ended, this, [this](JobId id, JobOutcome) {
     if (id != job_) return;

@@ -15,12 +15,42 @@ void Progress::report(double fraction) {
   if (listener_) listener_(fraction_.load(), stage());
 }
 
-void Progress::setStage(const std::string& stage) {
+std::string Stage::english() const {
+  const std::string level = "level " + std::to_string(number) + "/" + std::to_string(count);
+  switch (id) {
+    case StageId::Text: return text;
+    case StageId::PreparingPyramids: return "preparing pyramids and edges";
+    case StageId::MatchingLevel: return "matching " + level;
+    case StageId::MatchingLevelRightView: return "matching " + level + ", right view";
+    case StageId::ValidatingLevel: return "validating " + level;
+    case StageId::RefiningDepthSteps: return "refining depth steps, " + level;
+    case StageId::FillingFlatRegions: return "filling flat regions";
+    case StageId::RemovingSpeckles: return "removing speckles";
+    case StageId::SnappingDepthSteps: return "snapping depth steps to contours";
+    case StageId::RemovingSnappingSpeckles: return "removing speckles left by the snapping";
+    case StageId::MatchingSgbm: return "matching (SGBM)";
+    case StageId::SimulatingLayout: return "simulate: layout";
+    case StageId::SimulatingRendering: return "simulate: rendering";
+    case StageId::SimulatingRadiometry: return "simulate: radiometry";
+    case StageId::CorrelationCosts: return "correlation costs";
+    case StageId::ActivePolygon: return "active polygon";
+    case StageId::PolygonMoves: return "moves";
+    case StageId::PolygonDeletions: return "deletions";
+    case StageId::PolygonInsertion: return "insertion";
+    case StageId::PolygonNotch: return "notch";
+    case StageId::PolygonCourtyard: return "courtyard";
+    case StageId::DenseMatching: return "matching";
+    case StageId::DelineatingBuilding: return "building " + std::to_string(number);
+  }
+  return text;
+}
+
+void Progress::setStage(const Stage& stage) {
   std::lock_guard lock(stageMutex_);
   stage_ = stage;
 }
 
-std::string Progress::stage() const {
+Stage Progress::stageInfo() const {
   std::lock_guard lock(stageMutex_);
   return stage_;
 }
@@ -33,7 +63,7 @@ void Progress::Range::report(double fraction) {
   if (parent_ != nullptr) parent_->report(begin_ + (end_ - begin_) * std::clamp(fraction, 0.0, 1.0));
 }
 
-void Progress::Range::setStage(const std::string& stage) {
+void Progress::Range::setStage(const Stage& stage) {
   Progress::setStage(stage);
   if (parent_ != nullptr) parent_->setStage(stage);
 }

@@ -68,13 +68,15 @@ class Optimiser {
     if (core::isCanceled(progress_)) throw CanceledSignal{};
   }
   bool budgetLeft() const { return iterations_ < params_.maxIterations; }
-  void endSweep(const char* stage) {
+  void endSweep(core::StageId stage) {
     ++iterations_;
     if (progress_ != nullptr) {
       progress_->setStage(stage);
       progress_->report(std::min(0.99, static_cast<double>(iterations_) / params_.maxIterations));
     }
-    if (observer_) observer_({iterations_, stage, energy_.polygon(), energy_.terms()});
+    if (observer_) {
+      observer_({iterations_, core::Stage::of(stage).english(), energy_.polygon(), energy_.terms()});
+    }
     pollCancel();
   }
 
@@ -209,13 +211,13 @@ class Optimiser {
         // Edge moves cost as much as vertex moves: only when single vertices are stuck.
         if (!moved && params_.edgeMoves) moved = sweepEdgeMoves();
         if (!moved && params_.shortcutVertices >= 2) moved = sweepShortcuts();
-        endSweep("moves");
+        endSweep(core::StageId::PolygonMoves);
         any |= moved;
       }
       bool deleted = true;
       while (deleted && budgetLeft()) {
         deleted = sweepDeletions();
-        endSweep("deletions");
+        endSweep(core::StageId::PolygonDeletions);
         any |= deleted;
       }
       // One pass of moves after deletions decides whether another round is needed.
@@ -224,7 +226,7 @@ class Optimiser {
       if (!budgetLeft()) break;
       any = sweepMoves();
       if (!any && params_.edgeMoves) any = sweepEdgeMoves();
-      endSweep("moves");
+      endSweep(core::StageId::PolygonMoves);
     }
   }
 
@@ -241,7 +243,7 @@ class Optimiser {
     }
     energy_.setPolygon(p);
     refreshReferenceTotal();
-    endSweep("insertion");
+    endSweep(core::StageId::PolygonInsertion);
   }
 
   // Pixels of `inside` where the ground interval matches better than the roof's on average over
@@ -261,7 +263,7 @@ class Optimiser {
 
   // Optimises from `trial` and keeps the result only when its energy is lower than the current
   // polygon's; otherwise the current polygon is restored.
-  void tryFrom(const IntPolygon& trial, const char* stage) {
+  void tryFrom(const IntPolygon& trial, core::StageId stage) {
     const IntPolygon keep = energy_.polygon();
     const double energyBefore = energy_.total();
     energy_.setPolygon(trial);
@@ -331,7 +333,7 @@ class Optimiser {
       IntPolygon trial;
       trial.outer = polygonise(ring, params_.refinedSpacing, energy_.size());
       if (trial.outer.size() < 3 || !isValidPolygon(trial)) continue;
-      tryFrom(trial, "notch");
+      tryFrom(trial, core::StageId::PolygonNotch);
     }
   }
 
@@ -368,7 +370,7 @@ class Optimiser {
       if (hole.size() < 3 || !core::isSimple(toPolygon(IntPolygon{hole, {}}).outer)) continue;
       trial.holes.push_back(hole);
       if (!isValidPolygon(trial)) continue;
-      tryFrom(trial, "courtyard");
+      tryFrom(trial, core::StageId::PolygonCourtyard);
     }
   }
 

@@ -516,7 +516,7 @@ DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
         request.roof, {below, below + 2 * params.groundTolerance}, params.balanceIntervals);
     search = {std::min(r.min, g.min), std::max(r.max, request.roof.max)};
   }
-  core::setStage(progress, "correlation costs");
+  core::setStage(progress, core::StageId::CorrelationCosts);
   core::Progress::Range costProgress(progress, 0.0, 0.3);
   stereo::CostParams costParams;
   costParams.window = params.costWindow;
@@ -533,7 +533,7 @@ DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
   const PreparedEnergy prepared = prepareEnergy(*costs, left, right, request, params);
   result.ground = prepared.ground;
   result.noMatchCost = prepared.images.noMatchCost;
-  core::setStage(progress, "active polygon");
+  core::setStage(progress, core::StageId::ActivePolygon);
   core::Progress::Range optimiseProgress(progress, 0.3, 1.0);
   const cv::Point offset = result.roi.tl();
   IterationObserver forward;

@@ -203,7 +203,7 @@ RunSummary runPendingSteps(Project& project, core::Progress* progress) {
   cv::Mat disparity;
   if (project.disparity.empty()) {
     core::Progress::Range range(progress, 0.0, matchShare);
-    range.setStage("matching");
+    range.setStage(core::StageId::DenseMatching);
     MatchingOutcome matched = computeDisparity(project, pair.left, pair.right, &range);
     if (matched.status == core::RunStatus::Canceled) {
       summary.status = core::RunStatus::Canceled;
@@ -222,7 +222,7 @@ RunSummary runPendingSteps(Project& project, core::Progress* progress) {
     const double begin = matchShare + (1.0 - matchShare) * static_cast<double>(i) / static_cast<double>(pending.size());
     const double end = matchShare + (1.0 - matchShare) * static_cast<double>(i + 1) / static_cast<double>(pending.size());
     core::Progress::Range range(progress, begin, end);
-    range.setStage("building " + std::to_string(pending[i]));
+    range.setStage(core::StageId::DelineatingBuilding, pending[i]);
     Building& b = *project.find(pending[i]);
     if (!b.roofInterval) b.roofInterval = suggestRoofInterval(disparity, b.initial);
     try {

@@ -64,7 +64,7 @@ Scene simulateScene(const SceneParams& params, core::Progress* progress) {
   scene.groundDisparity = params.groundDisparity;
   scene.seed = params.seed;
 
-  core::setStage(progress, "simulate: layout");
+  core::setStage(progress, core::StageId::SimulatingLayout);
   const detail::Layout layout = detail::makeLayout(params);
   scene.buildingsPlaced = static_cast<int>(layout.buildings.size());
   scene.treesPlaced = static_cast<int>(layout.trees.size());
@@ -74,7 +74,7 @@ Scene simulateScene(const SceneParams& params, core::Progress* progress) {
     return scene;
   }
 
-  core::setStage(progress, "simulate: rendering");
+  core::setStage(progress, core::StageId::SimulatingRendering);
   const detail::RowRenderer renderer(params, layout);
   const int w = params.width, h = params.height;
   cv::Mat radianceLeft(h, w, CV_32F), radianceRight(h, w, CV_32F);
@@ -113,7 +113,7 @@ Scene simulateScene(const SceneParams& params, core::Progress* progress) {
 
   // Radiometry: the left view keeps the radiance, the right one gets gain and offset; both get
   // independent Gaussian noise, then 8-bit rounding.
-  core::setStage(progress, "simulate: radiometry");
+  core::setStage(progress, core::StageId::SimulatingRadiometry);
   scene.left.create(h, w, CV_8U);
   scene.right.create(h, w, CV_8U);
   const std::uint64_t noiseSeed = detail::mix64(static_cast<std::uint64_t>(params.seed) ^ 0x6e6f697365ULL);

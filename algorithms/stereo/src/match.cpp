@@ -257,7 +257,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   result.levelsUsed = levels;
 
   const int threads = threadCount(p);
-  core::setStage(progress, "preparing pyramids and edges");
+  core::setStage(progress, core::StageId::PreparingPyramids);
   const GreyMapping g = greyMapping(left, right);
   std::vector<Level> pyramid(static_cast<size_t>(levels));
   // Left and right are independent up to the matching: each side's preparation and pyramid is
@@ -315,8 +315,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   for (int k = levels - 1; k >= 0; --k) {
     const Level& lv = pyramid[static_cast<size_t>(k)];
     // "level 1/4" is the coarsest.
-    const std::string level = "level " + std::to_string(levels - k) + "/" + std::to_string(levels);
-    core::setStage(progress, "matching " + level);
+    const int levelNumber = levels - k;
+    core::setStage(progress, core::StageId::MatchingLevel, levelNumber, levels);
     detail::LevelInput inL, inR;
     inL.ref = lv.left;
     inL.other = lv.right;
@@ -344,7 +344,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       result.status = core::RunStatus::Canceled;
       return result;
     }
-    core::setStage(progress, "matching " + level + ", right view");
+    core::setStage(progress, core::StageId::MatchingLevelRightView, levelNumber, levels);
     if (k == 0) {
       // At the finest level the right map only validates the left one: only the right pixels
       // that a left match points to (the floor/ceil neighbours the validation reads) are
@@ -370,7 +370,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       return result;
     }
     done += w;
-    core::setStage(progress, "validating " + level);
+    core::setStage(progress, core::StageId::ValidatingLevel, levelNumber, levels);
     auto unmirror = [&] {
       runTasks({[&] { rightOut.disparity = flipped(mirrored.disparity); },
                 [&] { rightOut.lineShift = flipped(mirrored.lineShift); },
@@ -385,7 +385,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       // given a side and matched again on the window cut at the step (both maps, the right one
       // mirrored like its matching), then both are validated again. Part of the adaptive shapes:
       // off with plain square windows.
-      core::setStage(progress, "refining depth steps, " + level);
+      core::setStage(progress, core::StageId::RefiningDepthSteps, levelNumber, levels);
       detail::StepRefineSettings rs;
       rs.window = p.window;
       rs.minScore = p.minScore;
@@ -421,7 +421,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   result.score.setTo(kNaN, core::nanMask(result.disparity));
   // The fill runs on one worker; the snapping's contrast map (left image only) is prepared on
   // the other meanwhile.
-  core::setStage(progress, "filling flat regions");
+  core::setStage(progress, core::StageId::FillingFlatRegions);
   detail::StepContrast contrast;
   std::vector<std::function<void()>> post;
   if (p.fillRegions && p.adaptive) {
@@ -438,13 +438,13 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // gap between a roof and the ground split (sim 400² edge 88.1 → 90.7 %, seed 3 600² 76.1 →
   // 79.5 %); and again last, for the islands the snapping's cuts leave.
   if (p.speckleSize > 0) {
-    core::setStage(progress, "removing speckles");
+    core::setStage(progress, core::StageId::RemovingSpeckles);
     detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
     if (reachedButCanceled(0.92)) return result;
   }
   if (p.snapSteps && p.adaptive) {
     // Last, after the fill: a filled roof's edges are snapped like matched ones.
-    core::setStage(progress, "snapping depth steps to contours");
+    core::setStage(progress, core::StageId::SnappingDepthSteps);
     detail::StepSnapSettings snap;
     snap.threads = threads;
     detail::snapStepsToContours(left, right, contrast, snap, static_cast<float>(p.minScore),
@@ -452,7 +452,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     if (reachedButCanceled(0.98)) return result;
   }
   if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {
-    core::setStage(progress, "removing speckles left by the snapping");
+    core::setStage(progress, core::StageId::RemovingSnappingSpeckles);
     detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
   }
   core::report(progress, 1.0);
@@ -497,7 +497,7 @@ cv::Mat squareScore(const cv::Mat& left, const cv::Mat& right, const cv::Mat& di
 MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
                       core::Progress* progress) {
   MatchResult result;
-  core::setStage(progress, "matching (SGBM)");
+  core::setStage(progress, core::StageId::MatchingSgbm);
   core::report(progress, 0.0);
   if (core::isCanceled(progress)) {
     result.status = core::RunStatus::Canceled;

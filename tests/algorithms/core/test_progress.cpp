@@ -1,11 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <set>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include "delineo/core/progress.hpp"
 
 using delineo::core::Progress;
+using delineo::core::Stage;
+using delineo::core::StageId;
 
 TEST(Progress, ReportsAreClampedAndMonotone) {
   Progress p;
@@ -60,6 +64,28 @@ TEST(Progress, ListenerSeesStage) {
   p.report(0.5);
   EXPECT_EQ(seen, "matching");
   EXPECT_DOUBLE_EQ(last, 0.5);
+}
+
+TEST(Progress, AStageIsAnIdentifierWithItsNumbersWordedInEnglishForTheCli) {
+  Progress root;
+  Progress::Range half(&root, 0.0, 0.5);
+  half.setStage(StageId::MatchingLevelRightView, 2, 4);
+  // The range passes the identifier and its numbers on, not only the English text.
+  EXPECT_EQ(root.stageInfo(), Stage::of(StageId::MatchingLevelRightView, 2, 4));
+  EXPECT_EQ(root.stage(), "matching level 2/4, right view");
+  half.setStage(StageId::DelineatingBuilding, 17);
+  EXPECT_EQ(root.stage(), "building 17");
+  root.setStage("reading");
+  EXPECT_EQ(root.stageInfo().id, StageId::Text);
+  EXPECT_EQ(root.stage(), "reading");
+  // Every identifier has its own wording.
+  std::set<std::string> words;
+  for (int id = static_cast<int>(StageId::PreparingPyramids);
+       id <= static_cast<int>(delineo::core::kLastStageId); ++id) {
+    const std::string text = Stage::of(static_cast<StageId>(id), 1, 2).english();
+    EXPECT_FALSE(text.empty()) << id;
+    EXPECT_TRUE(words.insert(text).second) << text;
+  }
 }
 
 TEST(Progress, ConcurrentReportsAndCancel) {

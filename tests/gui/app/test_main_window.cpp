@@ -29,6 +29,7 @@
 #include "delineo/widgets/disparity_histogram.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
+#include "delineo/widgets/stage_text.hpp"
 #include "document.hpp"
 #include "main_window.hpp"
 
@@ -530,6 +531,25 @@ class MainWindowTest : public QObject {
     delineo::stereo::MatchParams matching;
     matching.visit(check);
     QVERIFY2(untranslated.isEmpty(), qPrintable(untranslated.join(QStringLiteral(", "))));
+    // The reusable widgets' strings are in the same translation.
+    QCOMPARE(translator.translate("delineo::widgets::JobProgressWidget", "Idle"), QStringLiteral("Inactif"));
+    QCOMPARE(translator.translate("delineo::widgets::PolygonOverlay", "Move vertex"),
+             QStringLiteral("Déplacer le sommet"));
+    // Every progress stage an algorithm names is worded in French in the status bar.
+    QStringList english;
+    for (int id = static_cast<int>(delineo::core::StageId::PreparingPyramids);
+         id <= static_cast<int>(delineo::core::kLastStageId); ++id) {
+      english << delineo::widgets::stageText(delineo::core::Stage::of(static_cast<delineo::core::StageId>(id), 2, 3));
+    }
+    QCoreApplication::installTranslator(&translator);
+    QStringList stillEnglish;
+    for (int id = static_cast<int>(delineo::core::StageId::PreparingPyramids);
+         id <= static_cast<int>(delineo::core::kLastStageId); ++id) {
+      const QString text = delineo::widgets::stageText(delineo::core::Stage::of(static_cast<delineo::core::StageId>(id), 2, 3));
+      if (english.contains(text)) stillEnglish << text;
+    }
+    QCoreApplication::removeTranslator(&translator);
+    QVERIFY2(stillEnglish.isEmpty(), qPrintable(stillEnglish.join(QStringLiteral(", "))));
   }
 
   void cleanupTestCase() { window_.reset(); }

@@ -1,4 +1,5 @@
 #include <QElapsedTimer>
+#include <QLabel>
 #include <QSignalSpy>
 #include <QThread>
 #include <QToolButton>
@@ -9,6 +10,7 @@
 
 #include "delineo/core/error.hpp"
 #include "delineo/widgets/job_runner.hpp"
+#include "delineo/widgets/stage_text.hpp"
 #include "gui_test_support.hpp"
 
 using delineo::core::Progress;
@@ -128,6 +130,26 @@ TEST(JobRunner, DestructorCancelsAndWaits) {
   }
   EXPECT_TRUE(sawCancel.load());  // the worker returned before the destructor did
   EXPECT_LT(timer.elapsed(), 2000);
+}
+
+TEST(JobRunner, ProgressWidgetWordsTheAlgorithmsStage) {
+  JobRunner runner;
+  JobProgressWidget widget(&runner);
+  const JobId id = runner.run<int>(QStringLiteral("Disparity"), [](Progress& p) {
+    p.setStage(delineo::core::StageId::MatchingLevelRightView, 2, 3);
+    return spin(p, 100000);
+  });
+  QElapsedTimer t;
+  t.start();
+  while (runner.jobFraction(id) <= 0.0 && t.elapsed() < 3000) QCoreApplication::processEvents(QEventLoop::AllEvents, 20);
+  auto* label = widget.findChild<QLabel*>();
+  ASSERT_NE(label, nullptr);
+  // The widget words the identifier itself (through tr(), here without a translator).
+  EXPECT_EQ(label->text(), QStringLiteral("Disparity: matching level 2/3, right view"));
+  EXPECT_EQ(stageText(delineo::core::Stage::of(delineo::core::StageId::DelineatingBuilding, 7)),
+            QStringLiteral("delineating building 7"));
+  runner.cancel(id);
+  ASSERT_TRUE(runner.waitForIdle(5000));
 }
 
 TEST(JobRunner, ProgressWidgetFollowsAndCancels) {

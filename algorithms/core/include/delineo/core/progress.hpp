@@ -13,6 +13,53 @@
 
 namespace delineo::core {
 
+// What a long operation is doing: an identifier and its numbers rather than a sentence, so that
+// each front end words it in its own language (the CLI prints english(), the GUI translates the
+// identifier). Front ends' own stages are free text (StageId::Text), already in their language.
+enum class StageId {
+  Text,
+  // Dense matching (number/count: the pyramid level, 1 = coarsest).
+  PreparingPyramids,
+  MatchingLevel,
+  MatchingLevelRightView,
+  ValidatingLevel,
+  RefiningDepthSteps,
+  FillingFlatRegions,
+  RemovingSpeckles,
+  SnappingDepthSteps,
+  RemovingSnappingSpeckles,
+  MatchingSgbm,
+  // Scene simulation.
+  SimulatingLayout,
+  SimulatingRendering,
+  SimulatingRadiometry,
+  // Delineation (the active polygon's sweeps: moves, deletions, insertion, notch, courtyard).
+  CorrelationCosts,
+  ActivePolygon,
+  PolygonMoves,
+  PolygonDeletions,
+  PolygonInsertion,
+  PolygonNotch,
+  PolygonCourtyard,
+  // Project pipeline (number: the building's id).
+  DenseMatching,
+  DelineatingBuilding,  // keep last (kLastStageId)
+};
+// The last identifier: wordings are checked for every id up to it.
+constexpr StageId kLastStageId = StageId::DelineatingBuilding;
+
+struct Stage {
+  StageId id = StageId::Text;
+  int number = 0;
+  int count = 0;
+  std::string text;  // StageId::Text only
+
+  static Stage of(StageId id, int number = 0, int count = 0) { return {id, number, count, {}}; }
+  // The stage in English (the CLI's wording).
+  std::string english() const;
+  bool operator==(const Stage&) const = default;
+};
+
 class Progress {
  public:
   // Called on the reporting thread with the overall fraction in [0, 1] and the current stage.
@@ -26,8 +73,11 @@ class Progress {
 
   // Reports the overall fraction done; values are clamped to [0, 1] and never go backwards.
   virtual void report(double fraction);
-  virtual void setStage(const std::string& stage);
-  std::string stage() const;
+  virtual void setStage(const Stage& stage);
+  void setStage(const std::string& text) { setStage(Stage{StageId::Text, 0, 0, text}); }
+  void setStage(StageId id, int number = 0, int count = 0) { setStage(Stage::of(id, number, count)); }
+  std::string stage() const { return stageInfo().english(); }
+  Stage stageInfo() const;
   double fraction() const noexcept { return fraction_.load(); }
 
   virtual void cancel() noexcept { canceled_.store(true); }
@@ -48,7 +98,7 @@ class Progress {
   std::atomic<int> reports_{0};
   std::atomic<int> cancelAfter_{-1};
   mutable std::mutex stageMutex_;
-  std::string stage_;
+  Stage stage_;
 };
 
 class Progress::Range : public Progress {
@@ -56,7 +106,8 @@ class Progress::Range : public Progress {
   // `parent` may be null: the range then only tracks its own cancel flag.
   Range(Progress* parent, double begin, double end);
   void report(double fraction) override;
-  void setStage(const std::string& stage) override;
+  using Progress::setStage;
+  void setStage(const Stage& stage) override;
   void cancel() noexcept override;
   bool canceled() const noexcept override;
 
@@ -71,8 +122,8 @@ inline bool isCanceled(const Progress* p) { return p != nullptr && p->canceled()
 inline void report(Progress* p, double fraction) {
   if (p != nullptr) p->report(fraction);
 }
-inline void setStage(Progress* p, const std::string& stage) {
-  if (p != nullptr) p->setStage(stage);
+inline void setStage(Progress* p, StageId id, int number = 0, int count = 0) {
+  if (p != nullptr) p->setStage(id, number, count);
 }
 
 // Outcome of a long operation that can be canceled. Cancel is not an error.
