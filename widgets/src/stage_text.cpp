@@ -1,64 +1,55 @@
 #include "delineo/widgets/stage_text.hpp"
 
 #include <QCoreApplication>
+#include <cstring>
+#include <iterator>
 
 namespace delineo::widgets {
+namespace {
+
+// The source wording of each StageId, in its order (Text has none): %1 is the number, %2 the
+// count. QT_TRANSLATE_NOOP lets lupdate collect them in the "Stages" context.
+constexpr const char* kStageWords[] = {
+    nullptr,
+    QT_TRANSLATE_NOOP("Stages", "preparing pyramids and edges"),
+    QT_TRANSLATE_NOOP("Stages", "matching level %1/%2"),
+    QT_TRANSLATE_NOOP("Stages", "matching level %1/%2, right view"),
+    QT_TRANSLATE_NOOP("Stages", "validating level %1/%2"),
+    QT_TRANSLATE_NOOP("Stages", "refining depth steps, level %1/%2"),
+    QT_TRANSLATE_NOOP("Stages", "filling flat regions"),
+    QT_TRANSLATE_NOOP("Stages", "removing speckles"),
+    QT_TRANSLATE_NOOP("Stages", "snapping depth steps to contours"),
+    QT_TRANSLATE_NOOP("Stages", "removing speckles left by the snapping"),
+    QT_TRANSLATE_NOOP("Stages", "matching (SGBM)"),
+    QT_TRANSLATE_NOOP("Stages", "simulating: layout"),
+    QT_TRANSLATE_NOOP("Stages", "simulating: rendering"),
+    QT_TRANSLATE_NOOP("Stages", "simulating: radiometry"),
+    QT_TRANSLATE_NOOP("Stages", "correlation costs"),
+    QT_TRANSLATE_NOOP("Stages", "active polygon"),
+    QT_TRANSLATE_NOOP("Stages", "active polygon: moves"),
+    QT_TRANSLATE_NOOP("Stages", "active polygon: deletions"),
+    QT_TRANSLATE_NOOP("Stages", "active polygon: insertion"),
+    QT_TRANSLATE_NOOP("Stages", "active polygon: notch"),
+    QT_TRANSLATE_NOOP("Stages", "active polygon: courtyard"),
+    QT_TRANSLATE_NOOP("Stages", "dense matching"),
+    QT_TRANSLATE_NOOP("Stages", "delineating building %1"),
+};
+static_assert(std::size(kStageWords) == static_cast<size_t>(core::kLastStageId) + 1,
+              "one wording per StageId");
+
+}  // namespace
+
 QString stageText(const core::Stage& stage) {
-  using core::StageId;
-  const int n = stage.number, count = stage.count;
-  switch (stage.id) {
-    case StageId::Text:
-      return QString::fromStdString(stage.text);
-    case StageId::PreparingPyramids:
-      return QCoreApplication::translate("Stages", "preparing pyramids and edges");
-    case StageId::MatchingLevel:
-      return QCoreApplication::translate("Stages", "matching level %1/%2").arg(n).arg(count);
-    case StageId::MatchingLevelRightView:
-      return QCoreApplication::translate("Stages", "matching level %1/%2, right view")
-          .arg(n)
-          .arg(count);
-    case StageId::ValidatingLevel:
-      return QCoreApplication::translate("Stages", "validating level %1/%2").arg(n).arg(count);
-    case StageId::RefiningDepthSteps:
-      return QCoreApplication::translate("Stages", "refining depth steps, level %1/%2")
-          .arg(n)
-          .arg(count);
-    case StageId::FillingFlatRegions:
-      return QCoreApplication::translate("Stages", "filling flat regions");
-    case StageId::RemovingSpeckles:
-      return QCoreApplication::translate("Stages", "removing speckles");
-    case StageId::SnappingDepthSteps:
-      return QCoreApplication::translate("Stages", "snapping depth steps to contours");
-    case StageId::RemovingSnappingSpeckles:
-      return QCoreApplication::translate("Stages", "removing speckles left by the snapping");
-    case StageId::MatchingSgbm:
-      return QCoreApplication::translate("Stages", "matching (SGBM)");
-    case StageId::SimulatingLayout:
-      return QCoreApplication::translate("Stages", "simulating: layout");
-    case StageId::SimulatingRendering:
-      return QCoreApplication::translate("Stages", "simulating: rendering");
-    case StageId::SimulatingRadiometry:
-      return QCoreApplication::translate("Stages", "simulating: radiometry");
-    case StageId::CorrelationCosts:
-      return QCoreApplication::translate("Stages", "correlation costs");
-    case StageId::ActivePolygon:
-      return QCoreApplication::translate("Stages", "active polygon");
-    case StageId::PolygonMoves:
-      return QCoreApplication::translate("Stages", "active polygon: moves");
-    case StageId::PolygonDeletions:
-      return QCoreApplication::translate("Stages", "active polygon: deletions");
-    case StageId::PolygonInsertion:
-      return QCoreApplication::translate("Stages", "active polygon: insertion");
-    case StageId::PolygonNotch:
-      return QCoreApplication::translate("Stages", "active polygon: notch");
-    case StageId::PolygonCourtyard:
-      return QCoreApplication::translate("Stages", "active polygon: courtyard");
-    case StageId::DenseMatching:
-      return QCoreApplication::translate("Stages", "dense matching");
-    case StageId::DelineatingBuilding:
-      return QCoreApplication::translate("Stages", "delineating building %1").arg(n);
+  const auto index = static_cast<size_t>(stage.id);
+  if (stage.id == core::StageId::Text || index >= std::size(kStageWords)) {
+    return QString::fromStdString(stage.english());
   }
-  return QString::fromStdString(stage.english());
+  QString text = QCoreApplication::translate("Stages", kStageWords[index]);
+  // The numbers the source wording asks for (a translation keeps the same placeholders).
+  const char* source = kStageWords[index];
+  if (std::strstr(source, "%2") != nullptr) return text.arg(stage.number).arg(stage.count);
+  if (std::strstr(source, "%1") != nullptr) return text.arg(stage.number);
+  return text;
 }
 
 }  // namespace delineo::widgets
