@@ -104,11 +104,17 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
   long outside = 0, inside = 0, missed = 0, located = 0;
   long insideBy[2][2] = {};
   long outsideBy[2] = {}, missedBy[2] = {};  // [ground on −x / on +x]  // [unmatched only / ground value][ground on −x / on +x]
+  // Outline pixels whose ground neighbour the other view does not see (a narrow street or
+  // courtyard hidden by the next roof): [located / not located].
+  long hiddenGround[2] = {};
   for (const Case::OutlinePixel& o : c.outline) {
     const float mid = 0.5F * (o.dRoof + o.dGround);
     const float sign = o.dRoof > o.dGround ? 1.0F : -1.0F;
     const float* row = disparity.ptr<float>(o.y);
     const int x = predictedRoofStart(disparity, o);
+    if (!c.evaluate.empty() && c.evaluate.at<uchar>(o.y, o.xb - o.dir) == 0) {
+      ++hiddenGround[x >= 0 && std::abs((o.xb - x) * o.dir) <= 1 ? 0 : 1];
+    }
     if (x >= 0) {
       const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
       if (std::abs(off) <= 1) ++located;
@@ -169,6 +175,8 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
               insideBy[0][1], insideBy[1][0] + insideBy[1][1], insideBy[1][0], insideBy[1][1]);
   std::printf("    outside: ground -x %ld, +x %ld; missed: ground -x %ld, +x %ld\n", outsideBy[0],
               outsideBy[1], missedBy[0], missedBy[1]);
+  std::printf("    ground beside hidden in the other view: %ld located, %ld not\n",
+              hiddenGround[0], hiddenGround[1]);
 }
 
 double outlineScore(const cv::Mat& disparity, const Case& c) {
