@@ -25,16 +25,17 @@ struct NearSideCut {
   int y = 0, b = 0, s0 = 0, s1 = 0;
   float dNear = 0, dFar = 0;
   int eFirst = 0;
+  int ownLast = 0;  // the last candidate the row may take on its own evidence (later ones: line only)
   std::vector<float> cost;
   int chosen = 0;
   int rowBest = 0;           // argmin of the row's own cost
   int prev = -1, next = -1;  // the same outline's cut in the rows above and below (index)
 };
 
-// The row's own best cut (the first of equal ones).
+// The row's own best cut (the first of equal ones), among the candidates it may take alone.
 int argminCut(const NearSideCut& cut) {
-  return cut.eFirst +
-         static_cast<int>(std::min_element(cut.cost.begin(), cut.cost.end()) - cut.cost.begin());
+  const auto end = cut.cost.begin() + (cut.ownLast - cut.eFirst + 1);
+  return cut.eFirst + static_cast<int>(std::min_element(cut.cost.begin(), end) - cut.cost.begin());
 }
 
 // The outline is a line across rows: each cut is linked to the cut of the same step (near and
@@ -77,10 +78,14 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
   }
   // Each row's costs relative to its own best, capped: a row far off the line costs at most
   // lineCap, whatever its error.
+  // Candidates past the row's own range (over far pixels) cost at least as much as its own
+  // best: a line takes them only where the neighbouring rows put it there.
   for (auto& row : rows) {
     for (NearSideCut& cut : row) {
-      const float best = *std::min_element(cut.cost.begin(), cut.cost.end());
-      for (float& c : cut.cost) c = std::min(static_cast<float>(settings.lineCap), c - best);
+      const float best = cut.cost[static_cast<size_t>(cut.rowBest - cut.eFirst)];
+      for (float& c : cut.cost) {
+        c = std::min(static_cast<float>(settings.lineCap), std::max(0.0F, c - best));
+      }
     }
   }
   const float cap = static_cast<float>(settings.lineCap);
@@ -179,7 +184,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
                         const StepSnapSettings& settings, float fillScore, cv::Mat& disparity,
                         cv::Mat& score) {
   CV_Assert(left.type() == CV_32F && disparity.type() == CV_32F && left.size() == disparity.size());
-  CV_Assert(settings.cutReach >= 0 && settings.cutReach + settings.maxGap + 4 <= kMaxCutSpan);
+  CV_Assert(settings.cutReach >= 0 && settings.cutAhead >= 0 &&
+            settings.cutReach + settings.maxGap + settings.cutAhead + 4 <= kMaxCutSpan);
   const int w = left.cols, h = left.rows;
   if (w < 3 || h < 1) return 0;
   CV_Assert(prepared.contrast.size() == cv::Size(w - 1, h));
@@ -267,7 +273,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     // Far pixels are scored up to b + 2 whatever they hold: every cut then scores the same
     // number of pixels (n − 1), and the first far pixel may still turn out to be near.
-    const int s1 = std::min(w - 1, b + 2);
+    const int s1 = std::min(w - 1, b + 2 + settings.cutAhead);
     const int n = s1 - s0 + 1;
     cut.s0 = s0;
     cut.s1 = s1;
@@ -279,7 +285,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
       farSum[k + 1] = farSum[k] + std::min(settings.errorCap, error(y, s0 + k, cut.dFar));
     }
     cut.eFirst = s0 - 1;
-    const int eLast = std::min(b, s1 - 1);
+    cut.ownLast = std::min(b, s1 - 1);
+    const int eLast = std::min(b + settings.cutAhead, s1 - 1);
     cut.cost.clear();
     for (int e = cut.eFirst; e <= eLast; ++e) {
       const int nearEnd = e - s0 + 1;                 // near pixels: [0, nearEnd)
@@ -295,7 +302,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   const auto applyCut = [&](const NearSideCut& cut, float* out, float* sc) {
     const int e = cut.chosen;
     int changes = 0;
-    for (int x = cut.s0; x <= std::min(cut.b, cut.s1 - 1); ++x) {
+    for (int x = cut.s0; x <= std::max(std::min(cut.b, cut.s1 - 1), e); ++x) {
       const bool nearValued = std::isfinite(out[x]) && std::abs(out[x] - cut.dNear) <= 1.0F;
       if (x <= e && !nearValued) {
         out[x] = cut.dNear;

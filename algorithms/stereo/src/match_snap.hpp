@@ -12,6 +12,7 @@ struct StepSnapSettings {
   double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
   // Checked cut of a roof's +x edge (see below).
   int cutReach = 8;                 // px: how far back over the near side the cut may go
+  int cutAhead = 4;                 // px: how far over the far side a line of cuts may take a row
   int carriedRuns = 3;              // px of a run on each side of a contour it crosses (0 = off)
   double carriedMargin = 1.0;       // noise sigmas: a farther disparity's lead over the run's
   double contourWeight = 2.0;       // error (noise sigmas) traded for one sigma of contour contrast
@@ -41,7 +42,10 @@ struct StepSnapSettings {
 // rightContourCap sigmas). With lineRows > 0 the cut of a row is taken on the line (through
 // rows y ± lineRows of the same step) of least total cost, each row's cost relative to its own
 // best and capped at lineCap: an outline is a line, and the rows whose own evidence is weak
-// follow their neighbours. Pixels up to e take the near disparity (score
+// follow their neighbours. The line may also take a row up to cutAhead pixels over its far
+// side (a roof edge that took the ground's value), at no less than the row's own best cost:
+// never on the row's own evidence (that fattened objects of the real pairs), only where the
+// neighbouring rows put the line. Pixels up to e take the near disparity (score
 // `fillScore`), near pixels after it become unmatched. Unchecked (`right` empty), the near side
 // ends at the strongest contrast within [a − reach, b + reach] when it is at least edgeSigmas
 // sigmas.

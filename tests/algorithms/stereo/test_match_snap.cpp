@@ -327,5 +327,44 @@ TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
   EXPECT_GE(roofEnds(StepSnapSettings{}), (rows - 2) * 9 / 10) << " of " << rows - 2;
 }
 
+// A roof (grey 112, disparity 20, [40, 70)) on textured ground (100 ± 12, disparity 5): a
+// weak contour. In rows 10–14 the ground's value was carried 4 px onto the roof (ground run from
+// x 66); elsewhere the step is at the outline. A row may not take far pixels on its own evidence
+// (that fattened objects in the real pairs), but the line through its neighbours' cuts takes
+// it over them, to the outline.
+TEST(SnapSteps, ARowWhoseEdgeTookTheGroundsValueFollowsTheLineOfItsNeighbours) {
+  const int rows = 30, cols = 170;
+  cv::RNG rng(23);
+  const cv::Mat ground = texturedGround(rows, cols + 40, 30, rng);
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = x >= 40 && x < 70 ? 112.0f : ground.at<float>(y, x + 20);
+      const bool roof = x + 20 >= 40 && x + 20 < 70;
+      right.at<float>(y, x) = roof ? 112.0f : ground.at<float>(y, x + 5 + 20);
+    }
+  }
+  testing::addSensorNoise(left, right, 2.0, rng);
+  cv::Mat matched(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(matched, 40, 70, 20.0f);
+  setRun(matched, 70, cols, 5.0f);
+  matched(cv::Rect(66, 10, 4, 5)).setTo(5.0f);
+  const auto carriedRowsLocated = [&](const StepSnapSettings& settings) {
+    cv::Mat disparity = matched.clone();
+    snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+    int located = 0;
+    for (int y = 10; y < 15; ++y) {
+      int end = 39;  // last pixel at the roof's disparity
+      while (end + 1 < cols && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+      located += std::abs(end - 69) <= 1 ? 1 : 0;
+    }
+    return located;
+  };
+  StepSnapSettings ownRangeOnly;
+  ownRangeOnly.cutAhead = 0;
+  EXPECT_EQ(carriedRowsLocated(ownRangeOnly), 0);
+  EXPECT_EQ(carriedRowsLocated(StepSnapSettings{}), 5);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
