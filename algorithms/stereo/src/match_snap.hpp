@@ -13,7 +13,7 @@ struct StepSnapSettings {
   // Checked cut of a roof's +x edge (see below).
   int cutReach = 8;                 // px: how far back over the near side the cut may go
   int cutAhead = 4;                 // px: how far over the far side a line of cuts may take a row
-  int carriedRuns = 3;              // px of a run on each side of a contour it crosses (0 = off)
+  int carriedRuns = 1;              // px of a run on each side of a contour it crosses (0 = off)
   double carriedMargin = 1.0;       // noise sigmas: a farther disparity's lead over the run's
   double contourWeight = 2.0;       // error (noise sigmas) traded for one sigma of contour contrast
   double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear

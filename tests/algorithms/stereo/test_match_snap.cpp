@@ -286,10 +286,11 @@ TEST(SnapSteps, ExtendsARoofRunEndingInUnmatchedShadowToTheContour) {
 
 // A roof (grey 140, disparity 20, [40, 70)) whose +x side is a textured shadow on the ground
 // (0.6 × its grey, disparity 5, [70, 90)); at the roof's disparity the right view shows the
-// roof's east wall there, plain (grey 100). The roof's value was carried 12 px onto the shadow,
-// followed by an unmatched gap and the ground's run. Noise sigma 1.5. Wide, so that the views'
-// grey-level map (from their column moments) comes from the ground.
-TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
+// roof's east wall there, plain (grey 100). The roof's value was carried `carried` px onto the
+// shadow, followed by an unmatched gap and the ground's run from x 100. Noise sigma 1.5. Wide,
+// so that the views' grey-level map (from their column moments) comes from the ground. Returns
+// the rows (of 28) whose roof ends within 1 px of its outline after the snapping.
+int roofRowsLocatedAfterACarriedRun(int carried, const StepSnapSettings& settings) {
   const int rows = 30;
   cv::RNG rng(17);
   const cv::Mat ground = texturedGround(rows, 400, 60, rng);
@@ -307,24 +308,33 @@ TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
     }
   }
   testing::addSensorNoise(left, right, 1.5, rng);
-  cv::Mat carried(rows, 360, CV_32F, cv::Scalar(kNaN)), score;
-  setRun(carried, 40, 82, 20.0f);
-  setRun(carried, 100, 360, 5.0f);
-  auto roofEnds = [&](const StepSnapSettings& settings) {
-    cv::Mat disparity = carried.clone();
-    snapStepsToContours(left, right, settings, 0.3f, disparity, score);
-    int located = 0;
-    for (int y = 1; y + 1 < rows; ++y) {
-      int end = 39;  // last pixel at the roof's disparity
-      while (end + 1 < 360 && disparity.at<float>(y, end + 1) == 20.0f) ++end;
-      located += std::abs(end - 69) <= 1 ? 1 : 0;
-    }
-    return located;
-  };
+  cv::Mat disparity(rows, 360, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 70 + carried, 20.0f);
+  setRun(disparity, 100, 360, 5.0f);
+  snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+  int located = 0;
+  for (int y = 1; y + 1 < rows; ++y) {
+    int end = 39;  // last pixel at the roof's disparity
+    while (end + 1 < 360 && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+    located += std::abs(end - 69) <= 1 ? 1 : 0;
+  }
+  return located;
+}
+
+TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
   StepSnapSettings off;
   off.carriedRuns = 0;
-  EXPECT_EQ(roofEnds(off), 0);
-  EXPECT_GE(roofEnds(StepSnapSettings{}), (rows - 2) * 9 / 10) << " of " << rows - 2;
+  EXPECT_EQ(roofRowsLocatedAfterACarriedRun(12, off), 0);
+  EXPECT_GE(roofRowsLocatedAfterACarriedRun(12, StepSnapSettings{}), 28 * 9 / 10);
+}
+
+// Carried only 3 px: the contour is split however few run pixels lie past it (requiring 3 on
+// each side, as before session 10, left these runs alone).
+TEST(SnapSteps, ARoofRunCarriedAFewPixelsOverAShadowStopsAtTheContourToo) {
+  StepSnapSettings threeEachSide;
+  threeEachSide.carriedRuns = 3;
+  EXPECT_EQ(roofRowsLocatedAfterACarriedRun(3, threeEachSide), 0);
+  EXPECT_GE(roofRowsLocatedAfterACarriedRun(3, StepSnapSettings{}), 28 * 9 / 10);
 }
 
 // A roof (grey 112, disparity 20, [40, 70)) on textured ground (100 ± 12, disparity 5): a
