@@ -143,14 +143,35 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
 }  // namespace
 
 namespace {
-// |I(x+1) − I(x)| averaged over the row and its two neighbours; nodata as 0. `filled`: no NaN.
+// Pixels on each side of x | x + 1 whose mean grey the contrast compares: a roof's outline is a
+// step between two grey levels, a roof's parapet line or a texture stroke 1–2 px wide is not
+// (with single pixels, a dark line 10 px inside a roof outweighed the outline: 11.7 σ against
+// 5.7 σ on 1000², row 841).
+constexpr int kStepSide = 2;
+
+// |mean I(x+1 .. x+kStepSide) − mean I(x−kStepSide+1 .. x)| averaged over the row and its two
+// neighbours (fewer pixels at the image's ends); nodata as 0. `filled`: no NaN.
 cv::Mat rowContrast(const cv::Mat& filled) {
   const int w = filled.cols, h = filled.rows;
   cv::Mat step(h, w - 1, CV_32F), out;
   for (int y = 0; y < h; ++y) {
     const float* row = filled.ptr<float>(y);
     float* s = step.ptr<float>(y);
-    for (int x = 0; x + 1 < w; ++x) s[x] = std::abs(row[x + 1] - row[x]);
+    for (int x = 0; x + 1 < w; ++x) {
+      float before = 0, after = 0;
+      int nBefore = 0, nAfter = 0;
+      for (int k = 0; k < kStepSide; ++k) {
+        if (x - k >= 0) {
+          before += row[x - k];
+          ++nBefore;
+        }
+        if (x + 1 + k < w) {
+          after += row[x + 1 + k];
+          ++nAfter;
+        }
+      }
+      s[x] = std::abs(after / static_cast<float>(nAfter) - before / static_cast<float>(nBefore));
+    }
   }
   cv::blur(step, out, {1, 3}, {-1, -1}, cv::BORDER_REPLICATE);
   return out;

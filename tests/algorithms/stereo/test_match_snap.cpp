@@ -328,13 +328,13 @@ TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
   EXPECT_GE(roofRowsLocatedAfterACarriedRun(12, StepSnapSettings{}), 28 * 9 / 10);
 }
 
-// Carried only 3 px: the contour is split however few run pixels lie past it (requiring 3 on
+// Carried only 2 px: the contour is split however few run pixels lie past it (requiring 3 on
 // each side, as before session 10, left these runs alone).
 TEST(SnapSteps, ARoofRunCarriedAFewPixelsOverAShadowStopsAtTheContourToo) {
   StepSnapSettings threeEachSide;
   threeEachSide.carriedRuns = 3;
-  EXPECT_EQ(roofRowsLocatedAfterACarriedRun(3, threeEachSide), 0);
-  EXPECT_GE(roofRowsLocatedAfterACarriedRun(3, StepSnapSettings{}), 28 * 9 / 10);
+  EXPECT_EQ(roofRowsLocatedAfterACarriedRun(2, threeEachSide), 0);
+  EXPECT_GE(roofRowsLocatedAfterACarriedRun(2, StepSnapSettings{}), 28 * 9 / 10);
 }
 
 // A roof (grey 112, disparity 20, [40, 70)) on textured ground (100 ± 12, disparity 5): a
