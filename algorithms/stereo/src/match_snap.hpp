@@ -37,7 +37,7 @@ struct StepSnapSettings {
 // noise sigmas, capped at errorCap): near pixels at the near disparity up to e, far ones at the
 // far disparity from e + 2 — pixel e + 1 mixes both surfaces through the image blur and was seen
 // to pull the cut onto the ground —, less contourWeight × the left image's contrast between e and
-// e + 1 (the step between the mean greys of 2 px on each side, over 3 rows, in sigmas), less
+// e + 1 (the step between the mean greys of 2 px on each side, in sigmas), less
 // rightContourWeight × the right view's
 // contrast where the cut falls in it (x − dNear: roof against the wall that view sees; capped at
 // rightContourCap sigmas). With lineRows > 0 the cut of a row is taken on the line (through
@@ -70,11 +70,9 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
                         float fillScore, cv::Mat& disparity, cv::Mat& score);
 
 // What the snapping reads of the images alone, so that it can be prepared while the
-// disparities are still being filled: the contrast between x and x + 1 (mean greys of 2 px on
-// each side) averaged over the row and
-// its two neighbours (a roof outline is a line across rows, a texture speck is not; CV_32F,
-// (w − 1) × h, nodata as 0) of the left image and, when `right` is given, of the right one, and
-// the left image's noise sigma.
+// disparities are still being filled: the contrast between x and x + 1 (the step between the
+// mean greys of 2 px on each side; CV_32F, (w − 1) × h, nodata as 0) of the left image and, when
+// `right` is given, of the right one, and the left image's noise sigma.
 struct StepContrast {
   cv::Mat contrast;
   cv::Mat rightContrast;
