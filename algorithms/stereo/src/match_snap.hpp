@@ -15,7 +15,7 @@ struct StepSnapSettings {
   int cutAhead = 4;                 // px: how far over the far side a line of cuts may take a row
   int carriedRuns = 1;              // px of a run on each side of a contour it crosses (0 = off)
   double carriedMargin = 1.0;       // noise sigmas: a farther disparity's lead over the run's
-  double contourWeight = 2.0;       // error (noise sigmas) traded for one sigma of contour contrast
+  double contourWeight = 1.5;       // error (noise sigmas) traded for one sigma of contour contrast
   double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear
   double rightContourCap = 6.0;     // noise sigmas: most right-view contrast counted
   double errorCap = 6.0;            // noise sigmas: most a single pixel's error counts
