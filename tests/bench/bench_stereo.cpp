@@ -98,6 +98,9 @@ int predictedRoofStart(const cv::Mat& disparity, const Case::OutlinePixel& o) {
   return -1;
 }
 
+// Whether edge% counts outline pixel o as located, from its predicted roof start x.
+bool outlineLocated(const Case::OutlinePixel& o, int x) { return x >= 0 && std::abs(x - o.xb) <= 1; }
+
 // Diagnostic only (not part of the metric): histogram of the predicted roof start relative to
 // the true outline, in px towards the ground (positive: roof fattened), as edge% walks it.
 void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
@@ -113,7 +116,7 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
     const float* row = disparity.ptr<float>(o.y);
     const int x = predictedRoofStart(disparity, o);
     if (!c.evaluate.empty() && c.evaluate.at<uchar>(o.y, o.xb - o.dir) == 0) {
-      ++hiddenGround[x >= 0 && std::abs((o.xb - x) * o.dir) <= 1 ? 0 : 1];
+      ++hiddenGround[outlineLocated(o, x) ? 0 : 1];
     }
     if (x >= 0) {
       const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
@@ -184,7 +187,7 @@ double outlineScore(const cv::Mat& disparity, const Case& c) {
   long located = 0;
   for (const Case::OutlinePixel& o : c.outline) {
     const int x = predictedRoofStart(disparity, o);
-    if (x >= 0 && std::abs(x - o.xb) <= 1) ++located;
+    if (outlineLocated(o, x)) ++located;
   }
   return 100.0 * static_cast<double>(located) / static_cast<double>(c.outline.size());
 }

@@ -77,9 +77,8 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
     }
   }
   // Each row's costs relative to its own best, capped: a row far off the line costs at most
-  // lineCap, whatever its error.
-  // Candidates past the row's own range (over far pixels) cost at least as much as its own
-  // best: a line takes them only where the neighbouring rows put it there.
+  // lineCap, whatever its error. Candidates past the row's own range (over far pixels) cost at
+  // least as much as its own best: a line takes them only where the neighbouring rows put it.
   for (auto& row : rows) {
     for (NearSideCut& cut : row) {
       const float best = cut.cost[static_cast<size_t>(cut.rowBest - cut.eFirst)];
