@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -12,6 +13,13 @@
 namespace delineo::stereo::detail {
 
 namespace {
+
+// The disparity a region is filled with: c + a·x + b·y in image coordinates (a = b = 0 for the
+// constant of the outline's matches).
+struct FillPlane {
+  double c = 0, a = 0, b = 0;
+  double at(int x, int y) const { return c + a * x + b * y; }
+};
 
 // Mean value of the matches within 1.5 px of `centre`.
 float clusterMean(const std::vector<float>& values, float centre) {
@@ -84,8 +92,8 @@ bool scanConfirms(const ErrorAt& errorAt, int dmin, int dmax, float best, double
 // within growPhotometric noise sigmas). The contour's mixed pixel fails the first test, the
 // surface beyond it both: the fill then ends at the image contour.
 void growToContour(const cv::Mat& left, const cv::Mat& right, const cv::Rect& box,
-                   const cv::Mat& region, int shift, double gain, double offset, double sigma,
-                   const RegionFillSettings& settings, cv::Mat& grown) {
+                   const cv::Mat& region, const FillPlane& plane, double gain, double offset,
+                   double sigma, const RegionFillSettings& settings, cv::Mat& grown) {
   cv::Mat leftBox = left(box).clone();
   cv::patchNaNs(leftBox, 0.0);
   cv::Mat regionF, sum, count;
@@ -94,7 +102,7 @@ void growToContour(const cv::Mat& left, const cv::Mat& right, const cv::Rect& bo
   cv::boxFilter(regionF, count, CV_32F, {7, 7}, {-1, -1}, false);
   const auto like = [&](int x, int y) {
     const float a = left.at<float>(box.y + y, box.x + x);
-    const int xr = box.x + x - shift;
+    const int xr = box.x + x - static_cast<int>(std::lround(plane.at(box.x + x, box.y + y)));
     if (!std::isfinite(a) || xr < 0 || xr >= right.cols) return false;
     const float b = right.at<float>(box.y + y, xr);
     const float n = count.at<float>(y, x);
@@ -126,18 +134,189 @@ cv::Mat outlineRing(const cv::Mat& region) {
   return outer & ~inner;
 }
 
+// Half-width of the flat test's window (5x5).
+constexpr int kFlatReach = 2;
+
+// Pixels of `image` whose 5x5 standard deviation is below flatSigmas noise sigmas (CV_8U
+// 0/255); the image's noise sigma in `sigmaOut`.
+cv::Mat flatMask(const cv::Mat& image, const RegionFillSettings& settings,
+                 double* sigmaOut = nullptr) {
+  cv::Mat finite = image.clone();
+  cv::patchNaNs(finite, 0.0);
+  const double sigma = std::max(1e-3, noiseSigma(finite));
+  if (sigmaOut != nullptr) *sigmaOut = sigma;
+  cv::Mat mean, meanSquare;
+  const cv::Size window(2 * kFlatReach + 1, 2 * kFlatReach + 1);
+  cv::blur(finite, mean, window);
+  cv::blur(finite.mul(finite), meanSquare, window);
+  const double flatVariance = settings.flatSigmas * settings.flatSigmas * sigma * sigma;
+  return (meanSquare - mean.mul(mean) < flatVariance) & (image == image);
+}
+
+// The flat regions of the right view, labelled as the left ones, with their mean grey levels.
+struct RightFlatRegions {
+  cv::Mat labels;  // CV_32S, 0 off the flat regions
+  std::vector<double> meanGrey;
+};
+
+RightFlatRegions rightFlatRegions(const cv::Mat& flat, const cv::Mat& right) {
+  RightFlatRegions out;
+  const int count = cv::connectedComponents(flat, out.labels, 4, CV_32S);
+  std::vector<double> sum(static_cast<size_t>(count), 0.0), n(static_cast<size_t>(count), 0.0);
+  for (int y = 0; y < right.rows; ++y) {
+    const int* l = out.labels.ptr<int>(y);
+    const float* g = right.ptr<float>(y);
+    for (int x = 0; x < right.cols; ++x) {
+      sum[static_cast<size_t>(l[x])] += g[x];
+      n[static_cast<size_t>(l[x])] += 1;
+    }
+  }
+  out.meanGrey.resize(static_cast<size_t>(count));
+  for (size_t k = 0; k < sum.size(); ++k) out.meanGrey[k] = n[k] > 0 ? sum[k] / n[k] : 0.0;
+  return out;
+}
+
+// Least-squares plane d = c + a·x + b·y through points (x, y, d), coordinates centred for the
+// conditioning; false when the points do not fix it (all on one row, ...).
+bool fitPlane(const std::vector<cv::Point3d>& points, FillPlane& plane) {
+  if (points.size() < 3) return false;
+  double mx = 0, my = 0;
+  for (const auto& p : points) {
+    mx += p.x;
+    my += p.y;
+  }
+  mx /= static_cast<double>(points.size());
+  my /= static_cast<double>(points.size());
+  cv::Matx33d normal = cv::Matx33d::zeros();
+  cv::Vec3d rhs(0, 0, 0);
+  for (const auto& p : points) {
+    const cv::Vec3d row(1.0, p.x - mx, p.y - my);
+    normal += row * row.t();
+    rhs += row * p.z;
+  }
+  cv::Vec3d coeffs;
+  if (!cv::solve(normal, rhs, coeffs, cv::DECOMP_CHOLESKY)) return false;
+  plane.a = coeffs[1];
+  plane.b = coeffs[2];
+  plane.c = coeffs[0] - plane.a * mx - plane.b * my;
+  return true;
+}
+
+// A flat region whose outline lines up at no constant disparity can be a sloped facet (a gable
+// roof's plain side): its disparity changes along the outline. Its counterpart in the right view is
+// a flat region of the same grey level, and the two flat masks stop the same 2 px inside the
+// facet's first and last pixels (their 5x5 windows reach the contour), so the ends of a row
+// correspond: the left region spans [l0, l1] on row y, its counterpart [r0, r1], and the facet's
+// disparity is l0 − r0 at (l0 − 2, y) and l1 − r1 at (l1 + 2, y). (Measured at l0 and l1 instead,
+// the slope of a 0.15 px/px facet came out 0.165.) A plane through those points, kept when most
+// rows agree with it within a pixel (a facet partly hidden in the right view or merged there with a
+// surface of the same grey gives rows that do not), fills the region. Of the right regions of about
+// the region's grey level in its search band, the one with the most agreeing points is taken.
+bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
+                      double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
+                      const RegionFillSettings& settings, FillPlane& plane) {
+  struct RowEnds {
+    int y, l0, l1;
+  };
+  std::vector<RowEnds> rows;
+  for (int y = 0; y < box.height; ++y) {
+    const uchar* m = region.ptr<uchar>(y);
+    int first = -1, last = -1;
+    for (int x = 0; x < box.width; ++x) {
+      if (!m[x]) continue;
+      if (first < 0) first = x;
+      last = x;
+    }
+    if (first >= 0 && last - first >= 2) rows.push_back({box.y + y, box.x + first, box.x + last});
+  }
+  if (static_cast<int>(rows.size()) < settings.planeMinRows) return false;
+  const int cols = right.labels.cols;
+  // Search band of a row: the right columns its ends can map to.
+  auto band = [&](const RowEnds& r) {
+    return std::pair<int, int>{std::max(0, r.l0 - dmax), std::min(cols - 1, r.l1 - dmin)};
+  };
+  // Right regions of the region's grey level met in the band, by pixel count.
+  std::vector<std::pair<int, int>> candidates;  // (count, label)
+  {
+    std::vector<int> counts;
+    for (const RowEnds& r : rows) {
+      const int* l = right.labels.ptr<int>(r.y);
+      const auto [x0, x1] = band(r);
+      for (int x = x0; x <= x1; ++x) {
+        if (l[x] == 0) continue;
+        if (static_cast<size_t>(l[x]) >= counts.size())
+          counts.resize(static_cast<size_t>(l[x]) + 1, 0);
+        ++counts[static_cast<size_t>(l[x])];
+      }
+    }
+    for (size_t k = 1; k < counts.size(); ++k) {
+      const double mapped = gain * right.meanGrey[k] + offset;
+      if (counts[k] >= settings.planeMinRows &&
+          std::abs(mapped - leftMean) <= settings.planeGreySigmas * sigma) {
+        candidates.emplace_back(counts[k], static_cast<int>(k));
+      }
+    }
+    std::sort(candidates.rbegin(), candidates.rend());
+    if (candidates.size() > 3) candidates.resize(3);
+  }
+  size_t bestInliers = 0;
+  for (const auto& [count, label] : candidates) {
+    std::vector<cv::Point3d> points;
+    for (const RowEnds& r : rows) {
+      const int* l = right.labels.ptr<int>(r.y);
+      const auto [x0, x1] = band(r);
+      int r0 = -1, r1 = -1;
+      for (int x = x0; x <= x1; ++x) {
+        if (l[x] != label) continue;
+        if (r0 < 0) r0 = x;
+        r1 = x;
+      }
+      // Ends cut by the band are not the region's ends.
+      if (r0 <= x0 || r1 >= x1) continue;
+      // The ends' difference is the disparity at the facet's first and last pixels (both masks
+      // stop kFlatReach px inside them; on a slanted facet those inner pixels are not the same
+      // surface points in the two views).
+      points.emplace_back(r.l0 - kFlatReach, r.y, r.l0 - r0);
+      points.emplace_back(r.l1 + kFlatReach, r.y, r.l1 - r1);
+    }
+    // Fit, keep the points within planeInlier px, fit again (twice).
+    FillPlane fitted;
+    std::vector<cv::Point3d> inliers = points;
+    bool ok = fitPlane(inliers, fitted);
+    for (int pass = 0; pass < 2 && ok; ++pass) {
+      std::vector<cv::Point3d> kept;
+      for (const auto& p : points) {
+        const double res = p.z - (fitted.c + fitted.a * p.x + fitted.b * p.y);
+        if (std::abs(res) <= settings.planeInlier) kept.push_back(p);
+      }
+      inliers = std::move(kept);
+      ok = fitPlane(inliers, fitted);
+    }
+    if (!ok || static_cast<double>(inliers.size()) < settings.planeMinShare * points.size() ||
+        static_cast<int>(inliers.size()) < 2 * settings.planeMinRows ||
+        std::abs(fitted.a) > settings.planeMaxSlope ||
+        std::abs(fitted.b) > settings.planeMaxSlope || inliers.size() <= bestInliers) {
+      continue;
+    }
+    // The whole region must lie inside the range (a plane's extremes on a row are its ends).
+    const bool inRange = std::all_of(rows.begin(), rows.end(), [&](const RowEnds& r) {
+      const double d0 = fitted.at(r.l0, r.y), d1 = fitted.at(r.l1, r.y);
+      return std::min(d0, d1) >= dmin && std::max(d0, d1) <= dmax;
+    });
+    if (!inRange) continue;
+    bestInliers = inliers.size();
+    plane = fitted;
+  }
+  return bestInliers > 0;
+}
+
 }  // namespace
 
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score) {
-  cv::Mat leftFinite = left.clone();
-  cv::patchNaNs(leftFinite, 0.0);
-  const double sigma = std::max(1e-3, noiseSigma(leftFinite));
-  cv::Mat mean, meanSquare;
-  cv::blur(leftFinite, mean, {5, 5});
-  cv::blur(leftFinite.mul(leftFinite), meanSquare, {5, 5});
-  const double flatVariance = settings.flatSigmas * settings.flatSigmas * sigma * sigma;
-  const cv::Mat flat = (meanSquare - mean.mul(mean) < flatVariance) & (left == left);
+  double sigma = 0;
+  const cv::Mat flat = flatMask(left, settings, &sigma);
+  RightFlatRegions rightFlat;  // the right view's flat regions, when a sloped facet needs them
   // The regions without their thin parts (see RegionFillSettings::coreOpening).
   cv::Mat flatCores;
   if (settings.coreOpening > 1) {
@@ -182,83 +361,99 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
         if (n[x] && std::isfinite(d[x])) matches.push_back(d[x]);
       }
     }
-    if (static_cast<int>(matches.size()) < settings.minMatched) continue;
-    // Mean |left − mapped right| over the ring at disparity `value`, the right view read with
-    // linear interpolation (the candidates are sub-pixel means).
-    auto ringError = [&](float value) {
-      const int whole = static_cast<int>(std::floor(value));
-      const float t = value - static_cast<float>(whole);
-      double sum = 0, n = 0;
-      for (int y = 0; y < box.height; ++y) {
-        const uchar* m = ring.ptr<uchar>(y);
-        const float* a = left.ptr<float>(box.y + y) + box.x;
-        const float* b = right.ptr<float>(box.y + y);
-        for (int x = 0; x < box.width; ++x) {
-          if (!m[x]) continue;
-          const int xr = box.x + x - whole;                 // x − value lies in [xr − 1, xr]
-          if (xr - 1 < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
-          const float bv = (1 - t) * b[xr] + t * b[xr - 1];
-          if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
-          sum += std::abs(a[x] - (gain * bv + offset));
-          n += 1;
+    // The constant disparity of the outline's matches, when the outline lines up there.
+    const auto constant = [&]() -> std::optional<float> {
+      if (static_cast<int>(matches.size()) < settings.minMatched) return std::nullopt;
+      // Mean |left − mapped right| over the ring at disparity `value`, the right view read with
+      // linear interpolation (the candidates are sub-pixel means).
+      auto ringError = [&](float value) {
+        const int whole = static_cast<int>(std::floor(value));
+        const float t = value - static_cast<float>(whole);
+        double sum = 0, n = 0;
+        for (int y = 0; y < box.height; ++y) {
+          const uchar* m = ring.ptr<uchar>(y);
+          const float* a = left.ptr<float>(box.y + y) + box.x;
+          const float* b = right.ptr<float>(box.y + y);
+          for (int x = 0; x < box.width; ++x) {
+            if (!m[x]) continue;
+            const int xr = box.x + x - whole;                 // x − value lies in [xr − 1, xr]
+            if (xr - 1 < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
+            const float bv = (1 - t) * b[xr] + t * b[xr - 1];
+            if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
+            sum += std::abs(a[x] - (gain * bv + offset));
+            n += 1;
+          }
+        }
+        return n > 0 ? sum / n : 1e30;
+      };
+      // The cluster candidates ranked by their error on the current ring.
+      const std::vector<int> centres =
+          twoLargestClusters(matches, dmin, dmax, settings.minMatched / 2);
+      struct Ranking {
+        float best = 0;
+        double bestError = 1e30, otherError = 1e30;
+      };
+      const auto rankCandidates = [&] {
+        Ranking k;
+        for (const int centre : centres) {
+          const float value = clusterMean(matches, static_cast<float>(centre));
+          const double e = ringError(value);
+          if (e < k.bestError) {
+            k.otherError = k.bestError;
+            k.bestError = e;
+            k.best = value;
+          } else {
+            k.otherError = std::min(k.otherError, e);
+          }
+        }
+        return k;
+      };
+      Ranking ranked = rankCandidates();
+      if (!flatCores.empty() && ranked.bestError < 1e29) {
+        // Thin flat parts joined to the region (a facade's plain bands between its window rows,
+        // joined to the roof above) put their own outline, which does not line up at the roof's
+        // disparity, into the ring. When the region's core (without them) lines up clearly better,
+        // the core is the region.
+        const int area = stats.at<int>(r, cv::CC_STAT_AREA);
+        const cv::Mat core = flatCores(box) & region;
+        const int coreArea = cv::countNonZero(core);
+        if (coreArea < area && coreArea >= settings.coreMinShare * area) {
+          const cv::Mat wholeRing = ring;
+          ring = outlineRing(core);
+          const Ranking onCore = rankCandidates();
+          if (onCore.bestError < settings.coreErrorRatio * ranked.bestError) {
+            region = core;
+            ranked = onCore;
+          } else {
+            ring = wholeRing;
+          }
         }
       }
-      return n > 0 ? sum / n : 1e30;
-    };
-    // The cluster candidates ranked by their error on the current ring.
-    const std::vector<int> centres =
-        twoLargestClusters(matches, dmin, dmax, settings.minMatched / 2);
-    struct Ranking {
-      float best = 0;
-      double bestError = 1e30, otherError = 1e30;
-    };
-    const auto rankCandidates = [&] {
-      Ranking k;
-      for (const int centre : centres) {
-        const float value = clusterMean(matches, static_cast<float>(centre));
-        const double e = ringError(value);
-        if (e < k.bestError) {
-          k.otherError = k.bestError;
-          k.bestError = e;
-          k.best = value;
-        } else {
-          k.otherError = std::min(k.otherError, e);
-        }
+      const auto [best, bestError, otherError] = ranked;
+      if (bestError > settings.photometric * sigma) return std::nullopt;
+      if (bestError > settings.contrast * otherError &&
+          !(settings.scanAgreement > 0 &&
+            scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement,
+                         settings.scanReach))) {
+        return std::nullopt;
       }
-      return k;
-    };
-    Ranking ranked = rankCandidates();
-    if (!flatCores.empty() && ranked.bestError < 1e29) {
-      // Thin flat parts joined to the region (a facade's plain bands between its window rows,
-      // joined to the roof above) put their own outline, which does not line up at the roof's
-      // disparity, into the ring. When the region's core (without them) lines up clearly better,
-      // the core is the region.
-      const int area = stats.at<int>(r, cv::CC_STAT_AREA);
-      const cv::Mat core = flatCores(box) & region;
-      const int coreArea = cv::countNonZero(core);
-      if (coreArea < area && coreArea >= settings.coreMinShare * area) {
-        const cv::Mat wholeRing = ring;
-        ring = outlineRing(core);
-        const Ranking onCore = rankCandidates();
-        if (onCore.bestError < settings.coreErrorRatio * ranked.bestError) {
-          region = core;
-          ranked = onCore;
-        } else {
-          ring = wholeRing;
-        }
+      return best;
+    }();
+    FillPlane plane;
+    if (constant) {
+      plane.c = *constant;
+    } else {
+      if (settings.planeMinRows <= 0) continue;
+      if (rightFlat.labels.empty()) rightFlat = rightFlatRegions(flatMask(right, settings), right);
+      const double leftMean = cv::mean(left(box), region)[0];
+      if (!slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma, dmin, dmax,
+                            settings, plane)) {
+        continue;
       }
     }
-    const auto [best, bestError, otherError] = ranked;
-    if (bestError > settings.photometric * sigma) continue;
-    if (bestError > settings.contrast * otherError &&
-        !(settings.scanAgreement > 0 &&
-          scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement, settings.scanReach))) {
-      continue;
-    }
-    const int shift = static_cast<int>(std::lround(best));
     cv::Mat grown = region.clone();
     if (settings.growReach > 0) {
-      growToContour(left, right, box, region, shift, gain, offset, sigma, settings, grown);
+      growToContour(left, right, box, region, plane, gain, offset, sigma, settings, grown);
     }
     for (int y = 0; y < box.height; ++y) {
       const uchar* m = grown.ptr<uchar>(y);
@@ -268,13 +463,15 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       float* s = score.ptr<float>(box.y + y) + box.x;
       const float* b = right.ptr<float>(box.y + y);
       for (int x = 0; x < box.width; ++x) {
-        const int xr = box.x + x - shift;
-        if (!m[x] || xr < 0 || xr >= right.cols || !std::isfinite(b[xr])) continue;
+        if (!m[x]) continue;
+        const double value = plane.at(box.x + x, box.y + y);
+        const int xr = box.x + x - static_cast<int>(std::lround(value));
+        if (xr < 0 || xr >= right.cols || !std::isfinite(b[xr])) continue;
         if (std::isfinite(d[x])) {
           // A grown pixel matched elsewhere (the far side's disparity carried over the outline
           // by a window that reached across it) is taken when the region's disparity explains
           // its grey level better than its own.
-          if (inRegion[x] || std::abs(d[x] - best) < 2.0F) continue;
+          if (inRegion[x] || std::abs(d[x] - value) < 2.0) continue;
           const int xo = box.x + x - static_cast<int>(std::lround(d[x]));
           if (xo < 0 || xo >= right.cols || !std::isfinite(b[xo])) continue;
           if (!(std::abs(a[x] - (gain * b[xo] + offset)) >
@@ -282,7 +479,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
             continue;
           }
         }
-        d[x] = best;
+        d[x] = static_cast<float>(value);
         s[x] = fillScore;
         ++filled;
       }

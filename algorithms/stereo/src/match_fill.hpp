@@ -20,6 +20,13 @@ struct RegionFillSettings {
   int coreOpening = 5;           // px: square opening that gives a region's core (0 = off)
   double coreMinShare = 0.5;     // the core replaces the region only when this share of it
   double coreErrorRatio = 0.85;  //   and when its ring's error is below this × the region's
+  // Sloped facets (regions whose outline lines up at no constant disparity): a plane through
+  // the row ends of the region and of its counterpart in the right view.
+  int planeMinRows = 10;         // rows (and right pixels) needed; 0 = no sloped facets
+  double planeGreySigmas = 3.0;  // × noise sigma: counterpart's mean grey vs the region's
+  double planeInlier = 1.0;      // px: a row end agrees with the plane within this
+  double planeMinShare = 0.7;    // share of the row ends that must agree
+  double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
 };
 
 // Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is
@@ -34,6 +41,10 @@ struct RegionFillSettings {
 // stops 2 px short: its 5x5 windows straddle it) over pixels that look like it and match at its
 // disparity on their own; its unmatched pixels and the grown ones whose own disparity explains
 // them worse take it, with `fillScore` as score.
+// A region that no constant lines up (a gable roof's plain facet, whose disparity changes along
+// its outline) takes a plane instead: the one through the row ends of the region and of its
+// counterpart in the right view (a right flat region of the same grey), when most rows agree
+// with it within `planeInlier` px (see slopedFacetPlane in match_fill.cpp).
 // A region's core is the region without its parts thinner than `coreOpening` (a morphological
 // opening): the core takes the region's place when it keeps at least `coreMinShare` of it and
 // the best candidate's error on the core's ring is below `coreErrorRatio` × the best one on the

@@ -160,5 +160,79 @@ TEST(FillFlatRegions, ThinFlatPartsJoinedToARoofDoNotDecideItsFill) {
   EXPECT_LE(spilledOntoTheGround(withCore), 3 * 6);
 }
 
+// A plain sloped facet (a gable roof's side: grey 180, noise sigma 2, 70x60 px at (60, 30)) whose
+// disparity rises by 0.15 px per column and falls by 0.05 px per row, 20 px at its top-left
+// corner, on textured ground at disparity 4; the facet's pixels unmatched, the ground matched up
+// to 3 px from it (as a window matcher leaves them).
+struct FacetScene {
+  cv::Mat left, right, disparity, score;
+  cv::Rect facet{60, 30, 70, 60};
+  double truth(int x, int y) const { return 20.0 + 0.15 * (x - facet.x) - 0.05 * (y - facet.y); }
+};
+
+FacetScene slopedFacet() {
+  FacetScene s;
+  const cv::Size size(200, 120);
+  const cv::Mat ground = testing::texture(cv::Size(size.width + 64, size.height), 31) * 0.6 + 20.0;
+  s.left.create(size, CV_32F);
+  s.right.create(size, CV_32F);
+  cv::RNG rng(4);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      s.left.at<float>(y, x) = (s.facet.contains({x, y}) ? 180.0f : ground.at<float>(y, x + 32)) +
+                               static_cast<float>(rng.gaussian(2.0));
+      // The facet point seen at right column xr: xr = x − d(x, y), d linear in x. The facet
+      // spans [facet.x − 0.5, facet.br().x − 0.5) in both views, sampled at pixel centres.
+      const double c = 20.0 - 0.15 * s.facet.x + 0.05 * s.facet.y;
+      const double xf = (x + c - 0.05 * y) / (1.0 - 0.15);
+      const bool seesFacet = y >= s.facet.y && y < s.facet.br().y && xf >= s.facet.x - 0.5 &&
+                             xf < s.facet.br().x - 0.5;
+      s.right.at<float>(y, x) = (seesFacet ? 180.0f : ground.at<float>(y, x + 4 + 32)) +
+                                static_cast<float>(rng.gaussian(2.0));
+    }
+  }
+  s.disparity = cv::Mat(size, CV_32F, cv::Scalar(kGround));
+  const cv::Rect around(s.facet.x - 3, s.facet.y - 3, s.facet.width + 6, s.facet.height + 6);
+  s.disparity(around).setTo(kNaN);
+  s.score = cv::Mat(size, CV_32F, cv::Scalar(0.9));
+  return s;
+}
+
+// Facet pixels whose disparity is within `tolerance` px of the facet's plane.
+int facetPixelsOnItsPlane(const FacetScene& s, double tolerance) {
+  int n = 0;
+  for (int y = s.facet.y; y < s.facet.br().y; ++y) {
+    for (int x = s.facet.x; x < s.facet.br().x; ++x) {
+      n += std::abs(s.disparity.at<float>(y, x) - s.truth(x, y)) <= tolerance ? 1 : 0;
+    }
+  }
+  return n;
+}
+
+TEST(FillFlatRegions, APlainSlopedFacetTakesThePlaneOfItsRowEndsInBothViews) {
+  FacetScene sloped = slopedFacet();
+  fillFlatRegions(sloped.left, sloped.right, RegionFillSettings{}, 0, 40, 0.3f, sloped.disparity,
+                  sloped.score);
+  FacetScene constantOnly = slopedFacet();
+  RegionFillSettings noPlanes;
+  noPlanes.planeMinRows = 0;
+  fillFlatRegions(constantOnly.left, constantOnly.right, noPlanes, 0, 40, 0.3f,
+                  constantOnly.disparity, constantOnly.score);
+  // No constant lines the facet's outline up (its disparity spans 20..27.9 px): unfilled.
+  EXPECT_EQ(facetPixelsOnItsPlane(constantOnly, 0.5), 0);
+  // The plane fills it to its contour, within half a pixel.
+  const int area = sloped.facet.area();
+  EXPECT_GE(facetPixelsOnItsPlane(sloped, 0.5), area * 95 / 100) << " of " << area;
+  // The ground keeps its disparity.
+  int spilled = 0;
+  for (int y = 0; y < sloped.left.rows; ++y) {
+    for (int x = 0; x < sloped.left.cols; ++x) {
+      const float d = sloped.disparity.at<float>(y, x);
+      spilled += !sloped.facet.contains({x, y}) && std::isfinite(d) && d > kGround + 1.0f ? 1 : 0;
+    }
+  }
+  EXPECT_LE(spilled, 2 * (sloped.facet.width + sloped.facet.height) / 10);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
