@@ -141,16 +141,36 @@ constexpr int kFlatReach = 2;
 // 0/255); the image's noise sigma in `sigmaOut`.
 cv::Mat flatMask(const cv::Mat& image, const RegionFillSettings& settings,
                  double* sigmaOut = nullptr) {
-  cv::Mat finite = image.clone();
-  cv::patchNaNs(finite, 0.0);
+  // Nodata as 0, and the squares, in one pass; then the two 5x5 means and the test in another.
+  cv::Mat finite(image.size(), CV_32F), squares(image.size(), CV_32F);
+  for (int y = 0; y < image.rows; ++y) {
+    const float* in = image.ptr<float>(y);
+    float* f = finite.ptr<float>(y);
+    float* q = squares.ptr<float>(y);
+    for (int x = 0; x < image.cols; ++x) {
+      f[x] = std::isfinite(in[x]) ? in[x] : 0.0F;
+      q[x] = f[x] * f[x];
+    }
+  }
   const double sigma = std::max(1e-3, noiseSigma(finite));
   if (sigmaOut != nullptr) *sigmaOut = sigma;
   cv::Mat mean, meanSquare;
   const cv::Size window(2 * kFlatReach + 1, 2 * kFlatReach + 1);
   cv::blur(finite, mean, window);
-  cv::blur(finite.mul(finite), meanSquare, window);
-  const double flatVariance = settings.flatSigmas * settings.flatSigmas * sigma * sigma;
-  return (meanSquare - mean.mul(mean) < flatVariance) & (image == image);
+  cv::blur(squares, meanSquare, window);
+  const auto flatVariance =
+      static_cast<float>(settings.flatSigmas * settings.flatSigmas * sigma * sigma);
+  cv::Mat flat(image.size(), CV_8U);
+  for (int y = 0; y < image.rows; ++y) {
+    const float* in = image.ptr<float>(y);
+    const float* m = mean.ptr<float>(y);
+    const float* mm = meanSquare.ptr<float>(y);
+    uchar* out = flat.ptr<uchar>(y);
+    for (int x = 0; x < image.cols; ++x) {
+      out[x] = mm[x] - m[x] * m[x] < flatVariance && std::isfinite(in[x]) ? 255 : 0;
+    }
+  }
+  return flat;
 }
 
 // The flat regions of the right view, labelled as the left ones, with their mean grey levels.
@@ -214,7 +234,8 @@ bool fitPlane(const std::vector<cv::Point3d>& points, FillPlane& plane) {
 // the region's grey level in its search band, the one with the most agreeing points is taken.
 bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
                       double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
-                      const RegionFillSettings& settings, FillPlane& plane) {
+                      const RegionFillSettings& settings, const std::optional<float>& constant,
+                      FillPlane& plane) {
   struct RowEnds {
     int y, l0, l1;
   };
@@ -260,6 +281,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     if (candidates.size() > 3) candidates.resize(3);
   }
   size_t bestInliers = 0;
+  std::vector<cv::Point3d> bestPoints;
   for (const auto& [count, label] : candidates) {
     std::vector<cv::Point3d> points;
     for (const RowEnds& r : rows) {
@@ -305,9 +327,30 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     });
     if (!inRange) continue;
     bestInliers = inliers.size();
+    bestPoints = std::move(points);
     plane = fitted;
   }
-  return bestInliers > 0;
+  if (bestInliers == 0) return false;
+  // A constant that explains the row ends as well keeps the region (a flat roof's plane has a
+  // slope of noise); one outside the plane's range over the region says the counterpart is
+  // another surface of the same grey.
+  if (constant) {
+    double lowest = 1e30, highest = -1e30;
+    for (const RowEnds& r : rows) {
+      for (const int x : {r.l0, r.l1}) {
+        lowest = std::min(lowest, plane.at(x, r.y));
+        highest = std::max(highest, plane.at(x, r.y));
+      }
+    }
+    if (*constant < lowest - settings.planeInlier || *constant > highest + settings.planeInlier) {
+      return false;
+    }
+    const auto agree = std::count_if(
+        bestPoints.begin(), bestPoints.end(),
+        [&](const cv::Point3d& p) { return std::abs(p.z - *constant) <= settings.planeInlier; });
+    if (static_cast<double>(agree) >= settings.planeMinShare * bestPoints.size()) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -361,31 +404,33 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
         if (n[x] && std::isfinite(d[x])) matches.push_back(d[x]);
       }
     }
+    // Mean |left − mapped right| over the ring at the plane's disparity, the right view read
+    // with linear interpolation (the candidates are sub-pixel).
+    auto planeRingError = [&](const FillPlane& plane) {
+      double sum = 0, n = 0;
+      for (int y = 0; y < box.height; ++y) {
+        const uchar* m = ring.ptr<uchar>(y);
+        const float* a = left.ptr<float>(box.y + y) + box.x;
+        const float* b = right.ptr<float>(box.y + y);
+        for (int x = 0; x < box.width; ++x) {
+          if (!m[x]) continue;
+          const double value = plane.at(box.x + x, box.y + y);
+          const int whole = static_cast<int>(std::floor(value));
+          const float t = static_cast<float>(value - whole);
+          const int xr = box.x + x - whole;                 // x − value lies in [xr − 1, xr]
+          if (xr - 1 < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
+          const float bv = (1 - t) * b[xr] + t * b[xr - 1];
+          if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
+          sum += std::abs(a[x] - (gain * bv + offset));
+          n += 1;
+        }
+      }
+      return n > 0 ? sum / n : 1e30;
+    };
     // The constant disparity of the outline's matches, when the outline lines up there.
     const auto constant = [&]() -> std::optional<float> {
       if (static_cast<int>(matches.size()) < settings.minMatched) return std::nullopt;
-      // Mean |left − mapped right| over the ring at disparity `value`, the right view read with
-      // linear interpolation (the candidates are sub-pixel means).
-      auto ringError = [&](float value) {
-        const int whole = static_cast<int>(std::floor(value));
-        const float t = value - static_cast<float>(whole);
-        double sum = 0, n = 0;
-        for (int y = 0; y < box.height; ++y) {
-          const uchar* m = ring.ptr<uchar>(y);
-          const float* a = left.ptr<float>(box.y + y) + box.x;
-          const float* b = right.ptr<float>(box.y + y);
-          for (int x = 0; x < box.width; ++x) {
-            if (!m[x]) continue;
-            const int xr = box.x + x - whole;                 // x − value lies in [xr − 1, xr]
-            if (xr - 1 < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
-            const float bv = (1 - t) * b[xr] + t * b[xr - 1];
-            if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
-            sum += std::abs(a[x] - (gain * bv + offset));
-            n += 1;
-          }
-        }
-        return n > 0 ? sum / n : 1e30;
-      };
+      auto ringError = [&](float value) { return planeRingError(FillPlane{value, 0, 0}); };
       // The cluster candidates ranked by their error on the current ring.
       const std::vector<int> centres =
           twoLargestClusters(matches, dmin, dmax, settings.minMatched / 2);
@@ -440,16 +485,20 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       return best;
     }();
     FillPlane plane;
-    if (constant) {
-      plane.c = *constant;
-    } else {
-      if (settings.planeMinRows <= 0) continue;
+    if (settings.planeMinRows > 0) {
       if (rightFlat.labels.empty()) rightFlat = rightFlatRegions(flatMask(right, settings), right);
       const double leftMean = cv::mean(left(box), region)[0];
-      if (!slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma, dmin, dmax,
-                            settings, plane)) {
-        continue;
+      const bool sloped = slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma,
+                                           dmin, dmax, settings, constant, plane);
+      // Over a constant the outline lines up at, the plane must line it up better.
+      if (!sloped ||
+          (constant && !(planeRingError(plane) < planeRingError(FillPlane{*constant, 0, 0})))) {
+        if (!constant) continue;
+        plane = FillPlane{*constant, 0, 0};
       }
+    } else {
+      if (!constant) continue;
+      plane.c = *constant;
     }
     cv::Mat grown = region.clone();
     if (settings.growReach > 0) {

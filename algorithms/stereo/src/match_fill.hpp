@@ -44,7 +44,10 @@ struct RegionFillSettings {
 // A region that no constant lines up (a gable roof's plain facet, whose disparity changes along
 // its outline) takes a plane instead: the one through the row ends of the region and of its
 // counterpart in the right view (a right flat region of the same grey), when most rows agree
-// with it within `planeInlier` px (see slopedFacetPlane in match_fill.cpp).
+// with it within `planeInlier` px (see slopedFacetPlane in match_fill.cpp). A region a constant
+// lines up takes that plane too when the constant disagrees with most row ends, lies within the
+// plane's range over the region and lines the outline up less well than the plane (a hip roof's
+// facet, which a constant fills as a step).
 // A region's core is the region without its parts thinner than `coreOpening` (a morphological
 // opening): the core takes the region's place when it keeps at least `coreMinShare` of it and
 // the best candidate's error on the core's ring is below `coreErrorRatio` × the best one on the

@@ -17,20 +17,36 @@ namespace delineo::stereo::detail {
 // brightness term).
 double noiseSigma(const cv::Mat& image) {
   if (image.rows < 9 || image.cols < 9) return 1.0;
-  const cv::Mat kernel = (cv::Mat_<double>(3, 3) << 1, -2, 1, -2, 4, -2, 1, -2, 1);
-  cv::Mat wide, response;
-  image.convertTo(wide, CV_64F);
-  cv::filter2D(wide, response, CV_64F, kernel);
-  const cv::Mat inner = response(cv::Rect(1, 1, image.cols - 2, image.rows - 2));
-  cv::Mat energy;
-  cv::blur(inner.mul(inner), energy, {7, 7});
-  std::vector<double> values;
-  values.reserve(static_cast<size_t>(energy.rows / 7 + 1) *
-                 static_cast<size_t>(energy.cols / 7 + 1));
-  for (int y = 3; y < energy.rows - 3; y += 7) {
-    for (int x = 3; x < energy.cols - 3; x += 7) values.push_back(energy.at<double>(y, x));
+  cv::Mat grey;
+  if (image.depth() == CV_32F) {
+    grey = image;
+  } else {
+    image.convertTo(grey, CV_32F);
   }
-  if (values.empty()) return 1.0;
+  // The response's mean square over the 7x7 blocks of the image without its 1-px border, each
+  // summed directly (one pass; no full-size response and block filter: this runs on every match).
+  const int blocksX = (grey.cols - 9) / 7 + 1, blocksY = (grey.rows - 9) / 7 + 1;
+  std::vector<double> values(static_cast<size_t>(blocksX) * static_cast<size_t>(blocksY), 0.0);
+  for (int j = 0; j < blocksY; ++j) {
+    double* energy = &values[static_cast<size_t>(j) * static_cast<size_t>(blocksX)];
+    for (int y = 7 * j + 1; y <= 7 * j + 7; ++y) {
+      const float* up = grey.ptr<float>(y - 1);
+      const float* mid = grey.ptr<float>(y);
+      const float* down = grey.ptr<float>(y + 1);
+      for (int i = 0; i < blocksX; ++i) {
+        double sum = 0;
+        for (int x = 7 * i + 1; x <= 7 * i + 7; ++x) {
+          const double corners =
+              static_cast<double>(up[x - 1]) + up[x + 1] + down[x - 1] + down[x + 1];
+          const double sides = static_cast<double>(up[x]) + down[x] + mid[x - 1] + mid[x + 1];
+          const double r = corners - 2.0 * sides + 4.0 * static_cast<double>(mid[x]);
+          sum += r * r;
+        }
+        energy[i] += sum;
+      }
+    }
+    for (int i = 0; i < blocksX; ++i) energy[i] /= 49.0;
+  }
   const auto q = values.begin() + static_cast<long>(values.size() / 4);
   std::nth_element(values.begin(), q, values.end());
   return std::sqrt(*q / 36.0);

@@ -160,31 +160,39 @@ TEST(FillFlatRegions, ThinFlatPartsJoinedToARoofDoNotDecideItsFill) {
   EXPECT_LE(spilledOntoTheGround(withCore), 3 * 6);
 }
 
-// A plain sloped facet (a gable roof's side: grey 180, noise sigma 2, 70x60 px at (60, 30)) whose
-// disparity rises by 0.15 px per column and falls by 0.05 px per row, 20 px at its top-left
-// corner, on textured ground at disparity 4; the facet's pixels unmatched, the ground matched up
-// to 3 px from it (as a window matcher leaves them).
+// A plain sloped facet (a roof's side: grey 180, noise sigma 2, 70x60 px at (60, 30)) whose
+// disparity is 20 px at its top-left corner and changes by `perColumn` and `perRow` px per
+// column and row, on textured ground at disparity 4; the facet's pixels unmatched, the ground
+// matched up to 3 px from it (as a window matcher leaves them). `edgeRowsMatched`: the facet's
+// top and bottom 2 rows carry their true disparity (their windows reach the outline).
 struct FacetScene {
   cv::Mat left, right, disparity, score;
   cv::Rect facet{60, 30, 70, 60};
-  double truth(int x, int y) const { return 20.0 + 0.15 * (x - facet.x) - 0.05 * (y - facet.y); }
+  double perColumn = 0, perRow = 0;
+  double truth(int x, int y) const {
+    return 20.0 + perColumn * (x - facet.x) + perRow * (y - facet.y);
+  }
 };
 
-FacetScene slopedFacet() {
+FacetScene slopedFacet(double perColumn = 0.15, double perRow = -0.05,
+                       bool edgeRowsMatched = false) {
   FacetScene s;
+  s.perColumn = perColumn;
+  s.perRow = perRow;
   const cv::Size size(200, 120);
   const cv::Mat ground = testing::texture(cv::Size(size.width + 64, size.height), 31) * 0.6 + 20.0;
   s.left.create(size, CV_32F);
   s.right.create(size, CV_32F);
   cv::RNG rng(4);
+  // d(x, y) = c + perColumn x + perRow y.
+  const double c = 20.0 - perColumn * s.facet.x - perRow * s.facet.y;
   for (int y = 0; y < size.height; ++y) {
     for (int x = 0; x < size.width; ++x) {
       s.left.at<float>(y, x) = (s.facet.contains({x, y}) ? 180.0f : ground.at<float>(y, x + 32)) +
                                static_cast<float>(rng.gaussian(2.0));
-      // The facet point seen at right column xr: xr = x − d(x, y), d linear in x. The facet
-      // spans [facet.x − 0.5, facet.br().x − 0.5) in both views, sampled at pixel centres.
-      const double c = 20.0 - 0.15 * s.facet.x + 0.05 * s.facet.y;
-      const double xf = (x + c - 0.05 * y) / (1.0 - 0.15);
+      // The facet point seen at right column x: x = xf − d(xf, y). The facet spans
+      // [facet.x − 0.5, facet.br().x − 0.5) in both views, sampled at pixel centres.
+      const double xf = (x + c + perRow * y) / (1.0 - perColumn);
       const bool seesFacet = y >= s.facet.y && y < s.facet.br().y && xf >= s.facet.x - 0.5 &&
                              xf < s.facet.br().x - 0.5;
       s.right.at<float>(y, x) = (seesFacet ? 180.0f : ground.at<float>(y, x + 4 + 32)) +
@@ -194,6 +202,15 @@ FacetScene slopedFacet() {
   s.disparity = cv::Mat(size, CV_32F, cv::Scalar(kGround));
   const cv::Rect around(s.facet.x - 3, s.facet.y - 3, s.facet.width + 6, s.facet.height + 6);
   s.disparity(around).setTo(kNaN);
+  if (edgeRowsMatched) {
+    for (const int y0 : {s.facet.y, s.facet.br().y - 2}) {
+      for (int y = y0; y < y0 + 2; ++y) {
+        for (int x = s.facet.x + 2; x < s.facet.br().x - 2; ++x) {
+          s.disparity.at<float>(y, x) = static_cast<float>(s.truth(x, y));
+        }
+      }
+    }
+  }
   s.score = cv::Mat(size, CV_32F, cv::Scalar(0.9));
   return s;
 }
@@ -232,6 +249,44 @@ TEST(FillFlatRegions, APlainSlopedFacetTakesThePlaneOfItsRowEndsInBothViews) {
     }
   }
   EXPECT_LE(spilled, 2 * (sloped.facet.width + sloped.facet.height) / 10);
+}
+
+TEST(FillFlatRegions, AFacetAConstantLinesUpTakesItsPlaneWhenTheRowEndsDisagreeWithTheConstant) {
+  // A facet sloping by 0.03 px per column (2.1 px across it) whose top and bottom rows are
+  // matched: their values cluster, and the constant lines the outline up well enough to fill
+  // it, with one value that misses both sides by up to 1 px. The row ends disagree with it.
+  // (At 0.02 px per column the constant agrees with the row ends within 1 px and stays; at 0.04
+  // no constant lines the outline up, the case of the test above.)
+  FacetScene planar = slopedFacet(0.03, 0.0, true);
+  fillFlatRegions(planar.left, planar.right, RegionFillSettings{}, 0, 40, 0.3f, planar.disparity,
+                  planar.score);
+  FacetScene constant = slopedFacet(0.03, 0.0, true);
+  RegionFillSettings noPlanes;
+  noPlanes.planeMinRows = 0;
+  fillFlatRegions(constant.left, constant.right, noPlanes, 0, 40, 0.3f, constant.disparity,
+                  constant.score);
+  const int area = planar.facet.area();
+  // Without planes the facet is filled, with one value.
+  EXPECT_GE(
+      cv::countNonZero(constant.disparity(constant.facet) ==
+                       constant.disparity.at<float>(constant.facet.y + 30, constant.facet.x + 35)),
+      area * 9 / 10);
+  EXPECT_LT(facetPixelsOnItsPlane(constant, 0.5), area * 6 / 10) << " of " << area;
+  EXPECT_GE(facetPixelsOnItsPlane(planar, 0.5), area * 95 / 100) << " of " << area;
+  // A flat facet keeps its constant (its plane's slope would be noise).
+  FacetScene flat = slopedFacet(0.0, 0.0, true);
+  fillFlatRegions(flat.left, flat.right, RegionFillSettings{}, 0, 40, 0.3f, flat.disparity,
+                  flat.score);
+  int constantPixels = 0;
+  for (int y = flat.facet.y + 2; y < flat.facet.br().y - 2; ++y) {
+    for (int x = flat.facet.x; x < flat.facet.br().x; ++x) {
+      constantPixels += flat.disparity.at<float>(y, x) ==
+                                flat.disparity.at<float>(flat.facet.y + 30, flat.facet.x + 35)
+                            ? 1
+                            : 0;
+    }
+  }
+  EXPECT_GE(constantPixels, (flat.facet.height - 4) * flat.facet.width * 95 / 100);
 }
 
 }  // namespace
