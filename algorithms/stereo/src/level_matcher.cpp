@@ -345,6 +345,8 @@ struct ShapeTemplate {
   alignas(32) int16_t aQ[16 * 16] = {};
   ShapeNccTerms terms;  // n, Σ_S A, ... (quantised)
   std::vector<float> templ, mask;
+  ShapeSpans spans;                // S as spans of its window rows (windows ≤ 15 columns)
+  bool hasSpans = false;           // false: a row has more gaps than the spans hold
   uint32_t rowBits[32] = {};       // S as bits: bit u of row v = window cell (u, v)
   int rowFirst = 0, rowLast = -1;  // window rows holding part of S
   int count = 0;
@@ -380,6 +382,15 @@ class LevelMatcher {
       const double scale = std::floor(kShapeQuantMax / maxAbs * 1e6) / 1e6;  // round(scale·v) ≤ max
       in.ref.convertTo(refQ_, CV_16S, scale);
       in.other.convertTo(otherQ_, CV_16S, scale);
+      if (useSpans_) {
+        // Row prefix sums of B and B² for the main-line span kernel.
+        otherPrefixB_.create(H_, W_ + 1 + kPrefixPad, CV_32S);
+        otherPrefixBB_.create(H_, W_ + 1 + kPrefixPad, CV_32S);
+        for (int y = 0; y < H_; ++y) {
+          rowPrefixSums(otherQ_.ptr<int16_t>(y), W_, otherPrefixB_.ptr<int32_t>(y),
+                        otherPrefixBB_.ptr<int32_t>(y));
+        }
+      }
       flatQ_ = kFlatVariance * scale * scale;
       // Float rows of the wider windows take B² from this image.
       if (s.window > 15) cv::multiply(in.other, in.other, otherSq_);
@@ -422,6 +433,8 @@ class LevelMatcher {
     tasks.emplace_back([&] { out.lineShift = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN)); });
     tasks.emplace_back([&] { out.score = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN)); });
     runTasks(tasks, s.threads);
+    otherQStride_ = static_cast<ptrdiff_t>(otherQ_.step1());
+    if (useSpans_) prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
     for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
   }
 
@@ -702,8 +715,8 @@ class LevelMatcher {
     // When S is the whole window minus its contour pixels (no free pixel left unreached: no
     // part of the window is cut off) and the square window is usable, the square serves the
     // pixel: the few contour pixels change its NCC little, and the square path is much cheaper.
+    alignas(32) uint16_t rows16[16];
     if (w <= 15) {
-      alignas(32) uint16_t rows16[16];
       const bool cut = fillWindow15(&freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)],
                                     windowRows_, r_, rows16);
       if (squareServes && !cut) return false;
@@ -734,6 +747,9 @@ class LevelMatcher {
                    &t.aQ[16 * t.rowFirst], count, sumA, sumAA);
       t.count = count;
       if (t.count < s_.minShape || t.count >= n_) return false;
+#ifdef DELINEO_STEREO_X86
+      t.hasSpans = useSpans_ && shapeSpansAvx2(rows16, t.spans);
+#endif
       const double n = t.count;
       // n² var_S(A), exact (< 2^53).
       const double varN = n * sumAA - static_cast<double>(sumA) * sumA;
@@ -832,9 +848,17 @@ class LevelMatcher {
     }
     const int top = y + t.rowFirst - r_;
     const int rows = t.rowLast - t.rowFirst + 1;
-    shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
-                   kMainLine, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, count,
-                   t.terms, scores);
+#ifdef DELINEO_STEREO_X86
+    if (t.hasSpans) {
+      shapeScoresSpansAvx2Dispatch(
+          otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_,
+          otherPrefixB_.ptr<int32_t>(top) + xb - r_, otherPrefixBB_.ptr<int32_t>(top) + xb - r_,
+          prefixStride_, t.spans, t.rowFirst, &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
+      return true;
+    }
+#endif
+    shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_, kMainLine,
+                   &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
     return true;
   }
 
@@ -862,9 +886,10 @@ class LevelMatcher {
     // As few passes as the batch size allows, of balanced sizes (an interval of 7 with batches
     // of 6: 4 + 3, not 6 + 1).
     float batch[kShapeMaxWindows];
+    const int perPass = t.hasSpans ? kShapeMaxWindows : batchWindows_;
     for (int d = lo; d <= hi;) {
       const int left = hi - d + 1;
-      const int passes = (left + batchWindows_ - 1) / batchWindows_;
+      const int passes = (left + perPass - 1) / perPass;
       const int count = (left + passes - 1) / passes;
       if (shapeScoresBatch(x, y, d, t, batch, count)) {
         for (int k = 0; k < count; ++k) peak.update(d + k, batch[k]);
@@ -993,10 +1018,14 @@ class LevelMatcher {
   LevelOutput& out_;
   const int W_, H_, r_, n_, L_;
   const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
-  const int batchWindows_ = shapeBatchWindows();  // main-line windows per pass over a shape
+  // The main-line span kernel (AVX2, windows ≤ 15 columns): 8 windows a pass.
+  const bool useSpans_ = cpuHasAvx2() && s_.window <= 15;
+  const int batchWindows_ = shapeBatchWindows();  // main-line windows per pass without spans
+  cv::Mat otherPrefixB_, otherPrefixBB_;  // CV_32S, row prefix sums of otherQ_ and its squares
   WindowStats refStats_, otherStats_;
   cv::Mat otherSq_;
   cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
+  ptrdiff_t otherQStride_ = 0, prefixStride_ = 0;  // their row strides, in elements
   double flatQ_ = 0;       // kFlatVariance in quantised units
   float squareLanes_[16] = {};  // 1 for the columns of a square window, 0 past it
   cv::Mat nearEdge_;

@@ -68,6 +68,70 @@ inline int shapeBatchWindows() {
   return 4;
 }
 
+// Main-line windows from the shape's spans. The windows d, d + 1, ... of a pixel lie one column
+// apart on the same rows, so Σ_S B and Σ_S B² of up to 8 of them come from row prefix sums of the
+// other image: a run of cells u0..u1 on row v adds P(v, x + u1 + 1) − P(v, x + u0) to window x,
+// and the 8 windows' differences are two 8-lane loads. Only Σ A·B is summed per window (A is 0
+// off S: no mask), one accumulator each, so AVX2 scores 8 windows a pass instead of 3 (the three
+// accumulators per window filled its 16 registers), with the same integer sums.
+
+// Terms of a shape's Σ B on each window row: + the prefix at `plus` − the prefix at `minus`
+// (columns of the window). Level 0 holds the row's cells from its first to its last; level g > 0
+// its g-th gap between them (a hole of S: most are contour pixels a shape leaves out), negated;
+// rows with fewer gaps hold empty terms (plus = minus) there. `levels` counts the levels any row
+// needs. Built for all 16 rows at once in vector lanes: a loop over each row's runs cost as much
+// as the kernel saved.
+constexpr int kSpanLevels = 4;  // the outer span and up to 3 gaps a row
+struct ShapeSpans {
+  alignas(32) int16_t plus[kSpanLevels][16];
+  alignas(32) int16_t minus[kSpanLevels][16];
+  int levels = 0;
+};
+
+// Portable version of shapeSpansAvx2 (also its reference): false when a row has more gaps.
+inline bool shapeSpansScalar(const uint16_t* rows, ShapeSpans& spans) {
+  spans.levels = 1;
+  for (int v = 0; v < 16; ++v) {
+    const uint32_t cells = rows[v];
+    const int first = __builtin_ctz(cells | (1U << 16));          // 16 for an empty row
+    const int end = cells != 0 ? 32 - __builtin_clz(cells) : 0;  // past the last cell
+    spans.plus[0][v] = static_cast<int16_t>(end);
+    spans.minus[0][v] = static_cast<int16_t>(first < end ? first : end);
+    uint32_t gaps = ~cells & ((1U << end) - 1U) & ~((1U << first) - 1U);
+    for (int g = 1; g < kSpanLevels; ++g) {
+      const int gap = __builtin_ctz(gaps | (1U << 16));  // 16 when none
+      const int length = __builtin_ctz(~(gaps >> gap));  // 0 when none
+      spans.plus[g][v] = static_cast<int16_t>(gap);
+      spans.minus[g][v] = static_cast<int16_t>(gap + length);
+      if (length > 0 && g + 1 > spans.levels) spans.levels = g + 1;
+      gaps &= ~(((1U << length) - 1U) << gap);
+    }
+    if (gaps != 0) return false;
+  }
+  return true;
+}
+
+// Extra entries a prefix row needs past the image's width for the 8-lane loads of the run kernel.
+constexpr int kPrefixPad = 32;
+
+// Row prefix sums of B and B²: p[x] = Σ_{x' < x} b[x'] for x ≤ width, then p[width] repeated
+// over kPrefixPad more entries; the same of b² in pp. Wrapping 32-bit arithmetic (unsigned, then
+// stored as int32): the sums of a row may pass 2^31, a run's difference (≤ 15 · 2184²) does not
+// and comes out exact.
+inline void rowPrefixSums(const int16_t* b, int width, int32_t* p, int32_t* pp) {
+  uint32_t sum = 0, sumSquares = 0;
+  for (int x = 0; x < width; ++x) {
+    p[x] = static_cast<int32_t>(sum);
+    pp[x] = static_cast<int32_t>(sumSquares);
+    sum += static_cast<uint32_t>(static_cast<int32_t>(b[x]));
+    sumSquares += static_cast<uint32_t>(static_cast<int32_t>(b[x]) * b[x]);
+  }
+  for (int x = width; x <= width + kPrefixPad; ++x) {
+    p[x] = static_cast<int32_t>(sum);
+    pp[x] = static_cast<int32_t>(sumSquares);
+  }
+}
+
 #ifdef DELINEO_STEREO_X86
 
 __attribute__((target("avx2"), always_inline)) inline int32_t laneSumAvx2(__m256i v) {
@@ -174,6 +238,138 @@ __attribute__((target("avx2"), always_inline)) inline void nccAvx2(__m128i sB, _
 DELINEO_STEREO_SHAPE_SCORES(shapeScoresIntAvx2, "avx2")
 DELINEO_STEREO_SHAPE_SCORES(shapeScoresIntAvx512, "avx2,avx512vl,avx512bw")
 #undef DELINEO_STEREO_SHAPE_SCORES
+
+// Bits set in each 16-bit lane of v.
+__attribute__((target("avx2"), always_inline)) inline __m256i popcount16Avx2(__m256i v) {
+  const __m256i table = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4, 0, 1, 1, 2,
+                                         1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4);
+  const __m256i nibble = _mm256_set1_epi8(0x0F);
+  const __m256i perByte =
+      _mm256_add_epi8(_mm256_shuffle_epi8(table, _mm256_and_si256(v, nibble)),
+                      _mm256_shuffle_epi8(table, _mm256_and_si256(_mm256_srli_epi16(v, 4), nibble)));
+  return _mm256_maddubs_epi16(perByte, _mm256_set1_epi8(1));
+}
+
+// shapeSpansScalar for the 16 rows at once, one row per 16-bit lane: the lowest cell and the
+// lowest gap cell isolated by x & −x, the cells up to the last one by smearing the bits down, a
+// gap as the run its lowest bit starts (gaps & ~(gaps + lowest)), positions by counting bits.
+__attribute__((target("avx2"))) inline bool shapeSpansAvx2(const uint16_t* rows,
+                                                           ShapeSpans& spans) {
+  const __m256i zero = _mm256_setzero_si256();
+  const __m256i one = _mm256_set1_epi16(1);
+  const __m256i cells = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows));
+  const __m256i lowest = _mm256_and_si256(cells, _mm256_sub_epi16(zero, cells));
+  const __m256i belowFirst = _mm256_sub_epi16(lowest, one);  // all 16 bits for an empty row
+  __m256i upToLast = _mm256_or_si256(cells, _mm256_srli_epi16(cells, 1));
+  upToLast = _mm256_or_si256(upToLast, _mm256_srli_epi16(upToLast, 2));
+  upToLast = _mm256_or_si256(upToLast, _mm256_srli_epi16(upToLast, 4));
+  upToLast = _mm256_or_si256(upToLast, _mm256_srli_epi16(upToLast, 8));
+  const __m256i first = popcount16Avx2(belowFirst);
+  const __m256i end = popcount16Avx2(upToLast);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(spans.plus[0]), end);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(spans.minus[0]), _mm256_min_epi16(first, end));
+  __m256i gaps = _mm256_andnot_si256(cells, _mm256_andnot_si256(belowFirst, upToLast));
+  spans.levels = 1;
+  for (int g = 1; g < kSpanLevels; ++g) {
+    if (_mm256_testz_si256(gaps, gaps) != 0) return true;
+    const __m256i gapLowest = _mm256_and_si256(gaps, _mm256_sub_epi16(zero, gaps));
+    const __m256i gap = _mm256_andnot_si256(_mm256_add_epi16(gaps, gapLowest), gaps);
+    const __m256i start = popcount16Avx2(_mm256_sub_epi16(gapLowest, one));  // 16 when none
+    _mm256_store_si256(reinterpret_cast<__m256i*>(spans.plus[g]), start);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(spans.minus[g]),
+                       _mm256_add_epi16(start, popcount16Avx2(gap)));
+    gaps = _mm256_andnot_si256(gap, gaps);
+    spans.levels = g + 1;
+  }
+  return _mm256_testz_si256(gaps, gaps) != 0;
+}
+
+// acc + the 8 values at p + plus − the 8 at p + minus (32-bit lanes).
+__attribute__((target("avx2"), always_inline)) inline __m256i addSpanAvx2(__m256i acc,
+                                                                         const int32_t* p,
+                                                                         ptrdiff_t plus,
+                                                                         ptrdiff_t minus) {
+  return _mm256_add_epi32(
+      acc, _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + plus)),
+                            _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + minus))));
+}
+
+// acc + the pairwise products of a and the 16 values at x, summed in pairs (32-bit lanes).
+__attribute__((target("avx2"), always_inline)) inline __m256i addDotAvx2(__m256i acc, __m256i a,
+                                                                        const int16_t* x) {
+  return _mm256_add_epi32(
+      acc, _mm256_madd_epi16(a, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(x))));
+}
+
+// NCC of the K (1..8) main-line windows at b, b − 1, ..., b − (K − 1) (window k = disparity d + k)
+// over the shape given by its spans (window rows firstRow ..) and its rows of A (0 off S). `pb` / `pbb`: the prefix rows of
+// B and B² at the column of b (same rows as b), `pStride` entries apart; they must be readable
+// from −(K − 1) to 16 + 8.
+template <int K>
+__attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
+    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb, ptrdiff_t pStride,
+    const ShapeSpans& spans, int firstRow, const int16_t* am, int rows,
+    const ShapeNccTerms& terms, float* scores) {
+  const __m256i zero = _mm256_setzero_si256();
+  __m256i ab0 = zero, ab1 = zero, ab2 = zero, ab3 = zero, ab4 = zero, ab5 = zero, ab6 = zero,
+          ab7 = zero;
+  for (int v = 0; v < rows; ++v) {
+    const int16_t* bv = b + v * stride;
+    const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(am + 16 * v));
+    ab0 = addDotAvx2(ab0, a, bv);
+    if constexpr (K > 1) ab1 = addDotAvx2(ab1, a, bv - 1);
+    if constexpr (K > 2) ab2 = addDotAvx2(ab2, a, bv - 2);
+    if constexpr (K > 3) ab3 = addDotAvx2(ab3, a, bv - 3);
+    if constexpr (K > 4) ab4 = addDotAvx2(ab4, a, bv - 4);
+    if constexpr (K > 5) ab5 = addDotAvx2(ab5, a, bv - 5);
+    if constexpr (K > 6) ab6 = addDotAvx2(ab6, a, bv - 6);
+    if constexpr (K > 7) ab7 = addDotAvx2(ab7, a, bv - 7);
+  }
+  // Lane j of the span sums holds window K − 1 − j.
+  __m256i sb = zero, sbb = zero;
+  for (int g = 0; g < spans.levels; ++g) {
+    const int16_t* plus = spans.plus[g] + firstRow;
+    const int16_t* minus = spans.minus[g] + firstRow;
+    for (int v = 0; v < rows; ++v) {
+      sb = addSpanAvx2(sb, pb + v * pStride - (K - 1), plus[v], minus[v]);
+      sbb = addSpanAvx2(sbb, pbb + v * pStride - (K - 1), plus[v], minus[v]);
+    }
+  }
+  // Window order (lanes past K are not used).
+  const __m256i order = _mm256_setr_epi32(K - 1, K - 2, K - 3, K - 4, K - 5, K - 6, K - 7, K - 8);
+  sb = _mm256_permutevar8x32_epi32(sb, order);
+  sbb = _mm256_permutevar8x32_epi32(sbb, order);
+  nccAvx2(_mm256_castsi256_si128(sb), _mm256_castsi256_si128(sbb),
+          laneSums4Avx2(ab0, ab1, ab2, ab3), terms, K < 4 ? K : 4, scores);
+  if constexpr (K > 4) {
+    nccAvx2(_mm256_extracti128_si256(sb, 1), _mm256_extracti128_si256(sbb, 1),
+            laneSums4Avx2(ab4, ab5, ab6, ab7), terms, K - 4, scores + 4);
+  }
+}
+
+__attribute__((target("avx2"))) inline void shapeScoresSpansAvx2Dispatch(
+    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb, ptrdiff_t pStride,
+    const ShapeSpans& spans, int firstRow, const int16_t* am, int rows, int count,
+    const ShapeNccTerms& terms, float* scores) {
+#define DELINEO_STEREO_SPANS_CASE(K)                                                               \
+  case K:                                                                                         \
+    shapeScoresSpansAvx2<K>(b, stride, pb, pbb, pStride, spans, firstRow, am, rows, terms, scores);  \
+    break;
+  switch (count) {
+    DELINEO_STEREO_SPANS_CASE(1)
+    DELINEO_STEREO_SPANS_CASE(2)
+    DELINEO_STEREO_SPANS_CASE(3)
+    DELINEO_STEREO_SPANS_CASE(4)
+    DELINEO_STEREO_SPANS_CASE(5)
+    DELINEO_STEREO_SPANS_CASE(6)
+    DELINEO_STEREO_SPANS_CASE(7)
+    default:
+      shapeScoresSpansAvx2<8>(b, stride, pb, pbb, pStride, spans, firstRow, am, rows, terms,
+                             scores);
+      break;
+  }
+#undef DELINEO_STEREO_SPANS_CASE
+}
 
 // Dense rows of a shape from its row bits (bit u of row v = cell (u, v)): mask, A on S, and
 // |S|, Σ_S A, Σ_S A².

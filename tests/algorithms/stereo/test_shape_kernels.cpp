@@ -161,4 +161,116 @@ TEST(ShapeKernels, VectorBuildsAgreeWithThePortableReference) {
   EXPECT_GT(flat, 10);  // the flat-window rule was exercised
 }
 
+// A shape row of 15 cells: one run with up to `maxGaps` random gaps (a contour crossing it), or
+// empty.
+uint32_t runWithGaps(std::mt19937& rng, int maxGaps) {
+  std::uniform_int_distribution<int> cell(0, 14);
+  int first = cell(rng), last = cell(rng);
+  if (first > last) std::swap(first, last);
+  uint32_t row = ((1U << (last + 1)) - 1U) & ~((1U << first) - 1U);
+  const int gaps = std::uniform_int_distribution<int>(0, maxGaps)(rng);
+  for (int g = 0; g < gaps; ++g) row &= ~(1U << cell(rng));
+  return std::uniform_int_distribution<int>(0, 9)(rng) == 0 ? 0U : row;
+}
+
+TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) {
+  std::mt19937 rng(777);
+  int shapes = 0, fallbacks = 0, windows = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    uint16_t rows[16] = {};
+    const int rowCount = std::uniform_int_distribution<int>(1, 15)(rng);
+    const int firstRow = std::uniform_int_distribution<int>(0, 15 - rowCount)(rng);
+    for (int v = firstRow; v < firstRow + rowCount; ++v) {
+      rows[v] = static_cast<uint16_t>(runWithGaps(rng, trial % 3 == 0 ? 8 : 3));
+    }
+    if (trial % 10 == 0) rows[firstRow] = 0x5555;  // every other cell: 7 gaps, more than held
+    // The portable spans: each row's cells are level 0 minus the gap levels.
+    ShapeSpans spans;
+    const bool fits = shapeSpansScalar(rows, spans);
+    for (int v = 0; v < 16 && fits; ++v) {
+      uint32_t covered = 0;
+      for (int g = 0; g < spans.levels; ++g) {
+        const uint32_t span = ((1U << spans.plus[g][v]) - 1U) ^ ((1U << spans.minus[g][v]) - 1U);
+        covered = g == 0 ? span : covered & ~span;
+      }
+      ASSERT_EQ(covered, rows[v]) << "trial " << trial << " row " << v;
+    }
+    fallbacks += fits ? 0 : 1;
+#ifdef DELINEO_STEREO_X86
+    if (!cpuHasAvx2()) continue;
+    ShapeSpans vectorSpans;
+    ASSERT_EQ(shapeSpansAvx2(rows, vectorSpans), fits) << "trial " << trial;
+    if (!fits) continue;
+    ASSERT_EQ(vectorSpans.levels, spans.levels) << "trial " << trial;
+    for (int g = 0; g < spans.levels; ++g) {
+      for (int v = 0; v < 16; ++v) {
+        ASSERT_EQ(vectorSpans.plus[g][v] - vectorSpans.minus[g][v],
+                  spans.plus[g][v] - spans.minus[g][v]);
+        if (spans.plus[g][v] != spans.minus[g][v]) {
+          ASSERT_EQ(vectorSpans.plus[g][v], spans.plus[g][v]);
+        }
+      }
+    }
+    // The span kernel against the reference sums, on the shape's rows of a random image, for
+    // 1..8 main-line windows (window k one column left of window k − 1).
+    const std::vector<int16_t> a = randomImage(rng, false);
+    const std::vector<int16_t> b = randomImage(rng, trial % 5 == 0);
+    RandomShape shape;
+    shape.rows = rowCount;
+    shape.mask.assign(16 * rowCount, 0);
+    shape.am.assign(16 * rowCount, 0);
+    int64_t n = 0, sumA = 0, sumAA = 0;
+    for (int v = 0; v < rowCount; ++v) {
+      for (int u = 0; u < 16; ++u) {
+        if (((rows[firstRow + v] >> u) & 1U) == 0) continue;
+        const int16_t x = a[v * kStride + u];
+        shape.mask[16 * v + u] = -1;
+        shape.am[16 * v + u] = x;
+        ++n;
+        sumA += x;
+        sumAA += static_cast<int64_t>(x) * x;
+      }
+    }
+    const double varN = static_cast<double>(n * sumAA - sumA * sumA);
+    if (n < 2 || varN <= 0) continue;
+    shape.terms.n = static_cast<int>(n);
+    shape.terms.sumA = static_cast<int32_t>(sumA);
+    shape.terms.invNormA = static_cast<float>(1.0 / std::sqrt(varN));
+    shape.terms.flatN = static_cast<float>(4.0 * n * n);
+    std::vector<int32_t> prefixB(kImageRows * (kStride + 1 + kPrefixPad));
+    std::vector<int32_t> prefixBB(prefixB.size());
+    const int prefixStride = kStride + 1 + kPrefixPad;
+    for (int y = 0; y < kImageRows; ++y) {
+      rowPrefixSums(&b[y * kStride], kStride, &prefixB[y * prefixStride],
+                    &prefixBB[y * prefixStride]);
+    }
+    const int count = std::uniform_int_distribution<int>(1, kShapeMaxWindows)(rng);
+    const int x0 = std::uniform_int_distribution<int>(count - 1, kStride - 16)(rng);
+    float expected[kShapeMaxWindows], got[kShapeMaxWindows];
+    for (int k = 0; k < count; ++k) {
+      const ptrdiff_t offset = x0 - k;
+      ShapeSumsInt sums;
+      shapeSumsIntScalar<1>(b.data(), kStride, &offset, shape.mask.data(), shape.am.data(),
+                            rowCount, &sums);
+      nccFromIntSums(&sums, 1, shape.terms, expected + k);
+    }
+    shapeScoresSpansAvx2Dispatch(b.data() + x0, kStride, prefixB.data() + x0, prefixBB.data() + x0,
+                                 prefixStride, vectorSpans, firstRow, shape.am.data(), rowCount,
+                                 count, shape.terms, got);
+    for (int k = 0; k < count; ++k) {
+      ASSERT_TRUE(sameFloat(expected[k], got[k])) << "trial " << trial << " window " << k;
+    }
+    windows += count;
+#endif
+    ++shapes;
+  }
+  EXPECT_GT(shapes, 300);
+  EXPECT_GE(fallbacks, 60);  // rows with more gaps than the levels hold were met
+#ifdef DELINEO_STEREO_X86
+  if (cpuHasAvx2()) {
+    EXPECT_GT(windows, 1000);
+  }
+#endif
+}
+
 }  // namespace
