@@ -115,25 +115,34 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
   cv::Mat out(map.disparity.size(), CV_32F);
   const int W = out.cols, H = out.rows;
   const double tolerance2 = tolerance * tolerance;  // compared with ex² + ey² (hypot's cost)
-  forRowBands(H, threads, [&](int rowStart, int rowEnd) {
+  // The other map's rows by plain arithmetic (the per-pixel Mat calls kept the loop's values on
+  // the stack).
+  const auto* otherD = other.disparity.ptr<float>(0);
+  const auto* otherS = other.lineShift.ptr<float>(0);
+  const size_t otherStep = other.disparity.step1(), shiftStep = other.lineShift.step1();
+  forRowBands(H, threads, [&, W, H, sign, tolerance2, otherD, otherS, otherStep,
+                           shiftStep](int rowStart, int rowEnd) {
     for (int y = rowStart; y < rowEnd; ++y) {
       float* d = out.ptr<float>(y);
       std::copy_n(map.disparity.ptr<float>(y), W, d);
       const float* dy = map.lineShift.ptr<float>(y);
       for (int x = 0; x < W; ++x) {
-        if (!std::isfinite(d[x])) continue;
-        const double xo = x - sign * d[x];
+        const float dx = d[x];
+        if (!std::isfinite(dx)) continue;
+        const double xo = x - sign * dx;
         const double yo = y + dy[x];
         const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
+        const int qx0 = std::max(0, fx), qx1 = std::min(W - 1, fx + 1);
+        const int qy0 = std::max(0, fy), qy1 = std::min(H - 1, fy + 1);
+        // All four neighbours, no early exit (a NaN neighbour fails the test by itself).
         bool consistent = false;
-        for (int qy = std::max(0, fy); qy <= std::min(H - 1, fy + 1) && !consistent; ++qy) {
-          const float* dq = other.disparity.ptr<float>(qy);
-          const float* sq = other.lineShift.ptr<float>(qy);
-          for (int qx = std::max(0, fx); qx <= std::min(W - 1, fx + 1) && !consistent; ++qx) {
-            if (!std::isfinite(dq[qx])) continue;
-            const double ex = d[x] - dq[qx];
+        for (int qy = qy0; qy <= qy1; ++qy) {
+          const float* dq = otherD + static_cast<size_t>(qy) * otherStep;
+          const float* sq = otherS + static_cast<size_t>(qy) * shiftStep;
+          for (int qx = qx0; qx <= qx1; ++qx) {
+            const double ex = dx - dq[qx];
             const double ey = dy[x] + sq[qx];
-            consistent = ex * ex + ey * ey <= tolerance2;
+            consistent |= ex * ex + ey * ey <= tolerance2;
           }
         }
         if (!consistent) d[x] = kNaN;
