@@ -889,8 +889,9 @@ class LevelMatcher {
     const int perPass = t.hasSpans ? kShapeMaxWindows : batchWindows_;
     for (int d = lo; d <= hi;) {
       const int left = hi - d + 1;
-      const int passes = (left + perPass - 1) / perPass;
-      const int count = (left + passes - 1) / passes;
+      // (Most intervals take one pass: no integer divisions for them.)
+      const int passes = left <= perPass ? 1 : (left + perPass - 1) / perPass;
+      const int count = passes == 1 ? left : (left + passes - 1) / passes;
       if (shapeScoresBatch(x, y, d, t, batch, count)) {
         for (int k = 0; k < count; ++k) peak.update(d + k, batch[k]);
       } else {
