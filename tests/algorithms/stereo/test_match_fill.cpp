@@ -69,24 +69,37 @@ int spilledOntoTheGround(const Scene& s) {
   return spilled;
 }
 
-int roofPixelsWithTheRoofsDisparity(const Scene& s) {
+// The fill on a test scene (range 0..dmax, fill score 0.3).
+template <class SceneT>
+void fill(SceneT& s, const RegionFillSettings& settings, int dmax) {
+  fillFlatRegions(s.left, s.right, settings, 0, dmax, 0.3f, s.disparity, s.score);
+}
+
+// Pixels of `area` whose disparity is within `tolerance` px (exclusive) of expected(x, y).
+template <class Expected>
+int pixelsWithin(const cv::Mat& disparity, const cv::Rect& area, Expected&& expected,
+                 double tolerance) {
   int n = 0;
-  for (int y = s.roof.y; y < s.roof.br().y; ++y) {
-    for (int x = s.roof.x; x < s.roof.br().x; ++x) {
-      n += std::abs(s.disparity.at<float>(y, x) - kRoof) < 0.5f ? 1 : 0;
+  for (int y = area.y; y < area.br().y; ++y) {
+    for (int x = area.x; x < area.br().x; ++x) {
+      n += std::abs(disparity.at<float>(y, x) - expected(x, y)) < tolerance ? 1 : 0;
     }
   }
   return n;
 }
 
+int roofPixelsWithTheRoofsDisparity(const Scene& s) {
+  return pixelsWithin(
+      s.disparity, s.roof, [](int, int) { return kRoof; }, 0.5);
+}
+
 TEST(FillFlatRegions, ReachesTheImageContourAndStopsThere) {
   Scene grown = scene();
-  fillFlatRegions(grown.left, grown.right, RegionFillSettings{}, 0, 32, 0.3f, grown.disparity,
-                  grown.score);
+  fill(grown, RegionFillSettings{}, 32);
   Scene plain = scene();
   RegionFillSettings noGrowth;
   noGrowth.growReach = 0;
-  fillFlatRegions(plain.left, plain.right, noGrowth, 0, 32, 0.3f, plain.disparity, plain.score);
+  fill(plain, noGrowth, 32);
   const int rows = grown.roof.height - 6;
   // The flat region stops 2 px short of the outline (its 5x5 windows straddle it).
   EXPECT_EQ(rowsFilledToTheOutline(plain), 0);
@@ -107,14 +120,12 @@ TEST(FillFlatRegions, AScanOfTheRangeConfirmsAnUnclearCandidate) {
   // of the roof's candidate is not half the ground's, but no other disparity of the range lines
   // the outline up as well.
   Scene scanned = scene(140.0f, 6.0);
-  fillFlatRegions(scanned.left, scanned.right, RegionFillSettings{}, 0, 32, 0.3f, scanned.disparity,
-                  scanned.score);
+  fill(scanned, RegionFillSettings{}, 32);
   Scene unscanned = scene(140.0f, 6.0);
   RegionFillSettings noScan;
   noScan.scanAgreement = 0;
   noScan.coreOpening = 0;  // the core (without the thin parts along the ground) lines up better
-  fillFlatRegions(unscanned.left, unscanned.right, noScan, 0, 32, 0.3f, unscanned.disparity,
-                  unscanned.score);
+  fill(unscanned, noScan, 32);
   const int rows = scanned.roof.height - 6;
   EXPECT_EQ(rowsFilledToTheOutline(unscanned), 0);
   EXPECT_GE(rowsFilledToTheOutline(scanned), rows * 8 / 10) << " of " << rows;
@@ -143,13 +154,11 @@ TEST(FillFlatRegions, ThinFlatPartsJoinedToARoofDoNotDecideItsFill) {
     return s;
   };
   Scene withCore = withBands(scene());
-  fillFlatRegions(withCore.left, withCore.right, RegionFillSettings{}, 0, 32, 0.3f,
-                  withCore.disparity, withCore.score);
+  fill(withCore, RegionFillSettings{}, 32);
   Scene wholeRegion = withBands(scene());
   RegionFillSettings noCore;
   noCore.coreOpening = 0;
-  fillFlatRegions(wholeRegion.left, wholeRegion.right, noCore, 0, 32, 0.3f, wholeRegion.disparity,
-                  wholeRegion.score);
+  fill(wholeRegion, noCore, 32);
   // Without the core the bands' outline keeps the roof unfilled; with it the roof is filled
   // (the growth back to its contour leaves a few single pixels out, as in the tests above).
   EXPECT_EQ(rowsFilledToTheOutline(wholeRegion), 0);
@@ -217,24 +226,17 @@ FacetScene slopedFacet(double perColumn = 0.15, double perRow = -0.05,
 
 // Facet pixels whose disparity is within `tolerance` px of the facet's plane.
 int facetPixelsOnItsPlane(const FacetScene& s, double tolerance) {
-  int n = 0;
-  for (int y = s.facet.y; y < s.facet.br().y; ++y) {
-    for (int x = s.facet.x; x < s.facet.br().x; ++x) {
-      n += std::abs(s.disparity.at<float>(y, x) - s.truth(x, y)) <= tolerance ? 1 : 0;
-    }
-  }
-  return n;
+  return pixelsWithin(
+      s.disparity, s.facet, [&](int x, int y) { return s.truth(x, y); }, tolerance);
 }
 
 TEST(FillFlatRegions, APlainSlopedFacetTakesThePlaneOfItsRowEndsInBothViews) {
   FacetScene sloped = slopedFacet();
-  fillFlatRegions(sloped.left, sloped.right, RegionFillSettings{}, 0, 40, 0.3f, sloped.disparity,
-                  sloped.score);
+  fill(sloped, RegionFillSettings{}, 40);
   FacetScene constantOnly = slopedFacet();
   RegionFillSettings noPlanes;
   noPlanes.planeMinRows = 0;
-  fillFlatRegions(constantOnly.left, constantOnly.right, noPlanes, 0, 40, 0.3f,
-                  constantOnly.disparity, constantOnly.score);
+  fill(constantOnly, noPlanes, 40);
   // No constant lines the facet's outline up (its disparity spans 20..27.9 px): unfilled.
   EXPECT_EQ(facetPixelsOnItsPlane(constantOnly, 0.5), 0);
   // The plane fills it to its contour, within half a pixel.
@@ -258,13 +260,11 @@ TEST(FillFlatRegions, AFacetAConstantLinesUpTakesItsPlaneWhenTheRowEndsDisagreeW
   // (At 0.02 px per column the constant agrees with the row ends within 1 px and stays; at 0.04
   // no constant lines the outline up, the case of the test above.)
   FacetScene planar = slopedFacet(0.03, 0.0, true);
-  fillFlatRegions(planar.left, planar.right, RegionFillSettings{}, 0, 40, 0.3f, planar.disparity,
-                  planar.score);
+  fill(planar, RegionFillSettings{}, 40);
   FacetScene constant = slopedFacet(0.03, 0.0, true);
   RegionFillSettings noPlanes;
   noPlanes.planeMinRows = 0;
-  fillFlatRegions(constant.left, constant.right, noPlanes, 0, 40, 0.3f, constant.disparity,
-                  constant.score);
+  fill(constant, noPlanes, 40);
   const int area = planar.facet.area();
   // Without planes the facet is filled, with one value.
   EXPECT_GE(
@@ -275,8 +275,7 @@ TEST(FillFlatRegions, AFacetAConstantLinesUpTakesItsPlaneWhenTheRowEndsDisagreeW
   EXPECT_GE(facetPixelsOnItsPlane(planar, 0.5), area * 95 / 100) << " of " << area;
   // A flat facet keeps its constant (its plane's slope would be noise).
   FacetScene flat = slopedFacet(0.0, 0.0, true);
-  fillFlatRegions(flat.left, flat.right, RegionFillSettings{}, 0, 40, 0.3f, flat.disparity,
-                  flat.score);
+  fill(flat, RegionFillSettings{}, 40);
   int constantPixels = 0;
   for (int y = flat.facet.y + 2; y < flat.facet.br().y - 2; ++y) {
     for (int x = flat.facet.x; x < flat.facet.br().x; ++x) {

@@ -30,16 +30,16 @@ struct RandomShape {
   ShapeNccTerms terms;
 };
 
-// Test-local reference of the dense shape rows (mask −1 on S, A on S, 0 elsewhere).
-RandomShape makeShape(std::mt19937& rng, const std::vector<int16_t>& a) {
+// Test-local reference of the dense shape rows (mask −1 on S, A on S, 0 elsewhere) and the NCC
+// terms, for row bits `bits` over the image `a` (row v of the shape = image row v).
+RandomShape shapeFromBits(const std::vector<uint32_t>& bits, const std::vector<int16_t>& a) {
   RandomShape s;
-  s.rows = std::uniform_int_distribution<int>(1, 15)(rng);
-  s.bits.resize(s.rows);
+  s.rows = static_cast<int>(bits.size());
+  s.bits = bits;
   s.mask.assign(16 * s.rows, 0);
   s.am.assign(16 * s.rows, 0);
   int64_t n = 0, sumA = 0, sumAA = 0;
   for (int v = 0; v < s.rows; ++v) {
-    s.bits[v] = std::uniform_int_distribution<uint32_t>(0, 0x7FFF)(rng);  // 15 columns
     for (int u = 0; u < 16; ++u) {
       if (((s.bits[v] >> u) & 1U) == 0) continue;
       const int16_t x = a[v * kStride + u];
@@ -56,6 +56,13 @@ RandomShape makeShape(std::mt19937& rng, const std::vector<int16_t>& a) {
   s.terms.invNormA = varN > 0 ? static_cast<float>(1.0 / std::sqrt(varN)) : 0.0f;
   s.terms.flatN = static_cast<float>(4.0 * n * n);  // var_S(B) < 4 quantised units²: flat
   return s;
+}
+
+// A shape of 1..15 random rows of 15 random cells.
+RandomShape makeShape(std::mt19937& rng, const std::vector<int16_t>& a) {
+  std::vector<uint32_t> bits(std::uniform_int_distribution<int>(1, 15)(rng));
+  for (auto& row : bits) row = std::uniform_int_distribution<uint32_t>(0, 0x7FFF)(rng);
+  return shapeFromBits(bits, a);
 }
 
 std::vector<int16_t> randomImage(std::mt19937& rng, bool flatPatch) {
@@ -215,28 +222,9 @@ TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) 
     // 1..8 main-line windows (window k one column left of window k − 1).
     const std::vector<int16_t> a = randomImage(rng, false);
     const std::vector<int16_t> b = randomImage(rng, trial % 5 == 0);
-    RandomShape shape;
-    shape.rows = rowCount;
-    shape.mask.assign(16 * rowCount, 0);
-    shape.am.assign(16 * rowCount, 0);
-    int64_t n = 0, sumA = 0, sumAA = 0;
-    for (int v = 0; v < rowCount; ++v) {
-      for (int u = 0; u < 16; ++u) {
-        if (((rows[firstRow + v] >> u) & 1U) == 0) continue;
-        const int16_t x = a[v * kStride + u];
-        shape.mask[16 * v + u] = -1;
-        shape.am[16 * v + u] = x;
-        ++n;
-        sumA += x;
-        sumAA += static_cast<int64_t>(x) * x;
-      }
-    }
-    const double varN = static_cast<double>(n * sumAA - sumA * sumA);
-    if (n < 2 || varN <= 0) continue;
-    shape.terms.n = static_cast<int>(n);
-    shape.terms.sumA = static_cast<int32_t>(sumA);
-    shape.terms.invNormA = static_cast<float>(1.0 / std::sqrt(varN));
-    shape.terms.flatN = static_cast<float>(4.0 * n * n);
+    const RandomShape shape =
+        shapeFromBits(std::vector<uint32_t>(rows + firstRow, rows + firstRow + rowCount), a);
+    if (shape.terms.n < 2 || shape.terms.invNormA == 0.0f) continue;
     std::vector<int32_t> prefixB(kImageRows * (kStride + 1 + kPrefixPad));
     std::vector<int32_t> prefixBB(prefixB.size());
     const int prefixStride = kStride + 1 + kPrefixPad;
