@@ -265,8 +265,9 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
       const auto [x0, x1] = band(r);
       for (int x = x0; x <= x1; ++x) {
         if (l[x] == 0) continue;
-        if (static_cast<size_t>(l[x]) >= counts.size())
+        if (static_cast<size_t>(l[x]) >= counts.size()) {
           counts.resize(static_cast<size_t>(l[x]) + 1, 0);
+        }
         ++counts[static_cast<size_t>(l[x])];
       }
     }
