@@ -515,6 +515,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       for (int x = 0; x < box.width; ++x) {
         if (!m[x]) continue;
         const double value = plane.at(box.x + x, box.y + y);
+        // (A plane may leave the range a little beyond the region's row ends.)
+        if (value < dmin || value > dmax) continue;
         const int xr = box.x + x - static_cast<int>(std::lround(value));
         if (xr < 0 || xr >= right.cols || !std::isfinite(b[xr])) continue;
         if (std::isfinite(d[x])) {
