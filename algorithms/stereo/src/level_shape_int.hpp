@@ -111,7 +111,7 @@ inline bool shapeSpansScalar(const uint16_t* rows, ShapeSpans& spans) {
   return true;
 }
 
-// Extra entries a prefix row needs past the image's width for the 8-lane loads of the run kernel.
+// Entries a prefix row needs past the image's width for the 8-lane loads of the span kernel.
 constexpr int kPrefixPad = 32;
 
 // Row prefix sums of B and B²: p[x] = Σ_{x' < x} b[x'] for x ≤ width, then p[width] repeated
