@@ -1,6 +1,7 @@
 // Depth steps moved onto the left image's contour (internal snapStepsToContours).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -295,7 +296,8 @@ int roofRowsLocatedAfterACarriedRun(int carried, const StepSnapSettings& setting
   cv::RNG rng(17);
   const cv::Mat ground = texturedGround(rows, 400, 60, rng);
   auto groundAt = [&](int y, int x) {  // left-image column x of the ground, shadowed on [70, 90)
-    const float g = ground.at<float>(y, x + 40);
+    // (The right view's last 5 columns read past the ground's 400: its last column repeats.)
+    const float g = ground.at<float>(y, std::min(x + 40, ground.cols - 1));
     return x >= 70 && x < 90 ? 0.6f * g : g;
   };
   cv::Mat left(rows, 360, CV_32F), right(rows, 360, CV_32F);
