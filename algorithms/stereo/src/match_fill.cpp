@@ -429,6 +429,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       return n > 0 ? sum / n : 1e30;
     };
     // The constant disparity of the outline's matches, when the outline lines up there.
+    double constantError = 0;  // the constant's error on the (final) ring
     const auto constant = [&]() -> std::optional<float> {
       if (static_cast<int>(matches.size()) < settings.minMatched) return std::nullopt;
       auto ringError = [&](float value) { return planeRingError(FillPlane{value, 0, 0}); };
@@ -483,6 +484,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                          settings.scanReach))) {
         return std::nullopt;
       }
+      constantError = bestError;
       return best;
     }();
     FillPlane plane;
@@ -492,8 +494,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       const bool sloped = slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma,
                                            dmin, dmax, settings, constant, plane);
       // Over a constant the outline lines up at, the plane must line it up better.
-      if (!sloped ||
-          (constant && !(planeRingError(plane) < planeRingError(FillPlane{*constant, 0, 0})))) {
+      if (!sloped || (constant && !(planeRingError(plane) < constantError))) {
         if (!constant) continue;
         plane = FillPlane{*constant, 0, 0};
       }
