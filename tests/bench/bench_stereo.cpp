@@ -308,28 +308,41 @@ class StageClock : public core::Progress {
   void setStage(const core::Stage& stage) override {
     core::Progress::setStage(stage);
     const std::lock_guard lock(mutex_);
-    marks_.emplace_back(stage.english(), Clock::now());
+    marks_.push_back({stage.english(), Clock::now(), std::clock()});
   }
-  // Each stage's seconds, from its start to the next stage's start (the last one to `end`).
-  void print(const std::string& method, Clock::time_point begin, Clock::time_point end) const {
+  // Each stage's wall seconds, from its start to the next stage's start (the last one to `end`),
+  // and the process CPU seconds over the same span: their ratio is how many cores the stage
+  // kept busy (a stage near 1.0 on a 2-core machine runs serially).
+  void print(const std::string& method, Clock::time_point begin, std::clock_t cpuBegin,
+             Clock::time_point end, std::clock_t cpuEnd) const {
     const std::lock_guard lock(mutex_);
     Clock::time_point from = begin;
+    std::clock_t cpuFrom = cpuBegin;
     std::string name = "(before the first stage)";
     for (size_t i = 0; i <= marks_.size(); ++i) {
-      const Clock::time_point to = i < marks_.size() ? marks_[i].second : end;
+      const Clock::time_point to = i < marks_.size() ? marks_[i].wall : end;
+      const std::clock_t cpuTo = i < marks_.size() ? marks_[i].cpu : cpuEnd;
       const double seconds = std::chrono::duration<double>(to - from).count();
+      const double cpu = static_cast<double>(cpuTo - cpuFrom) / CLOCKS_PER_SEC;
       if (i > 0 || seconds > 1e-4)
-        std::printf("    %s %-42s %7.3f s\n", method.c_str(), name.c_str(), seconds);
+        std::printf("    %s %-42s %7.3f s  cpu %7.3f s\n", method.c_str(), name.c_str(), seconds,
+                    cpu);
       if (i < marks_.size()) {
-        name = marks_[i].first;
-        from = marks_[i].second;
+        name = marks_[i].name;
+        from = marks_[i].wall;
+        cpuFrom = marks_[i].cpu;
       }
     }
   }
 
  private:
+  struct Mark {
+    std::string name;
+    Clock::time_point wall;
+    std::clock_t cpu;
+  };
   mutable std::mutex mutex_;
-  std::vector<std::pair<std::string, Clock::time_point>> marks_;
+  std::vector<Mark> marks_;
 };
 
 bool gStageTimes = false;
@@ -365,7 +378,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       const stereo::MatchResult result = stereo::matchStereo(c.left, c.right, p, &stages);
       const auto end = std::chrono::steady_clock::now();
       best[i] = std::min(best[i], std::chrono::duration<double>(end - start).count());
-      if (gStageTimes) stages.print(methods[i], start, end);
+      if (gStageTimes) stages.print(methods[i], start, cpu0, end, std::clock());
       disparity[i] = result.disparity;
       if (printCpu) {
         std::printf("  cpu %s %.3f s\n", methods[i].c_str(),
