@@ -32,8 +32,12 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr double kCoarsestRange = 20.0;  // ΔP_N of the paper, px
 constexpr int kMinLevelSide = 32;        // px, coarsest level kept at least this large
 
-int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-int ceilDiv(int a, int b) { return -floorDiv(-a, b); }
+int floorDiv(int a, int b) {
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+int ceilDiv(int a, int b) {
+  return -floorDiv(-a, b);
+}
 
 // The driver's own per-level work (preparation, Canny, validation, intervals) runs on the
 // level's threads (workers.hpp); serial, it was ~0.17 s CPU of the 1000²/128 d run.
@@ -120,35 +124,45 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
   const auto* otherD = other.disparity.ptr<float>(0);
   const auto* otherS = other.lineShift.ptr<float>(0);
   const size_t otherStep = other.disparity.step1(), shiftStep = other.lineShift.step1();
-  forRowBands(H, threads, [&, W, H, sign, tolerance2, otherD, otherS, otherStep,
-                           shiftStep](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      float* d = out.ptr<float>(y);
-      std::copy_n(map.disparity.ptr<float>(y), W, d);
-      const float* dy = map.lineShift.ptr<float>(y);
-      for (int x = 0; x < W; ++x) {
-        const float dx = d[x];
-        if (!std::isfinite(dx)) continue;
-        const double xo = x - sign * dx;
-        const double yo = y + dy[x];
-        const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
-        const int qx0 = std::max(0, fx), qx1 = std::min(W - 1, fx + 1);
-        const int qy0 = std::max(0, fy), qy1 = std::min(H - 1, fy + 1);
-        // All four neighbours, no early exit (a NaN neighbour fails the test by itself).
-        bool consistent = false;
-        for (int qy = qy0; qy <= qy1; ++qy) {
-          const float* dq = otherD + static_cast<size_t>(qy) * otherStep;
-          const float* sq = otherS + static_cast<size_t>(qy) * shiftStep;
-          for (int qx = qx0; qx <= qx1; ++qx) {
-            const double ex = dx - dq[qx];
-            const double ey = dy[x] + sq[qx];
-            consistent |= ex * ex + ey * ey <= tolerance2;
+  forRowBands(
+      H, threads,
+      [&, W, H, sign, tolerance2, otherD, otherS, otherStep, shiftStep](int rowStart, int rowEnd) {
+        for (int y = rowStart; y < rowEnd; ++y) {
+          float* d = out.ptr<float>(y);
+          std::copy_n(map.disparity.ptr<float>(y), W, d);
+          const float* dy = map.lineShift.ptr<float>(y);
+          for (int x = 0; x < W; ++x) {
+            const float dx = d[x];
+            if (!std::isfinite(dx)) continue;
+            // Where the match lands in the other map (float, as the map's values).
+            const float xo = static_cast<float>(x) - static_cast<float>(sign) * dx;
+            const float yo = static_cast<float>(y) + dy[x];
+            const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
+            if (fx + 1 < 0 || fx > W - 1 || fy + 1 < 0 || fy > H - 1) {
+              d[x] = kNaN;  // no neighbour inside the other map
+              continue;
+            }
+            // The four floor/ceil neighbours, clamped to the map: a clamped one repeats an inside
+            // one, which leaves the "any of them" test unchanged. No branches, no early exit (a NaN
+            // neighbour fails the test by itself).
+            const int qx0 = std::max(0, fx), qx1 = std::min(W - 1, fx + 1);
+            const int qy0 = std::max(0, fy), qy1 = std::min(H - 1, fy + 1);
+            const float* d0 = otherD + static_cast<size_t>(qy0) * otherStep;
+            const float* d1 = otherD + static_cast<size_t>(qy1) * otherStep;
+            const float* s0 = otherS + static_cast<size_t>(qy0) * shiftStep;
+            const float* s1 = otherS + static_cast<size_t>(qy1) * shiftStep;
+            const float shift = dy[x];
+            auto near = [dx, shift, tolerance2](float dq, float sq) {
+              const double ex = dx - dq;  // differences in float, their squares in double
+              const double ey = shift + sq;
+              return ex * ex + ey * ey <= tolerance2;
+            };
+            const bool consistent = near(d0[qx0], s0[qx0]) | near(d0[qx1], s0[qx1]) |
+                                    near(d1[qx0], s1[qx0]) | near(d1[qx1], s1[qx1]);
+            if (!consistent) d[x] = kNaN;
           }
         }
-        if (!consistent) d[x] = kNaN;
-      }
-    }
-  });
+      });
   return out;
 }
 
@@ -404,7 +418,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                leftOut);
       // At the finest level the right map only validates the left one: its pixels that no left
       // match points to are not matched again (the result is the same).
-      const cv::Mat rightNeeded = k == 0 ? flipped(pointedTo(leftOut, p.lineShift, threads)) : cv::Mat();
+      const cv::Mat rightNeeded =
+          k == 0 ? flipped(pointedTo(leftOut, p.lineShift, threads)) : cv::Mat();
       detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid,
                                flipped(coarseRight), rs, mirrored, rightNeeded);
       unmirror();
@@ -439,7 +454,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                               static_cast<float>(p.minScore), result.disparity, result.score);
     });
   }
-  if (p.snapSteps && p.adaptive) post.emplace_back([&] { contrast = detail::stepContrast(left, right); });
+  if (p.snapSteps && p.adaptive)
+    post.emplace_back([&] { contrast = detail::stepContrast(left, right); });
   runTasks(post, threads);
   if (reachedButCanceled(0.9)) return result;
   // Speckles are removed after the fill (before it, the fill lost its seeds: 600² edge 66.1 %
@@ -523,10 +539,10 @@ MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchPara
   const int range = p.dmax - p.dmin + 1;
   const int numDisparities = ((range + 15) / 16) * 16;
   const int block = 5;  // SGBM's own aggregation does the smoothing: a small block is customary
-  auto sgbm = cv::StereoSGBM::create(p.dmin, numDisparities, block, 8 * block * block,
-                                     32 * block * block,
-                                     std::max(1, static_cast<int>(std::ceil(p.tolerance))), 0, 10,
-                                     100, 2, cv::StereoSGBM::MODE_SGBM_3WAY);
+  auto sgbm =
+      cv::StereoSGBM::create(p.dmin, numDisparities, block, 8 * block * block, 32 * block * block,
+                             std::max(1, static_cast<int>(std::ceil(p.tolerance))), 0, 10, 100, 2,
+                             cv::StereoSGBM::MODE_SGBM_3WAY);
   cv::Mat raw;
   sgbm->compute(l8, r8, raw);
   if (core::isCanceled(progress)) {
@@ -556,9 +572,9 @@ MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchPara
 void MatchParams::validate() const {
   core::checkDeclaredRanges(*this);
   if (dmin > dmax) {
-    throw Error(ErrorCode::InvalidParameter, "empty disparity range: dmin = " +
-                                                 std::to_string(dmin) + " > dmax = " +
-                                                 std::to_string(dmax));
+    throw Error(ErrorCode::InvalidParameter,
+                "empty disparity range: dmin = " + std::to_string(dmin) +
+                    " > dmax = " + std::to_string(dmax));
   }
   if (window % 2 == 0) {
     throw Error(ErrorCode::InvalidParameter, "window = " + std::to_string(window) + " must be odd");
