@@ -169,28 +169,34 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
 // Pixels of the other map that the matches of `map` point to (the floor/ceil neighbours the
 // validation reads), CV_8U 0/1; x_other = x − d. By bands of output rows: a band scans the
 // source rows whose line shift (|dy| <= lineShift + 1) can reach it and writes only its own rows.
+// Bands of 64 rows: each scans 2 · (lineShift + 2) rows beyond its own.
+constexpr int kPointedBandRows = 64;
 cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
   cv::Mat needed = cv::Mat::zeros(map.disparity.size(), CV_8U);
   const int reach = lineShift + 2;
-  forRowBands(needed.rows, threads, [&](int rowStart, int rowEnd) {
-    for (int y = std::max(0, rowStart - reach); y < std::min(needed.rows, rowEnd + reach); ++y) {
-      const float* d = map.disparity.ptr<float>(y);
-      const float* dy = map.lineShift.ptr<float>(y);
-      for (int x = 0; x < needed.cols; ++x) {
-        if (!std::isfinite(d[x])) continue;
-        const int fx = static_cast<int>(std::floor(x - d[x]));
-        const int fy = static_cast<int>(std::floor(y + dy[x]));
-        for (int m = 0; m <= 1; ++m) {
-          const int qy = fy + m;
-          if (qy < rowStart || qy >= rowEnd) continue;
-          for (int n = 0; n <= 1; ++n) {
-            const int qx = fx + n;
-            if (qx >= 0 && qx < needed.cols) needed.at<uchar>(qy, qx) = 1;
+  forRowBands(
+      needed.rows, threads,
+      [&](int rowStart, int rowEnd) {
+        for (int y = std::max(0, rowStart - reach); y < std::min(needed.rows, rowEnd + reach);
+             ++y) {
+          const float* d = map.disparity.ptr<float>(y);
+          const float* dy = map.lineShift.ptr<float>(y);
+          for (int x = 0; x < needed.cols; ++x) {
+            if (!std::isfinite(d[x])) continue;
+            const int fx = static_cast<int>(std::floor(static_cast<float>(x) - d[x]));
+            const int fy = static_cast<int>(std::floor(static_cast<float>(y) + dy[x]));
+            for (int m = 0; m <= 1; ++m) {
+              const int qy = fy + m;
+              if (qy < rowStart || qy >= rowEnd) continue;
+              for (int n = 0; n <= 1; ++n) {
+                const int qx = fx + n;
+                if (qx >= 0 && qx < needed.cols) needed.at<uchar>(qy, qx) = 1;
+              }
+            }
           }
         }
-      }
-    }
-  });
+      },
+      kPointedBandRows);
   return needed;
 }
 
