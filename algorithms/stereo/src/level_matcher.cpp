@@ -332,6 +332,29 @@ struct LinePeak {
     }
     prev = s;
   }
+
+  // update(d + k, s[k]) for k = 0 .. count − 1, with the same outcome: the pass's first
+  // highest score replaces the peak when it beats it (later updates would erase the earlier
+  // ones' effects), and only the scores next to the final peak are kept.
+  void updatePass(int d, const float* s, int count) {
+    int top = -1;
+    float topScore = best;
+    for (int k = 0; k < count; ++k) {
+      if (s[k] > topScore) {  // NaN never wins
+        topScore = s[k];
+        top = k;
+      }
+    }
+    if (top < 0) {
+      if (d == bestD + 1) above = s[0];
+    } else {
+      best = topScore;
+      bestD = d + top;
+      below = top > 0 ? s[top - 1] : prev;
+      above = top + 1 < count ? s[top + 1] : kNaN;
+    }
+    prev = s[count - 1];
+  }
 };
 
 // Dense rows of an adaptive shape S.
@@ -893,7 +916,7 @@ class LevelMatcher {
       const int passes = left <= perPass ? 1 : (left + perPass - 1) / perPass;
       const int count = passes == 1 ? left : (left + passes - 1) / passes;
       if (shapeScoresBatch(x, y, d, t, batch, count)) {
-        for (int k = 0; k < count; ++k) peak.update(d + k, batch[k]);
+        peak.updatePass(d, batch, count);
       } else {
         for (int k = 0; k < count; ++k) peak.update(d + k, shapeScore(x, y, d + k, 0, t));
       }
