@@ -733,8 +733,8 @@ class LevelMatcher {
     const uint32_t full = w == 32 ? ~0U : (1U << w) - 1U;
     // Bit-parallel flood fill on w-bit rows: a row's reach grows from the rows above and below
     // and is then filled along the row through free pixels (shift-and-mask doubling, the
-    // "occluded fill" of bitboards), until no row changes.
-    uint32_t reach[32];
+    // "occluded fill" of bitboards), until no row changes. Filled in place in the template.
+    uint32_t* reach = t.rowBits;
     // When S is the whole window minus its contour pixels (no free pixel left unreached: no
     // part of the window is cut off) and the square window is usable, the square serves the
     // pixel: the few contour pixels change its NCC little, and the square path is much cheaper.
@@ -743,7 +743,8 @@ class LevelMatcher {
       const bool cut = fillWindow15(&freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)],
                                     windowRows_, r_, rows16);
       if (squareServes && !cut) return false;
-      for (int v = 0; v < w; ++v) reach[v] = rows16[v];
+      // All 16 rows (those past the window are 0): a fixed count the compiler widens in vectors.
+      for (int v = 0; v < 16; ++v) reach[v] = rows16[v];
     } else {
       uint32_t free[32];
       for (int v = 0; v < w; ++v) {
@@ -755,7 +756,6 @@ class LevelMatcher {
       for (int v = 0; v < w; ++v) unreached |= free[v] & ~reach[v];
       if (squareServes && unreached == 0) return false;
     }
-    for (int v = 0; v < w; ++v) t.rowBits[v] = reach[v];
     const int P = rowStride_;
     t.rowFirst = 0;
     while (reach[t.rowFirst] == 0) ++t.rowFirst;  // the centre row is never empty
