@@ -448,7 +448,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // 79.5 %); and again last, for the islands the snapping's cuts leave.
   if (p.speckleSize > 0) {
     core::setStage(progress, core::StageId::RemovingSpeckles);
-    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
+    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
     if (reachedButCanceled(0.92)) return result;
   }
   if (p.snapSteps && p.adaptive) {
@@ -462,7 +462,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {
     core::setStage(progress, core::StageId::RemovingSnappingSpeckles);
-    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
+    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
   }
   core::report(progress, 1.0);
   return result;
