@@ -25,7 +25,8 @@ struct NearSideCut {
   int y = 0, b = 0, s0 = 0, s1 = 0;
   float dNear = 0, dFar = 0;
   int eFirst = 0;
-  int ownLast = 0;  // the last candidate the row may take on its own evidence (later ones: line only)
+  // The last candidate the row may take on its own evidence (later ones: line only).
+  int ownLast = 0;
   std::vector<float> cost;
   int chosen = 0;
   int rowBest = 0;           // argmin of the row's own cost
@@ -43,10 +44,19 @@ int argminCut(const NearSideCut& cut) {
 // below. The row's cut is then the point of the line through rows y ± lineRows of least total
 // cost, each row's cost taken relative to its own best and capped at lineCap (a row that the
 // line misses, at a corner or a notch, costs no more than that).
+// Three passes over bands of rows on the workers (`threads`). A row's work writes only its own
+// cuts, and the `next` links of the row above, which no other row sets; of the other rows it
+// reads only fields that an earlier pass wrote, or that no pass changes: the result does not
+// depend on the bands.
 void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSettings& settings) {
-  for (auto& row : rows) {
-    for (NearSideCut& cut : row) cut.chosen = cut.rowBest = argminCut(cut);
-  }
+  const int h = static_cast<int>(rows.size());
+  forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      for (NearSideCut& cut : rows[static_cast<size_t>(y)]) {
+        cut.chosen = cut.rowBest = argminCut(cut);
+      }
+    }
+  });
   if (settings.lineRows <= 0) return;
   const auto overlaps = [](const NearSideCut& p, const NearSideCut& c) {
     const int pLast = p.eFirst + static_cast<int>(p.cost.size()) - 1;
@@ -54,90 +64,96 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
     return std::min(pLast, cLast) + 2 >= std::max(p.eFirst, c.eFirst);
   };
   const float link = static_cast<float>(settings.linkDisparity);
-  for (size_t y = 1; y < rows.size(); ++y) {
-    for (size_t i = 0; i < rows[y].size(); ++i) {
-      NearSideCut& c = rows[y][i];
-      int bestJ = -1, bestDistance = std::numeric_limits<int>::max();
-      for (size_t j = 0; j < rows[y - 1].size(); ++j) {
-        const NearSideCut& p = rows[y - 1][j];
-        if (p.next >= 0 || std::abs(p.dNear - c.dNear) > link || std::abs(p.dFar - c.dFar) > link ||
-            !overlaps(p, c)) {
-          continue;
-        }
-        const int distance = std::abs(p.rowBest - c.rowBest);
-        if (distance < bestDistance) {
-          bestDistance = distance;
-          bestJ = static_cast<int>(j);
-        }
-      }
-      if (bestJ >= 0) {
-        c.prev = bestJ;
-        rows[y - 1][static_cast<size_t>(bestJ)].next = static_cast<int>(i);
-      }
-    }
-  }
-  // Each row's costs relative to its own best, capped: a row far off the line costs at most
-  // lineCap, whatever its error. Candidates past the row's own range (over far pixels) cost at
-  // least as much as its own best: a line takes them only where the neighbouring rows put it.
-  for (auto& row : rows) {
-    for (NearSideCut& cut : row) {
-      const float best = cut.cost[static_cast<size_t>(cut.rowBest - cut.eFirst)];
-      for (float& c : cut.cost) {
-        c = std::min(static_cast<float>(settings.lineCap), std::max(0.0F, c - best));
-      }
-    }
-  }
   const float cap = static_cast<float>(settings.lineCap);
-  const int slopes = 2 * settings.slopeSteps + 1;
-  std::vector<const NearSideCut*> chain;
-  for (auto& row : rows) {
-    for (NearSideCut& c : row) {
-      // The chain's cuts in rows y - lineRows .. y + lineRows (nullptr: no cut of this step).
-      chain.assign(static_cast<size_t>(2 * settings.lineRows + 1), nullptr);
-      chain[static_cast<size_t>(settings.lineRows)] = &c;
-      int linked = 0;
-      const NearSideCut* p = &c;
-      for (int k = 1; k <= settings.lineRows && p->prev >= 0; ++k, ++linked) {
-        p = &rows[static_cast<size_t>(p->y - 1)][static_cast<size_t>(p->prev)];
-        chain[static_cast<size_t>(settings.lineRows - k)] = p;
-      }
-      p = &c;
-      for (int k = 1; k <= settings.lineRows && p->next >= 0; ++k, ++linked) {
-        p = &rows[static_cast<size_t>(p->y + 1)][static_cast<size_t>(p->next)];
-        chain[static_cast<size_t>(settings.lineRows + k)] = p;
-      }
-      // Fewer than lineRows linked rows above and below together: too short to be a line, the
-      // row decides.
-      if (linked < settings.lineRows) continue;
-      // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost.
-      double bestSum = std::numeric_limits<double>::infinity();
-      int bestE = c.chosen, bestSlope = 0;
-      for (size_t i = 0; i < c.cost.size(); ++i) {
-        const int e0 = c.eFirst + static_cast<int>(i);
-        for (int si = 0; si < slopes; ++si) {
-          const double slope = settings.maxSlope * static_cast<double>(si - settings.slopeSteps) /
-                               settings.slopeSteps;
-          double sum = 0;
-          for (int k = -settings.lineRows; k <= settings.lineRows && sum < bestSum; ++k) {
-            const NearSideCut* q = chain[static_cast<size_t>(k + settings.lineRows)];
-            if (q == nullptr) continue;
-            const int e = e0 + static_cast<int>(std::lround(slope * k));
-            const int j = e - q->eFirst;
-            sum += j >= 0 && j < static_cast<int>(q->cost.size()) ? q->cost[static_cast<size_t>(j)]
-                                                                  : cap;
+  forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = std::max(1, rowStart); y < rowEnd; ++y) {
+      std::vector<NearSideCut>& row = rows[static_cast<size_t>(y)];
+      std::vector<NearSideCut>& above = rows[static_cast<size_t>(y - 1)];
+      for (size_t i = 0; i < row.size(); ++i) {
+        NearSideCut& c = row[i];
+        int bestJ = -1, bestDistance = std::numeric_limits<int>::max();
+        for (size_t j = 0; j < above.size(); ++j) {
+          const NearSideCut& p = above[j];
+          if (p.next >= 0 || std::abs(p.dNear - c.dNear) > link ||
+              std::abs(p.dFar - c.dFar) > link || !overlaps(p, c)) {
+            continue;
           }
-          if (sum < bestSum) {
-            bestSum = sum;
-            bestE = e0;
-            bestSlope = si - settings.slopeSteps;
+          const int distance = std::abs(p.rowBest - c.rowBest);
+          if (distance < bestDistance) {
+            bestDistance = distance;
+            bestJ = static_cast<int>(j);
           }
         }
+        if (bestJ >= 0) {
+          c.prev = bestJ;
+          above[static_cast<size_t>(bestJ)].next = static_cast<int>(i);
+        }
       }
-      // A line at the steepest slope tried is likely steeper still (a near-horizontal edge,
-      // whose rows the chain links loosely): the row alone decides there.
-      if (std::abs(bestSlope) < settings.slopeSteps) c.chosen = bestE;
     }
-  }
+    // Each row's costs relative to its own best, capped: a row far off the line costs at most
+    // lineCap, whatever its error. Candidates past the row's own range (over far pixels) cost
+    // at least as much as its own best: a line takes them only where the neighbouring rows put
+    // it. (The links above read only the costs' count.)
+    for (int y = rowStart; y < rowEnd; ++y) {
+      for (NearSideCut& cut : rows[static_cast<size_t>(y)]) {
+        const float best = cut.cost[static_cast<size_t>(cut.rowBest - cut.eFirst)];
+        for (float& c : cut.cost) c = std::min(cap, std::max(0.0F, c - best));
+      }
+    }
+  });
+  const int slopes = 2 * settings.slopeSteps + 1;
+  forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
+    std::vector<const NearSideCut*> chain;
+    for (int y = rowStart; y < rowEnd; ++y) {
+      for (NearSideCut& c : rows[static_cast<size_t>(y)]) {
+        // The chain's cuts in rows y - lineRows .. y + lineRows (nullptr: no cut of this step).
+        chain.assign(static_cast<size_t>(2 * settings.lineRows + 1), nullptr);
+        chain[static_cast<size_t>(settings.lineRows)] = &c;
+        int linked = 0;
+        const NearSideCut* p = &c;
+        for (int k = 1; k <= settings.lineRows && p->prev >= 0; ++k, ++linked) {
+          p = &rows[static_cast<size_t>(p->y - 1)][static_cast<size_t>(p->prev)];
+          chain[static_cast<size_t>(settings.lineRows - k)] = p;
+        }
+        p = &c;
+        for (int k = 1; k <= settings.lineRows && p->next >= 0; ++k, ++linked) {
+          p = &rows[static_cast<size_t>(p->y + 1)][static_cast<size_t>(p->next)];
+          chain[static_cast<size_t>(settings.lineRows + k)] = p;
+        }
+        // Fewer than lineRows linked rows above and below together: too short to be a line,
+        // the row decides.
+        if (linked < settings.lineRows) continue;
+        // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost.
+        double bestSum = std::numeric_limits<double>::infinity();
+        int bestE = c.chosen, bestSlope = 0;
+        for (size_t i = 0; i < c.cost.size(); ++i) {
+          const int e0 = c.eFirst + static_cast<int>(i);
+          for (int si = 0; si < slopes; ++si) {
+            const double slope = settings.maxSlope * static_cast<double>(si - settings.slopeSteps) /
+                                 settings.slopeSteps;
+            double sum = 0;
+            for (int k = -settings.lineRows; k <= settings.lineRows && sum < bestSum; ++k) {
+              const NearSideCut* q = chain[static_cast<size_t>(k + settings.lineRows)];
+              if (q == nullptr) continue;
+              const int e = e0 + static_cast<int>(std::lround(slope * k));
+              const int j = e - q->eFirst;
+              sum += j >= 0 && j < static_cast<int>(q->cost.size())
+                         ? q->cost[static_cast<size_t>(j)]
+                         : cap;
+            }
+            if (sum < bestSum) {
+              bestSum = sum;
+              bestE = e0;
+              bestSlope = si - settings.slopeSteps;
+            }
+          }
+        }
+        // A line at the steepest slope tried is likely steeper still (a near-horizontal edge,
+        // whose rows the chain links loosely): the row alone decides there.
+        if (std::abs(bestSlope) < settings.slopeSteps) c.chosen = bestE;
+      }
+    }
+  });
 }
 }  // namespace
 
