@@ -235,11 +235,41 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   double gain = 1, offset = 0;
   int dlo = 0;  // the smallest disparity of the map (checked only): carried runs search from it
   if (checked) {
-    int dhi = 0;
+    // The extremes of the non-NaN disparities, by bands of rows on the workers (0 and 0 when
+    // there are none, as cv::minMaxIdx under a mask gives).
+    const int bandRows = 16;
+    std::vector<std::pair<float, float>> bandRange(
+        static_cast<size_t>((h + bandRows - 1) / bandRows),
+        {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
+    std::atomic<bool> found{false};
+    forRowBands(
+        h, settings.threads,
+        [&](int rowStart, int rowEnd) {
+          auto& [lo, hi] = bandRange[static_cast<size_t>(rowStart / bandRows)];
+          bool seen = false;
+          for (int y = rowStart; y < rowEnd; ++y) {
+            const float* d = disparity.ptr<float>(y);
+            for (int x = 0; x < w; ++x) {
+              if (d[x] != d[x]) continue;
+              lo = std::min(lo, d[x]);
+              hi = std::max(hi, d[x]);
+              seen = true;
+            }
+          }
+          if (seen) found = true;
+        },
+        bandRows);
     double mn = 0, mx = 0;
-    cv::minMaxIdx(disparity, &mn, &mx, nullptr, nullptr, disparity == disparity);
+    if (found) {
+      mn = std::numeric_limits<double>::infinity();
+      mx = -mn;
+      for (const auto& [lo, hi] : bandRange) {
+        mn = std::min(mn, static_cast<double>(lo));
+        mx = std::max(mx, static_cast<double>(hi));
+      }
+    }
     dlo = static_cast<int>(std::floor(mn));
-    dhi = static_cast<int>(std::ceil(mx));
+    const int dhi = static_cast<int>(std::ceil(mx));
     std::tie(gain, offset) = radiometricMap(left, right, dlo, dhi);
   }
   const auto error = [&](int y, int x, float d) {
@@ -399,7 +429,6 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     return changed;
   };
 
-  cv::Mat source = disparity.clone();
   // The checked cuts of each row, applied once every row's are known (continuity below).
   std::vector<std::vector<NearSideCut>> cutsByRow(static_cast<size_t>(h));
   // Rows are independent (each writes only its own): bands of rows on the workers.
@@ -407,8 +436,12 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
     int changed = 0;
     std::vector<int> matched;
+    // The row's disparities as they came in (its decisions read them while it writes its output;
+    // a row reads and writes no other row's).
+    std::vector<float> source(static_cast<size_t>(w));
     for (int y = rowStart; y < rowEnd; ++y) {
-      float* d = source.ptr<float>(y);
+      float* d = source.data();
+      std::copy_n(disparity.ptr<float>(y), w, d);
       const float* c = contrast.ptr<float>(y);
       float* out = disparity.ptr<float>(y);
       float* sc = score.empty() ? nullptr : score.ptr<float>(y);
