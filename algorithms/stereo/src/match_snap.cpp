@@ -9,7 +9,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "delineo/core/nan_mask.hpp"
 #include "radiometry.hpp"
 #include "workers.hpp"
 
@@ -181,31 +180,46 @@ constexpr int kStepSide = 2;
 cv::Mat rowContrast(const cv::Mat& filled) {
   const int w = filled.cols, h = filled.rows;
   cv::Mat step(h, w - 1, CV_32F);
+  // Both sides' sums as written out for the general case below, so that the values are the
+  // same; without the image's ends the loop has no branches and is vectorised.
+  static_assert(kStepSide == 2);
+  const auto edge = [w](const float* row, int x) {
+    float before = 0, after = 0;
+    int nBefore = 0, nAfter = 0;
+    for (int k = 0; k < kStepSide; ++k) {
+      if (x - k >= 0) {
+        before += row[x - k];
+        ++nBefore;
+      }
+      if (x + 1 + k < w) {
+        after += row[x + 1 + k];
+        ++nAfter;
+      }
+    }
+    return std::abs(after / static_cast<float>(nAfter) - before / static_cast<float>(nBefore));
+  };
   for (int y = 0; y < h; ++y) {
     const float* row = filled.ptr<float>(y);
     float* s = step.ptr<float>(y);
-    for (int x = 0; x + 1 < w; ++x) {
-      float before = 0, after = 0;
-      int nBefore = 0, nAfter = 0;
-      for (int k = 0; k < kStepSide; ++k) {
-        if (x - k >= 0) {
-          before += row[x - k];
-          ++nBefore;
-        }
-        if (x + 1 + k < w) {
-          after += row[x + 1 + k];
-          ++nAfter;
-        }
-      }
-      s[x] = std::abs(after / static_cast<float>(nAfter) - before / static_cast<float>(nBefore));
+    s[0] = edge(row, 0);
+    for (int x = 1; x + 2 < w; ++x) {
+      const float before = (0.0F + row[x]) + row[x - 1];
+      const float after = (0.0F + row[x + 1]) + row[x + 2];
+      s[x] = std::abs(after / 2.0F - before / 2.0F);
     }
+    for (int x = std::max(1, w - 2); x + 1 < w; ++x) s[x] = edge(row, x);
   }
   return step;
 }
 
+// NaN as 0, in one pass.
 cv::Mat withoutNaN(const cv::Mat& m) {
-  cv::Mat filled = m.clone();
-  filled.setTo(0.0f, core::nanMask(m));
+  cv::Mat filled(m.size(), CV_32F);
+  for (int y = 0; y < m.rows; ++y) {
+    const float* in = m.ptr<float>(y);
+    float* out = filled.ptr<float>(y);
+    for (int x = 0; x < m.cols; ++x) out[x] = in[x] == in[x] ? in[x] : 0.0F;
+  }
   return filled;
 }
 }  // namespace
