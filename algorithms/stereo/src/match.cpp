@@ -449,20 +449,21 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   result.disparity = coarseLeft;
   result.score = leftOut.score.clone();
   result.score.setTo(kNaN, core::nanMask(result.disparity));
-  // The fill runs on one worker; the snapping's contrast map (left image only) is prepared on
-  // the other meanwhile.
+  // The fill runs on one worker; the snapping's contrast map (images only) is prepared on the
+  // other meanwhile, after the fill's right-view flat regions.
   core::setStage(progress, core::StageId::FillingFlatRegions);
   detail::StepContrast contrast;
-  std::vector<std::function<void()>> post;
-  if (p.fillRegions && p.adaptive) {
-    post.emplace_back([&] {
-      detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
-                              static_cast<float>(p.minScore), result.disparity, result.score);
-    });
+  std::function<void()> prepareContrast;
+  if (p.snapSteps && p.adaptive) {
+    prepareContrast = [&] { contrast = detail::stepContrast(left, right); };
   }
-  if (p.snapSteps && p.adaptive)
-    post.emplace_back([&] { contrast = detail::stepContrast(left, right); });
-  runTasks(post, threads);
+  if (p.fillRegions && p.adaptive) {
+    detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
+                            static_cast<float>(p.minScore), result.disparity, result.score, threads,
+                            prepareContrast);
+  } else if (prepareContrast) {
+    prepareContrast();
+  }
   if (reachedButCanceled(0.9)) return result;
   // Speckles are removed after the fill (before it, the fill lost its seeds: 600² edge 66.1 %
   // against 74.7 % removed last) and before the snapping, whose steps a wrong island inside the
@@ -470,7 +471,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // 79.5 %); and again last, for the islands the snapping's cuts leave.
   if (p.speckleSize > 0) {
     core::setStage(progress, core::StageId::RemovingSpeckles);
-    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
+    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
     if (reachedButCanceled(0.92)) return result;
   }
   if (p.snapSteps && p.adaptive) {
@@ -484,7 +485,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {
     core::setStage(progress, core::StageId::RemovingSnappingSpeckles);
-    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange);
+    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
   }
   core::report(progress, 1.0);
   return result;

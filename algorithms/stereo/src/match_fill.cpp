@@ -3,12 +3,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <latch>
 #include <optional>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
 #include "radiometry.hpp"
+#include "workers.hpp"
 
 namespace delineo::stereo::detail {
 
@@ -354,13 +357,13 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
   return true;
 }
 
-}  // namespace
-
-int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
-                    int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score) {
+// The fill itself; `rightFlatRegionsOf()` gives the right view's flat regions.
+template <class RightFlat>
+int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
+                int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
+                const RightFlat& rightFlatRegionsOf) {
   double sigma = 0;
   const cv::Mat flat = flatMask(left, settings, &sigma);
-  RightFlatRegions rightFlat;  // the right view's flat regions, when a sloped facet needs them
   // The regions without their thin parts (see RegionFillSettings::coreOpening).
   cv::Mat flatCores;
   if (settings.coreOpening > 1) {
@@ -489,7 +492,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
     }();
     FillPlane plane;
     if (settings.planeMinRows > 0) {
-      if (rightFlat.labels.empty()) rightFlat = rightFlatRegions(flatMask(right, settings), right);
+      const RightFlatRegions& rightFlat = rightFlatRegionsOf();
       const double leftMean = cv::mean(left(box), region)[0];
       const bool sloped = slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma,
                                            dmin, dmax, settings, constant, plane);
@@ -538,6 +541,46 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       }
     }
   }
+  return filled;
+}
+
+}  // namespace
+
+int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
+                    int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
+                    int threads, const std::function<void()>& alongside) {
+  // With a second worker, it makes the right view's flat regions and then runs `alongside`,
+  // while this one makes the left ones and fills the regions, waiting for the right ones only
+  // when a region first needs them (about as long to make as the left ones).
+  if (threads > 1 && settings.planeMinRows > 0) {
+    RightFlatRegions rightFlat;
+    std::latch rightReady(1);
+    int filled = 0;
+    runTasks({[&] {
+                filled = fillRegions(left, right, settings, dmin, dmax, fillScore, disparity, score,
+                                     [&]() -> const RightFlatRegions& {
+                                       rightReady.wait();
+                                       return rightFlat;
+                                     });
+              },
+              [&] {
+                rightFlat = rightFlatRegions(flatMask(right, settings), right);
+                rightReady.count_down();
+                if (alongside) alongside();
+              }},
+             threads);
+    return filled;
+  }
+  // Else the right view's flat regions only when a region first needs them.
+  RightFlatRegions rightFlat;
+  const int filled = fillRegions(left, right, settings, dmin, dmax, fillScore, disparity, score,
+                                 [&]() -> const RightFlatRegions& {
+                                   if (rightFlat.labels.empty()) {
+                                     rightFlat = rightFlatRegions(flatMask(right, settings), right);
+                                   }
+                                   return rightFlat;
+                                 });
+  if (alongside) alongside();
   return filled;
 }
 

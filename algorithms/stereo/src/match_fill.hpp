@@ -1,6 +1,8 @@
 #pragma once
 // Disparity of flat (textureless) regions from the matches along their outline (internal to
 // delineo_stereo).
+#include <functional>
+
 #include <opencv2/core.hpp>
 
 namespace delineo::stereo::detail {
@@ -55,7 +57,11 @@ struct RegionFillSettings {
 // the thin parts, joined through the roof's grey (a facade's plain bands between its window
 // rows), no longer decide whether the roof is filled, and are not filled with it.
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
+// `threads` > 1: the right view's flat regions are made on a second worker, which then runs
+// `alongside` (the caller's own work, independent of the fill) while the fill goes on; else
+// `alongside` runs after the fill. Same result on any number of threads.
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
-                    int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score);
+                    int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
+                    int threads = 1, const std::function<void()>& alongside = {});
 
 }  // namespace delineo::stereo::detail

@@ -9,7 +9,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "delineo/core/nan_mask.hpp"
 #include "radiometry.hpp"
 #include "workers.hpp"
 
@@ -25,7 +24,8 @@ struct NearSideCut {
   int y = 0, b = 0, s0 = 0, s1 = 0;
   float dNear = 0, dFar = 0;
   int eFirst = 0;
-  int ownLast = 0;  // the last candidate the row may take on its own evidence (later ones: line only)
+  // The last candidate the row may take on its own evidence (later ones: line only).
+  int ownLast = 0;
   std::vector<float> cost;
   int chosen = 0;
   int rowBest = 0;           // argmin of the row's own cost
@@ -43,10 +43,19 @@ int argminCut(const NearSideCut& cut) {
 // below. The row's cut is then the point of the line through rows y ± lineRows of least total
 // cost, each row's cost taken relative to its own best and capped at lineCap (a row that the
 // line misses, at a corner or a notch, costs no more than that).
+// Three passes over bands of rows on the workers (`threads`). A row's work writes only its own
+// cuts, and the `next` links of the row above, which no other row sets; of the other rows it
+// reads only fields that an earlier pass wrote, or that no pass changes: the result does not
+// depend on the bands.
 void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSettings& settings) {
-  for (auto& row : rows) {
-    for (NearSideCut& cut : row) cut.chosen = cut.rowBest = argminCut(cut);
-  }
+  const int h = static_cast<int>(rows.size());
+  forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      for (NearSideCut& cut : rows[static_cast<size_t>(y)]) {
+        cut.chosen = cut.rowBest = argminCut(cut);
+      }
+    }
+  });
   if (settings.lineRows <= 0) return;
   const auto overlaps = [](const NearSideCut& p, const NearSideCut& c) {
     const int pLast = p.eFirst + static_cast<int>(p.cost.size()) - 1;
@@ -54,90 +63,107 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
     return std::min(pLast, cLast) + 2 >= std::max(p.eFirst, c.eFirst);
   };
   const float link = static_cast<float>(settings.linkDisparity);
-  for (size_t y = 1; y < rows.size(); ++y) {
-    for (size_t i = 0; i < rows[y].size(); ++i) {
-      NearSideCut& c = rows[y][i];
-      int bestJ = -1, bestDistance = std::numeric_limits<int>::max();
-      for (size_t j = 0; j < rows[y - 1].size(); ++j) {
-        const NearSideCut& p = rows[y - 1][j];
-        if (p.next >= 0 || std::abs(p.dNear - c.dNear) > link || std::abs(p.dFar - c.dFar) > link ||
-            !overlaps(p, c)) {
-          continue;
-        }
-        const int distance = std::abs(p.rowBest - c.rowBest);
-        if (distance < bestDistance) {
-          bestDistance = distance;
-          bestJ = static_cast<int>(j);
-        }
-      }
-      if (bestJ >= 0) {
-        c.prev = bestJ;
-        rows[y - 1][static_cast<size_t>(bestJ)].next = static_cast<int>(i);
-      }
-    }
-  }
-  // Each row's costs relative to its own best, capped: a row far off the line costs at most
-  // lineCap, whatever its error. Candidates past the row's own range (over far pixels) cost at
-  // least as much as its own best: a line takes them only where the neighbouring rows put it.
-  for (auto& row : rows) {
-    for (NearSideCut& cut : row) {
-      const float best = cut.cost[static_cast<size_t>(cut.rowBest - cut.eFirst)];
-      for (float& c : cut.cost) {
-        c = std::min(static_cast<float>(settings.lineCap), std::max(0.0F, c - best));
-      }
-    }
-  }
   const float cap = static_cast<float>(settings.lineCap);
-  const int slopes = 2 * settings.slopeSteps + 1;
-  std::vector<const NearSideCut*> chain;
-  for (auto& row : rows) {
-    for (NearSideCut& c : row) {
-      // The chain's cuts in rows y - lineRows .. y + lineRows (nullptr: no cut of this step).
-      chain.assign(static_cast<size_t>(2 * settings.lineRows + 1), nullptr);
-      chain[static_cast<size_t>(settings.lineRows)] = &c;
-      int linked = 0;
-      const NearSideCut* p = &c;
-      for (int k = 1; k <= settings.lineRows && p->prev >= 0; ++k, ++linked) {
-        p = &rows[static_cast<size_t>(p->y - 1)][static_cast<size_t>(p->prev)];
-        chain[static_cast<size_t>(settings.lineRows - k)] = p;
-      }
-      p = &c;
-      for (int k = 1; k <= settings.lineRows && p->next >= 0; ++k, ++linked) {
-        p = &rows[static_cast<size_t>(p->y + 1)][static_cast<size_t>(p->next)];
-        chain[static_cast<size_t>(settings.lineRows + k)] = p;
-      }
-      // Fewer than lineRows linked rows above and below together: too short to be a line, the
-      // row decides.
-      if (linked < settings.lineRows) continue;
-      // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost.
-      double bestSum = std::numeric_limits<double>::infinity();
-      int bestE = c.chosen, bestSlope = 0;
-      for (size_t i = 0; i < c.cost.size(); ++i) {
-        const int e0 = c.eFirst + static_cast<int>(i);
-        for (int si = 0; si < slopes; ++si) {
-          const double slope = settings.maxSlope * static_cast<double>(si - settings.slopeSteps) /
-                               settings.slopeSteps;
-          double sum = 0;
-          for (int k = -settings.lineRows; k <= settings.lineRows && sum < bestSum; ++k) {
-            const NearSideCut* q = chain[static_cast<size_t>(k + settings.lineRows)];
-            if (q == nullptr) continue;
-            const int e = e0 + static_cast<int>(std::lround(slope * k));
-            const int j = e - q->eFirst;
-            sum += j >= 0 && j < static_cast<int>(q->cost.size()) ? q->cost[static_cast<size_t>(j)]
-                                                                  : cap;
+  forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = std::max(1, rowStart); y < rowEnd; ++y) {
+      std::vector<NearSideCut>& row = rows[static_cast<size_t>(y)];
+      std::vector<NearSideCut>& above = rows[static_cast<size_t>(y - 1)];
+      for (size_t i = 0; i < row.size(); ++i) {
+        NearSideCut& c = row[i];
+        int bestJ = -1, bestDistance = std::numeric_limits<int>::max();
+        for (size_t j = 0; j < above.size(); ++j) {
+          const NearSideCut& p = above[j];
+          if (p.next >= 0 || std::abs(p.dNear - c.dNear) > link ||
+              std::abs(p.dFar - c.dFar) > link || !overlaps(p, c)) {
+            continue;
           }
-          if (sum < bestSum) {
-            bestSum = sum;
-            bestE = e0;
-            bestSlope = si - settings.slopeSteps;
+          const int distance = std::abs(p.rowBest - c.rowBest);
+          if (distance < bestDistance) {
+            bestDistance = distance;
+            bestJ = static_cast<int>(j);
           }
         }
+        if (bestJ >= 0) {
+          c.prev = bestJ;
+          above[static_cast<size_t>(bestJ)].next = static_cast<int>(i);
+        }
       }
-      // A line at the steepest slope tried is likely steeper still (a near-horizontal edge,
-      // whose rows the chain links loosely): the row alone decides there.
-      if (std::abs(bestSlope) < settings.slopeSteps) c.chosen = bestE;
+    }
+    // Each row's costs relative to its own best, capped: a row far off the line costs at most
+    // lineCap, whatever its error. Candidates past the row's own range (over far pixels) cost
+    // at least as much as its own best: a line takes them only where the neighbouring rows put
+    // it. (The links above read only the costs' count.)
+    for (int y = rowStart; y < rowEnd; ++y) {
+      for (NearSideCut& cut : rows[static_cast<size_t>(y)]) {
+        const float best = cut.cost[static_cast<size_t>(cut.rowBest - cut.eFirst)];
+        for (float& c : cut.cost) c = std::min(cap, std::max(0.0F, c - best));
+      }
+    }
+  });
+  const int slopes = 2 * settings.slopeSteps + 1;
+  const int span = 2 * settings.lineRows + 1;
+  // The line's offset from e0 in row y + k, round(slope · k), for each slope tried: computed
+  // once here, not in the innermost loop (lround was a tenth of the snapping's instructions).
+  std::vector<int> lineOffset(static_cast<size_t>(slopes) * static_cast<size_t>(span));
+  for (int si = 0; si < slopes; ++si) {
+    const double slope =
+        settings.maxSlope * static_cast<double>(si - settings.slopeSteps) / settings.slopeSteps;
+    for (int k = -settings.lineRows; k <= settings.lineRows; ++k) {
+      lineOffset[static_cast<size_t>(si * span + k + settings.lineRows)] =
+          static_cast<int>(std::lround(slope * k));
     }
   }
+  forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
+    std::vector<const NearSideCut*> chain;
+    for (int y = rowStart; y < rowEnd; ++y) {
+      for (NearSideCut& c : rows[static_cast<size_t>(y)]) {
+        // The chain's cuts in rows y - lineRows .. y + lineRows (nullptr: no cut of this step).
+        chain.assign(static_cast<size_t>(2 * settings.lineRows + 1), nullptr);
+        chain[static_cast<size_t>(settings.lineRows)] = &c;
+        int linked = 0;
+        const NearSideCut* p = &c;
+        for (int k = 1; k <= settings.lineRows && p->prev >= 0; ++k, ++linked) {
+          p = &rows[static_cast<size_t>(p->y - 1)][static_cast<size_t>(p->prev)];
+          chain[static_cast<size_t>(settings.lineRows - k)] = p;
+        }
+        p = &c;
+        for (int k = 1; k <= settings.lineRows && p->next >= 0; ++k, ++linked) {
+          p = &rows[static_cast<size_t>(p->y + 1)][static_cast<size_t>(p->next)];
+          chain[static_cast<size_t>(settings.lineRows + k)] = p;
+        }
+        // Fewer than lineRows linked rows above and below together: too short to be a line,
+        // the row decides.
+        if (linked < settings.lineRows) continue;
+        // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost.
+        double bestSum = std::numeric_limits<double>::infinity();
+        int bestE = c.chosen, bestSlope = 0;
+        for (size_t i = 0; i < c.cost.size(); ++i) {
+          const int e0 = c.eFirst + static_cast<int>(i);
+          for (int si = 0; si < slopes; ++si) {
+            const int* offsets = &lineOffset[static_cast<size_t>(si * span)];
+            double sum = 0;
+            for (int k = -settings.lineRows; k <= settings.lineRows && sum < bestSum; ++k) {
+              const NearSideCut* q = chain[static_cast<size_t>(k + settings.lineRows)];
+              if (q == nullptr) continue;
+              const int e = e0 + offsets[k + settings.lineRows];
+              const int j = e - q->eFirst;
+              sum += j >= 0 && j < static_cast<int>(q->cost.size())
+                         ? q->cost[static_cast<size_t>(j)]
+                         : cap;
+            }
+            if (sum < bestSum) {
+              bestSum = sum;
+              bestE = e0;
+              bestSlope = si - settings.slopeSteps;
+            }
+          }
+        }
+        // A line at the steepest slope tried is likely steeper still (a near-horizontal edge,
+        // whose rows the chain links loosely): the row alone decides there.
+        if (std::abs(bestSlope) < settings.slopeSteps) c.chosen = bestE;
+      }
+    }
+  });
 }
 }  // namespace
 
@@ -154,31 +180,46 @@ constexpr int kStepSide = 2;
 cv::Mat rowContrast(const cv::Mat& filled) {
   const int w = filled.cols, h = filled.rows;
   cv::Mat step(h, w - 1, CV_32F);
+  // Both sides' sums as written out for the general case below, so that the values are the
+  // same; without the image's ends the loop has no branches and is vectorised.
+  static_assert(kStepSide == 2);
+  const auto edge = [w](const float* row, int x) {
+    float before = 0, after = 0;
+    int nBefore = 0, nAfter = 0;
+    for (int k = 0; k < kStepSide; ++k) {
+      if (x - k >= 0) {
+        before += row[x - k];
+        ++nBefore;
+      }
+      if (x + 1 + k < w) {
+        after += row[x + 1 + k];
+        ++nAfter;
+      }
+    }
+    return std::abs(after / static_cast<float>(nAfter) - before / static_cast<float>(nBefore));
+  };
   for (int y = 0; y < h; ++y) {
     const float* row = filled.ptr<float>(y);
     float* s = step.ptr<float>(y);
-    for (int x = 0; x + 1 < w; ++x) {
-      float before = 0, after = 0;
-      int nBefore = 0, nAfter = 0;
-      for (int k = 0; k < kStepSide; ++k) {
-        if (x - k >= 0) {
-          before += row[x - k];
-          ++nBefore;
-        }
-        if (x + 1 + k < w) {
-          after += row[x + 1 + k];
-          ++nAfter;
-        }
-      }
-      s[x] = std::abs(after / static_cast<float>(nAfter) - before / static_cast<float>(nBefore));
+    s[0] = edge(row, 0);
+    for (int x = 1; x + 2 < w; ++x) {
+      const float before = (0.0F + row[x]) + row[x - 1];
+      const float after = (0.0F + row[x + 1]) + row[x + 2];
+      s[x] = std::abs(after / 2.0F - before / 2.0F);
     }
+    for (int x = std::max(1, w - 2); x + 1 < w; ++x) s[x] = edge(row, x);
   }
   return step;
 }
 
+// NaN as 0, in one pass.
 cv::Mat withoutNaN(const cv::Mat& m) {
-  cv::Mat filled = m.clone();
-  filled.setTo(0.0f, core::nanMask(m));
+  cv::Mat filled(m.size(), CV_32F);
+  for (int y = 0; y < m.rows; ++y) {
+    const float* in = m.ptr<float>(y);
+    float* out = filled.ptr<float>(y);
+    for (int x = 0; x < m.cols; ++x) out[x] = in[x] == in[x] ? in[x] : 0.0F;
+  }
   return filled;
 }
 }  // namespace
@@ -219,11 +260,41 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   double gain = 1, offset = 0;
   int dlo = 0;  // the smallest disparity of the map (checked only): carried runs search from it
   if (checked) {
-    int dhi = 0;
+    // The extremes of the non-NaN disparities, by bands of rows on the workers (0 and 0 when
+    // there are none, as cv::minMaxIdx under a mask gives).
+    const int bandRows = 16;
+    std::vector<std::pair<float, float>> bandRange(
+        static_cast<size_t>((h + bandRows - 1) / bandRows),
+        {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
+    std::atomic<bool> found{false};
+    forRowBands(
+        h, settings.threads,
+        [&](int rowStart, int rowEnd) {
+          auto& [lo, hi] = bandRange[static_cast<size_t>(rowStart / bandRows)];
+          bool seen = false;
+          for (int y = rowStart; y < rowEnd; ++y) {
+            const float* d = disparity.ptr<float>(y);
+            for (int x = 0; x < w; ++x) {
+              if (d[x] != d[x]) continue;
+              lo = std::min(lo, d[x]);
+              hi = std::max(hi, d[x]);
+              seen = true;
+            }
+          }
+          if (seen) found = true;
+        },
+        bandRows);
     double mn = 0, mx = 0;
-    cv::minMaxIdx(disparity, &mn, &mx, nullptr, nullptr, disparity == disparity);
+    if (found) {
+      mn = std::numeric_limits<double>::infinity();
+      mx = -mn;
+      for (const auto& [lo, hi] : bandRange) {
+        mn = std::min(mn, static_cast<double>(lo));
+        mx = std::max(mx, static_cast<double>(hi));
+      }
+    }
     dlo = static_cast<int>(std::floor(mn));
-    dhi = static_cast<int>(std::ceil(mx));
+    const int dhi = static_cast<int>(std::ceil(mx));
     std::tie(gain, offset) = radiometricMap(left, right, dlo, dhi);
   }
   const auto error = [&](int y, int x, float d) {
@@ -383,7 +454,6 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     return changed;
   };
 
-  cv::Mat source = disparity.clone();
   // The checked cuts of each row, applied once every row's are known (continuity below).
   std::vector<std::vector<NearSideCut>> cutsByRow(static_cast<size_t>(h));
   // Rows are independent (each writes only its own): bands of rows on the workers.
@@ -391,8 +461,12 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   forRowBands(h, settings.threads, [&](int rowStart, int rowEnd) {
     int changed = 0;
     std::vector<int> matched;
+    // The row's disparities as they came in (its decisions read them while it writes its output;
+    // a row reads and writes no other row's).
+    std::vector<float> source(static_cast<size_t>(w));
     for (int y = rowStart; y < rowEnd; ++y) {
-      float* d = source.ptr<float>(y);
+      float* d = source.data();
+      std::copy_n(disparity.ptr<float>(y), w, d);
       const float* c = contrast.ptr<float>(y);
       float* out = disparity.ptr<float>(y);
       float* sc = score.empty() ? nullptr : score.ptr<float>(y);

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -52,6 +53,62 @@ TEST(RemoveSpecklesConnectivity, KeepsADiagonalStaircaseAndSlopes) {
   EXPECT_EQ(matchedCount(disparity), 60 + 40);
   // With a range below the slope's step, every pixel of the slope is its own region.
   EXPECT_EQ(removeSpeckles(disparity, noScore, 20, 1.0), 40);
+}
+
+// The regions of `disparity` smaller than maxSize by a plain flood fill (the reference).
+cv::Mat smallRegions(const cv::Mat& disparity, int maxSize, float range) {
+  cv::Mat label(disparity.size(), CV_32S, cv::Scalar(-1));
+  cv::Mat small(disparity.size(), CV_8U, cv::Scalar(0));
+  std::vector<cv::Point> region;
+  for (int y0 = 0; y0 < disparity.rows; ++y0) {
+    for (int x0 = 0; x0 < disparity.cols; ++x0) {
+      if (!std::isfinite(disparity.at<float>(y0, x0)) || label.at<int>(y0, x0) >= 0) continue;
+      region.assign(1, {x0, y0});
+      label.at<int>(y0, x0) = 1;
+      for (size_t k = 0; k < region.size(); ++k) {
+        const cv::Point p = region[k];
+        for (int v = -1; v <= 1; ++v) {
+          for (int u = -1; u <= 1; ++u) {
+            const cv::Point q(p.x + u, p.y + v);
+            if (q.x < 0 || q.y < 0 || q.x >= disparity.cols || q.y >= disparity.rows ||
+                label.at<int>(q) >= 0 ||
+                !(std::abs(disparity.at<float>(q) - disparity.at<float>(p)) <= range)) {
+              continue;
+            }
+            label.at<int>(q) = 1;
+            region.push_back(q);
+          }
+        }
+      }
+      if (static_cast<int>(region.size()) < maxSize) {
+        for (const cv::Point& p : region) small.at<uchar>(p) = 255;
+      }
+    }
+  }
+  return small;
+}
+
+TEST(RemoveSpecklesThreads, SameRemovalsInBandsOfRows) {
+  // Random patches of a few disparities: many regions cross the band borders, some through a
+  // single diagonal neighbour.
+  cv::Mat base(301, 257, CV_32F);
+  cv::RNG rng(7);
+  for (int y = 0; y < base.rows; ++y) {
+    for (int x = 0; x < base.cols; ++x) {
+      const int k = rng.uniform(0, 10);
+      base.at<float>(y, x) = k < 3 ? kNaN : static_cast<float>(4 * (k % 3));
+    }
+  }
+  const cv::Mat expected = smallRegions(base, 20, 2.0F);
+  const int expectedCount = cv::countNonZero(expected);
+  ASSERT_GT(expectedCount, 0);
+  for (const int threads : {1, 2, 3, 8}) {
+    cv::Mat banded = base.clone(), bandedScore = base.clone();
+    EXPECT_EQ(removeSpeckles(banded, bandedScore, 20, 2.0, threads), expectedCount);
+    const cv::Mat removed = core::nanMask(banded) & ~core::nanMask(base);
+    EXPECT_EQ(cv::countNonZero(removed != expected), 0) << threads << " threads";
+    EXPECT_EQ(cv::countNonZero(core::nanMask(bandedScore) != core::nanMask(banded)), 0);
+  }
 }
 
 }  // namespace
