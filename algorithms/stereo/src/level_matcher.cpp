@@ -386,9 +386,12 @@ struct Scratch {
 
 class LevelMatcher {
  public:
-  LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out)
+  // `in` is padded; the outputs cover `inner`, the unpadded image, and are written at
+  // (x, y) − inner.tl() (only inner pixels are searched: the padding's intervals are empty).
+  LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out, cv::Rect inner)
       : in_(in), s_(s), out_(out), W_(in.ref.cols), H_(in.ref.rows), r_(s.window / 2),
-        n_(s.window * s.window), L_(s.lineShift), rowStride_(s.window <= 16 ? 16 : 32) {
+        n_(s.window * s.window), L_(s.lineShift), outX_(inner.x), outY_(inner.y),
+        rowStride_(s.window <= 16 ? 16 : 32) {
     // Independent preparations, run on the level's threads (serial, they took ~12 % of the
     // matcher's time).
     std::vector<std::function<void()>> tasks;
@@ -452,9 +455,9 @@ class LevelMatcher {
         nearEdge_ = cv::Mat::zeros(in.ref.size(), CV_8U);
       }
     });
-    tasks.emplace_back([&] { out.disparity = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN)); });
-    tasks.emplace_back([&] { out.lineShift = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN)); });
-    tasks.emplace_back([&] { out.score = cv::Mat(in.ref.size(), CV_32F, cv::Scalar(kNaN)); });
+    tasks.emplace_back([&] { out.disparity = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
+    tasks.emplace_back([&] { out.lineShift = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
+    tasks.emplace_back([&] { out.score = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
     runTasks(tasks, s.threads);
     otherQStride_ = static_cast<ptrdiff_t>(otherQ_.step1());
     if (useSpans_) prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
@@ -1032,15 +1035,16 @@ class LevelMatcher {
       du = off.x;
       dv = off.y;
     }
-    out_.disparity.at<float>(y, x) = static_cast<float>(cd) + du;
-    out_.lineShift.at<float>(y, x) = static_cast<float>(cdy) + dv;
-    out_.score.at<float>(y, x) = std::min(best, 1.0F);
+    out_.disparity.at<float>(y - outY_, x - outX_) = static_cast<float>(cd) + du;
+    out_.lineShift.at<float>(y - outY_, x - outX_) = static_cast<float>(cdy) + dv;
+    out_.score.at<float>(y - outY_, x - outX_) = std::min(best, 1.0F);
   }
 
   const LevelInput& in_;
   const LevelSettings& s_;
   LevelOutput& out_;
   const int W_, H_, r_, n_, L_;
+  const int outX_, outY_;  // the outputs' origin in the padded input
   const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
   // The main-line span kernel (AVX2, windows ≤ 15 columns): 8 windows a pass.
   const bool useSpans_ = cpuHasAvx2() && s_.window <= 15;
@@ -1087,8 +1091,8 @@ bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput
     cv::copyMakeBorder(m, padded, r, r, r, r + 32, cv::BORDER_CONSTANT, cv::Scalar(value));
     return padded;
   };
-  // The copies in and out run on the level's threads too (serial, they were ~4 % of the
-  // level's wall time with two threads).
+  // The padded copies run on the level's threads too (serial, the copies in and out were ~4 %
+  // of the level's wall time with two threads).
   LevelInput padded = in;
   runTasks({[&] { padded.ref = pad(in.ref, 0); },
             [&] { padded.other = pad(in.other, 0); },
@@ -1098,15 +1102,9 @@ bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput
             [&] { padded.lo = pad(in.lo, 1); },  // lo > hi: not searched
             [&] { padded.hi = pad(in.hi, 0); }},
            settings.threads);
-  LevelOutput paddedOut;
-  LevelMatcher matcher(padded, settings, paddedOut);
-  if (!matcher.run(progress)) return false;
-  const cv::Rect inner(r, r, in.ref.cols, in.ref.rows);
-  runTasks({[&] { out.disparity = paddedOut.disparity(inner).clone(); },
-            [&] { out.lineShift = paddedOut.lineShift(inner).clone(); },
-            [&] { out.score = paddedOut.score(inner).clone(); }},
-           settings.threads);
-  return true;
+  // The matcher writes the unpadded outputs directly (no copy out).
+  LevelMatcher matcher(padded, settings, out, cv::Rect(r, r, in.ref.cols, in.ref.rows));
+  return matcher.run(progress);
 }
 
 }  // namespace delineo::stereo::detail
