@@ -256,6 +256,29 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     return best;
   };
+  // Signed mean of left − mapped right over the pixel and its two vertical neighbours at
+  // disparity d, in noise sigmas (0 where nothing is read).
+  const auto signedResidual = [&](int y, int x, float d) {
+    double sum = 0;
+    int n = 0;
+    for (int v = std::max(0, y - 1); v <= std::min(h - 1, y + 1); ++v) {
+      const float xr = static_cast<float>(x) - d;
+      const int x0 = static_cast<int>(std::floor(xr));
+      if (x0 < 0 || x0 + 1 >= w) continue;
+      const float t = xr - static_cast<float>(x0);
+      const float* r = right.ptr<float>(v);
+      const float a = left.at<float>(v, x);
+      const float b = (1 - t) * r[x0] + t * r[x0 + 1];
+      if (!std::isfinite(a) || !std::isfinite(b)) continue;
+      sum += a - (gain * b + offset);
+      ++n;
+    }
+    return n > 0 ? sum / n / sigma : 0.0;
+  };
+  // Brightness offset (noise sigmas) that tells two surfaces apart: above the sensor noise and
+  // above the few grey levels by which two views of one surface differ (exposure, non-Lambertian
+  // surfaces). The grey levels are the mapped ones (step 1), alike for every input.
+  const double offsetBound = std::max(settings.carriedOffset, settings.carriedOffsetGrey / sigma);
   const auto fitsFarBetter = [&](int y, int x, float dNear, float dFar) {
     return !checked || error(y, x, dFar) < error(y, x, dNear);
   };
@@ -370,6 +393,23 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
             sum += std::min(settings.errorCap, error(y, x, static_cast<float>(df)));
           }
           carried = sum < bound;
+        }
+        // Or the stretch's mean brightness differs from its counterpart's at the run's disparity
+        // while the run's own pixels before the contour agree: two surfaces. A roof's value
+        // carried onto ground that the right view does not see (hidden by the next building)
+        // maps, at the roof's disparity, onto the wall only the right view shows; no disparity
+        // explains that ground, and the wall's texture can correlate with it (NCC ignores the
+        // offset), but its brightness does not. Texture and interpolation errors cancel in the
+        // signed mean; an offset does not.
+        if (!carried && settings.carriedOffset > 0 && n >= settings.carriedOffsetPixels) {
+          double after = 0, before = 0;
+          int nBefore = 0;
+          for (int x = e + 2; x <= x1; ++x) after += signedResidual(y, x, d[x]);
+          for (int x = std::max(x0, e - n); x < e; ++x, ++nBefore) {
+            before += signedResidual(y, x, d[x]);
+          }
+          carried = nBefore > 0 && std::abs(after / n) >= offsetBound &&
+                    std::abs(before / nBefore) <= offsetBound / 2;
         }
         for (int x = e + 1; carried && x <= x1; ++x) {
           d[x] = kNaN;
