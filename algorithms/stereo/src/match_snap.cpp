@@ -486,12 +486,34 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
         // nearer the run's last pixel than the pixel beyond the contour: the last pixels of a
         // roof's +x edge mix roof and ground through the blur, and their neighbour in the right
         // view is another surface, so the photometric test alone stopped 1-2 px short.
+        // Up to openReach, a contour farther than that is taken when the brightness says the
+        // run's surface ends there: at the run's disparity the two pixels past it (after the
+        // mixed one) are offset from their counterpart by at least offsetBound, the pixels up to
+        // it within half that on average, and no stronger contrast lies between the run's end
+        // and it (a roof's texture inside its outline is a weaker step than the outline).
         const float* grey = left.ptr<float>(y);
         for (size_t i = 0; i < matched.size(); ++i) {
           const int a = matched[i];
           const int next = i + 1 < matched.size() ? matched[i + 1] : w;
           if (next - a - 1 <= settings.maxGap) continue;
-          const int best = strongestContour(c, a, std::min(w - 2, a + settings.reach));
+          int best = strongestContour(c, a, std::min(w - 2, a + settings.reach));
+          if (settings.openReach > 0 && settings.carriedOffset > 0) {
+            double inside = 0;  // signed residuals of a + 1 .. e at the run's disparity
+            float strongest = 0, bestContrast = 0;
+            for (int e = a; e <= std::min({w - 4, a + settings.openReach, next - 4}); ++e) {
+              if (e > a) inside += signedResidual(y, e, d[a]);
+              const bool strongestSoFar = c[e] >= strongest;
+              strongest = std::max(strongest, c[e]);
+              if (!strongestSoFar || c[e] < minContrast || c[e] <= bestContrast) continue;
+              if (e > a && std::abs(inside / (e - a)) > offsetBound / 2) continue;
+              const double beyond =
+                  (signedResidual(y, e + 2, d[a]) + signedResidual(y, e + 3, d[a])) / 2;
+              if (std::abs(beyond) >= offsetBound) {
+                bestContrast = c[e];
+                best = std::max(best, e);
+              }
+            }
+          }
           for (int x = a + 1; x <= best; ++x) {
             const bool looksNear = std::abs(grey[x] - grey[a]) < std::abs(grey[x] - grey[best + 1]);
             if (!looksNear && error(y, x, d[a]) > settings.checkSigmas) break;
