@@ -327,6 +327,29 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     return best;
   };
+  // Signed mean of left − mapped right over the pixel and its two vertical neighbours at
+  // disparity d, in noise sigmas (0 where nothing is read).
+  const auto signedResidual = [&](int y, int x, float d) {
+    double sum = 0;
+    int n = 0;
+    for (int v = std::max(0, y - 1); v <= std::min(h - 1, y + 1); ++v) {
+      const float xr = static_cast<float>(x) - d;
+      const int x0 = static_cast<int>(std::floor(xr));
+      if (x0 < 0 || x0 + 1 >= w) continue;
+      const float t = xr - static_cast<float>(x0);
+      const float* r = right.ptr<float>(v);
+      const float a = left.at<float>(v, x);
+      const float b = (1 - t) * r[x0] + t * r[x0 + 1];
+      if (!std::isfinite(a) || !std::isfinite(b)) continue;
+      sum += a - (gain * b + offset);
+      ++n;
+    }
+    return n > 0 ? sum / n / sigma : 0.0;
+  };
+  // Brightness offset (noise sigmas) that tells two surfaces apart: above the sensor noise and
+  // above the few grey levels by which two views of one surface differ (exposure, non-Lambertian
+  // surfaces). The grey levels are the mapped ones (step 1), alike for every input.
+  const double offsetBound = std::max(settings.carriedOffset, settings.carriedOffsetGrey / sigma);
   const auto fitsFarBetter = [&](int y, int x, float dNear, float dFar) {
     return !checked || error(y, x, dFar) < error(y, x, dNear);
   };
@@ -442,6 +465,23 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
           }
           carried = sum < bound;
         }
+        // Or the stretch's mean brightness differs from its counterpart's at the run's disparity
+        // while the run's own pixels before the contour agree: two surfaces. A roof's value
+        // carried onto ground that the right view does not see (hidden by the next building)
+        // maps, at the roof's disparity, onto the wall only the right view shows; no disparity
+        // explains that ground, and the wall's texture can correlate with it (NCC ignores the
+        // offset), but its brightness does not. Texture and interpolation errors cancel in the
+        // signed mean; an offset does not.
+        if (!carried && settings.carriedOffset > 0 && n >= settings.carriedOffsetPixels) {
+          double after = 0, before = 0;
+          int nBefore = 0;
+          for (int x = e + 2; x <= x1; ++x) after += signedResidual(y, x, d[x]);
+          for (int x = std::max(x0, e - n); x < e; ++x, ++nBefore) {
+            before += signedResidual(y, x, d[x]);
+          }
+          carried = nBefore > 0 && std::abs(after / n) >= offsetBound &&
+                    std::abs(before / nBefore) <= offsetBound / 2;
+        }
         for (int x = e + 1; carried && x <= x1; ++x) {
           d[x] = kNaN;
           out[x] = kNaN;
@@ -520,12 +560,34 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
         // nearer the run's last pixel than the pixel beyond the contour: the last pixels of a
         // roof's +x edge mix roof and ground through the blur, and their neighbour in the right
         // view is another surface, so the photometric test alone stopped 1-2 px short.
+        // Up to openReach, a contour farther than that is taken when the brightness says the
+        // run's surface ends there: at the run's disparity the two pixels past it (after the
+        // mixed one) are offset from their counterpart by at least offsetBound, the pixels up to
+        // it within half that on average, and no stronger contrast lies between the run's end
+        // and it (a roof's texture inside its outline is a weaker step than the outline).
         const float* grey = left.ptr<float>(y);
         for (size_t i = 0; i < matched.size(); ++i) {
           const int a = matched[i];
           const int next = i + 1 < matched.size() ? matched[i + 1] : w;
           if (next - a - 1 <= settings.maxGap) continue;
-          const int best = strongestContour(c, a, std::min(w - 2, a + settings.reach));
+          int best = strongestContour(c, a, std::min(w - 2, a + settings.reach));
+          if (settings.openReach > 0 && settings.carriedOffset > 0) {
+            double inside = 0;  // signed residuals of a + 1 .. e at the run's disparity
+            float strongest = 0, bestContrast = 0;
+            for (int e = a; e <= std::min({w - 4, a + settings.openReach, next - 4}); ++e) {
+              if (e > a) inside += signedResidual(y, e, d[a]);
+              const bool strongestSoFar = c[e] >= strongest;
+              strongest = std::max(strongest, c[e]);
+              if (!strongestSoFar || c[e] < minContrast || c[e] <= bestContrast) continue;
+              if (e > a && std::abs(inside / (e - a)) > offsetBound / 2) continue;
+              const double beyond =
+                  (signedResidual(y, e + 2, d[a]) + signedResidual(y, e + 3, d[a])) / 2;
+              if (std::abs(beyond) >= offsetBound) {
+                bestContrast = c[e];
+                best = std::max(best, e);
+              }
+            }
+          }
           for (int x = a + 1; x <= best; ++x) {
             const bool looksNear = std::abs(grey[x] - grey[a]) < std::abs(grey[x] - grey[best + 1]);
             if (!looksNear && error(y, x, d[a]) > settings.checkSigmas) break;

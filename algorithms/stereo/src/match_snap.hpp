@@ -15,6 +15,10 @@ struct StepSnapSettings {
   int cutAhead = 4;                 // px: how far over the far side a line of cuts may take a row
   int carriedRuns = 1;              // px of a run on each side of a contour it crosses (0 = off)
   double carriedMargin = 1.0;       // noise sigmas: a farther disparity's lead over the run's
+  double carriedOffset = 4.0;       // noise sigmas: brightness offset that splits a run (0 = off)
+  double carriedOffsetGrey = 8.0;   // grey levels: the least such offset, whatever the noise
+  int carriedOffsetPixels = 2;      // px: fewest pixels past the contour the offset is read on
+  int openReach = 5;                // px: farthest contour an open end reaches by the offset
   double contourWeight = 1.5;       // error (noise sigmas) traded for one sigma of contour contrast
   double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear
   double rightContourCap = 6.0;     // noise sigmas: most right-view contrast counted
@@ -56,14 +60,23 @@ struct StepSnapSettings {
 // Open ends (checked only): a matched run followed by more than maxGap unmatched pixels (a roof
 // next to a shadow or textureless ground) is extended to the strongest contrast within `reach`
 // (at least edgeSigmas), over pixels that match at its disparity or whose grey is nearer the
-// run's last pixel than the pixel beyond that contrast.
+// run's last pixel than the pixel beyond that contrast. Up to openReach px, a farther contour
+// (the strongest from the run's end to it, at least edgeSigmas) is taken instead when the two
+// pixels past its mixed pixel are offset from the right view at the run's disparity by at
+// least max(carriedOffset sigmas, carriedOffsetGrey grey levels) and the pixels up to it are
+// within half that on average: there the brightness says the run's surface ends.
 // Runs carried across a contour (checked only; first, on each row): a matched run whose
 // neighbours differ by ≤ 1 px, with the strongest left contour (≥ edgeSigmas) of its last
 // maxGap px at least carriedRuns px from both ends. When an integer disparity at least minStep
 // farther explains the run's pixels after the contour (mean capped error ≤ checkSigmas and
 // carriedMargin below theirs at the run's disparity), those pixels become unmatched: a roof's
 // value spread onto the dark ground beyond its +x edge, which at the roof's disparity falls on
-// the wall the right view sees. The gap left is then snapped like the others.
+// the wall the right view sees. They are also split when their mean signed residual
+// (left − mapped right) at the run's disparity is at least max(carriedOffset sigmas,
+// carriedOffsetGrey grey levels) while the run's pixels before the contour (as many, at most)
+// stay within half that: ground the right view does not see, which no disparity explains,
+// carries the roof's value onto the wall only that view shows. The gap left is then snapped
+// like the others.
 // The far side is always left alone. `left`, `right`: the original images (CV_32F, NaN =
 // nodata). Returns the pixels changed.
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,

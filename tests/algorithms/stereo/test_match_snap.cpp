@@ -339,6 +339,113 @@ TEST(SnapSteps, ARoofRunCarriedAFewPixelsOverAShadowStopsAtTheContourToo) {
   EXPECT_GE(roofRowsLocatedAfterACarriedRun(2, StepSnapSettings{}), 28 * 9 / 10);
 }
 
+// A roof (grey 140, disparity 20, [40, 70)) beside a courtyard ([70, 85), textured ground of
+// grey ~70 at disparity 5) that the right view does not see: the next building's roof (textured,
+// disparity 20, from x 85) hides it there. At the roof's disparity the courtyard falls, in the
+// right view, on the first roof's east wall (plain, grey 40), which only that view shows, so no
+// disparity explains the courtyard. The roof's value was carried 10 px onto it, up to a 5 px gap
+// before the next roof. With `hidden` false the courtyard is a dark band of the roof itself
+// (grey ~70, disparity 20, seen by both views): the run is right there. Returns the rows (of 28)
+// whose roof run ends within 1 px of x 69.
+int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings) {
+  const int rows = 30, cols = 300;
+  cv::RNG rng(23);
+  const cv::Mat texture = texturedGround(rows, cols, 0, rng);
+  const auto courtyard = [&](int y, int x) { return 0.7f * texture.at<float>(y, x); };
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      float& l = left.at<float>(y, x);
+      l = x < 40   ? texture.at<float>(y, x)
+          : x < 70 ? 140.0f
+          : x < 85 ? courtyard(y, x)
+                   : texture.at<float>(y, x) + 40.0f;
+      // Right column x: the first roof up to 50, the wall or the band up to 65, the next roof
+      // after; the ground (disparity 5) before the first roof.
+      const int onRoof = x + 20;
+      float& r = right.at<float>(y, x);
+      r = onRoof < 40   ? texture.at<float>(y, std::min(x + 5, cols - 1))
+          : onRoof < 70 ? 140.0f
+          : onRoof < 85 ? (hidden ? 40.0f : courtyard(y, onRoof))
+                        : texture.at<float>(y, std::min(onRoof, cols - 1)) + 40.0f;
+    }
+  }
+  testing::addSensorNoise(left, right, 1.5, rng);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 0, 15, 5.0f);
+  setRun(disparity, 40, 80, 20.0f);
+  setRun(disparity, 85, cols, 20.0f);
+  snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+  int located = 0;
+  for (int y = 1; y + 1 < rows; ++y) {
+    int end = 39;  // last pixel of the roof's run
+    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+    located += std::abs(end - 69) <= 1 ? 1 : 0;
+  }
+  return located;
+}
+
+TEST(SnapSteps, ARoofRunCarriedOverGroundTheRightViewDoesNotSeeStopsAtTheContour) {
+  StepSnapSettings noOffset;
+  noOffset.carriedOffset = 0;
+  EXPECT_EQ(roofRowsEndingAtTheCourtyard(true, noOffset), 0);
+  EXPECT_GE(roofRowsEndingAtTheCourtyard(true, StepSnapSettings{}), 28 * 9 / 10);
+  // A dark band of the roof itself, which both views show alike, keeps the roof's value.
+  EXPECT_EQ(roofRowsEndingAtTheCourtyard(false, StepSnapSettings{}), 0);
+}
+
+// A roof (disparity 20, [40, 70): grey 140, 130 on its last 3 columns, a step of 10 grey levels
+// inside it) beside a textured shadow on the ground ([70, 90), 0.6 × the ground's grey,
+// disparity 5) that is not matched: the roof's run ends at x 64 and is followed by 25
+// unmatched pixels before the ground's run. At the roof's disparity the shadow falls, in the
+// right view, on the roof's east wall, grey `wall`. Returns the rows (of 28) whose roof run
+// ends within 1 px of x 69.
+int roofRowsReachingTheOutlineFromAnOpenEnd(float wall, const StepSnapSettings& settings) {
+  const int rows = 30, cols = 400;
+  cv::RNG rng(29);
+  const cv::Mat ground = texturedGround(rows, cols, 0, rng);
+  const auto groundAt = [&](int y, int x) {  // left-image column x of the ground
+    const float g = ground.at<float>(y, std::min(x, cols - 1));
+    return x >= 70 && x < 90 ? 0.6f * g : g;
+  };
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = x < 40 || x >= 70 ? groundAt(y, x) : x < 67 ? 140.0f : 130.0f;
+    }
+    for (int x = 0; x < cols; ++x) {
+      const int onRoof = x + 20;
+      right.at<float>(y, x) = onRoof >= 40 && onRoof < 70  ? left.at<float>(y, onRoof)
+                              : onRoof >= 70 && x + 5 < 70 ? wall
+                                                           : groundAt(y, x + 5);
+    }
+  }
+  testing::addSensorNoise(left, right, 1.5, rng);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 65, 20.0f);
+  setRun(disparity, 90, cols, 5.0f);
+  snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+  int located = 0;
+  for (int y = 1; y + 1 < rows; ++y) {
+    int end = 39;  // last pixel of the roof's run
+    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 20.0f) ++end;
+    located += std::abs(end - 69) <= 1 ? 1 : 0;
+  }
+  return located;
+}
+
+TEST(SnapSteps, AnOpenEndReachesTheContourBeyondWhichTheRightViewShowsAnotherBrightness) {
+  // A wall of grey 100 where the shadow (~60) would be: the outline, not the roof's inner
+  // step (within `reach` of the run's end), ends the roof.
+  StepSnapSettings nearest;
+  nearest.openReach = 0;
+  EXPECT_EQ(roofRowsReachingTheOutlineFromAnOpenEnd(100.0f, nearest), 0);
+  EXPECT_GE(roofRowsReachingTheOutlineFromAnOpenEnd(100.0f, StepSnapSettings{}), 28 * 9 / 10);
+  // A wall as dark as the shadow: the brightness says little, the run mostly stops at the inner
+  // step (in a few rows the shadow's own texture is offset from the plain wall by the bound).
+  EXPECT_LE(roofRowsReachingTheOutlineFromAnOpenEnd(60.0f, StepSnapSettings{}), 28 / 3);
+}
+
 // A roof (grey 112, disparity 20, [40, 70)) on textured ground (100 ± 12, disparity 5): a
 // weak contour. In rows 10–14 the ground's value was carried 4 px onto the roof (ground run from
 // x 66); elsewhere the step is at the outline. A row may not take far pixels on its own evidence
