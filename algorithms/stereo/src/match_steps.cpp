@@ -34,14 +34,17 @@ struct CutWindow {
 };
 
 // Mask and template of one row of a cut window, over Stride columns (a compile-time count, so
-// the loops are whole vectors). Inputs are copies padded beyond the window's `n` columns.
+// the loops are whole vectors). Inputs are the image rows themselves or copies padded beyond
+// the window's `n` columns; `inWindow` (0 beyond them) keeps whatever lies there out of the
+// sums (grey values are finite: a masked column adds ±0, which leaves every sum unchanged).
 template <int Stride>
 struct CutRowSums {
   float a[Stride] = {}, aa[Stride] = {}, n[Stride] = {}, bad[Stride] = {};
 
-  void add(const float* __restrict grey, const float* __restrict valid,
-           const float* __restrict sd, const float* __restrict val, const float* __restrict inWindow,
-           float side, float centre, float* __restrict m) {
+  template <class Valid>
+  void add(const float* __restrict grey, const Valid* __restrict valid, const float* __restrict sd,
+           const float* __restrict val, const float* __restrict inWindow, float side, float centre,
+           float* __restrict m) {
     for (int j = 0; j < Stride; ++j) {
       // NaN compares false: off the segments (sd NaN) the validated value decides.
       const bool onSegment = sd[j] == sd[j];
@@ -52,7 +55,7 @@ struct CutRowSums {
       const float c = grey[j] - centre;
       m[j] = mj;
       n[j] += mj;
-      bad[j] += mj * (1.0F - valid[j]);
+      bad[j] += mj * (1.0F - static_cast<float>(valid[j]));
       a[j] += mj * c;
       aa[j] += mj * c * c;
     }
@@ -67,8 +70,10 @@ __attribute__((target_clones("avx2", "default"))) void buildCutWindowPadded(
     const cv::Mat& ref, const cv::Mat& refValid, const cv::Mat& sideD, const cv::Mat& validated,
     float side, int x, int y, int r, int minPixels, CutWindow& w) {
   const int n = w.side;
-  // Rows copied into padded buffers (values relative to the centre pixel: small sums on flat
-  // windows, where the variance test needs them exact).
+  // Where the padded rows lie inside the image the sums read them in place; else the rows are
+  // copied into padded buffers. (Values relative to the centre pixel: small sums on flat
+  // windows, where the variance test needs them exact.)
+  const bool inPlace = x - r + Stride <= ref.cols;
   float grey[Stride], valid[Stride], sd[Stride], val[Stride], inWindow[Stride];
   for (int j = 0; j < Stride; ++j) {
     grey[j] = valid[j] = 0.0F;
@@ -83,14 +88,18 @@ __attribute__((target_clones("avx2", "default"))) void buildCutWindowPadded(
     const uchar* va = refValid.ptr<uchar>(v) + (x - r);
     const float* sdRow = sideD.ptr<float>(v) + (x - r);
     const float* valRow = validated.ptr<float>(v) + (x - r);
+    float* m = w.mask.data() + static_cast<size_t>(i) * Stride;
+    if (inPlace) {
+      sums.add(a, va, sdRow, valRow, inWindow, side, centre, m);
+      continue;
+    }
     for (int j = 0; j < n; ++j) {
       grey[j] = a[j];
       valid[j] = va[j];
       sd[j] = sdRow[j];
       val[j] = valRow[j];
     }
-    sums.add(grey, valid, sd, val, inWindow, side, centre,
-             w.mask.data() + static_cast<size_t>(i) * Stride);
+    sums.add(grey, valid, sd, val, inWindow, side, centre, m);
   }
   float sa = 0, saa = 0, count = 0, bad = 0;
   for (int j = 0; j < Stride; ++j) {
@@ -108,6 +117,11 @@ __attribute__((target_clones("avx2", "default"))) void buildCutWindowPadded(
     const size_t row = static_cast<size_t>(i) * Stride;
     const float* m = w.mask.data() + row;
     float* t = w.t.data() + row;
+    if (inPlace) {
+      // Whole rows: beyond the window the mask makes the template ±0 (no sum changes).
+      for (int j = 0; j < Stride; ++j) t[j] = m[j] * ((a[j] - mean) * norm);
+      continue;
+    }
     for (int j = 0; j < n; ++j) t[j] = m[j] * ((a[j] - mean) * norm);
     for (int j = n; j < Stride; ++j) t[j] = 0.0F;
   }
