@@ -243,28 +243,32 @@ float cutWindowNcc(const CutWindow& w, const cv::Mat& other, const cv::Mat& othe
   return stb / std::sqrt(varb);
 }
 
-// Photometric error of ref column x (rows y - r .. y + r) against other at (x - d, y + dy), d
-// real (linear interpolation along x); NaN when out of the image or on nodata.
-float columnError(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
-                  const cv::Mat& otherValid, int x, int y, int r, float d, int dy) {
+// Photometric errors of ref columns xStart .. xStart + n − 1 (rows y − r .. y + r) against
+// other at (x − d, y + dy), d real (linear interpolation along x), into errors[0 .. n − 1];
+// false (errors partly written) when one leaves the image or touches nodata.
+bool columnErrors(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
+                  const cv::Mat& otherValid, int xStart, int n, int y, int r, float d, int dy,
+                  float* errors) {
   const int W = ref.cols, H = ref.rows;
-  const float xo = static_cast<float>(x) - d;
-  const int x0 = static_cast<int>(std::floor(xo));
-  const float t = xo - static_cast<float>(x0);
-  if (x0 < 0 || x0 + 1 >= W || y - r < 0 || y + r >= H || y + dy - r < 0 || y + dy + r >= H) {
-    return kNaN;
-  }
-  float e = 0;
-  for (int v = -r; v <= r; ++v) {
-    if (!refValid.at<uchar>(y + v, x) || !otherValid.at<uchar>(y + dy + v, x0) ||
-        !otherValid.at<uchar>(y + dy + v, x0 + 1)) {
-      return kNaN;
+  if (y - r < 0 || y + r >= H || y + dy - r < 0 || y + dy + r >= H) return false;
+  for (int k = 0; k < n; ++k) {
+    const int x = xStart + k;
+    const float xo = static_cast<float>(x) - d;
+    const int x0 = static_cast<int>(std::floor(xo));
+    const float t = xo - static_cast<float>(x0);
+    if (x0 < 0 || x0 + 1 >= W) return false;
+    float e = 0;
+    for (int v = -r; v <= r; ++v) {
+      const uchar* bValid = otherValid.ptr<uchar>(y + dy + v);
+      if (!refValid.ptr<uchar>(y + v)[x] || !bValid[x0] || !bValid[x0 + 1]) return false;
+      const float* b = other.ptr<float>(y + dy + v);
+      const float diff = ref.ptr<float>(y + v)[x] - ((1 - t) * b[x0] + t * b[x0 + 1]);
+      e += diff * diff;
     }
-    const float* b = other.ptr<float>(y + dy + v);
-    const float diff = ref.at<float>(y + v, x) - ((1 - t) * b[x0] + t * b[x0 + 1]);
-    e += diff * diff;
+    if (!std::isfinite(e)) return false;
+    errors[k] = e;
   }
-  return e;
+  return true;
 }
 
 // Best disparity within ±2 px of `side` over a shape, with a parabola sub-pixel fit; NaN score
@@ -357,18 +361,14 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
         // photometric error (both hypotheses scored on the same pixels, so texture strength
         // does not bias the choice as it does when two windows' NCCs are compared).
         const int n = s1 - s0 + 1;
-        costA.assign(static_cast<size_t>(n), 0.0F);
-        costB.assign(static_cast<size_t>(n), 0.0F);
-        bool usable = true;
-        for (int k = 0; k < n && usable; ++k) {
-          costA[static_cast<size_t>(k)] =
-              columnError(ref, other, refValid, otherValid, s0 + k, y, s.costRadius, da, dyA);
-          costB[static_cast<size_t>(k)] =
-              columnError(ref, other, refValid, otherValid, s0 + k, y, s.costRadius, db, dyB);
-          usable = std::isfinite(costA[static_cast<size_t>(k)]) &&
-                   std::isfinite(costB[static_cast<size_t>(k)]);
+        costA.resize(static_cast<size_t>(n));
+        costB.resize(static_cast<size_t>(n));
+        if (!columnErrors(ref, other, refValid, otherValid, s0, n, y, s.costRadius, da, dyA,
+                          costA.data()) ||
+            !columnErrors(ref, other, refValid, otherValid, s0, n, y, s.costRadius, db, dyB,
+                          costB.data())) {
+          continue;
         }
-        if (!usable) continue;
         // Occluded strip: when the +x surface is nearer, the `strip` columns before it are not
         // seen in the other view; the boundary then has the strip between the two sides, and
         // every position scores the same number of columns (n - strip).
