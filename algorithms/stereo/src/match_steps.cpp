@@ -164,18 +164,21 @@ int invalidIn(const cv::Mat& invalidSum, int x0, int y0, int x1, int y1) {
 }
 
 // Σ m·c, Σ m·c², Σ t·c over a window's rows, c = b − offset, with whole rows of Stride columns
-// (compile-time: whole vectors); `rows[i]` points at the other image under row i.
+// (compile-time: whole vectors); `rows` points at the other image under row 0, `step` floats
+// apart.
 template <int Stride>
-__attribute__((target_clones("avx2", "default"))) void cutWindowSumsPadded(
-    const CutWindow& w, const float* const* rows, float offset, float& sb, float& sbb,
-    float& stb) {
+__attribute__((target_clones("avx2", "default"))) void cutWindowSumsPadded(const CutWindow& w,
+                                                                           const float* rows,
+                                                                           size_t step,
+                                                                           float offset, float& sb,
+                                                                           float& sbb, float& stb) {
   // 8-float vectors (GCC vector extension; two SSE registers in the baseline clone).
   using Float8 = float __attribute__((vector_size(32)));
   constexpr int kVectors = Stride / 8;
   Float8 colB[kVectors] = {}, colBB[kVectors] = {}, colTB[kVectors] = {};
   const Float8 off = {offset, offset, offset, offset, offset, offset, offset, offset};
   for (int i = 0; i < w.side; ++i) {
-    const float* b = rows[i];
+    const float* b = rows + static_cast<size_t>(i) * step;
     const float* m = w.mask.data() + static_cast<size_t>(i) * Stride;
     const float* t = w.t.data() + static_cast<size_t>(i) * Stride;
     for (int k = 0; k < kVectors; ++k) {
@@ -214,13 +217,21 @@ float cutWindowNcc(const CutWindow& w, const cv::Mat& other, const cv::Mat& othe
   // Fast path: the padded rows lie inside the image and the window holds no nodata.
   const bool inside = x0 >= 0 && x0 + stride <= other.cols && y0 >= 0 && y0 + side <= other.rows;
   if (inside && invalidIn(otherInvalidSum, x0, y0, x0 + side - 1, y0 + side - 1) == 0) {
-    const float* rows[kMaxStride];
-    for (int i = 0; i < side; ++i) rows[i] = other.ptr<float>(y0 + i) + x0;
+    const float* rows = other.ptr<float>(y0) + x0;
+    const size_t step = other.step1();
     switch (stride) {
-      case 8: cutWindowSumsPadded<8>(w, rows, offset, sb, sbb, stb); break;
-      case 16: cutWindowSumsPadded<16>(w, rows, offset, sb, sbb, stb); break;
-      case 24: cutWindowSumsPadded<24>(w, rows, offset, sb, sbb, stb); break;
-      default: cutWindowSumsPadded<kMaxStride>(w, rows, offset, sb, sbb, stb); break;
+      case 8:
+        cutWindowSumsPadded<8>(w, rows, step, offset, sb, sbb, stb);
+        break;
+      case 16:
+        cutWindowSumsPadded<16>(w, rows, step, offset, sb, sbb, stb);
+        break;
+      case 24:
+        cutWindowSumsPadded<24>(w, rows, step, offset, sb, sbb, stb);
+        break;
+      default:
+        cutWindowSumsPadded<kMaxStride>(w, rows, step, offset, sb, sbb, stb);
+        break;
     }
   } else {
     // Edge of the image or nodata nearby: only the window's own pixels must be usable.
@@ -271,6 +282,15 @@ bool columnErrors(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refVa
   return true;
 }
 
+// std::lround(v) as an int without the libm call: halves away from zero (v − trunc(v) is exact
+// in float); NaN and values beyond the int range still go through std::lround.
+int roundHalfAway(float v) {
+  if (!(std::abs(v) < 2147483648.0F)) return static_cast<int>(std::lround(v));
+  const int i = static_cast<int>(v);
+  const float f = v - static_cast<float>(i);
+  return i + (f >= 0.5F ? 1 : 0) - (f <= -0.5F ? 1 : 0);
+}
+
 // Best disparity within ±2 px of `side` over a shape, with a parabola sub-pixel fit; NaN score
 // when the peak is on the border of that search (a slope).
 struct Hypothesis {
@@ -280,7 +300,7 @@ struct Hypothesis {
 Hypothesis bestNear(const CutWindow& w, const cv::Mat& other, const cv::Mat& otherValid,
                     const cv::Mat& otherInvalidSum, float side, int dy) {
   Hypothesis best;
-  const int centre = static_cast<int>(std::lround(side));
+  const int centre = roundHalfAway(side);
   // Centre ±1 first; ±2 only on the side where the maximum of those three lies on the border.
   float sc[5] = {kNaN, kNaN, kNaN, kNaN, kNaN};
   int bestK = -1;
@@ -355,8 +375,8 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
                          std::abs(val[x] - db) > 1.0F;
         }
         if (thirdSurface) continue;
-        const int dyA = static_cast<int>(std::lround(shift[ua]));
-        const int dyB = static_cast<int>(std::lround(shift[ub]));
+        const int dyA = roundHalfAway(shift[ua]);
+        const int dyB = roundHalfAway(shift[ub]);
         // Boundary β: columns ≤ β on the −x surface, > β on the +x one, at the least total
         // photometric error (both hypotheses scored on the same pixels, so texture strength
         // does not bias the choice as it does when two windows' NCCs are compared).
@@ -372,7 +392,7 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
         // Occluded strip: when the +x surface is nearer, the `strip` columns before it are not
         // seen in the other view; the boundary then has the strip between the two sides, and
         // every position scores the same number of columns (n - strip).
-        const int strip = s.occlusionStrip && db > da ? static_cast<int>(std::lround(db - da)) : 0;
+        const int strip = s.occlusionStrip && db > da ? roundHalfAway(db - da) : 0;
         if (n - strip < 2) continue;
         float total = 0;
         for (int k = strip; k < n; ++k) total += costB[static_cast<size_t>(k)];
@@ -407,7 +427,7 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
           if (q - p < 2 || q - p > s.gapFill + 1) continue;
           if (std::abs(val[p] - val[q]) > s.gapTolerance) continue;
           const float surface = 0.5F * (val[p] + val[q]);
-          const schar dySurface = static_cast<schar>(std::lround(shift[p]));
+          const schar dySurface = static_cast<schar>(roundHalfAway(shift[p]));
           for (int x = p + 1; x < q; ++x) {
             if (std::isfinite(sideRow[x])) continue;  // part of a step segment
             sideRow[x] = surface;
