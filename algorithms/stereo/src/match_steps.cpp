@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <thread>
 #include <vector>
@@ -341,14 +342,19 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
   const int W = ref.cols, H = ref.rows;
   const int h = s.window / 2;
   std::atomic<long> changed{0};
-  const cv::Mat shifts = raw.lineShift.clone();  // line shifts of the sides' source pixels
-  // Side chosen for each pixel of a step segment: its surface's disparity and line shift.
-  cv::Mat sideD(ref.size(), CV_32F, cv::Scalar(kNaN));
-  cv::Mat sideDy(ref.size(), CV_8S, cv::Scalar(0));
-  forRowBands(H, s.threads, [&](int rowStart, int rowEnd) {
+  // Line shifts of the sides' source pixels: only the second pass below writes raw.lineShift,
+  // after the first has read them (no copy needed).
+  const cv::Mat& shifts = raw.lineShift;
+  // Side chosen for each pixel of a step segment: its surface's disparity and line shift (each
+  // band of the first pass initialises its own rows).
+  cv::Mat sideD(ref.size(), CV_32F);
+  cv::Mat sideDy(ref.size(), CV_8S);
+  auto chooseSides = [&](int rowStart, int rowEnd) {
     std::vector<int> valid;
     std::vector<float> costA, costB;
     for (int y = rowStart; y < rowEnd; ++y) {
+      std::fill_n(sideD.ptr<float>(y), W, kNaN);
+      std::fill_n(sideDy.ptr<schar>(y), W, schar{0});
       const float* val = validated.ptr<float>(y);
       const float* shift = shifts.ptr<float>(y);
       valid.clear();
@@ -446,11 +452,19 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
         }
       }
     }
-  }, /*bandRows=*/8);
+  };
+  // Bands of 8 rows as tasks, with the integral image of the other image's nodata pixels (for
+  // the second pass) one more task among them.
+  cv::Mat otherInvalidSum;
+  constexpr int kBandRows = 8;
+  std::vector<std::function<void()>> tasks;
+  tasks.emplace_back([&] { cv::integral(1 - otherValid, otherInvalidSum, CV_32S); });
+  for (int y0 = 0; y0 < H; y0 += kBandRows) {
+    tasks.emplace_back([&, y0] { chooseSides(y0, std::min(H, y0 + kBandRows)); });
+  }
+  runTasks(tasks, s.threads);
   // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
   // own side (same side value), and the validated pixels off the segments on that surface.
-  cv::Mat otherInvalidSum;  // integral image of the other image's nodata pixels
-  cv::integral(1 - otherValid, otherInvalidSum, CV_32S);
   forRowBands(H, s.threads, [&](int rowStart, int rowEnd) {
     CutWindow window;
     for (int y = rowStart; y < rowEnd; ++y) {
