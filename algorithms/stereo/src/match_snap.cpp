@@ -594,6 +594,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
           // after a seam, next to plain dark ground). A contour within 2 px of the first pixel
           // that evidence fails on (it mixes both surfaces through the blur) is the surface's
           // edge when the pixels up to it match at the run's disparity on average.
+          int grown = a;  // the pixels up to it were checked by the growth
           if (settings.openGrowth > 0 && next < w && d[next] <= d[a] - settings.minStep) {
             int g = a;
             while (g + 1 < std::min(next, a + 1 + settings.openGrowth)) {
@@ -612,12 +613,15 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
               double own = 0;
               for (int x = a + 1; x <= e; ++x)
                 own += std::min(settings.errorCap, error(y, x, d[a]));
-              if (own <= settings.checkSigmas * (e - a)) best = e;
+              if (own <= settings.checkSigmas * (e - a)) {
+                best = e;
+                grown = std::min(g, e);
+              }
             }
           }
           for (int x = a + 1; x <= best; ++x) {
             const bool looksNear = std::abs(grey[x] - grey[a]) < std::abs(grey[x] - grey[best + 1]);
-            if (!looksNear && error(y, x, d[a]) > settings.checkSigmas) break;
+            if (x > grown && !looksNear && error(y, x, d[a]) > settings.checkSigmas) break;
             out[x] = d[a];
             if (sc) sc[x] = fillScore;
             ++changed;

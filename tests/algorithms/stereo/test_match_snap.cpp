@@ -452,8 +452,10 @@ TEST(SnapSteps, AnOpenEndReachesTheContourBeyondWhichTheRightViewShowsAnotherBri
   EXPECT_GE(roofRowsReachingTheOutlineFromAnOpenEnd(60.0f, StepSnapSettings{}), 28 * 8 / 10);
 }
 
-// A roof (disparity 40, [40, 70)) whose run is matched on its textured part [40, 52) only: a dark
-// seam [52, 54) and then a plain strip (grey 140) up to the outline. Beside it plain dark ground
+// A roof (disparity 40, [40, 70)) whose run is matched on its textured part [40, 52) only, a
+// tenth of a pixel off (40.1): a dark seam [52, 54) and then a plain strip (grey 140, with a thin
+// dark line of grey 80 at x 60, which errs by ~5 sigmas at the run's disparity through the
+// interpolation) up to the outline. Beside it plain dark ground
 // ([70, 100), grey 60, disparity 5) is unmatched before the textured ground's run: the roof's
 // run is an open end 48 px from the next run. At the roof's disparity the strip matches; at the
 // ground's it falls, in the right view, on the roof's east wall (grey 90). Returns the rows (of
@@ -471,6 +473,7 @@ int roofRowsGrowingOverAPlainStripToTheOutline(const StepSnapSettings& settings)
       left.at<float>(y, x) = x < 40 || x >= 70 ? groundAt(y, x)
                              : x < 52          ? groundAt(y, x) + 40.0f
                              : x < 54          ? 80.0f
+                             : x == 60         ? 80.0f
                                                : 140.0f;
     }
     for (int x = 0; x < cols; ++x) {
@@ -482,13 +485,13 @@ int roofRowsGrowingOverAPlainStripToTheOutline(const StepSnapSettings& settings)
   }
   testing::addSensorNoise(left, right, 1.5, rng);
   cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
-  setRun(disparity, 40, 52, 40.0f);
+  setRun(disparity, 40, 52, 40.1f);
   setRun(disparity, 100, cols, 5.0f);
   snapStepsToContours(left, right, settings, 0.3f, disparity, score);
   int located = 0;
   for (int y = 1; y + 1 < rows; ++y) {
     int end = 39;  // last pixel of the roof's run
-    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 40.0f) ++end;
+    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 40.1f) ++end;
     located += std::abs(end - 69) <= 1 ? 1 : 0;
   }
   return located;
