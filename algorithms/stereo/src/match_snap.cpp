@@ -588,9 +588,40 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
               }
             }
           }
+          // The run grows over the gap's pixels its disparity explains better (by carriedMargin)
+          // than the far side's after the gap (within errorCap: a thin seam's pixels err by a few
+          // sigmas through interpolation): the run's surface goes on there (a plain roof strip
+          // after a seam, next to plain dark ground). A contour within 2 px of the first pixel
+          // that evidence fails on (it mixes both surfaces through the blur) is the surface's
+          // edge when the pixels up to it match at the run's disparity on average.
+          int grown = a;  // the pixels up to it were checked by the growth
+          if (settings.openGrowth > 0 && next < w && d[next] <= d[a] - settings.minStep) {
+            int g = a;
+            while (g + 1 < std::min(next, a + 1 + settings.openGrowth)) {
+              const double own = error(y, g + 1, d[a]);
+              if (own > settings.errorCap ||
+                  own + settings.carriedMargin > error(y, g + 1, d[next])) {
+                break;
+              }
+              ++g;
+            }
+            const int e = g > a + 1 ? strongestContour(c, std::max(a, g - 2),
+                                                       std::min({w - 3, g + 2, next - 2}))
+                                    : -1;
+            // The contrast of a step spreads over the pixels beside it: only its peak is the edge.
+            if (e > best && c[e] >= c[e - 1] && c[e] >= c[e + 1]) {
+              double own = 0;
+              for (int x = a + 1; x <= e; ++x)
+                own += std::min(settings.errorCap, error(y, x, d[a]));
+              if (own <= settings.checkSigmas * (e - a)) {
+                best = e;
+                grown = std::min(g, e);
+              }
+            }
+          }
           for (int x = a + 1; x <= best; ++x) {
             const bool looksNear = std::abs(grey[x] - grey[a]) < std::abs(grey[x] - grey[best + 1]);
-            if (!looksNear && error(y, x, d[a]) > settings.checkSigmas) break;
+            if (x > grown && !looksNear && error(y, x, d[a]) > settings.checkSigmas) break;
             out[x] = d[a];
             if (sc) sc[x] = fillScore;
             ++changed;

@@ -19,6 +19,7 @@ struct StepSnapSettings {
   double carriedOffsetGrey = 8.0;   // grey levels: the least such offset, whatever the noise
   int carriedOffsetPixels = 2;      // px: fewest pixels past the contour the offset is read on
   int openReach = 5;                // px: farthest contour an open end reaches by the offset
+  int openGrowth = 16;              // px: farthest an open end grows over pixels only it explains
   double contourWeight = 1.5;       // error (noise sigmas) traded for one sigma of contour contrast
   double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear
   double rightContourCap = 6.0;     // noise sigmas: most right-view contrast counted
@@ -64,7 +65,11 @@ struct StepSnapSettings {
 // (the strongest from the run's end to it, at least edgeSigmas) is taken instead when the two
 // pixels past its mixed pixel are offset from the right view at the run's disparity by at
 // least max(carriedOffset sigmas, carriedOffsetGrey grey levels) and the pixels up to it are
-// within half that on average: there the brightness says the run's surface ends.
+// within half that on average: there the brightness says the run's surface ends. When the run is
+// the near side of the run after the gap, it grows (up to openGrowth px) over the pixels its
+// disparity explains better by carriedMargin than that run's (each within errorCap); a contour
+// within 2 px of where that stops, at a peak of the contrast, is taken when the pixels up to it
+// match at the run's disparity within checkSigmas on average.
 // Runs carried across a contour (checked only; first, on each row): a matched run whose
 // neighbours differ by ≤ 1 px, with the strongest left contour (≥ edgeSigmas) of its last
 // maxGap px at least carriedRuns px from both ends. When an integer disparity at least minStep

@@ -437,13 +437,71 @@ int roofRowsReachingTheOutlineFromAnOpenEnd(float wall, const StepSnapSettings& 
 TEST(SnapSteps, AnOpenEndReachesTheContourBeyondWhichTheRightViewShowsAnotherBrightness) {
   // A wall of grey 100 where the shadow (~60) would be: the outline, not the roof's inner
   // step (within `reach` of the run's end), ends the roof.
-  StepSnapSettings nearest;
+  // The growth over pixels only the run's disparity explains (next test) reaches it too: off.
+  StepSnapSettings offset;
+  offset.openGrowth = 0;
+  StepSnapSettings nearest = offset;
   nearest.openReach = 0;
   EXPECT_EQ(roofRowsReachingTheOutlineFromAnOpenEnd(100.0f, nearest), 0);
-  EXPECT_GE(roofRowsReachingTheOutlineFromAnOpenEnd(100.0f, StepSnapSettings{}), 28 * 9 / 10);
+  EXPECT_GE(roofRowsReachingTheOutlineFromAnOpenEnd(100.0f, offset), 28 * 9 / 10);
   // A wall as dark as the shadow: the brightness says little, the run mostly stops at the inner
   // step (in a few rows the shadow's own texture is offset from the plain wall by the bound).
-  EXPECT_LE(roofRowsReachingTheOutlineFromAnOpenEnd(60.0f, StepSnapSettings{}), 28 / 3);
+  EXPECT_LE(roofRowsReachingTheOutlineFromAnOpenEnd(60.0f, offset), 28 / 3);
+  // The roof's last pixels match at its disparity and not at the shadow's (they would fall on
+  // the wall): the growth takes the run to the outline whatever the wall's brightness.
+  EXPECT_GE(roofRowsReachingTheOutlineFromAnOpenEnd(60.0f, StepSnapSettings{}), 28 * 8 / 10);
+}
+
+// A roof (disparity 40, [40, 70)) whose run is matched on its textured part [40, 52) only, a
+// tenth of a pixel off (40.1): a dark seam [52, 54) and then a plain strip (grey 140, with a thin
+// dark line of grey 80 at x 60, which errs by ~5 sigmas at the run's disparity through the
+// interpolation) up to the outline. Beside it plain dark ground
+// ([70, 100), grey 60, disparity 5) is unmatched before the textured ground's run: the roof's
+// run is an open end 48 px from the next run. At the roof's disparity the strip matches; at the
+// ground's it falls, in the right view, on the roof's east wall (grey 90). Returns the rows (of
+// 28) whose roof run ends within 1 px of x 69.
+int roofRowsGrowingOverAPlainStripToTheOutline(const StepSnapSettings& settings) {
+  const int rows = 30, cols = 300;
+  cv::RNG rng(31);
+  const cv::Mat ground = texturedGround(rows, cols, 0, rng);
+  const auto groundAt = [&](int y, int x) {  // left-image column x of the ground
+    return x >= 70 && x < 100 ? 60.0f : ground.at<float>(y, std::min(x, cols - 1));
+  };
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = x < 40 || x >= 70 ? groundAt(y, x)
+                             : x < 52          ? groundAt(y, x) + 40.0f
+                             : x < 54          ? 80.0f
+                             : x == 60         ? 80.0f
+                                               : 140.0f;
+    }
+    for (int x = 0; x < cols; ++x) {
+      const int onRoof = x + 40;
+      right.at<float>(y, x) = onRoof >= 40 && onRoof < 70  ? left.at<float>(y, onRoof)
+                              : onRoof >= 70 && x + 5 < 70 ? 90.0f
+                                                           : groundAt(y, x + 5);
+    }
+  }
+  testing::addSensorNoise(left, right, 1.5, rng);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 52, 40.1f);
+  setRun(disparity, 100, cols, 5.0f);
+  snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+  int located = 0;
+  for (int y = 1; y + 1 < rows; ++y) {
+    int end = 39;  // last pixel of the roof's run
+    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 40.1f) ++end;
+    located += std::abs(end - 69) <= 1 ? 1 : 0;
+  }
+  return located;
+}
+
+TEST(SnapSteps, AnOpenEndGrowsOverPixelsOnlyItsDisparityExplainsToTheContour) {
+  StepSnapSettings noGrowth;
+  noGrowth.openGrowth = 0;
+  EXPECT_EQ(roofRowsGrowingOverAPlainStripToTheOutline(noGrowth), 0);
+  EXPECT_GE(roofRowsGrowingOverAPlainStripToTheOutline(StepSnapSettings{}), 28 * 9 / 10);
 }
 
 // A roof (grey 112, disparity 20, [40, 70)) on textured ground (100 ± 12, disparity 5): a
