@@ -297,7 +297,10 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     const int dhi = static_cast<int>(std::ceil(mx));
     std::tie(gain, offset) = radiometricMap(left, right, dlo, dhi);
   }
-  const auto error = [&](int y, int x, float d) {
+  // Mean of left − mapped right (its absolute value, or signed: a brightness offset) over the
+  // pixel and its two vertical neighbours at disparity d, in noise sigmas; `none` where nothing
+  // is read.
+  const auto meanResidual = [&](int y, int x, float d, bool absolute, double none) {
     double sum = 0;
     int n = 0;
     for (int v = std::max(0, y - 1); v <= std::min(h - 1, y + 1); ++v) {
@@ -309,11 +312,13 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
       const float a = left.at<float>(v, x);
       const float b = (1 - t) * r[x0] + t * r[x0 + 1];
       if (!std::isfinite(a) || !std::isfinite(b)) continue;
-      sum += std::abs(a - (gain * b + offset));
+      const double residual = a - (gain * b + offset);
+      sum += absolute ? std::abs(residual) : residual;
       ++n;
     }
-    return n > 0 ? sum / n / sigma : 1e30;
+    return n > 0 ? sum / n / sigma : none;
   };
+  const auto error = [&](int y, int x, float d) { return meanResidual(y, x, d, true, 1e30); };
   // Contour position e (between pixels e and e + 1) of the strongest contrast in [e0, e1] of a
   // row's contrast `c`, when it is at least minContrast; -1 otherwise.
   const auto strongestContour = [&](const float* c, int e0, int e1) {
@@ -327,24 +332,9 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     return best;
   };
-  // Signed mean of left − mapped right over the pixel and its two vertical neighbours at
-  // disparity d, in noise sigmas (0 where nothing is read).
+  // Signed mean residual, in noise sigmas (0 where nothing is read).
   const auto signedResidual = [&](int y, int x, float d) {
-    double sum = 0;
-    int n = 0;
-    for (int v = std::max(0, y - 1); v <= std::min(h - 1, y + 1); ++v) {
-      const float xr = static_cast<float>(x) - d;
-      const int x0 = static_cast<int>(std::floor(xr));
-      if (x0 < 0 || x0 + 1 >= w) continue;
-      const float t = xr - static_cast<float>(x0);
-      const float* r = right.ptr<float>(v);
-      const float a = left.at<float>(v, x);
-      const float b = (1 - t) * r[x0] + t * r[x0 + 1];
-      if (!std::isfinite(a) || !std::isfinite(b)) continue;
-      sum += a - (gain * b + offset);
-      ++n;
-    }
-    return n > 0 ? sum / n / sigma : 0.0;
+    return meanResidual(y, x, d, false, 0.0);
   };
   // Brightness offset (noise sigmas) that tells two surfaces apart: above the sensor noise and
   // above the few grey levels by which two views of one surface differ (exposure, non-Lambertian

@@ -339,6 +339,18 @@ TEST(SnapSteps, ARoofRunCarriedAFewPixelsOverAShadowStopsAtTheContourToo) {
   EXPECT_GE(roofRowsLocatedAfterACarriedRun(2, StepSnapSettings{}), 28 * 9 / 10);
 }
 
+// Rows (all but the first and the last) whose run of `value` from x 40 ends within 1 px of
+// `outline`.
+int rowsWhoseRoofRunEndsAt(const cv::Mat& disparity, float value, int outline) {
+  int located = 0;
+  for (int y = 1; y + 1 < disparity.rows; ++y) {
+    int end = 39;  // last pixel of the roof's run
+    while (end + 1 < disparity.cols && disparity.at<float>(y, end + 1) == value) ++end;
+    located += std::abs(end - outline) <= 1 ? 1 : 0;
+  }
+  return located;
+}
+
 // A roof (grey 140, disparity 20, [40, 70)) beside a courtyard ([70, 85), textured ground of
 // grey ~70 at disparity 5) that the right view does not see: the next building's roof (textured,
 // disparity 20, from x 85) hides it there. At the roof's disparity the courtyard falls, in the
@@ -376,13 +388,7 @@ int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings) 
   setRun(disparity, 40, 80, 20.0f);
   setRun(disparity, 85, cols, 20.0f);
   snapStepsToContours(left, right, settings, 0.3f, disparity, score);
-  int located = 0;
-  for (int y = 1; y + 1 < rows; ++y) {
-    int end = 39;  // last pixel of the roof's run
-    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 20.0f) ++end;
-    located += std::abs(end - 69) <= 1 ? 1 : 0;
-  }
-  return located;
+  return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
 }
 
 TEST(SnapSteps, ARoofRunCarriedOverGroundTheRightViewDoesNotSeeStopsAtTheContour) {
@@ -425,13 +431,7 @@ int roofRowsReachingTheOutlineFromAnOpenEnd(float wall, const StepSnapSettings& 
   setRun(disparity, 40, 65, 20.0f);
   setRun(disparity, 90, cols, 5.0f);
   snapStepsToContours(left, right, settings, 0.3f, disparity, score);
-  int located = 0;
-  for (int y = 1; y + 1 < rows; ++y) {
-    int end = 39;  // last pixel of the roof's run
-    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 20.0f) ++end;
-    located += std::abs(end - 69) <= 1 ? 1 : 0;
-  }
-  return located;
+  return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
 }
 
 TEST(SnapSteps, AnOpenEndReachesTheContourBeyondWhichTheRightViewShowsAnotherBrightness) {
@@ -488,13 +488,7 @@ int roofRowsGrowingOverAPlainStripToTheOutline(const StepSnapSettings& settings)
   setRun(disparity, 40, 52, 40.1f);
   setRun(disparity, 100, cols, 5.0f);
   snapStepsToContours(left, right, settings, 0.3f, disparity, score);
-  int located = 0;
-  for (int y = 1; y + 1 < rows; ++y) {
-    int end = 39;  // last pixel of the roof's run
-    while (end + 1 < cols && disparity.at<float>(y, end + 1) == 40.1f) ++end;
-    located += std::abs(end - 69) <= 1 ? 1 : 0;
-  }
-  return located;
+  return rowsWhoseRoofRunEndsAt(disparity, 40.1f, 69);
 }
 
 TEST(SnapSteps, AnOpenEndGrowsOverPixelsOnlyItsDisparityExplainsToTheContour) {
