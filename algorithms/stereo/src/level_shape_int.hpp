@@ -79,18 +79,21 @@ inline int shapeBatchWindows() {
 // (columns of the window). Level 0 holds the row's cells from its first to its last; level g > 0
 // its g-th gap between them (a hole of S: most are contour pixels a shape leaves out), negated;
 // rows with fewer gaps hold empty terms (plus = minus) there. `levels` counts the levels any row
-// needs. Built for all 16 rows at once in vector lanes: a loop over each row's runs cost as much
-// as the kernel saved.
+// needs; gapRows[g] (g > 0) has bit 2v set where row v's term of level g is not empty (most rows
+// have no gap: the kernel skips the empty terms). Built for all 16 rows at once in vector lanes:
+// a loop over each row's runs cost as much as the kernel saved.
 constexpr int kSpanLevels = 4;  // the outer span and up to 3 gaps a row
 struct ShapeSpans {
   alignas(32) int16_t plus[kSpanLevels][16];
   alignas(32) int16_t minus[kSpanLevels][16];
+  uint32_t gapRows[kSpanLevels] = {};
   int levels = 0;
 };
 
 // Portable version of shapeSpansAvx2 (also its reference): false when a row has more gaps.
 inline bool shapeSpansScalar(const uint16_t* rows, ShapeSpans& spans) {
   spans.levels = 1;
+  for (uint32_t& gapRows : spans.gapRows) gapRows = 0;
   for (int v = 0; v < 16; ++v) {
     const uint32_t cells = rows[v];
     const int first = __builtin_ctz(cells | (1U << 16));          // 16 for an empty row
@@ -103,6 +106,7 @@ inline bool shapeSpansScalar(const uint16_t* rows, ShapeSpans& spans) {
       const int length = __builtin_ctz(~(gaps >> gap));  // 0 when none
       spans.plus[g][v] = static_cast<int16_t>(gap);
       spans.minus[g][v] = static_cast<int16_t>(gap + length);
+      if (length > 0) spans.gapRows[g] |= 1U << (2 * v);
       if (length > 0 && g + 1 > spans.levels) spans.levels = g + 1;
       gaps &= ~(((1U << length) - 1U) << gap);
     }
@@ -275,9 +279,11 @@ __attribute__((target("avx2"))) inline bool shapeSpansAvx2(const uint16_t* rows,
     const __m256i gapLowest = _mm256_and_si256(gaps, _mm256_sub_epi16(zero, gaps));
     const __m256i gap = _mm256_andnot_si256(_mm256_add_epi16(gaps, gapLowest), gaps);
     const __m256i start = popcount16Avx2(_mm256_sub_epi16(gapLowest, one));  // 16 when none
+    const __m256i stop = _mm256_add_epi16(start, popcount16Avx2(gap));
     _mm256_store_si256(reinterpret_cast<__m256i*>(spans.plus[g]), start);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(spans.minus[g]),
-                       _mm256_add_epi16(start, popcount16Avx2(gap)));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(spans.minus[g]), stop);
+    spans.gapRows[g] =
+        ~static_cast<uint32_t>(_mm256_movemask_epi8(_mm256_cmpeq_epi16(start, stop))) & 0x55555555U;
     gaps = _mm256_andnot_si256(gap, gaps);
     spans.levels = g + 1;
   }
@@ -325,14 +331,23 @@ __attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
     if constexpr (K > 6) ab6 = addDotAvx2(ab6, a, bv - 6);
     if constexpr (K > 7) ab7 = addDotAvx2(ab7, a, bv - 7);
   }
-  // Lane j of the span sums holds window K − 1 − j.
+  // Lane j of the span sums holds window K − 1 − j. Every row has a level-0 term; the gap
+  // levels visit only their rows with a gap.
   __m256i sb = zero, sbb = zero;
-  for (int g = 0; g < spans.levels; ++g) {
-    const int16_t* plus = spans.plus[g] + firstRow;
-    const int16_t* minus = spans.minus[g] + firstRow;
+  {
+    const int16_t* plus = spans.plus[0] + firstRow;
+    const int16_t* minus = spans.minus[0] + firstRow;
     for (int v = 0; v < rows; ++v) {
       sb = addSpanAvx2(sb, pb + v * pStride - (K - 1), plus[v], minus[v]);
       sbb = addSpanAvx2(sbb, pbb + v * pStride - (K - 1), plus[v], minus[v]);
+    }
+  }
+  for (int g = 1; g < spans.levels; ++g) {
+    for (uint32_t m = spans.gapRows[g]; m != 0; m &= m - 1) {
+      const int v = __builtin_ctz(m) >> 1;  // window row
+      const ptrdiff_t row = (v - firstRow) * pStride - (K - 1);
+      sb = addSpanAvx2(sb, pb + row, spans.plus[g][v], spans.minus[g][v]);
+      sbb = addSpanAvx2(sbb, pbb + row, spans.plus[g][v], spans.minus[g][v]);
     }
   }
   // Window order (lanes past K are not used).

@@ -209,6 +209,15 @@ TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) 
     ASSERT_EQ(shapeSpansAvx2(rows, vectorSpans), fits) << "trial " << trial;
     if (!fits) continue;
     ASSERT_EQ(vectorSpans.levels, spans.levels) << "trial " << trial;
+    for (int g = 1; g < spans.levels; ++g) {
+      // The rows the kernel visits on a gap level: exactly those with a non-empty term.
+      uint32_t nonEmpty = 0;
+      for (int v = 0; v < 16; ++v) {
+        if (spans.plus[g][v] != spans.minus[g][v]) nonEmpty |= 1U << (2 * v);
+      }
+      ASSERT_EQ(spans.gapRows[g], nonEmpty) << "trial " << trial << " level " << g;
+      ASSERT_EQ(vectorSpans.gapRows[g], nonEmpty) << "trial " << trial << " level " << g;
+    }
     for (int g = 0; g < spans.levels; ++g) {
       for (int v = 0; v < 16; ++v) {
         ASSERT_EQ(vectorSpans.plus[g][v] - vectorSpans.minus[g][v],
