@@ -838,9 +838,15 @@ class LevelMatcher {
     if (rowStride_ == 16) {
       const ptrdiff_t here = 0;
       float score;
-      shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, static_cast<ptrdiff_t>(otherQ_.step1()),
-                     &here, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, 1, t.terms,
-                     &score);
+#ifdef DELINEO_STEREO_X86
+      if (avx2_) {
+        shapeScoreIntAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, here, &t.maskQ[16 * t.rowFirst],
+                          &t.aQ[16 * t.rowFirst], otherQStride_, rows, t.terms, &score);
+        return score;
+      }
+#endif
+      shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_, &here,
+                     &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, 1, t.terms, &score);
       return score;
     }
     const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
@@ -896,9 +902,18 @@ class LevelMatcher {
     if (y - 1 < r_ || y + 1 >= H_ - r_ || xb < r_ || xb >= W_ - r_) return false;
     if (!otherStats_.ok.at<uchar>(y - 1, xb) || !otherStats_.ok.at<uchar>(y + 1, xb)) return false;
     const int top = y + t.rowFirst - r_;
-    const auto stride = static_cast<ptrdiff_t>(otherQ_.step1());
-    const ptrdiff_t lines[2] = {-stride, stride};
+    const ptrdiff_t stride = otherQStride_;
     float scores[2];
+#ifdef DELINEO_STEREO_X86
+    if (avx2_) {
+      shapeScoresPairAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, stride, &t.maskQ[16 * t.rowFirst],
+                          &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, t.terms, scores);
+      minus = scores[0];
+      plus = scores[1];
+      return true;
+    }
+#endif
+    const ptrdiff_t lines[2] = {-stride, stride};
     shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, stride, lines, &t.maskQ[16 * t.rowFirst],
                    &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 2, t.terms, scores);
     minus = scores[0];
@@ -1008,15 +1023,25 @@ class LevelMatcher {
           }
         }
         int bi = 1, bj = 1;
-        for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < 3; ++j) {
-            // Leaving the current line needs a clear gain: on weakly textured surfaces the
-            // neighbouring lines correlate almost as well and noise would pick among them.
-            const float gain = j != 1 ? kLineShiftGain : 0.0F;
-            if (s[i][j] > s[bi][bj] + gain) {
-              bi = i;
-              bj = j;
-            }
+        // Leaving the current line needs a clear gain: on weakly textured surfaces the
+        // neighbouring lines correlate almost as well and noise would pick among them.
+        auto consider = [&](int i, int j) {
+          const float gain = j != 1 ? kLineShiftGain : 0.0F;
+          if (s[i][j] > s[bi][bj] + gain) {
+            bi = i;
+            bj = j;
+          }
+        };
+        if (step == 0) {
+          // Same order and outcome as the loop below: the corners are still NaN (never win),
+          // and the centre never beats a neighbour that beat it.
+          consider(0, 1);
+          consider(1, 0);
+          consider(1, 2);
+          consider(2, 1);
+        } else {
+          for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) consider(i, j);
           }
         }
         if ((bi == 1 && bj == 1) || step == kMaxAscentSteps) break;
@@ -1048,6 +1073,7 @@ class LevelMatcher {
   const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
   // The main-line span kernel (AVX2, windows ≤ 15 columns): 8 windows a pass.
   const bool useSpans_ = cpuHasAvx2() && s_.window <= 15;
+  const bool avx2_ = cpuHasAvx2();  // single windows and the ±1 pair straight to AVX2
   const int batchWindows_ = shapeBatchWindows();  // main-line windows per pass without spans
   cv::Mat otherPrefixB_, otherPrefixBB_;  // CV_32S, row prefix sums of otherQ_ and its squares
   WindowStats refStats_, otherStats_;

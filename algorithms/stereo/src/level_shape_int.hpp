@@ -243,6 +243,25 @@ DELINEO_STEREO_SHAPE_SCORES(shapeScoresIntAvx2, "avx2")
 DELINEO_STEREO_SHAPE_SCORES(shapeScoresIntAvx512, "avx2,avx512vl,avx512bw")
 #undef DELINEO_STEREO_SHAPE_SCORES
 
+// One window and the ±1 line pair straight to the AVX2 kernel (the matcher's most frequent
+// calls besides the main line): shapeScoresInt's dispatch and batching loop cost more than a
+// tenth of these calls.
+__attribute__((target("avx2"))) inline void shapeScoreIntAvx2(const int16_t* b, ptrdiff_t offset,
+                                                              const int16_t* mask,
+                                                              const int16_t* am, ptrdiff_t stride,
+                                                              int rows, const ShapeNccTerms& terms,
+                                                              float* score) {
+  shapeScoresIntAvx2<1>(b, stride, &offset, mask, am, rows, terms, score);
+}
+__attribute__((target("avx2"))) inline void shapeScoresPairAvx2(const int16_t* b, ptrdiff_t stride,
+                                                                const int16_t* mask,
+                                                                const int16_t* am, int rows,
+                                                                const ShapeNccTerms& terms,
+                                                                float* scores) {
+  const ptrdiff_t lines[2] = {-stride, stride};
+  shapeScoresIntAvx2<2>(b, stride, lines, mask, am, rows, terms, scores);
+}
+
 // Bits set in each 16-bit lane of v.
 __attribute__((target("avx2"), always_inline)) inline __m256i popcount16Avx2(__m256i v) {
   const __m256i table = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4, 0, 1, 1, 2,

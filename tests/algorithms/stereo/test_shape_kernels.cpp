@@ -142,6 +142,26 @@ TEST(ShapeKernels, VectorBuildsAgreeWithThePortableReference) {
       for (int k = 0; k < count; ++k) {
         ASSERT_TRUE(sameFloat(expected[k], got[k])) << "AVX2, trial " << trial << " window " << k;
       }
+      // One window, and the ±1 line pair around the first window (rows −1 and +1 of the image
+      // start at b + kStride).
+      float single = 0.0f;
+      shapeScoreIntAvx2(b.data(), offsets[0], s.mask.data(), s.am.data(), kStride, s.rows, s.terms,
+                        &single);
+      ASSERT_TRUE(sameFloat(expected[0], single)) << "AVX2 single, trial " << trial;
+      if (s.rows + 2 <= kImageRows) {
+        const ptrdiff_t lines[2] = {offsets[0], offsets[0] + 2 * kStride};
+        float pairExpected[2], pair[2];
+        for (int k = 0; k < 2; ++k) {
+          ShapeSumsInt sums;
+          shapeSumsIntScalar<1>(b.data(), kStride, lines + k, s.mask.data(), s.am.data(), s.rows,
+                                &sums);
+          nccFromIntSums(&sums, 1, s.terms, pairExpected + k);
+        }
+        shapeScoresPairAvx2(b.data() + kStride + offsets[0], kStride, s.mask.data(), s.am.data(),
+                            s.rows, s.terms, pair);
+        ASSERT_TRUE(sameFloat(pairExpected[0], pair[0])) << "AVX2 pair −1, trial " << trial;
+        ASSERT_TRUE(sameFloat(pairExpected[1], pair[1])) << "AVX2 pair +1, trial " << trial;
+      }
       // Dense rows built from the fill bits.
       std::vector<int16_t> mask(16 * s.rows), am(16 * s.rows);
       int32_t n = 0, sumA = 0, sumAA = 0;
