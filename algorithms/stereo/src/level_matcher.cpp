@@ -460,6 +460,9 @@ class LevelMatcher {
     tasks.emplace_back([&] { out.score = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
     runTasks(tasks, s.threads);
     otherQStride_ = static_cast<ptrdiff_t>(otherQ_.step1());
+    refQStride_ = static_cast<ptrdiff_t>(refQ_.step1());
+    refStride_ = in.ref.step1();
+    otherStride_ = in.other.step1();
     if (useSpans_) prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
     for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
   }
@@ -542,8 +545,8 @@ class LevelMatcher {
     float sab = 0;
     if (s_.window <= 16) {
       // Reads 16 columns: the inputs are padded on the right.
-      sab = windowDot16(in_.ref.ptr<float>(y - r_) + x - r_, in_.ref.step1(),
-                        in_.other.ptr<float>(yb - r_) + xb - r_, in_.other.step1(), s_.window,
+      sab = windowDot16(in_.ref.ptr<float>(y - r_) + x - r_, refStride_,
+                        in_.other.ptr<float>(yb - r_) + xb - r_, otherStride_, s_.window,
                         squareLanes_);
     } else {
       for (int v = -r_; v <= r_; ++v) {
@@ -769,8 +772,8 @@ class LevelMatcher {
       // The rows first: they give |S| too (cheaper than counting bits without popcnt).
       int32_t count = 0, sumA = 0, sumAA = 0;
       shapeRowsInt(&reach[t.rowFirst], rows, refQ_.ptr<int16_t>(y + t.rowFirst - r_) + x - r_,
-                   static_cast<ptrdiff_t>(refQ_.step1()), &t.maskQ[16 * t.rowFirst],
-                   &t.aQ[16 * t.rowFirst], count, sumA, sumAA);
+                   refQStride_, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], count, sumA,
+                   sumAA);
       t.count = count;
       if (t.count < s_.minShape || t.count >= n_) return false;
 #ifdef DELINEO_STEREO_X86
@@ -874,10 +877,13 @@ class LevelMatcher {
     if (rowStride_ != 16) return false;
     const int xb = x - d;
     if (y < r_ || y >= H_ - r_ || xb - (count - 1) < r_ || xb >= W_ - r_) return false;
-    const uchar* ok = otherStats_.ok.ptr<uchar>(y);
-    for (int k = 0; k < count; ++k) {
-      if (!ok[xb - k]) return false;
-    }
+    // The `count` ok flags (0 or 1) of windows xb − count + 1 .. xb as one 8-byte word: the 8
+    // bytes stay inside the image's rows (y + 1 is a row of it).
+    static_assert(kShapeMaxWindows <= 8);
+    uint64_t flags;
+    __builtin_memcpy(&flags, otherStats_.ok.ptr<uchar>(y) + xb - (count - 1), sizeof flags);
+    const uint64_t all = 0x0101010101010101ULL >> (8 * (kShapeMaxWindows - count));
+    if ((flags & all) != all) return false;
     const int top = y + t.rowFirst - r_;
     const int rows = t.rowLast - t.rowFirst + 1;
 #ifdef DELINEO_STEREO_X86
@@ -1080,6 +1086,9 @@ class LevelMatcher {
   cv::Mat otherSq_;
   cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
   ptrdiff_t otherQStride_ = 0, prefixStride_ = 0;  // their row strides, in elements
+  // cv::Mat::step1 is a library call, not inlined: the strides the per-pixel paths use.
+  ptrdiff_t refQStride_ = 0;
+  size_t refStride_ = 0, otherStride_ = 0;
   double flatQ_ = 0;       // kFlatVariance in quantised units
   float squareLanes_[16] = {};  // 1 for the columns of a square window, 0 past it
   cv::Mat nearEdge_;
