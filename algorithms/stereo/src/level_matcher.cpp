@@ -617,9 +617,10 @@ class LevelMatcher {
     }
     for (const auto& [width, i] : byWidth) {
       const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
-      finish(x, y, sc.peaks[static_cast<size_t>(i)],
-             [&](int d, int dy) { return squareScore(x, y, d, dy); },
-             [](int, float&, float&) { return false; });
+      finish(
+          x, y, in_.lo.at<int>(y, x), in_.hi.at<int>(y, x), sc.peaks[static_cast<size_t>(i)],
+          [&](int d, int dy) { return squareScore(x, y, d, dy); },
+          [](int, float&, float&) { return false; });
     }
   }
 
@@ -745,12 +746,26 @@ class LevelMatcher {
     // part of the window is cut off) and the square window is usable, the square serves the
     // pixel: the few contour pixels change its NCC little, and the square path is much cheaper.
     alignas(32) uint16_t rows16[16];
+    bool rowsFound = false;  // t.rowFirst, t.rowLast
     if (w <= 15) {
       const bool cut = fillWindow15(&freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)],
                                     windowRows_, r_, rows16);
       if (squareServes && !cut) return false;
       // All 16 rows (those past the window are 0): a fixed count the compiler widens in vectors.
       for (int v = 0; v < 16; ++v) reach[v] = rows16[v];
+#ifdef DELINEO_STEREO_X86
+      // The rows holding part of S from one mask of the empty rows (the scans below cost ~20
+      // instructions a shape).
+      const __m128i zero = _mm_setzero_si128();
+      const auto* words = reinterpret_cast<const __m128i*>(rows16);
+      const auto empty = static_cast<uint32_t>(
+          _mm_movemask_epi8(_mm_packs_epi16(_mm_cmpeq_epi16(_mm_load_si128(words), zero),
+                                            _mm_cmpeq_epi16(_mm_load_si128(words + 1), zero))));
+      const uint32_t used = ~empty & 0xFFFFU;  // the centre row is never empty
+      t.rowFirst = __builtin_ctz(used);
+      t.rowLast = 31 - __builtin_clz(used);
+      rowsFound = true;
+#endif
     } else {
       uint32_t free[32];
       for (int v = 0; v < w; ++v) {
@@ -763,10 +778,12 @@ class LevelMatcher {
       if (squareServes && unreached == 0) return false;
     }
     const int P = rowStride_;
-    t.rowFirst = 0;
-    while (reach[t.rowFirst] == 0) ++t.rowFirst;  // the centre row is never empty
-    t.rowLast = w - 1;
-    while (reach[t.rowLast] == 0) --t.rowLast;
+    if (!rowsFound) {
+      t.rowFirst = 0;
+      while (reach[t.rowFirst] == 0) ++t.rowFirst;  // the centre row is never empty
+      t.rowLast = w - 1;
+      while (reach[t.rowLast] == 0) --t.rowLast;
+    }
     const int rows = t.rowLast - t.rowFirst + 1;
     if (P == 16) {
       // The rows first: they give |S| too (cheaper than counting bits without popcnt).
@@ -946,8 +963,11 @@ class LevelMatcher {
       }
       d += count;
     }
-    finish(x, y, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); },
-           [&](int dd, float& minus, float& plus) { return shapeScorePair(x, y, dd, t, minus, plus); });
+    finish(
+        x, y, lo, hi, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); },
+        [&](int dd, float& minus, float& plus) {
+          return shapeScorePair(x, y, dd, t, minus, plus);
+        });
   }
 
   // ---- peak ------------------------------------------------------------------------------
@@ -956,10 +976,10 @@ class LevelMatcher {
   // surface, d within the pixel's interval, |dy| <= lineShift), rejection tests, sub-pixel
   // offset, output.
   // `pair(d, minus, plus)` may give the scores at (d, ∓1) in one go (returns false when not).
+  // [lo, hi]: the pixel's interval (in_.lo, in_.hi at (x, y)).
   template <class Score, class Pair>
-  void finish(int x, int y, const LinePeak& peak, Score&& score, Pair&& pair) {
+  void finish(int x, int y, int lo, int hi, const LinePeak& peak, Score&& score, Pair&& pair) {
     if (!(peak.best > kNegInf)) return;
-    int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
     int cd = peak.bestD, cdy = 0;
     float best = peak.best;
     float below = peak.below, above = peak.above;
