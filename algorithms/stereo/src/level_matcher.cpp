@@ -335,16 +335,39 @@ struct LinePeak {
 
   // update(d + k, s[k]) for k = 0 .. count − 1, with the same outcome: the pass's first
   // highest score replaces the peak when it beats it (later updates would erase the earlier
-  // ones' effects), and only the scores next to the final peak are kept.
+  // ones' effects), and only the scores next to the final peak are kept. `s` holds 8 readable
+  // floats (those past `count` are ignored).
   void updatePass(int d, const float* s, int count) {
     int top = -1;
     float topScore = best;
+#ifdef DELINEO_STEREO_X86
+    // The first of the pass's highest scores is where the scan above stops: the maximum of the
+    // lanes (NaN and the lanes past `count` left out as −inf), then its first lane (branches
+    // and a compare a window cost ~50 instructions a pass).
+    const __m128i n = _mm_set1_epi32(count);
+    const __m128 negInf = _mm_set1_ps(kNegInf);
+    const __m128 in0 = _mm_castsi128_ps(_mm_cmpgt_epi32(n, _mm_setr_epi32(0, 1, 2, 3)));
+    const __m128 in1 = _mm_castsi128_ps(_mm_cmpgt_epi32(n, _mm_setr_epi32(4, 5, 6, 7)));
+    const __m128 s0 = _mm_or_ps(_mm_and_ps(in0, _mm_loadu_ps(s)), _mm_andnot_ps(in0, negInf));
+    const __m128 s1 = _mm_or_ps(_mm_and_ps(in1, _mm_loadu_ps(s + 4)), _mm_andnot_ps(in1, negInf));
+    // maxps gives its second operand where the first is NaN.
+    __m128 m = _mm_max_ps(s1, _mm_max_ps(s0, negInf));
+    m = _mm_max_ps(m, _mm_shuffle_ps(m, m, 0x4E));
+    m = _mm_max_ps(m, _mm_shuffle_ps(m, m, 0xB1));
+    if (_mm_cvtss_f32(m) > best) {
+      const int equal =
+          _mm_movemask_ps(_mm_cmpeq_ps(s0, m)) | (_mm_movemask_ps(_mm_cmpeq_ps(s1, m)) << 4);
+      top = __builtin_ctz(static_cast<unsigned>(equal));
+      topScore = s[top];
+    }
+#else
     for (int k = 0; k < count; ++k) {
       if (s[k] > topScore) {  // NaN never wins
         topScore = s[k];
         top = k;
       }
     }
+#endif
     if (top < 0) {
       if (d == bestD + 1) above = s[0];
     } else {
