@@ -486,6 +486,7 @@ class LevelMatcher {
     refQStride_ = static_cast<ptrdiff_t>(refQ_.step1());
     refStride_ = in.ref.step1();
     otherStride_ = in.other.step1();
+    invalidStride_ = static_cast<ptrdiff_t>(otherInvalidBits_.step1());
     if (useSpans_) prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
     for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
   }
@@ -870,11 +871,11 @@ class LevelMatcher {
     if (yb < r_ || yb >= H_ - r_ || xb < r_ || xb >= W_ - r_) return kNaN;
     if (!otherStats_.ok.at<uchar>(yb, xb)) {
       // Window partly nodata (or flat: the variance test below decides): S must avoid nodata.
-      uint32_t touches = 0;
-      for (int v = t.rowFirst; v <= t.rowLast; ++v) {
-        touches |= static_cast<uint32_t>(otherInvalidBits_.at<int>(yb + v - r_, xb)) & t.rowBits[v];
+      // Most such windows lie on the padding, where the first row of S already touches it.
+      const int* invalid = otherInvalidBits_.ptr<int>(yb + t.rowFirst - r_) + xb;
+      for (int v = t.rowFirst; v <= t.rowLast; ++v, invalid += invalidStride_) {
+        if ((static_cast<uint32_t>(*invalid) & t.rowBits[v]) != 0) return kNaN;
       }
-      if (touches != 0) return kNaN;
     }
     const int rows = t.rowLast - t.rowFirst + 1;
     const int top = yb + t.rowFirst - r_;
@@ -1132,6 +1133,7 @@ class LevelMatcher {
   // cv::Mat::step1 is a library call, not inlined: the strides the per-pixel paths use.
   ptrdiff_t refQStride_ = 0;
   size_t refStride_ = 0, otherStride_ = 0;
+  ptrdiff_t invalidStride_ = 0;  // of otherInvalidBits_
   double flatQ_ = 0;       // kFlatVariance in quantised units
   float squareLanes_[16] = {};  // 1 for the columns of a square window, 0 past it
   cv::Mat nearEdge_;
