@@ -145,6 +145,13 @@ __attribute__((target("avx2"), always_inline)) inline int32_t laneSumAvx2(__m256
   return _mm_cvtsi128_si32(s);
 }
 
+// After a loop over rows: the accumulator v is in a vector register here (an empty asm, no
+// instruction). Without it GCC computed each row's sum into a new register and copied it back,
+// one move per accumulator and row (~20 % of the pair kernel's loop).
+__attribute__((always_inline)) inline void settledAvx2(__m256i& v) {
+  __asm__("" : "+x"(v));
+}
+
 // One row of one window: B on S (A and the mask are 0 off S) into the three accumulators.
 __attribute__((target("avx2"), always_inline)) inline void accumulateRowAvx2(
     const int16_t* x, __m256i m, __m256i a, __m256i& accB, __m256i& accBB, __m256i& accAB) {
@@ -211,6 +218,14 @@ __attribute__((target("avx2"), always_inline)) inline void nccAvx2(__m128i sB, _
       if constexpr (K > 6) accumulateRowAvx2(bv + offsets[6], m, a, b6, bb6, ab6);              \
       if constexpr (K > 7) accumulateRowAvx2(bv + offsets[7], m, a, b7, bb7, ab7);              \
     }                                                                                           \
+    settledAvx2(b0), settledAvx2(bb0), settledAvx2(ab0);                                        \
+    if constexpr (K > 1) settledAvx2(b1), settledAvx2(bb1), settledAvx2(ab1);                   \
+    if constexpr (K > 2) settledAvx2(b2), settledAvx2(bb2), settledAvx2(ab2);                   \
+    if constexpr (K > 3) settledAvx2(b3), settledAvx2(bb3), settledAvx2(ab3);                   \
+    if constexpr (K > 4) settledAvx2(b4), settledAvx2(bb4), settledAvx2(ab4);                   \
+    if constexpr (K > 5) settledAvx2(b5), settledAvx2(bb5), settledAvx2(ab5);                   \
+    if constexpr (K > 6) settledAvx2(b6), settledAvx2(bb6), settledAvx2(ab6);                   \
+    if constexpr (K > 7) settledAvx2(b7), settledAvx2(bb7), settledAvx2(ab7);                   \
     /* Σ B widened from its 16-bit column sums. */                                              \
     const __m256i ones = _mm256_set1_epi16(1);                                                  \
     nccAvx2(laneSums4Avx2(_mm256_madd_epi16(b0, ones), _mm256_madd_epi16(b1, ones),             \
@@ -335,6 +350,30 @@ __attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
     const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb, ptrdiff_t pStride,
     const ShapeSpans& spans, int firstRow, const int16_t* am, int rows,
     const ShapeNccTerms& terms, float* scores) {
+  // Lane j of the span sums holds window K − 1 − j. Every row has a level-0 term (rows ≥ 1; the
+  // sums start from the first row's: starting from zero, GCC copied both sums at every row); the
+  // gap levels visit only their rows with a gap.
+  __m256i sb, sbb;
+  {
+    const int16_t* plus = spans.plus[0] + firstRow;
+    const int16_t* minus = spans.minus[0] + firstRow;
+    sb = addSpanAvx2(_mm256_setzero_si256(), pb - (K - 1), plus[0], minus[0]);
+    sbb = addSpanAvx2(_mm256_setzero_si256(), pbb - (K - 1), plus[0], minus[0]);
+    for (int v = 1; v < rows; ++v) {
+      sb = addSpanAvx2(sb, pb + v * pStride - (K - 1), plus[v], minus[v]);
+      sbb = addSpanAvx2(sbb, pbb + v * pStride - (K - 1), plus[v], minus[v]);
+    }
+  }
+  for (int g = 1; g < spans.levels; ++g) {
+    for (uint32_t m = spans.gapRows[g]; m != 0; m &= m - 1) {
+      const int v = __builtin_ctz(m) >> 1;  // window row
+      const ptrdiff_t row = (v - firstRow) * pStride - (K - 1);
+      sb = addSpanAvx2(sb, pb + row, spans.plus[g][v], spans.minus[g][v]);
+      sbb = addSpanAvx2(sbb, pbb + row, spans.plus[g][v], spans.minus[g][v]);
+    }
+  }
+  // The dot products last: their 8 accumulators then go straight to the reductions (before
+  // the span sums, GCC copied each accumulator at every row).
   const __m256i zero = _mm256_setzero_si256();
   __m256i ab0 = zero, ab1 = zero, ab2 = zero, ab3 = zero, ab4 = zero, ab5 = zero, ab6 = zero,
           ab7 = zero;
@@ -350,25 +389,14 @@ __attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
     if constexpr (K > 6) ab6 = addDotAvx2(ab6, a, bv - 6);
     if constexpr (K > 7) ab7 = addDotAvx2(ab7, a, bv - 7);
   }
-  // Lane j of the span sums holds window K − 1 − j. Every row has a level-0 term; the gap
-  // levels visit only their rows with a gap.
-  __m256i sb = zero, sbb = zero;
-  {
-    const int16_t* plus = spans.plus[0] + firstRow;
-    const int16_t* minus = spans.minus[0] + firstRow;
-    for (int v = 0; v < rows; ++v) {
-      sb = addSpanAvx2(sb, pb + v * pStride - (K - 1), plus[v], minus[v]);
-      sbb = addSpanAvx2(sbb, pbb + v * pStride - (K - 1), plus[v], minus[v]);
-    }
-  }
-  for (int g = 1; g < spans.levels; ++g) {
-    for (uint32_t m = spans.gapRows[g]; m != 0; m &= m - 1) {
-      const int v = __builtin_ctz(m) >> 1;  // window row
-      const ptrdiff_t row = (v - firstRow) * pStride - (K - 1);
-      sb = addSpanAvx2(sb, pb + row, spans.plus[g][v], spans.minus[g][v]);
-      sbb = addSpanAvx2(sbb, pbb + row, spans.plus[g][v], spans.minus[g][v]);
-    }
-  }
+  settledAvx2(ab0);
+  if constexpr (K > 1) settledAvx2(ab1);
+  if constexpr (K > 2) settledAvx2(ab2);
+  if constexpr (K > 3) settledAvx2(ab3);
+  if constexpr (K > 4) settledAvx2(ab4);
+  if constexpr (K > 5) settledAvx2(ab5);
+  if constexpr (K > 6) settledAvx2(ab6);
+  if constexpr (K > 7) settledAvx2(ab7);
   // Window order (lanes past K are not used).
   const __m256i order = _mm256_setr_epi32(K - 1, K - 2, K - 3, K - 4, K - 5, K - 6, K - 7, K - 8);
   sb = _mm256_permutevar8x32_epi32(sb, order);
@@ -428,6 +456,9 @@ __attribute__((target("avx2"))) inline void shapeRowsIntAvx2(const uint32_t* bit
     accA = _mm256_add_epi16(accA, xm);
     accAA = _mm256_add_epi32(accAA, _mm256_madd_epi16(xm, xm));
   }
+  settledAvx2(accN);
+  settledAvx2(accA);
+  settledAvx2(accAA);
   count = -laneSumAvx2(_mm256_madd_epi16(accN, _mm256_set1_epi16(1)));
   sumA = laneSumAvx2(_mm256_madd_epi16(accA, _mm256_set1_epi16(1)));
   sumAA = laneSumAvx2(accAA);
