@@ -148,7 +148,7 @@ __attribute__((target("avx2"), always_inline)) inline int32_t laneSumAvx2(__m256
 // After a loop over rows: the accumulator v is in a vector register here (an empty asm, no
 // instruction). Without it GCC computed each row's sum into a new register and copied it back,
 // one move per accumulator and row (~20 % of the pair kernel's loop).
-__attribute__((always_inline)) inline void settledAvx2(__m256i& v) {
+__attribute__((target("avx2"), always_inline)) inline void settledAvx2(__m256i& v) {
   __asm__("" : "+x"(v));
 }
 
