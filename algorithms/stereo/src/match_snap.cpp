@@ -429,6 +429,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     const float* c = contrast.ptr<float>(y);
     int changed = 0;
     const int m = settings.carriedRuns;
+    int previousEnd = -1;  // last pixel of the run before (-1: none)
     for (int x0 = 0; x0 < w;) {
       if (!std::isfinite(d[x0])) {
         ++x0;
@@ -436,6 +437,39 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
       }
       int x1 = x0;  // the run is [x0, x1]
       while (x1 + 1 < w && std::isfinite(d[x1 + 1]) && std::abs(d[x1 + 1] - d[x1]) <= 1.0F) ++x1;
+      const int nearEnd = previousEnd;
+      previousEnd = x1;
+      // A short run of its own just past a nearer run's end, across a contour, offset in
+      // brightness from its counterpart at its own disparity while the nearer run's last pixels
+      // agree: the nearer surface's value carried onto ground the right view does not see (it
+      // maps onto the wall only that view shows), split off at the outline (no pixels of its
+      // own before the contour to compare with).
+      if (settings.carriedOwnRuns > 0 && settings.carriedOffset > 0 && nearEnd >= 0 &&
+          x0 - nearEnd - 1 <= settings.carriedOwnGap && x1 - x0 + 1 <= settings.carriedOwnRuns &&
+          x1 - x0 + 1 >= settings.carriedOffsetPixels && d[nearEnd] > d[x0] &&
+          strongestContour(c, std::max(0, nearEnd - 1), std::min(w - 2, x0)) >= 0) {
+        const int n = x1 - x0 + 1;
+        double after = 0, nearRun = 0;
+        int nNear = 0;
+        for (int x = x0; x <= x1; ++x) after += signedResidual(y, x, d[x]);
+        for (int x = nearEnd - 1;
+             x >= 0 && nNear < n && std::isfinite(d[x]) && std::abs(d[x] - d[nearEnd]) <= 1.0F;
+             --x, ++nNear) {
+          nearRun += signedResidual(y, x, d[x]);
+        }
+        if (nNear > 0 && std::abs(after / n) >= offsetBound &&
+            std::abs(nearRun / nNear) <= offsetBound / 2) {
+          for (int x = x0; x <= x1; ++x) {
+            d[x] = kNaN;
+            out[x] = kNaN;
+            if (sc) sc[x] = kNaN;
+            ++changed;
+          }
+          previousEnd = nearEnd;
+          x0 = x1 + 1;
+          continue;
+        }
+      }
       // The stretch after a contour near the run's end is scored at the run's disparities and
       // at each integer disparity at least minStep farther: when one of those explains it
       // (within checkSigmas) better by carriedMargin sigmas, the run was carried across.

@@ -18,6 +18,8 @@ struct StepSnapSettings {
   double carriedOffset = 4.0;       // noise sigmas: brightness offset that splits a run (0 = off)
   double carriedOffsetGrey = 8.0;   // grey levels: the least such offset, whatever the noise
   int carriedOffsetPixels = 2;      // px: fewest pixels past the contour the offset is read on
+  int carriedOwnRuns = 16;          // px: longest run of its own split off by the offset (0 = off)
+  int carriedOwnGap = 2;            // px: most unmatched pixels between it and the nearer run
   int openReach = 5;                // px: farthest contour an open end reaches by the offset
   int openGrowth = 16;              // px: farthest an open end grows over pixels only it explains
   double contourWeight = 1.5;       // error (noise sigmas) traded for one sigma of contour contrast
