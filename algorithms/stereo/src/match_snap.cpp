@@ -390,6 +390,45 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     cut.eFirst = s0 - 1;
     cut.ownLast = std::min(b, s1 - 1);
+    // The near side's value may explain the gap's pixels as well as the far side's does (a plain
+    // roof beside plain ground of its grey): the photometric costs then tie, and a seam or a
+    // texture line inside the roof took the cut (seed 3 600², rows 143-152: 4-9 px short). Where
+    // the near disparity fails hard on two pixels that the far one explains (at the near
+    // disparity the ground past a roof's +x edge falls on the wall only the right view shows),
+    // after gap pixels it explains on average (within checkSigmas + carriedMargin, each capped at
+    // errorCap: a thin seam errs by more), the near surface reaches that far: cuts before it
+    // cost hardEndPenalty × errorCap more per pixel left out.
+    int hardEnd = -1;
+    if (settings.hardEndPenalty > 0) {
+      const int last = std::min(b, s1 - 1);
+      const auto failsHard = [&](int x) {
+        return x + 1 <= last && error(y, x, cut.dNear) >= settings.errorCap &&
+               error(y, x + 1, cut.dNear) >= settings.errorCap &&
+               error(y, x, cut.dFar) <= settings.checkSigmas &&
+               error(y, x + 1, cut.dFar) <= settings.checkSigmas;
+      };
+      double sum = 0;
+      int counted = 0;
+      for (int x = a + 1; x <= last; ++x) {
+        // The near surface's last pixel: two before the failure (the one before it mixes both
+        // surfaces through the blur and may fail on its own).
+        int end = -1;
+        if (failsHard(x)) {
+          end = x - 2;
+        } else if (error(y, x, cut.dNear) > settings.errorCap && failsHard(x + 1)) {
+          end = x - 1;
+        }
+        if (end >= 0) {
+          if (end > a && counted > 0 &&
+              sum <= (settings.checkSigmas + settings.carriedMargin) * counted) {
+            hardEnd = end;
+          }
+          break;
+        }
+        sum += std::min(settings.errorCap, error(y, x, cut.dNear));
+        ++counted;
+      }
+    }
     const int eLast = std::min(b + settings.cutAhead, s1 - 1);
     cut.cost.clear();
     for (int e = cut.eFirst; e <= eLast; ++e) {
@@ -399,6 +438,10 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
           static_cast<float>(nearSum[nearEnd] + farSum[n] - farSum[farStart] -
                              settings.contourWeight * (e >= 0 ? c[e] / sigma : 0.0) -
                              settings.rightContourWeight * rightContrastAt(y, e, cut.dNear)));
+      if (e < hardEnd) {
+        cut.cost.back() +=
+            static_cast<float>(settings.hardEndPenalty * settings.errorCap * (hardEnd - e));
+      }
     }
     return cut;
   };

@@ -563,5 +563,46 @@ TEST(SnapSteps, ARowWhoseEdgeTookTheGroundsValueFollowsTheLineOfItsNeighbours) {
   EXPECT_EQ(carriedRowsLocated(StepSnapSettings{}), 5);
 }
 
+// A roof (disparity 20, [40, 70)) textured up to a dark seam at x 61-62, plain grey 100 after
+// it, beside textured ground (disparity 5, grey ~100) matched from x 72. The right view shows the
+// roof's east wall at its columns [50, 65): bright (160) on its first 6, the roof's grey after.
+// So at the ground's disparity the plain strip [63, 70) falls on the wall's roof-grey part and
+// is explained as well as at the roof's: only the ground past the outline, which at the roof's
+// disparity falls on the bright part, tells where the roof ends. Returns the rows (of 28) whose
+// roof run ends within 1 px of x 69.
+int plainRoofStripRowsReachingTheOutline(const StepSnapSettings& settings) {
+  const int rows = 30, cols = 200;
+  cv::RNG rng(31);
+  const cv::Mat texture = texturedGround(rows, cols, 0, rng);
+  const auto leftAt = [&](int y, int x) {
+    if (x < 40 || x >= 70) return texture.at<float>(y, x);
+    if (x == 61 || x == 62) return 60.0f;
+    return x < 61 ? texture.at<float>(y, (x + 100) % cols) + 20.0f : 100.0f;
+  };
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = leftAt(y, x);
+      const int onRoof = x + 20;
+      right.at<float>(y, x) = onRoof >= 40 && onRoof < 70 ? leftAt(y, onRoof)
+                              : x >= 50 && x < 65         ? (x < 56 ? 160.0f : 100.0f)
+                                                  : texture.at<float>(y, std::min(x + 5, cols - 1));
+    }
+  }
+  testing::addSensorNoise(left, right, 1.5, rng);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 61, 20.0f);
+  setRun(disparity, 72, cols, 5.0f);
+  snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+  return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
+}
+
+TEST(SnapSteps, APlainRoofStripTheGroundsValueExplainsReachesWhereTheRoofsValueFailsHard) {
+  StepSnapSettings noHardEnd;
+  noHardEnd.hardEndPenalty = 0;
+  EXPECT_EQ(plainRoofStripRowsReachingTheOutline(noHardEnd), 0);
+  EXPECT_GE(plainRoofStripRowsReachingTheOutline(StepSnapSettings{}), 28 * 9 / 10);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
