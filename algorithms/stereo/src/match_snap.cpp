@@ -390,6 +390,45 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     }
     cut.eFirst = s0 - 1;
     cut.ownLast = std::min(b, s1 - 1);
+    // The near side's value may explain the gap's pixels as well as the far side's does (a plain
+    // roof beside plain ground of its grey): the photometric costs then tie, and a seam or a
+    // texture line inside the roof took the cut (seed 3 600², rows 143-152: 4-9 px short). Where
+    // the near disparity fails hard on two pixels that the far one explains (at the near
+    // disparity the ground past a roof's +x edge falls on the wall only the right view shows),
+    // after gap pixels it explains on average (within checkSigmas + carriedMargin, each capped at
+    // errorCap: a thin seam errs by more), the near surface reaches that far: cuts before it
+    // cost hardEndPenalty × errorCap more per pixel left out.
+    int hardEnd = -1;
+    if (settings.hardEndPenalty > 0) {
+      const int last = std::min(b, s1 - 1);
+      const auto failsHard = [&](int x) {
+        return x + 1 <= last && error(y, x, cut.dNear) >= settings.errorCap &&
+               error(y, x + 1, cut.dNear) >= settings.errorCap &&
+               error(y, x, cut.dFar) <= settings.checkSigmas &&
+               error(y, x + 1, cut.dFar) <= settings.checkSigmas;
+      };
+      double sum = 0;
+      int counted = 0;
+      for (int x = a + 1; x <= last; ++x) {
+        // The near surface's last pixel: two before the failure (the one before it mixes both
+        // surfaces through the blur and may fail on its own).
+        int end = -1;
+        if (failsHard(x)) {
+          end = x - 2;
+        } else if (error(y, x, cut.dNear) > settings.errorCap && failsHard(x + 1)) {
+          end = x - 1;
+        }
+        if (end >= 0) {
+          if (end > a && counted > 0 &&
+              sum <= (settings.checkSigmas + settings.carriedMargin) * counted) {
+            hardEnd = end;
+          }
+          break;
+        }
+        sum += std::min(settings.errorCap, error(y, x, cut.dNear));
+        ++counted;
+      }
+    }
     const int eLast = std::min(b + settings.cutAhead, s1 - 1);
     cut.cost.clear();
     for (int e = cut.eFirst; e <= eLast; ++e) {
@@ -399,6 +438,10 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
           static_cast<float>(nearSum[nearEnd] + farSum[n] - farSum[farStart] -
                              settings.contourWeight * (e >= 0 ? c[e] / sigma : 0.0) -
                              settings.rightContourWeight * rightContrastAt(y, e, cut.dNear)));
+      if (e < hardEnd) {
+        cut.cost.back() +=
+            static_cast<float>(settings.hardEndPenalty * settings.errorCap * (hardEnd - e));
+      }
     }
     return cut;
   };
@@ -429,6 +472,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     const float* c = contrast.ptr<float>(y);
     int changed = 0;
     const int m = settings.carriedRuns;
+    int previousEnd = -1;  // last pixel of the run before (-1: none)
     for (int x0 = 0; x0 < w;) {
       if (!std::isfinite(d[x0])) {
         ++x0;
@@ -436,6 +480,39 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
       }
       int x1 = x0;  // the run is [x0, x1]
       while (x1 + 1 < w && std::isfinite(d[x1 + 1]) && std::abs(d[x1 + 1] - d[x1]) <= 1.0F) ++x1;
+      const int nearEnd = previousEnd;
+      previousEnd = x1;
+      // A short run of its own just past a nearer run's end, across a contour, offset in
+      // brightness from its counterpart at its own disparity while the nearer run's last pixels
+      // agree: the nearer surface's value carried onto ground the right view does not see (it
+      // maps onto the wall only that view shows), split off at the outline (no pixels of its
+      // own before the contour to compare with).
+      if (settings.carriedOwnRuns > 0 && settings.carriedOffset > 0 && nearEnd >= 0 &&
+          x0 - nearEnd - 1 <= settings.carriedOwnGap && x1 - x0 + 1 <= settings.carriedOwnRuns &&
+          x1 - x0 + 1 >= settings.carriedOffsetPixels && d[nearEnd] > d[x0] &&
+          strongestContour(c, std::max(0, nearEnd - 1), std::min(w - 2, x0)) >= 0) {
+        const int n = x1 - x0 + 1;
+        double after = 0, nearRun = 0;
+        int nNear = 0;
+        for (int x = x0; x <= x1; ++x) after += signedResidual(y, x, d[x]);
+        for (int x = nearEnd - 1;
+             x >= 0 && nNear < n && std::isfinite(d[x]) && std::abs(d[x] - d[nearEnd]) <= 1.0F;
+             --x, ++nNear) {
+          nearRun += signedResidual(y, x, d[x]);
+        }
+        if (nNear > 0 && std::abs(after / n) >= offsetBound &&
+            std::abs(nearRun / nNear) <= offsetBound / 2) {
+          for (int x = x0; x <= x1; ++x) {
+            d[x] = kNaN;
+            out[x] = kNaN;
+            if (sc) sc[x] = kNaN;
+            ++changed;
+          }
+          previousEnd = nearEnd;
+          x0 = x1 + 1;
+          continue;
+        }
+      }
       // The stretch after a contour near the run's end is scored at the run's disparities and
       // at each integer disparity at least minStep farther: when one of those explains it
       // (within checkSigmas) better by carriedMargin sigmas, the run was carried across.

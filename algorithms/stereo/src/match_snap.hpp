@@ -18,8 +18,11 @@ struct StepSnapSettings {
   double carriedOffset = 4.0;       // noise sigmas: brightness offset that splits a run (0 = off)
   double carriedOffsetGrey = 8.0;   // grey levels: the least such offset, whatever the noise
   int carriedOffsetPixels = 2;      // px: fewest pixels past the contour the offset is read on
+  int carriedOwnRuns = 16;          // px: longest run of its own split off by the offset (0 = off)
+  int carriedOwnGap = 2;            // px: most unmatched pixels between it and the nearer run
   int openReach = 5;                // px: farthest contour an open end reaches by the offset
   int openGrowth = 16;              // px: farthest an open end grows over pixels only it explains
+  double hardEndPenalty = 2.0;      // × errorCap per px: cut before where the near side fails hard
   double contourWeight = 1.5;       // error (noise sigmas) traded for one sigma of contour contrast
   double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear
   double rightContourCap = 6.0;     // noise sigmas: most right-view contrast counted
@@ -51,9 +54,14 @@ struct StepSnapSettings {
 // follow their neighbours. The line may also take a row up to cutAhead pixels over its far
 // side (a roof edge that took the ground's value), at no less than the row's own best cost:
 // never on the row's own evidence (that fattened objects of the real pairs), only where the
-// neighbouring rows put the line. Pixels up to e take the near disparity (score
-// `fillScore`), near pixels after it become unmatched. Unchecked (`right` empty), the near side
-// ends at the strongest contrast within [a − reach, b + reach] when it is at least edgeSigmas
+// neighbouring rows put the line. Where the near disparity fails hard (≥ errorCap) on two
+// pixels of the gap that the far one explains (≤ checkSigmas), after gap pixels it explains
+// within checkSigmas + carriedMargin on average, cuts before the pixel two before that failure
+// cost hardEndPenalty × errorCap more per pixel: a plain roof beside plain ground of its grey
+// ties both hypotheses, and only the ground past the outline (on the wall only the right view
+// shows, at the roof's disparity) tells where it ends. Pixels up to e take the near disparity
+// (score `fillScore`), near pixels after it become unmatched. Unchecked (`right` empty), the near
+// side ends at the strongest contrast within [a − reach, b + reach] when it is at least edgeSigmas
 // sigmas.
 // Near side on the right (the left map's −x edge of a roof): the unmatched pixels before it are
 // mostly ground the right view does not see and stay unmatched; near pixels before the strongest
@@ -80,7 +88,11 @@ struct StepSnapSettings {
 // (left − mapped right) at the run's disparity is at least max(carriedOffset sigmas,
 // carriedOffsetGrey grey levels) while the run's pixels before the contour (as many, at most)
 // stay within half that: ground the right view does not see, which no disparity explains,
-// carries the roof's value onto the wall only that view shows. The gap left is then snapped
+// carries the roof's value onto the wall only that view shows. A run of its own (at most
+// carriedOwnRuns px, at least carriedOffsetPixels) starting at most carriedOwnGap px after a
+// nearer run's end, across a contour (≥ edgeSigmas) at that end, is split off the same way: its
+// mean signed residual at its own disparities at least that bound, the nearer run's last pixels
+// (as many, at most; its mixed last pixel left out) within half of it. The gap left is then snapped
 // like the others.
 // The far side is always left alone. `left`, `right`: the original images (CV_32F, NaN =
 // nodata). Returns the pixels changed.

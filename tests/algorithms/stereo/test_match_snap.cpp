@@ -359,7 +359,10 @@ int rowsWhoseRoofRunEndsAt(const cv::Mat& disparity, float value, int outline) {
 // before the next roof. With `hidden` false the courtyard is a dark band of the roof itself
 // (grey ~70, disparity 20, seen by both views): the run is right there. Returns the rows (of 28)
 // whose roof run ends within 1 px of x 69.
-int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings) {
+// With `ownRunGap` > 0 the carried value is a run of its own, 18 px, starting that many pixels
+// past the roof's run (ended at the outline); returns then the rows (of 28) whose courtyard
+// ([70, 80)) keeps none of it.
+int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings, int ownRunGap = 0) {
   const int rows = 30, cols = 300;
   cv::RNG rng(23);
   const cv::Mat texture = texturedGround(rows, cols, 0, rng);
@@ -385,10 +388,22 @@ int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings) 
   testing::addSensorNoise(left, right, 1.5, rng);
   cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
   setRun(disparity, 0, 15, 5.0f);
-  setRun(disparity, 40, 80, 20.0f);
+  if (ownRunGap > 0) {
+    setRun(disparity, 40, 70, 20.0f);
+    setRun(disparity, 70 + ownRunGap, 80, 18.0f);
+  } else {
+    setRun(disparity, 40, 80, 20.0f);
+  }
   setRun(disparity, 85, cols, 20.0f);
   snapStepsToContours(left, right, settings, 0.3f, disparity, score);
-  return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
+  if (ownRunGap == 0) return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
+  int clear = 0;
+  for (int y = 1; y + 1 < rows; ++y) {
+    bool carried = false;
+    for (int x = 70; x < 80; ++x) carried = carried || std::isfinite(disparity.at<float>(y, x));
+    clear += carried ? 0 : 1;
+  }
+  return clear;
 }
 
 TEST(SnapSteps, ARoofRunCarriedOverGroundTheRightViewDoesNotSeeStopsAtTheContour) {
@@ -398,6 +413,17 @@ TEST(SnapSteps, ARoofRunCarriedOverGroundTheRightViewDoesNotSeeStopsAtTheContour
   EXPECT_GE(roofRowsEndingAtTheCourtyard(true, StepSnapSettings{}), 28 * 9 / 10);
   // A dark band of the roof itself, which both views show alike, keeps the roof's value.
   EXPECT_EQ(roofRowsEndingAtTheCourtyard(false, StepSnapSettings{}), 0);
+}
+
+TEST(SnapSteps, ARoofValueCarriedOntoHiddenGroundAsARunOfItsOwnIsSplitOff) {
+  StepSnapSettings noOwnRuns;
+  noOwnRuns.carriedOwnRuns = 0;
+  for (const int gap : {1, 2}) {
+    EXPECT_EQ(roofRowsEndingAtTheCourtyard(true, noOwnRuns, gap), 0);
+    EXPECT_GE(roofRowsEndingAtTheCourtyard(true, StepSnapSettings{}, gap), 28 * 9 / 10);
+    // A dark band of the roof, which both views show alike: its run is kept.
+    EXPECT_EQ(roofRowsEndingAtTheCourtyard(false, StepSnapSettings{}, gap), 0);
+  }
 }
 
 // A roof (disparity 20, [40, 70): grey 140, 130 on its last 3 columns, a step of 10 grey levels
@@ -535,6 +561,47 @@ TEST(SnapSteps, ARowWhoseEdgeTookTheGroundsValueFollowsTheLineOfItsNeighbours) {
   ownRangeOnly.cutAhead = 0;
   EXPECT_EQ(carriedRowsLocated(ownRangeOnly), 0);
   EXPECT_EQ(carriedRowsLocated(StepSnapSettings{}), 5);
+}
+
+// A roof (disparity 20, [40, 70)) textured up to a dark seam at x 61-62, plain grey 100 after
+// it, beside textured ground (disparity 5, grey ~100) matched from x 72. The right view shows the
+// roof's east wall at its columns [50, 65): bright (160) on its first 6, the roof's grey after.
+// So at the ground's disparity the plain strip [63, 70) falls on the wall's roof-grey part and
+// is explained as well as at the roof's: only the ground past the outline, which at the roof's
+// disparity falls on the bright part, tells where the roof ends. Returns the rows (of 28) whose
+// roof run ends within 1 px of x 69.
+int plainRoofStripRowsReachingTheOutline(const StepSnapSettings& settings) {
+  const int rows = 30, cols = 200;
+  cv::RNG rng(31);
+  const cv::Mat texture = texturedGround(rows, cols, 0, rng);
+  const auto leftAt = [&](int y, int x) {
+    if (x < 40 || x >= 70) return texture.at<float>(y, x);
+    if (x == 61 || x == 62) return 60.0f;
+    return x < 61 ? texture.at<float>(y, (x + 100) % cols) + 20.0f : 100.0f;
+  };
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = leftAt(y, x);
+      const int onRoof = x + 20;
+      right.at<float>(y, x) = onRoof >= 40 && onRoof < 70 ? leftAt(y, onRoof)
+                              : x >= 50 && x < 65         ? (x < 56 ? 160.0f : 100.0f)
+                                                  : texture.at<float>(y, std::min(x + 5, cols - 1));
+    }
+  }
+  testing::addSensorNoise(left, right, 1.5, rng);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 61, 20.0f);
+  setRun(disparity, 72, cols, 5.0f);
+  snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+  return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
+}
+
+TEST(SnapSteps, APlainRoofStripTheGroundsValueExplainsReachesWhereTheRoofsValueFailsHard) {
+  StepSnapSettings noHardEnd;
+  noHardEnd.hardEndPenalty = 0;
+  EXPECT_EQ(plainRoofStripRowsReachingTheOutline(noHardEnd), 0);
+  EXPECT_GE(plainRoofStripRowsReachingTheOutline(StepSnapSettings{}), 28 * 9 / 10);
 }
 
 }  // namespace
