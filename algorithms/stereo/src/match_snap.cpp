@@ -340,6 +340,13 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   // above the few grey levels by which two views of one surface differ (exposure, non-Lambertian
   // surfaces). The grey levels are the mapped ones (step 1), alike for every input.
   const double offsetBound = std::max(settings.carriedOffset, settings.carriedOffsetGrey / sigma);
+  // Two surfaces by brightness: the pixels past a contour are offset from their counterparts by
+  // at least offsetBound on average while the run's pixels before it agree within half that
+  // (sums of signed residuals and their counts).
+  const auto offsetSplits = [offsetBound](double after, int nAfter, double before, int nBefore) {
+    return nBefore > 0 && std::abs(after / nAfter) >= offsetBound &&
+           std::abs(before / nBefore) <= offsetBound / 2;
+  };
   const auto fitsFarBetter = [&](int y, int x, float dNear, float dFar) {
     return !checked || error(y, x, dFar) < error(y, x, dNear);
   };
@@ -473,6 +480,15 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     int changed = 0;
     const int m = settings.carriedRuns;
     int previousEnd = -1;  // last pixel of the run before (-1: none)
+    // Leaves [first, last] unmatched; returns the pixels changed.
+    const auto clearRun = [&](int first, int last) {
+      for (int x = first; x <= last; ++x) {
+        d[x] = kNaN;
+        out[x] = kNaN;
+        if (sc) sc[x] = kNaN;
+      }
+      return std::max(0, last - first + 1);
+    };
     for (int x0 = 0; x0 < w;) {
       if (!std::isfinite(d[x0])) {
         ++x0;
@@ -500,14 +516,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
              --x, ++nNear) {
           nearRun += signedResidual(y, x, d[x]);
         }
-        if (nNear > 0 && std::abs(after / n) >= offsetBound &&
-            std::abs(nearRun / nNear) <= offsetBound / 2) {
-          for (int x = x0; x <= x1; ++x) {
-            d[x] = kNaN;
-            out[x] = kNaN;
-            if (sc) sc[x] = kNaN;
-            ++changed;
-          }
+        if (offsetSplits(after, n, nearRun, nNear)) {
+          changed += clearRun(x0, x1);
           previousEnd = nearEnd;
           x0 = x1 + 1;
           continue;
@@ -546,15 +556,9 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
           for (int x = std::max(x0, e - n); x < e; ++x, ++nBefore) {
             before += signedResidual(y, x, d[x]);
           }
-          carried = nBefore > 0 && std::abs(after / n) >= offsetBound &&
-                    std::abs(before / nBefore) <= offsetBound / 2;
+          carried = offsetSplits(after, n, before, nBefore);
         }
-        for (int x = e + 1; carried && x <= x1; ++x) {
-          d[x] = kNaN;
-          out[x] = kNaN;
-          if (sc) sc[x] = kNaN;
-          ++changed;
-        }
+        if (carried) changed += clearRun(e + 1, x1);
       }
       x0 = x1 + 1;
     }
