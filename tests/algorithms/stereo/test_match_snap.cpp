@@ -604,5 +604,57 @@ TEST(SnapSteps, APlainRoofStripTheGroundsValueExplainsReachesWhereTheRoofsValueF
   EXPECT_GE(plainRoofStripRowsReachingTheOutline(StepSnapSettings{}), 28 * 9 / 10);
 }
 
+// A roof facet sloping towards its +x edge (disparity 30 at x 40 down to 18.4 at x 69, 0.4 px per
+// px; textured as strongly as the ground, of its mean grey) beside textured ground (disparity 5).
+// The roof is matched along its slope up to x 63, the ground from x 72. At the run's last disparity
+// the facet's last pixels are 1-2.4 px off and fail as the ground's does; along the run's slope
+// they match. Returns the rows (of 28) whose roof run ends within 1 px of x 69.
+int slopedFacetRowsReachingTheOutline(const StepSnapSettings& settings) {
+  const int rows = 30, cols = 200;
+  cv::RNG rng(17);
+  const cv::Mat texture = testing::texture(cv::Size(cols, rows), 17, 1.0) * 0.5 + 40;
+  const auto roofDisparity = [](double x) { return 30.0 - 0.4 * (x - 40.0); };
+  // The facet's texture at left x (linear between pixels; roof pixels are read 100 px on).
+  const auto facet = [&](int y, double x) {
+    const int x0 = static_cast<int>(std::floor(x));
+    const double t = x - x0;
+    return static_cast<float>((1 - t) * texture.at<float>(y, x0 + 100) +
+                              t * texture.at<float>(y, x0 + 101));
+  };
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = x >= 40 && x < 70 ? facet(y, x) : texture.at<float>(y, x);
+      // The facet point the right view sees at x: x = xl − roofDisparity(xl).
+      const double xl = (x + 30.0 + 0.4 * 40.0) / 1.4;
+      right.at<float>(y, x) =
+          xl >= 40 && xl < 70 ? facet(y, xl) : texture.at<float>(y, std::min(x + 5, cols - 1));
+    }
+  }
+  testing::addSensorNoise(left, right, 1.5, rng);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(kNaN)), score;
+  for (int x = 40; x < 64; ++x) setRun(disparity, x, x + 1, static_cast<float>(roofDisparity(x)));
+  setRun(disparity, 72, cols, 5.0f);
+  snapStepsToContours(left, right, settings, 0.3f, disparity, score);
+  int located = 0;
+  for (int y = 1; y + 1 < rows; ++y) {
+    int end = 39;  // last pixel on the roof's side of the mid-level
+    while (end + 1 < cols && disparity.at<float>(y, end + 1) > 12.0f) ++end;
+    located += std::abs(end - 69) <= 1 ? 1 : 0;
+  }
+  return located;
+}
+
+TEST(SnapSteps, ASlopedFacetIsCutAlongItsSlope) {
+  // Each row on its own evidence (the line through the rows' cuts would hide the difference).
+  StepSnapSettings rowAlone;
+  rowAlone.lineRows = 0;
+  StepSnapSettings level = rowAlone;
+  level.nearSlopePixels = 0;
+  const int alongSlope = slopedFacetRowsReachingTheOutline(rowAlone);
+  EXPECT_GE(alongSlope, 28 * 3 / 4);
+  EXPECT_LE(slopedFacetRowsReachingTheOutline(level), alongSlope - 6);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
