@@ -25,7 +25,7 @@ constexpr int kMinSlopePixels = 4;
 struct NearSideCut {
   int y = 0, a = 0, b = 0, s0 = 0, s1 = 0;
   float dNear = 0, dFar = 0;
-  // The near surface's slope along the row (px of disparity per px) past its last pixel a.
+  // The near surface's slope along the row (px of disparity per px) through its last pixel a.
   float slope = 0;
   int eFirst = 0;
   // The last candidate the row may take on its own evidence (later ones: line only).
@@ -34,8 +34,8 @@ struct NearSideCut {
   int chosen = 0;
   int rowBest = 0;           // argmin of the row's own cost
   int prev = -1, next = -1;  // the same outline's cut in the rows above and below (index)
-  // The near surface's disparity at x: dNear up to a, then along its slope.
-  float nearAt(int x) const { return x > a ? dNear + slope * static_cast<float>(x - a) : dNear; }
+  // The near surface's disparity at x: dNear at a, along its slope on either side.
+  float nearAt(int x) const { return dNear + slope * static_cast<float>(x - a); }
 };
 
 // The row's own best cut (the first of equal ones), among the candidates it may take alone.
@@ -362,8 +362,10 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   // scored at the near disparity (along its slope) up to e, far ones at the far disparity from
   // e + 2 (pixel e + 1 mixes both surfaces through the blur, and in the right view its roof part
   // is missing: it biased the cut towards the ground), minus contourWeight × the contrast between
-  // e and e + 1. s0 goes back over the near side's pixels by up to cutReach (fattened roofs).
-  // Errors are capped so that one outlier pixel does not decide. Pixels up to e take the near
+  // e and e + 1. s0 goes back over the near side's pixels by up to cutReach (fattened roofs),
+  // over holes of at most nearHoleGap unmatched pixels too (a roof's pixel matched alone before
+  // its outline was kept by the cut and then removed as a speckle, the hole left open). Errors
+  // are capped so that one outlier pixel does not decide. Pixels up to e take the near
   // disparity, the near pixels after it become unmatched; the far side is left alone.
   // The roof's edge is a contour in the right view too (roof against the wall that view sees),
   // at x − dNear: its contrast there, in the left view's grey levels and noise sigmas, capped so
@@ -405,9 +407,13 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     cut.dNear = d[a];
     cut.dFar = d[b];
     int s0 = a;
-    while (s0 - 1 >= std::max(0, a - settings.cutReach) && std::isfinite(d[s0 - 1]) &&
-           std::abs(d[s0 - 1] - cut.dNear) <= 1.0F) {
-      --s0;
+    const int reachStart = std::max(0, a - settings.cutReach);
+    for (;;) {
+      // The next near pixel back, over at most nearHoleGap unmatched ones.
+      int x = s0 - 1;
+      while (x >= reachStart && s0 - 1 - x < settings.nearHoleGap && !std::isfinite(d[x])) --x;
+      if (x < reachStart || !std::isfinite(d[x]) || std::abs(d[x] - cut.dNear) > 1.0F) break;
+      s0 = x;
     }
     // Far pixels are scored up to b + 2 whatever they hold: every cut then scores the same
     // number of pixels (n − 1), and the first far pixel may still turn out to be near.
@@ -419,8 +425,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     double nearSum[kMaxCutSpan + 1], farSum[kMaxCutSpan + 1];
     nearSum[0] = farSum[0] = 0;
     // The near surface may slope along the row (a pitched roof's facet, sloping towards its
-    // outline): past a, its disparity follows the line fitted to its last pixels. (The hard end
-    // below reads the level near disparity: along the slope, seed 3 600² lost 0.2 edge%.)
+    // outline): its disparity follows the line fitted to its last pixels, through d[a]. (The hard
+    // end below reads the level near disparity: along the slope, seed 3 600² lost 0.2 edge%.)
     cut.a = a;
     cut.slope = static_cast<float>(nearSlope(a, d, 0.5 * (cut.dNear + cut.dFar)));
     for (int k = 0; k < n; ++k) {

@@ -12,6 +12,7 @@ struct StepSnapSettings {
   double checkSigmas = 3.0;  // × noise sigma: photometric check of the pixels changed (0 = off)
   // Checked cut of a roof's +x edge (see below).
   int cutReach = 8;                 // px: how far back over the near side the cut may go
+  int nearHoleGap = 8;              // px: most unmatched pixels inside the near side it goes over
   int cutAhead = 4;                 // px: how far over the far side a line of cuts may take a row
   int carriedRuns = 1;              // px of a run on each side of a contour it crosses (0 = off)
   double carriedMargin = 1.0;       // noise sigmas: a farther disparity's lead over the run's
@@ -42,32 +43,34 @@ struct StepSnapSettings {
 // maxGap) and disparities at least minStep apart are the two sides of a depth step.
 // Near side on the left (larger disparity: a roof's +x edge, where both views see the ground): with
 // `right` given and checkSigmas > 0, the near side's last pixel e is chosen in [a − cutReach,
-// b − 1] (back over the near side's own pixels only) at the least total photometric error (mean
-// |left − mapped right| of the pixel and its two vertical neighbours, in noise sigmas, capped at
-// errorCap): near pixels at the near disparity up to e, far ones at the far disparity from e + 2
-// (past a, the near disparity follows the near side's slope along the row: the least-squares line
-// through the row's matched pixels of its last nearSlopePixels px on its side of the mid-level,
-// from d[a], at most maxNearSlope px per px; a pitched roof's facet sloping to its outline comes
-// out of fronto-parallel windows as steps, and at the last step's value its last pixels failed like
-// the ground's) — pixel e + 1 mixes both surfaces through the image blur and was seen to pull the
-// cut onto the ground —, less contourWeight × the left image's contrast between e and e + 1 (the
-// step between the mean greys of 2 px on each side, in sigmas), less rightContourWeight × the right
-// view's contrast where the cut falls in it (x − dNear: roof against the wall that view sees;
-// capped at rightContourCap sigmas). With lineRows > 0 the cut of a row is taken on the line
-// (through rows y ± lineRows of the same step) of least total cost, each row's cost relative to its
-// own best and capped at lineCap: an outline is a line, and the rows whose own evidence is weak
-// follow their neighbours. The line may also take a row up to cutAhead pixels over its far side (a
-// roof edge that took the ground's value), at no less than the row's own best cost: never on the
-// row's own evidence (that fattened objects of the real pairs), only where the neighbouring rows
-// put the line. Where the near disparity (along its slope) fails hard (≥ errorCap) on two pixels of
-// the gap that the far one explains (≤ checkSigmas), after gap pixels it explains within
-// checkSigmas + carriedMargin on average, cuts before the pixel two before that failure cost
-// hardEndPenalty × errorCap more per pixel: a plain roof beside plain ground of its grey ties both
-// hypotheses, and only the ground past the outline (on the wall only the right view shows, at the
-// roof's disparity) tells where it ends. Pixels up to e take the near disparity (along its slope;
-// score `fillScore`), near pixels after it become unmatched. Unchecked (`right` empty), the near
-// side ends at the strongest contrast within [a − reach, b + reach] when it is at least edgeSigmas
-// sigmas.
+// b − 1] (back over the near side's own pixels only, and over holes of at most nearHoleGap
+// unmatched pixels between them: a roof's pixel matched alone just before its outline, a few pixels
+// after the roof's run, was kept by the cut and then removed as a speckle, the hole between them
+// left open) at the least total photometric error (mean |left − mapped right| of the pixel and its
+// two vertical neighbours, in noise sigmas, capped at errorCap): near pixels at the near disparity
+// up to e, far ones at the far disparity from e + 2 (the near disparity follows the near side's
+// slope along the row: the least-squares line through the row's matched pixels of its last
+// nearSlopePixels px on its side of the mid-level, through d[a], at most maxNearSlope px per px; a
+// pitched roof's facet sloping to its outline comes out of fronto-parallel windows as steps, and at
+// the last step's value its last pixels failed like the ground's) — pixel e + 1 mixes both surfaces
+// through the image blur and was seen to pull the cut onto the ground —, less contourWeight × the
+// left image's contrast between e and e + 1 (the step between the mean greys of 2 px on each side,
+// in sigmas), less rightContourWeight × the right view's contrast where the cut falls in it
+// (x − dNear: roof against the wall that view sees; capped at rightContourCap sigmas). With
+// lineRows > 0 the cut of a row is taken on the line (through rows y ± lineRows of the same step)
+// of least total cost, each row's cost relative to its own best and capped at lineCap: an outline
+// is a line, and the rows whose own evidence is weak follow their neighbours. The line may also
+// take a row up to cutAhead pixels over its far side (a roof edge that took the ground's value), at
+// no less than the row's own best cost: never on the row's own evidence (that fattened objects of
+// the real pairs), only where the neighbouring rows put the line. Where the near disparity (along
+// its slope) fails hard (≥ errorCap) on two pixels of the gap that the far one explains
+// (≤ checkSigmas), after gap pixels it explains within checkSigmas + carriedMargin on average, cuts
+// before the pixel two before that failure cost hardEndPenalty × errorCap more per pixel: a plain
+// roof beside plain ground of its grey ties both hypotheses, and only the ground past the outline
+// (on the wall only the right view shows, at the roof's disparity) tells where it ends. Pixels up
+// to e take the near disparity (along its slope, holes too; score `fillScore`), near pixels after
+// it become unmatched. Unchecked (`right` empty), the near side ends at the strongest contrast
+// within [a − reach, b + reach] when it is at least edgeSigmas sigmas.
 // Near side on the right (the left map's −x edge of a roof): the unmatched pixels before it are
 // mostly ground the right view does not see and stay unmatched; near pixels before the strongest
 // contrast (as above) are cut, checked ones only when the far disparity explains them better.

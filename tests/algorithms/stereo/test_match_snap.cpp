@@ -656,5 +656,26 @@ TEST(SnapSteps, ASlopedFacetIsCutAlongItsSlope) {
   EXPECT_LE(slopedFacetRowsReachingTheOutline(level), alongSlope - 6);
 }
 
+// The roof of texturedPair() matched on [40, 58) and on pixel 61 alone (a hole in between), the
+// ground from x 76: the cut of the step after pixel 61 reaches back over the hole to the roof's
+// run, and the roof's run from x 40 ends at the outline (x 69). Returns the rows (of 18) where it
+// does.
+int roofRowsClosedOverAHoleToTheOutline(const StepSnapSettings& settings) {
+  const TexturedPair pair = texturedPair();
+  cv::Mat disparity(20, 120, CV_32F, cv::Scalar(kNaN)), score;
+  setRun(disparity, 40, 58, 20.0f);
+  setRun(disparity, 61, 62, 20.0f);
+  setRun(disparity, 76, 120, 5.0f);
+  snapStepsToContours(pair.left, pair.right, settings, 0.3f, disparity, score);
+  return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
+}
+
+TEST(SnapSteps, TheCutReachesBackOverAHoleInsideTheNearSide) {
+  StepSnapSettings noHoles;
+  noHoles.nearHoleGap = 0;
+  EXPECT_EQ(roofRowsClosedOverAHoleToTheOutline(noHoles), 0);
+  EXPECT_EQ(roofRowsClosedOverAHoleToTheOutline(StepSnapSettings{}), 18);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
