@@ -122,6 +122,48 @@ cv::Mat flipped(const cv::Mat& m) {
   return out;
 }
 
+// One row of validate(): `d` holds the row's disparities (a copy of the map's row), `dy` its
+// line shifts; the inconsistent ones are set to NaN. Also built for AVX2 (one rounding
+// instruction per floor instead of a library call; no FMA, so the same arithmetic).
+__attribute__((target_clones("avx2", "default"))) void validateRow(
+    float* d, const float* dy, int y, int W, int H, float sign, double tolerance2,
+    const float* otherD, size_t otherStep, const float* otherS, size_t shiftStep) {
+  const auto fw = static_cast<float>(W), fh = static_cast<float>(H);
+  const float yf = static_cast<float>(y);
+  for (int x = 0; x < W; ++x) {
+    const float dx = d[x];
+    if (!std::isfinite(dx)) continue;
+    // Where the match lands in the other map (float, as the map's values).
+    const float xo = static_cast<float>(x) - sign * dx;
+    const float shift = dy[x];
+    const float yo = yf + shift;
+    // A neighbour inside the other map: floor(xo) + 1 >= 0 and floor(xo) <= W - 1, i.e.
+    // -1 <= xo < W (W exact in float); the same for yo (false for NaN).
+    if (!(xo >= -1.0F && xo < fw && yo >= -1.0F && yo < fh)) {
+      d[x] = kNaN;  // no neighbour inside the other map
+      continue;
+    }
+    const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
+    // The four floor/ceil neighbours, clamped to the map: a clamped one repeats an inside one,
+    // which leaves the "any of them" test unchanged. The first that passes decides (the test
+    // is an OR); a NaN neighbour fails by itself.
+    const int qx0 = std::max(0, fx), qx1 = std::min(W - 1, fx + 1);
+    const int qy0 = std::max(0, fy), qy1 = std::min(H - 1, fy + 1);
+    const float* d0 = otherD + static_cast<size_t>(qy0) * otherStep;
+    const float* s0 = otherS + static_cast<size_t>(qy0) * shiftStep;
+    auto near = [dx, shift, tolerance2](float dq, float sq) {
+      const double ex = dx - dq;  // differences in float, their squares in double
+      const double ey = shift + sq;
+      return ex * ex + ey * ey <= tolerance2;
+    };
+    if (near(d0[qx0], s0[qx0]) || near(d0[qx1], s0[qx1])) continue;
+    const float* d1 = otherD + static_cast<size_t>(qy1) * otherStep;
+    const float* s1 = otherS + static_cast<size_t>(qy1) * shiftStep;
+    if (near(d1[qx0], s1[qx0]) || near(d1[qx1], s1[qx1])) continue;
+    d[x] = kNaN;
+  }
+}
+
 // Keeps the matches of `map` (with line shifts) whose match in the other map points back
 // within `tolerance` for at least one of the four floor/ceil neighbours. `sign`: +1 when `map` is
 // the left map (x_other = x - d), -1 for the right map (x_other = x + d).
@@ -141,37 +183,8 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
         for (int y = rowStart; y < rowEnd; ++y) {
           float* d = out.ptr<float>(y);
           std::copy_n(map.disparity.ptr<float>(y), W, d);
-          const float* dy = map.lineShift.ptr<float>(y);
-          for (int x = 0; x < W; ++x) {
-            const float dx = d[x];
-            if (!std::isfinite(dx)) continue;
-            // Where the match lands in the other map (float, as the map's values).
-            const float xo = static_cast<float>(x) - static_cast<float>(sign) * dx;
-            const float yo = static_cast<float>(y) + dy[x];
-            const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
-            if (fx + 1 < 0 || fx > W - 1 || fy + 1 < 0 || fy > H - 1) {
-              d[x] = kNaN;  // no neighbour inside the other map
-              continue;
-            }
-            // The four floor/ceil neighbours, clamped to the map: a clamped one repeats an inside
-            // one, which leaves the "any of them" test unchanged. No branches, no early exit (a NaN
-            // neighbour fails the test by itself).
-            const int qx0 = std::max(0, fx), qx1 = std::min(W - 1, fx + 1);
-            const int qy0 = std::max(0, fy), qy1 = std::min(H - 1, fy + 1);
-            const float* d0 = otherD + static_cast<size_t>(qy0) * otherStep;
-            const float* d1 = otherD + static_cast<size_t>(qy1) * otherStep;
-            const float* s0 = otherS + static_cast<size_t>(qy0) * shiftStep;
-            const float* s1 = otherS + static_cast<size_t>(qy1) * shiftStep;
-            const float shift = dy[x];
-            auto near = [dx, shift, tolerance2](float dq, float sq) {
-              const double ex = dx - dq;  // differences in float, their squares in double
-              const double ey = shift + sq;
-              return ex * ex + ey * ey <= tolerance2;
-            };
-            const bool consistent = near(d0[qx0], s0[qx0]) | near(d0[qx1], s0[qx1]) |
-                                    near(d1[qx0], s1[qx0]) | near(d1[qx1], s1[qx1]);
-            if (!consistent) d[x] = kNaN;
-          }
+          validateRow(d, map.lineShift.ptr<float>(y), y, W, H, static_cast<float>(sign), tolerance2,
+                      otherD, otherStep, otherS, shiftStep);
         }
       });
   return out;
@@ -182,6 +195,27 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
 // source rows whose line shift (|dy| <= lineShift + 1) can reach it and writes only its own rows.
 // Bands of 64 rows: each scans 2 · (lineShift + 2) rows beyond its own.
 constexpr int kPointedBandRows = 64;
+// One source row of pointedTo(): marks the pointed pixels in output rows rowStart..rowEnd − 1
+// (`needed` is row 0 of the map). Also built for AVX2 (floor in one instruction).
+__attribute__((target_clones("avx2", "default"))) void pointedRow(const float* d, const float* dy,
+                                                                  int y, int W, int rowStart,
+                                                                  int rowEnd, uchar* needed,
+                                                                  size_t step) {
+  const auto yf = static_cast<float>(y);
+  for (int x = 0; x < W; ++x) {
+    if (!std::isfinite(d[x])) continue;
+    const int fx = static_cast<int>(std::floor(static_cast<float>(x) - d[x]));
+    const int fy = static_cast<int>(std::floor(yf + dy[x]));
+    for (int m = 0; m <= 1; ++m) {
+      const int qy = fy + m;
+      if (qy < rowStart || qy >= rowEnd) continue;
+      uchar* row = needed + static_cast<size_t>(qy) * step;
+      if (fx >= 0 && fx < W) row[fx] = 1;
+      if (fx + 1 >= 0 && fx + 1 < W) row[fx + 1] = 1;
+    }
+  }
+}
+
 cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
   cv::Mat needed = cv::Mat::zeros(map.disparity.size(), CV_8U);
   const int reach = lineShift + 2;
@@ -190,21 +224,8 @@ cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
       [&](int rowStart, int rowEnd) {
         for (int y = std::max(0, rowStart - reach); y < std::min(needed.rows, rowEnd + reach);
              ++y) {
-          const float* d = map.disparity.ptr<float>(y);
-          const float* dy = map.lineShift.ptr<float>(y);
-          for (int x = 0; x < needed.cols; ++x) {
-            if (!std::isfinite(d[x])) continue;
-            const int fx = static_cast<int>(std::floor(static_cast<float>(x) - d[x]));
-            const int fy = static_cast<int>(std::floor(static_cast<float>(y) + dy[x]));
-            for (int m = 0; m <= 1; ++m) {
-              const int qy = fy + m;
-              if (qy < rowStart || qy >= rowEnd) continue;
-              for (int n = 0; n <= 1; ++n) {
-                const int qx = fx + n;
-                if (qx >= 0 && qx < needed.cols) needed.at<uchar>(qy, qx) = 1;
-              }
-            }
-          }
+          pointedRow(map.disparity.ptr<float>(y), map.lineShift.ptr<float>(y), y, needed.cols,
+                     rowStart, rowEnd, needed.ptr<uchar>(0), needed.step1());
         }
       },
       kPointedBandRows);
