@@ -772,8 +772,13 @@ class LevelMatcher {
     alignas(32) uint16_t rows16[16];
     bool rowsFound = false;  // t.rowFirst, t.rowLast
     if (w <= 15) {
-      const bool cut = fillWindow15(&freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)],
-                                    windowRows_, r_, rows16);
+      const uint16_t* freeRows = &freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)];
+#ifdef DELINEO_STEREO_X86
+      const bool cut = fillAvx2_ ? fillWindow15Avx2(freeRows, windowRows_, r_, rows16)
+                                 : fillWindow15(freeRows, windowRows_, r_, rows16);
+#else
+      const bool cut = fillWindow15(freeRows, windowRows_, r_, rows16);
+#endif
       if (squareServes && !cut) return false;
       // All 16 rows (those past the window are 0): a fixed count the compiler widens in vectors.
       for (int v = 0; v < 16; ++v) reach[v] = rows16[v];
@@ -1124,6 +1129,9 @@ class LevelMatcher {
   // The main-line span kernel (AVX2, windows ≤ 15 columns): 8 windows a pass.
   const bool useSpans_ = cpuHasAvx2() && s_.window <= 15;
   const bool avx2_ = cpuHasAvx2();  // single windows and the ±1 pair straight to AVX2
+  // The fill's AVX2 version where AVX-512 is missing (fillWindow15's AVX-512 clone does each
+  // doubling step's AND-OR in one instruction).
+  const bool fillAvx2_ = cpuHasAvx2() && !cpuHasAvx512Vl();
   const int batchWindows_ = shapeBatchWindows();  // main-line windows per pass without spans
   cv::Mat otherPrefixB_, otherPrefixBB_;  // CV_32S, row prefix sums of otherQ_ and its squares
   WindowStats refStats_, otherStats_;
