@@ -15,6 +15,13 @@
 //    from the centre that does not cross contour pixels) and a direct NCC over S, computed on
 //    dense w x w rows (element-wise, vectorisable).
 // Memory is bounded by a few tile-sized buffers per worker: no cost volume is stored.
+//
+// The matcher is built twice: for the x86-64 baseline (namespace `base`) and, as this file
+// includes itself once more under #pragma GCC target("avx2"), for AVX2 (namespace
+// `avx2build`); matchLevel() picks the AVX2 build when the CPU has it. Built for AVX2 as a
+// whole, the driver inlines the AVX2 kernels and uses three-operand instructions. No FMA in
+// either build: the same arithmetic, the same maps.
+#ifndef DELINEO_LEVEL_MATCHER_AVX2_PASS
 #include "level_matcher.hpp"
 
 #include <algorithm>
@@ -31,7 +38,18 @@
 #include "level_shape_int.hpp"
 #include "workers.hpp"
 
-namespace delineo::stereo::detail {
+#define DELINEO_LEVEL_MATCHER_BUILD base
+// Functions also built for other instruction sets (target_clones) in the baseline build; plain
+// AVX2 functions in the AVX2 build (a function under the AVX2 pragma cannot be cloned).
+#define DELINEO_LEVEL_MATCHER_CLONES(...) __attribute__((target_clones(__VA_ARGS__)))
+#else
+#undef DELINEO_LEVEL_MATCHER_BUILD
+#undef DELINEO_LEVEL_MATCHER_CLONES
+#define DELINEO_LEVEL_MATCHER_BUILD avx2build
+#define DELINEO_LEVEL_MATCHER_CLONES(...)
+#endif
+
+namespace delineo::stereo::detail::DELINEO_LEVEL_MATCHER_BUILD {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -56,9 +74,8 @@ struct WindowStats {
 };
 
 // Also built for AVX2 (the column sums 4 doubles a vector; no FMA, so the same arithmetic).
-__attribute__((target_clones("avx2", "default"))) WindowStats windowStats(const cv::Mat& img,
-                                                                          const cv::Mat& valid,
-                                                                          int window) {
+DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
+WindowStats windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
   // Running sums (double): per column over the window's rows, slid down one row at a time,
   // then along the row. Two passes over the image instead of three integral images.
   const int r = window / 2;
@@ -149,9 +166,9 @@ inline void shapeSums(const float* b, const float* b2, size_t stride, const floa
 
 // Windows wider than 15 columns (the narrower ones take the integer kernels of
 // level_shape_int.hpp), also built for AVX2 (picked at run time when the CPU has it).
-__attribute__((target_clones("avx2", "default"))) void shapeSums32(
-    const float* b, const float* b2, size_t stride, const float* mask, const float* templ,
-    int rows, float out[3]) {
+DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
+void shapeSums32(const float* b, const float* b2, size_t stride, const float* mask,
+                 const float* templ, int rows, float out[3]) {
   shapeSums<32>(b, b2, stride, mask, templ, rows, out);
 }
 
@@ -176,8 +193,9 @@ constexpr ptrdiff_t kMainLine[kShapeMaxWindows] = {0, -1, -2, -3, -4, -5, -6, -7
 
 // Σ A·B over `rows` rows of two windows ≤ 16 columns wide; `lanes` weighs the 16 columns read
 // (1 inside the window, 0 past it).
-__attribute__((target_clones("avx2", "default"))) float windowDot16(
-    const float* a, size_t aStride, const float* b, size_t bStride, int rows, const float* lanes) {
+DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
+float windowDot16(const float* a, size_t aStride, const float* b, size_t bStride, int rows,
+                  const float* lanes) {
   Float8 acc0{}, acc1{}, w0, w1;
   load8(w0, lanes);
   load8(w1, lanes + 8);
@@ -242,6 +260,7 @@ __attribute__((always_inline)) inline bool sameWords(const Word4& a, const Word4
   return (x[0] | x[1] | x[2] | x[3]) == 0;
 }
 
+#ifndef DELINEO_LEVEL_MATCHER_AVX2_PASS
 // The shape S of a window of ≤ 15 columns: `freeRows` are the window's 16 row words (bit u of
 // row v: cell (u, v) is neither contour nor nodata; bit 15 is 0), `inWindow` keeps the rows
 // v < window. The 4-connected component of the centre (r, r) in the free cells plus the centre
@@ -316,6 +335,10 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) bool fillWin
   const Word4 cut = free & ~seed;
   return (cut[0] | cut[1] | cut[2] | cut[3]) != 0;
 }
+#else
+// The AVX2 build calls the baseline build's fill (and with it its AVX-512 clone).
+using base::fillWindow15;
+#endif
 
 // Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
 struct LinePeak {
@@ -1158,19 +1181,8 @@ class LevelMatcher {
 
 }  // namespace
 
-cv::Point2f subpixelPeak(const float s[3][3]) {
-  // Separable parabolas through the peak row and column.
-  auto parabola = [](float m, float c0, float p) -> float {
-    if (!std::isfinite(m) || !std::isfinite(p)) return 0.0F;
-    const float denom = m - 2.0F * c0 + p;
-    if (!(denom < 0.0F)) return 0.0F;
-    return std::clamp(0.5F * (m - p) / denom, -1.0F, 1.0F);
-  };
-  return {parabola(s[0][1], s[1][1], s[2][1]), parabola(s[1][0], s[1][1], s[1][2])};
-}
-
-bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
-                core::Progress* progress) {
+bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
+                     core::Progress* progress) {
   // Padding every input by the window radius with nodata lets adaptive shapes serve the pixels
   // whose window leaves the image (their shape stops at the border), and keeps every window
   // access inside the buffers.
@@ -1198,4 +1210,37 @@ bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput
   return matcher.run(progress);
 }
 
+}  // namespace delineo::stereo::detail::DELINEO_LEVEL_MATCHER_BUILD
+
+#ifndef DELINEO_LEVEL_MATCHER_AVX2_PASS
+#ifdef DELINEO_STEREO_X86
+#define DELINEO_LEVEL_MATCHER_AVX2_PASS 1
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#include "level_matcher.cpp"  // NOLINT(bugprone-suspicious-include): the AVX2 build
+#pragma GCC pop_options
+#endif
+
+namespace delineo::stereo::detail {
+
+cv::Point2f subpixelPeak(const float s[3][3]) {
+  // Separable parabolas through the peak row and column.
+  auto parabola = [](float m, float c0, float p) -> float {
+    if (!std::isfinite(m) || !std::isfinite(p)) return 0.0F;
+    const float denom = m - 2.0F * c0 + p;
+    if (!(denom < 0.0F)) return 0.0F;
+    return std::clamp(0.5F * (m - p) / denom, -1.0F, 1.0F);
+  };
+  return {parabola(s[0][1], s[1][1], s[2][1]), parabola(s[1][0], s[1][1], s[1][2])};
+}
+
+bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
+                core::Progress* progress) {
+#ifdef DELINEO_STEREO_X86
+  if (cpuHasAvx2()) return avx2build::matchLevelBuild(in, settings, out, progress);
+#endif
+  return base::matchLevelBuild(in, settings, out, progress);
+}
+
 }  // namespace delineo::stereo::detail
+#endif
