@@ -340,6 +340,18 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) bool fillWin
 using base::fillWindow15;
 #endif
 
+// subpixelPeak() (level_matcher.hpp), inlined in the matcher.
+inline cv::Point2f subpixelOffset(const float s[3][3]) {
+  // Separable parabolas through the peak row and column.
+  auto parabola = [](float m, float c0, float p) -> float {
+    if (!std::isfinite(m) || !std::isfinite(p)) return 0.0F;
+    const float denom = m - 2.0F * c0 + p;
+    if (!(denom < 0.0F)) return 0.0F;
+    return std::clamp(0.5F * (m - p) / denom, -1.0F, 1.0F);
+  };
+  return {parabola(s[0][1], s[1][1], s[2][1]), parabola(s[1][0], s[1][1], s[1][2])};
+}
+
 // Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
 struct LinePeak {
   float best = kNegInf;
@@ -1137,7 +1149,7 @@ class LevelMatcher {
     if ((cd == lo && lo > in_.dmin) || (cd == hi && hi < in_.dmax)) return;
     float du = 0, dv = 0;
     if (s_.subpixel) {
-      const cv::Point2f off = subpixelPeak(s);
+      const cv::Point2f off = subpixelOffset(s);
       du = off.x;
       dv = off.y;
     }
@@ -1224,14 +1236,7 @@ bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelO
 namespace delineo::stereo::detail {
 
 cv::Point2f subpixelPeak(const float s[3][3]) {
-  // Separable parabolas through the peak row and column.
-  auto parabola = [](float m, float c0, float p) -> float {
-    if (!std::isfinite(m) || !std::isfinite(p)) return 0.0F;
-    const float denom = m - 2.0F * c0 + p;
-    if (!(denom < 0.0F)) return 0.0F;
-    return std::clamp(0.5F * (m - p) / denom, -1.0F, 1.0F);
-  };
-  return {parabola(s[0][1], s[1][1], s[2][1]), parabola(s[1][0], s[1][1], s[1][2])};
+  return base::subpixelOffset(s);
 }
 
 bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
