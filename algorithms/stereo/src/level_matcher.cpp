@@ -532,7 +532,7 @@ class LevelMatcher {
   // Per pixel, the row of its window as one word: bit u set when (x - r + u, y) is marked in
   // `marked` (CV_8U) or lies outside the image.
   cv::Mat rowWindowBits(const cv::Mat& marked) const {
-    cv::Mat out(marked.size(), CV_32S, cv::Scalar(0));
+    cv::Mat out(marked.size(), CV_32S);  // every element is written below
     const int w = s_.window;
     for (int y = 0; y < H_; ++y) {
       const uchar* b = marked.ptr<uchar>(y);
