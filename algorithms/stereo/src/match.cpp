@@ -12,6 +12,11 @@
 #include <thread>
 #include <vector>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define DELINEO_MATCH_X86 1
+#endif
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -126,11 +131,11 @@ cv::Mat flipped(const cv::Mat& m) {
 // line shifts; the inconsistent ones are set to NaN. Also built for AVX2 (one rounding
 // instruction per floor instead of a library call; no FMA, so the same arithmetic).
 __attribute__((target_clones("avx2", "default"))) void validateRow(
-    float* d, const float* dy, int y, int W, int H, float sign, double tolerance2,
+    float* d, const float* dy, int xStart, int y, int W, int H, float sign, double tolerance2,
     const float* otherD, size_t otherStep, const float* otherS, size_t shiftStep) {
   const auto fw = static_cast<float>(W), fh = static_cast<float>(H);
   const float yf = static_cast<float>(y);
-  for (int x = 0; x < W; ++x) {
+  for (int x = xStart; x < W; ++x) {
     const float dx = d[x];
     if (!std::isfinite(dx)) continue;
     // Where the match lands in the other map (float, as the map's values).
@@ -164,6 +169,100 @@ __attribute__((target_clones("avx2", "default"))) void validateRow(
   }
 }
 
+#ifdef DELINEO_MATCH_X86
+bool cpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2") != 0;
+  return has;
+}
+
+// Bit k set when lane k of the 4 float pairs (ex, ey) has ex² + ey² <= tolerance2, the squares
+// and their sum in double as in validateRow().
+__attribute__((target("avx2"), always_inline)) inline int nearLanes4(__m128 ex, __m128 ey,
+                                                                     __m256d tolerance2) {
+  const __m256d x = _mm256_cvtps_pd(ex), y = _mm256_cvtps_pd(ey);
+  const __m256d e = _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y));
+  return _mm256_movemask_pd(_mm256_cmp_pd(e, tolerance2, _CMP_LE_OQ));
+}
+
+// The same for one neighbour of 8 pixels (disparities dx, line shifts `shift`): its values
+// gathered at rowD + qx in otherD and rowS + qx in otherS.
+__attribute__((target("avx2"), always_inline)) inline int nearNeighbour(
+    const float* otherD, const float* otherS, __m256i rowD, __m256i rowS, __m256i qx, __m256 dx,
+    __m256 shift, __m256d tolerance2) {
+  const __m256 dq = _mm256_i32gather_ps(otherD, _mm256_add_epi32(rowD, qx), 4);
+  const __m256 sq = _mm256_i32gather_ps(otherS, _mm256_add_epi32(rowS, qx), 4);
+  const __m256 ex = _mm256_sub_ps(dx, dq), ey = _mm256_add_ps(shift, sq);
+  return nearLanes4(_mm256_castps256_ps128(ex), _mm256_castps256_ps128(ey), tolerance2) |
+         (nearLanes4(_mm256_extractf128_ps(ex, 1), _mm256_extractf128_ps(ey, 1), tolerance2) << 4);
+}
+
+// validateRow() for 8 pixels at a time (the rest by validateRow()): the same floats, floors,
+// clamps and double tests per pixel, the four neighbours gathered. Indices of the other maps
+// as int32: the caller checks that they fit.
+__attribute__((target("avx2"))) void validateRowAvx2(float* d, const float* dy, int y, int W, int H,
+                                                     float sign, double tolerance2,
+                                                     const float* otherD, size_t otherStep,
+                                                     const float* otherS, size_t shiftStep) {
+  const __m256 fw = _mm256_set1_ps(static_cast<float>(W));
+  const __m256 fh = _mm256_set1_ps(static_cast<float>(H));
+  const __m256 minusOne = _mm256_set1_ps(-1.0F);
+  const __m256 yf = _mm256_set1_ps(static_cast<float>(y));
+  const __m256 signV = _mm256_set1_ps(sign);
+  const __m256 nan = _mm256_set1_ps(kNaN);
+  const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
+  const __m256i lastX = _mm256_set1_epi32(W - 1), lastY = _mm256_set1_epi32(H - 1);
+  const __m256i stepD = _mm256_set1_epi32(static_cast<int>(otherStep));
+  const __m256i stepS = _mm256_set1_epi32(static_cast<int>(shiftStep));
+  const __m256i exponent = _mm256_set1_epi32(0x7F800000);
+  const __m256d tol2 = _mm256_set1_pd(tolerance2);
+  const __m256i lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  int x = 0;
+  for (; x + 8 <= W; x += 8) {
+    const __m256 dx = _mm256_loadu_ps(d + x);
+    // Finite lanes (exponent not all ones), as std::isfinite.
+    const __m256i finite = _mm256_xor_si256(
+        _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_castps_si256(dx), exponent), exponent),
+        _mm256_set1_epi32(-1));
+    if (_mm256_testz_si256(finite, finite) != 0) continue;
+    const __m256 xs = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x), lanes));
+    const __m256 xo = _mm256_sub_ps(xs, _mm256_mul_ps(signV, dx));
+    const __m256 shift = _mm256_loadu_ps(dy + x);
+    const __m256 yo = _mm256_add_ps(yf, shift);
+    const __m256 inside = _mm256_and_ps(
+        _mm256_and_ps(_mm256_cmp_ps(xo, minusOne, _CMP_GE_OQ), _mm256_cmp_ps(xo, fw, _CMP_LT_OQ)),
+        _mm256_and_ps(_mm256_cmp_ps(yo, minusOne, _CMP_GE_OQ), _mm256_cmp_ps(yo, fh, _CMP_LT_OQ)));
+    const __m256i tested = _mm256_and_si256(finite, _mm256_castps_si256(inside));
+    // Floors of the tested lanes (the others: 0, any index inside the maps).
+    const __m256i fx = _mm256_and_si256(
+        _mm256_cvttps_epi32(_mm256_round_ps(xo, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)),
+        tested);
+    const __m256i fy = _mm256_and_si256(
+        _mm256_cvttps_epi32(_mm256_round_ps(yo, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)),
+        tested);
+    const __m256i qx0 = _mm256_max_epi32(zero, fx);
+    const __m256i qx1 = _mm256_min_epi32(lastX, _mm256_add_epi32(fx, one));
+    const __m256i qy0 = _mm256_max_epi32(zero, fy);
+    const __m256i qy1 = _mm256_min_epi32(lastY, _mm256_add_epi32(fy, one));
+    const __m256i rowD0 = _mm256_mullo_epi32(qy0, stepD), rowD1 = _mm256_mullo_epi32(qy1, stepD);
+    const __m256i rowS0 = _mm256_mullo_epi32(qy0, stepS), rowS1 = _mm256_mullo_epi32(qy1, stepS);
+    const int passed = nearNeighbour(otherD, otherS, rowD0, rowS0, qx0, dx, shift, tol2) |
+                       nearNeighbour(otherD, otherS, rowD0, rowS0, qx1, dx, shift, tol2) |
+                       nearNeighbour(otherD, otherS, rowD1, rowS1, qx0, dx, shift, tol2) |
+                       nearNeighbour(otherD, otherS, rowD1, rowS1, qx1, dx, shift, tol2);
+    // NaN: finite lanes outside the other map, and tested lanes no neighbour passed.
+    const int finiteBits = _mm256_movemask_ps(_mm256_castsi256_ps(finite));
+    const int testedBits = _mm256_movemask_ps(_mm256_castsi256_ps(tested));
+    const int rejected = (finiteBits & ~testedBits) | (testedBits & ~passed);
+    if (rejected == 0) continue;
+    const __m256i bits =
+        _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(rejected), lanes), one);
+    _mm256_storeu_ps(d + x,
+                     _mm256_blendv_ps(dx, nan, _mm256_castsi256_ps(_mm256_cmpeq_epi32(bits, one))));
+  }
+  validateRow(d, dy, x, y, W, H, sign, tolerance2, otherD, otherStep, otherS, shiftStep);
+}
+#endif
+
 // Keeps the matches of `map` (with line shifts) whose match in the other map points back
 // within `tolerance` for at least one of the four floor/ceil neighbours. `sign`: +1 when `map` is
 // the left map (x_other = x - d), -1 for the right map (x_other = x + d).
@@ -177,14 +276,30 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
   const auto* otherD = other.disparity.ptr<float>(0);
   const auto* otherS = other.lineShift.ptr<float>(0);
   const size_t otherStep = other.disparity.step1(), shiftStep = other.lineShift.step1();
+#ifdef DELINEO_MATCH_X86
+  // The AVX2 rows gather with int32 indices.
+  const bool avx2 =
+      cpuHasAvx2() &&
+      static_cast<double>(H) * static_cast<double>(std::max(otherStep, shiftStep)) < 2e9;
+#else
+  const bool avx2 = false;
+#endif
   forRowBands(
       H, threads,
       [&, W, H, sign, tolerance2, otherD, otherS, otherStep, shiftStep](int rowStart, int rowEnd) {
         for (int y = rowStart; y < rowEnd; ++y) {
           float* d = out.ptr<float>(y);
           std::copy_n(map.disparity.ptr<float>(y), W, d);
-          validateRow(d, map.lineShift.ptr<float>(y), y, W, H, static_cast<float>(sign), tolerance2,
-                      otherD, otherStep, otherS, shiftStep);
+          const float* dy = map.lineShift.ptr<float>(y);
+#ifdef DELINEO_MATCH_X86
+          if (avx2) {
+            validateRowAvx2(d, dy, y, W, H, static_cast<float>(sign), tolerance2, otherD, otherStep,
+                            otherS, shiftStep);
+            continue;
+          }
+#endif
+          validateRow(d, dy, 0, y, W, H, static_cast<float>(sign), tolerance2, otherD, otherStep,
+                      otherS, shiftStep);
         }
       });
   return out;
