@@ -1225,7 +1225,9 @@ bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelO
 }  // namespace delineo::stereo::detail::DELINEO_LEVEL_MATCHER_BUILD
 
 #ifndef DELINEO_LEVEL_MATCHER_AVX2_PASS
-#ifdef DELINEO_STEREO_X86
+// The AVX2 build needs GCC's target pragma (other compilers: the baseline build only).
+#if defined(DELINEO_STEREO_X86) && defined(__GNUC__) && !defined(__clang__)
+#define DELINEO_LEVEL_MATCHER_HAS_AVX2_BUILD 1
 #define DELINEO_LEVEL_MATCHER_AVX2_PASS 1
 #pragma GCC push_options
 #pragma GCC target("avx2")
@@ -1241,7 +1243,7 @@ cv::Point2f subpixelPeak(const float s[3][3]) {
 
 bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
                 core::Progress* progress) {
-#ifdef DELINEO_STEREO_X86
+#ifdef DELINEO_LEVEL_MATCHER_HAS_AVX2_BUILD
   if (cpuHasAvx2()) return avx2build::matchLevelBuild(in, settings, out, progress);
 #endif
   return base::matchLevelBuild(in, settings, out, progress);
