@@ -682,7 +682,7 @@ class LevelMatcher {
       finish(
           x, y, in_.lo.at<int>(y, x), in_.hi.at<int>(y, x), sc.peaks[static_cast<size_t>(i)],
           [&](int d, int dy) { return squareScore(x, y, d, dy); },
-          [](int, float&, float&) { return false; });
+          [](int, float&, float&) { return false; }, [](int, int, float*) { return false; });
     }
   }
 
@@ -984,6 +984,19 @@ class LevelMatcher {
     return true;
   }
 
+  // Scores at (d .. d + 2, dy) in one pass; false when a window is not a plain one.
+  bool shapeScoresLine(int x, int y, int d, int dy, const ShapeTemplate& t, float* scores) const {
+    if (rowStride_ != 16) return false;
+    const int xb = x - d, yb = y + dy;  // windows xb, xb − 1, xb − 2
+    if (yb < r_ || yb >= H_ - r_ || xb - 2 < r_ || xb >= W_ - r_) return false;
+    const uchar* ok = otherStats_.ok.ptr<uchar>(yb);
+    if (!ok[xb] || !ok[xb - 1] || !ok[xb - 2]) return false;
+    shapeScoresInt(otherQ_.ptr<int16_t>(yb + t.rowFirst - r_) + xb - r_, otherQStride_, kMainLine,
+                   &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 3,
+                   t.terms, scores);
+    return true;
+  }
+
   // Scores at (d, -1) and (d, +1) in one pass; false when a window is not a plain one.
   bool shapeScorePair(int x, int y, int d, const ShapeTemplate& t, float& minus,
                       float& plus) const {
@@ -1032,9 +1045,8 @@ class LevelMatcher {
     }
     finish(
         x, y, lo, hi, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); },
-        [&](int dd, float& minus, float& plus) {
-          return shapeScorePair(x, y, dd, t, minus, plus);
-        });
+        [&](int dd, float& minus, float& plus) { return shapeScorePair(x, y, dd, t, minus, plus); },
+        [&](int dd, int dy, float* scores) { return shapeScoresLine(x, y, dd, dy, t, scores); });
   }
 
   // ---- peak ------------------------------------------------------------------------------
@@ -1042,10 +1054,12 @@ class LevelMatcher {
   // From the main-line peak: local ascent over the line shifts (3x3 neighbourhoods of the 2D
   // surface, d within the pixel's interval, |dy| <= lineShift), rejection tests, sub-pixel
   // offset, output.
-  // `pair(d, minus, plus)` may give the scores at (d, ∓1) in one go (returns false when not).
+  // `pair(d, minus, plus)` may give the scores at (d, ∓1) in one go (returns false when not),
+  // `line(d, dy, scores)` those at (d .. d + 2, dy) (the same values as `score`, or false).
   // [lo, hi]: the pixel's interval (in_.lo, in_.hi at (x, y)).
-  template <class Score, class Pair>
-  void finish(int x, int y, int lo, int hi, const LinePeak& peak, Score&& score, Pair&& pair) {
+  template <class Score, class Pair, class Line>
+  void finish(int x, int y, int lo, int hi, const LinePeak& peak, Score&& score, Pair&& pair,
+              Line&& line) {
     if (!(peak.best > kNegInf)) return;
     int cd = peak.bestD, cdy = 0;
     float best = peak.best;
@@ -1109,9 +1123,15 @@ class LevelMatcher {
             s[1][2] = at(cd, 1);
           }
         } else {
-          for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) {
-              if (i != 1 || j != 1) s[i][j] = at(cd + i - 1, cdy + j - 1);
+          // The 8 neighbours by line: the three windows of a line in one pass when they all
+          // lie in the interval and the line in range (`at` gives the same values then).
+          for (int j = 0; j < 3; ++j) {
+            const int dy = cdy + j - 1;
+            float three[3];
+            const bool batched =
+                cd - 1 >= lo && cd + 1 <= hi && dy >= -L_ && dy <= L_ && line(cd - 1, dy, three);
+            for (int i = 0; i < 3; ++i) {
+              if (i != 1 || j != 1) s[i][j] = batched ? three[i] : at(cd + i - 1, dy);
             }
           }
         }
