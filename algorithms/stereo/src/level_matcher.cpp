@@ -15,6 +15,13 @@
 //    from the centre that does not cross contour pixels) and a direct NCC over S, computed on
 //    dense w x w rows (element-wise, vectorisable).
 // Memory is bounded by a few tile-sized buffers per worker: no cost volume is stored.
+//
+// The matcher is built twice: for the x86-64 baseline (namespace `base`) and, as this file
+// includes itself once more under #pragma GCC target("avx2"), for AVX2 (namespace
+// `avx2build`); matchLevel() picks the AVX2 build when the CPU has it. Built for AVX2 as a
+// whole, the driver inlines the AVX2 kernels and uses three-operand instructions. No FMA in
+// either build: the same arithmetic, the same maps.
+#ifndef DELINEO_LEVEL_MATCHER_AVX2_PASS
 #include "level_matcher.hpp"
 
 #include <algorithm>
@@ -31,7 +38,18 @@
 #include "level_shape_int.hpp"
 #include "workers.hpp"
 
-namespace delineo::stereo::detail {
+#define DELINEO_LEVEL_MATCHER_BUILD base
+// Functions also built for other instruction sets (target_clones) in the baseline build; plain
+// AVX2 functions in the AVX2 build (a function under the AVX2 pragma cannot be cloned).
+#define DELINEO_LEVEL_MATCHER_CLONES(...) __attribute__((target_clones(__VA_ARGS__)))
+#else
+#undef DELINEO_LEVEL_MATCHER_BUILD
+#undef DELINEO_LEVEL_MATCHER_CLONES
+#define DELINEO_LEVEL_MATCHER_BUILD avx2build
+#define DELINEO_LEVEL_MATCHER_CLONES(...)
+#endif
+
+namespace delineo::stereo::detail::DELINEO_LEVEL_MATCHER_BUILD {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -55,6 +73,8 @@ struct WindowStats {
   cv::Mat ok;        // CV_8U
 };
 
+// Also built for AVX2 (the column sums 4 doubles a vector; no FMA, so the same arithmetic).
+DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
 WindowStats windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
   // Running sums (double): per column over the window's rows, slid down one row at a time,
   // then along the row. Two passes over the image instead of three integral images.
@@ -146,9 +166,9 @@ inline void shapeSums(const float* b, const float* b2, size_t stride, const floa
 
 // Windows wider than 15 columns (the narrower ones take the integer kernels of
 // level_shape_int.hpp), also built for AVX2 (picked at run time when the CPU has it).
-__attribute__((target_clones("avx2", "default"))) void shapeSums32(
-    const float* b, const float* b2, size_t stride, const float* mask, const float* templ,
-    int rows, float out[3]) {
+DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
+void shapeSums32(const float* b, const float* b2, size_t stride, const float* mask,
+                 const float* templ, int rows, float out[3]) {
   shapeSums<32>(b, b2, stride, mask, templ, rows, out);
 }
 
@@ -173,8 +193,9 @@ constexpr ptrdiff_t kMainLine[kShapeMaxWindows] = {0, -1, -2, -3, -4, -5, -6, -7
 
 // Σ A·B over `rows` rows of two windows ≤ 16 columns wide; `lanes` weighs the 16 columns read
 // (1 inside the window, 0 past it).
-__attribute__((target_clones("avx2", "default"))) float windowDot16(
-    const float* a, size_t aStride, const float* b, size_t bStride, int rows, const float* lanes) {
+DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
+float windowDot16(const float* a, size_t aStride, const float* b, size_t bStride, int rows,
+                  const float* lanes) {
   Float8 acc0{}, acc1{}, w0, w1;
   load8(w0, lanes);
   load8(w1, lanes + 8);
@@ -239,6 +260,7 @@ __attribute__((always_inline)) inline bool sameWords(const Word4& a, const Word4
   return (x[0] | x[1] | x[2] | x[3]) == 0;
 }
 
+#ifndef DELINEO_LEVEL_MATCHER_AVX2_PASS
 // The shape S of a window of ≤ 15 columns: `freeRows` are the window's 16 row words (bit u of
 // row v: cell (u, v) is neither contour nor nodata; bit 15 is 0), `inWindow` keeps the rows
 // v < window. The 4-connected component of the centre (r, r) in the free cells plus the centre
@@ -312,6 +334,22 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) bool fillWin
   __builtin_memcpy(reach, &seed, sizeof seed);
   const Word4 cut = free & ~seed;
   return (cut[0] | cut[1] | cut[2] | cut[3]) != 0;
+}
+#else
+// The AVX2 build calls the baseline build's fill (and with it its AVX-512 clone).
+using base::fillWindow15;
+#endif
+
+// subpixelPeak() (level_matcher.hpp), inlined in the matcher.
+inline cv::Point2f subpixelOffset(const float s[3][3]) {
+  // Separable parabolas through the peak row and column.
+  auto parabola = [](float m, float c0, float p) -> float {
+    if (!std::isfinite(m) || !std::isfinite(p)) return 0.0F;
+    const float denom = m - 2.0F * c0 + p;
+    if (!(denom < 0.0F)) return 0.0F;
+    return std::clamp(0.5F * (m - p) / denom, -1.0F, 1.0F);
+  };
+  return {parabola(s[0][1], s[1][1], s[2][1]), parabola(s[1][0], s[1][1], s[1][2])};
 }
 
 // Main-line (dy = 0) peak of one pixel, built while its interval is visited in increasing d.
@@ -494,7 +532,7 @@ class LevelMatcher {
   // Per pixel, the row of its window as one word: bit u set when (x - r + u, y) is marked in
   // `marked` (CV_8U) or lies outside the image.
   cv::Mat rowWindowBits(const cv::Mat& marked) const {
-    cv::Mat out(marked.size(), CV_32S, cv::Scalar(0));
+    cv::Mat out(marked.size(), CV_32S);  // every element is written below
     const int w = s_.window;
     for (int y = 0; y < H_; ++y) {
       const uchar* b = marked.ptr<uchar>(y);
@@ -644,7 +682,7 @@ class LevelMatcher {
       finish(
           x, y, in_.lo.at<int>(y, x), in_.hi.at<int>(y, x), sc.peaks[static_cast<size_t>(i)],
           [&](int d, int dy) { return squareScore(x, y, d, dy); },
-          [](int, float&, float&) { return false; });
+          [](int, float&, float&) { return false; }, [](int, int, float*) { return false; });
     }
   }
 
@@ -772,8 +810,13 @@ class LevelMatcher {
     alignas(32) uint16_t rows16[16];
     bool rowsFound = false;  // t.rowFirst, t.rowLast
     if (w <= 15) {
-      const bool cut = fillWindow15(&freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)],
-                                    windowRows_, r_, rows16);
+      const uint16_t* freeRows = &freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)];
+#ifdef DELINEO_STEREO_X86
+      const bool cut = fillAvx2_ ? fillWindow15Avx2(freeRows, windowRows_, r_, rows16)
+                                 : fillWindow15(freeRows, windowRows_, r_, rows16);
+#else
+      const bool cut = fillWindow15(freeRows, windowRows_, r_, rows16);
+#endif
       if (squareServes && !cut) return false;
       // All 16 rows (those past the window are 0): a fixed count the compiler widens in vectors.
       for (int v = 0; v < 16; ++v) reach[v] = rows16[v];
@@ -941,6 +984,19 @@ class LevelMatcher {
     return true;
   }
 
+  // Scores at (d .. d + 2, dy) in one pass; false when a window is not a plain one.
+  bool shapeScoresLine(int x, int y, int d, int dy, const ShapeTemplate& t, float* scores) const {
+    if (rowStride_ != 16) return false;
+    const int xb = x - d, yb = y + dy;  // windows xb, xb − 1, xb − 2
+    if (yb < r_ || yb >= H_ - r_ || xb - 2 < r_ || xb >= W_ - r_) return false;
+    const uchar* ok = otherStats_.ok.ptr<uchar>(yb);
+    if (!ok[xb] || !ok[xb - 1] || !ok[xb - 2]) return false;
+    shapeScoresInt(otherQ_.ptr<int16_t>(yb + t.rowFirst - r_) + xb - r_, otherQStride_, kMainLine,
+                   &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 3,
+                   t.terms, scores);
+    return true;
+  }
+
   // Scores at (d, -1) and (d, +1) in one pass; false when a window is not a plain one.
   bool shapeScorePair(int x, int y, int d, const ShapeTemplate& t, float& minus,
                       float& plus) const {
@@ -989,9 +1045,8 @@ class LevelMatcher {
     }
     finish(
         x, y, lo, hi, peak, [&](int dd, int dy) { return shapeScore(x, y, dd, dy, t); },
-        [&](int dd, float& minus, float& plus) {
-          return shapeScorePair(x, y, dd, t, minus, plus);
-        });
+        [&](int dd, float& minus, float& plus) { return shapeScorePair(x, y, dd, t, minus, plus); },
+        [&](int dd, int dy, float* scores) { return shapeScoresLine(x, y, dd, dy, t, scores); });
   }
 
   // ---- peak ------------------------------------------------------------------------------
@@ -999,10 +1054,12 @@ class LevelMatcher {
   // From the main-line peak: local ascent over the line shifts (3x3 neighbourhoods of the 2D
   // surface, d within the pixel's interval, |dy| <= lineShift), rejection tests, sub-pixel
   // offset, output.
-  // `pair(d, minus, plus)` may give the scores at (d, ∓1) in one go (returns false when not).
+  // `pair(d, minus, plus)` may give the scores at (d, ∓1) in one go (returns false when not),
+  // `line(d, dy, scores)` those at (d .. d + 2, dy) (the same values as `score`, or false).
   // [lo, hi]: the pixel's interval (in_.lo, in_.hi at (x, y)).
-  template <class Score, class Pair>
-  void finish(int x, int y, int lo, int hi, const LinePeak& peak, Score&& score, Pair&& pair) {
+  template <class Score, class Pair, class Line>
+  void finish(int x, int y, int lo, int hi, const LinePeak& peak, Score&& score, Pair&& pair,
+              Line&& line) {
     if (!(peak.best > kNegInf)) return;
     int cd = peak.bestD, cdy = 0;
     float best = peak.best;
@@ -1066,9 +1123,15 @@ class LevelMatcher {
             s[1][2] = at(cd, 1);
           }
         } else {
-          for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) {
-              if (i != 1 || j != 1) s[i][j] = at(cd + i - 1, cdy + j - 1);
+          // The 8 neighbours by line: the three windows of a line in one pass when they all
+          // lie in the interval and the line in range (`at` gives the same values then).
+          for (int j = 0; j < 3; ++j) {
+            const int dy = cdy + j - 1;
+            float three[3];
+            const bool batched =
+                cd - 1 >= lo && cd + 1 <= hi && dy >= -L_ && dy <= L_ && line(cd - 1, dy, three);
+            for (int i = 0; i < 3; ++i) {
+              if (i != 1 || j != 1) s[i][j] = batched ? three[i] : at(cd + i - 1, dy);
             }
           }
         }
@@ -1106,7 +1169,7 @@ class LevelMatcher {
     if ((cd == lo && lo > in_.dmin) || (cd == hi && hi < in_.dmax)) return;
     float du = 0, dv = 0;
     if (s_.subpixel) {
-      const cv::Point2f off = subpixelPeak(s);
+      const cv::Point2f off = subpixelOffset(s);
       du = off.x;
       dv = off.y;
     }
@@ -1124,6 +1187,9 @@ class LevelMatcher {
   // The main-line span kernel (AVX2, windows ≤ 15 columns): 8 windows a pass.
   const bool useSpans_ = cpuHasAvx2() && s_.window <= 15;
   const bool avx2_ = cpuHasAvx2();  // single windows and the ±1 pair straight to AVX2
+  // The fill's AVX2 version where AVX-512 is missing (fillWindow15's AVX-512 clone does each
+  // doubling step's AND-OR in one instruction).
+  const bool fillAvx2_ = cpuHasAvx2() && !cpuHasAvx512Vl();
   const int batchWindows_ = shapeBatchWindows();  // main-line windows per pass without spans
   cv::Mat otherPrefixB_, otherPrefixBB_;  // CV_32S, row prefix sums of otherQ_ and its squares
   WindowStats refStats_, otherStats_;
@@ -1147,19 +1213,8 @@ class LevelMatcher {
 
 }  // namespace
 
-cv::Point2f subpixelPeak(const float s[3][3]) {
-  // Separable parabolas through the peak row and column.
-  auto parabola = [](float m, float c0, float p) -> float {
-    if (!std::isfinite(m) || !std::isfinite(p)) return 0.0F;
-    const float denom = m - 2.0F * c0 + p;
-    if (!(denom < 0.0F)) return 0.0F;
-    return std::clamp(0.5F * (m - p) / denom, -1.0F, 1.0F);
-  };
-  return {parabola(s[0][1], s[1][1], s[2][1]), parabola(s[1][0], s[1][1], s[1][2])};
-}
-
-bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
-                core::Progress* progress) {
+bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
+                     core::Progress* progress) {
   // Padding every input by the window radius with nodata lets adaptive shapes serve the pixels
   // whose window leaves the image (their shape stops at the border), and keeps every window
   // access inside the buffers.
@@ -1187,4 +1242,32 @@ bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput
   return matcher.run(progress);
 }
 
+}  // namespace delineo::stereo::detail::DELINEO_LEVEL_MATCHER_BUILD
+
+#ifndef DELINEO_LEVEL_MATCHER_AVX2_PASS
+// The AVX2 build needs GCC's target pragma (other compilers: the baseline build only).
+#if defined(DELINEO_STEREO_X86) && defined(__GNUC__) && !defined(__clang__)
+#define DELINEO_LEVEL_MATCHER_HAS_AVX2_BUILD 1
+#define DELINEO_LEVEL_MATCHER_AVX2_PASS 1
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#include "level_matcher.cpp"  // NOLINT(bugprone-suspicious-include): the AVX2 build
+#pragma GCC pop_options
+#endif
+
+namespace delineo::stereo::detail {
+
+cv::Point2f subpixelPeak(const float s[3][3]) {
+  return base::subpixelOffset(s);
+}
+
+bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
+                core::Progress* progress) {
+#ifdef DELINEO_LEVEL_MATCHER_HAS_AVX2_BUILD
+  if (cpuHasAvx2()) return avx2build::matchLevelBuild(in, settings, out, progress);
+#endif
+  return base::matchLevelBuild(in, settings, out, progress);
+}
+
 }  // namespace delineo::stereo::detail
+#endif

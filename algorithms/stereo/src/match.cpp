@@ -12,6 +12,11 @@
 #include <thread>
 #include <vector>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define DELINEO_MATCH_X86 1
+#endif
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -122,6 +127,142 @@ cv::Mat flipped(const cv::Mat& m) {
   return out;
 }
 
+// One row of validate(): `d` holds the row's disparities (a copy of the map's row), `dy` its
+// line shifts; the inconsistent ones are set to NaN. Also built for AVX2 (one rounding
+// instruction per floor instead of a library call; no FMA, so the same arithmetic).
+__attribute__((target_clones("avx2", "default"))) void validateRow(
+    float* d, const float* dy, int xStart, int y, int W, int H, float sign, double tolerance2,
+    const float* otherD, size_t otherStep, const float* otherS, size_t shiftStep) {
+  const auto fw = static_cast<float>(W), fh = static_cast<float>(H);
+  const float yf = static_cast<float>(y);
+  for (int x = xStart; x < W; ++x) {
+    const float dx = d[x];
+    if (!std::isfinite(dx)) continue;
+    // Where the match lands in the other map (float, as the map's values).
+    const float xo = static_cast<float>(x) - sign * dx;
+    const float shift = dy[x];
+    const float yo = yf + shift;
+    // A neighbour inside the other map: floor(xo) + 1 >= 0 and floor(xo) <= W - 1, i.e.
+    // -1 <= xo < W (W exact in float); the same for yo (false for NaN).
+    if (!(xo >= -1.0F && xo < fw && yo >= -1.0F && yo < fh)) {
+      d[x] = kNaN;  // no neighbour inside the other map
+      continue;
+    }
+    const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
+    // The four floor/ceil neighbours, clamped to the map: a clamped one repeats an inside one,
+    // which leaves the "any of them" test unchanged. The first that passes decides (the test
+    // is an OR); a NaN neighbour fails by itself.
+    const int qx0 = std::max(0, fx), qx1 = std::min(W - 1, fx + 1);
+    const int qy0 = std::max(0, fy), qy1 = std::min(H - 1, fy + 1);
+    const float* d0 = otherD + static_cast<size_t>(qy0) * otherStep;
+    const float* s0 = otherS + static_cast<size_t>(qy0) * shiftStep;
+    auto near = [dx, shift, tolerance2](float dq, float sq) {
+      const double ex = dx - dq;  // differences in float, their squares in double
+      const double ey = shift + sq;
+      return ex * ex + ey * ey <= tolerance2;
+    };
+    if (near(d0[qx0], s0[qx0]) || near(d0[qx1], s0[qx1])) continue;
+    const float* d1 = otherD + static_cast<size_t>(qy1) * otherStep;
+    const float* s1 = otherS + static_cast<size_t>(qy1) * shiftStep;
+    if (near(d1[qx0], s1[qx0]) || near(d1[qx1], s1[qx1])) continue;
+    d[x] = kNaN;
+  }
+}
+
+#ifdef DELINEO_MATCH_X86
+bool cpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2") != 0;
+  return has;
+}
+
+// Bit k set when lane k of the 4 float pairs (ex, ey) has ex² + ey² <= tolerance2, the squares
+// and their sum in double as in validateRow().
+__attribute__((target("avx2"), always_inline)) inline int nearLanes4(__m128 ex, __m128 ey,
+                                                                     __m256d tolerance2) {
+  const __m256d x = _mm256_cvtps_pd(ex), y = _mm256_cvtps_pd(ey);
+  const __m256d e = _mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y));
+  return _mm256_movemask_pd(_mm256_cmp_pd(e, tolerance2, _CMP_LE_OQ));
+}
+
+// The same for one neighbour of 8 pixels (disparities dx, line shifts `shift`): its values
+// gathered at rowD + qx in otherD and rowS + qx in otherS.
+__attribute__((target("avx2"), always_inline)) inline int nearNeighbour(
+    const float* otherD, const float* otherS, __m256i rowD, __m256i rowS, __m256i qx, __m256 dx,
+    __m256 shift, __m256d tolerance2) {
+  const __m256 dq = _mm256_i32gather_ps(otherD, _mm256_add_epi32(rowD, qx), 4);
+  const __m256 sq = _mm256_i32gather_ps(otherS, _mm256_add_epi32(rowS, qx), 4);
+  const __m256 ex = _mm256_sub_ps(dx, dq), ey = _mm256_add_ps(shift, sq);
+  return nearLanes4(_mm256_castps256_ps128(ex), _mm256_castps256_ps128(ey), tolerance2) |
+         (nearLanes4(_mm256_extractf128_ps(ex, 1), _mm256_extractf128_ps(ey, 1), tolerance2) << 4);
+}
+
+// validateRow() for 8 pixels at a time (the rest by validateRow()): the same floats, floors,
+// clamps and double tests per pixel, the four neighbours gathered. Indices of the other maps
+// as int32: the caller checks that they fit.
+__attribute__((target("avx2"))) void validateRowAvx2(float* d, const float* dy, int y, int W, int H,
+                                                     float sign, double tolerance2,
+                                                     const float* otherD, size_t otherStep,
+                                                     const float* otherS, size_t shiftStep) {
+  const __m256 fw = _mm256_set1_ps(static_cast<float>(W));
+  const __m256 fh = _mm256_set1_ps(static_cast<float>(H));
+  const __m256 minusOne = _mm256_set1_ps(-1.0F);
+  const __m256 yf = _mm256_set1_ps(static_cast<float>(y));
+  const __m256 signV = _mm256_set1_ps(sign);
+  const __m256 nan = _mm256_set1_ps(kNaN);
+  const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
+  const __m256i lastX = _mm256_set1_epi32(W - 1), lastY = _mm256_set1_epi32(H - 1);
+  const __m256i stepD = _mm256_set1_epi32(static_cast<int>(otherStep));
+  const __m256i stepS = _mm256_set1_epi32(static_cast<int>(shiftStep));
+  const __m256i exponent = _mm256_set1_epi32(0x7F800000);
+  const __m256d tol2 = _mm256_set1_pd(tolerance2);
+  const __m256i lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  int x = 0;
+  for (; x + 8 <= W; x += 8) {
+    const __m256 dx = _mm256_loadu_ps(d + x);
+    // Finite lanes (exponent not all ones), as std::isfinite.
+    const __m256i finite = _mm256_xor_si256(
+        _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_castps_si256(dx), exponent), exponent),
+        _mm256_set1_epi32(-1));
+    if (_mm256_testz_si256(finite, finite) != 0) continue;
+    const __m256 xs = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x), lanes));
+    const __m256 xo = _mm256_sub_ps(xs, _mm256_mul_ps(signV, dx));
+    const __m256 shift = _mm256_loadu_ps(dy + x);
+    const __m256 yo = _mm256_add_ps(yf, shift);
+    const __m256 inside = _mm256_and_ps(
+        _mm256_and_ps(_mm256_cmp_ps(xo, minusOne, _CMP_GE_OQ), _mm256_cmp_ps(xo, fw, _CMP_LT_OQ)),
+        _mm256_and_ps(_mm256_cmp_ps(yo, minusOne, _CMP_GE_OQ), _mm256_cmp_ps(yo, fh, _CMP_LT_OQ)));
+    const __m256i tested = _mm256_and_si256(finite, _mm256_castps_si256(inside));
+    // Floors of the tested lanes (the others: 0, any index inside the maps).
+    const __m256i fx = _mm256_and_si256(
+        _mm256_cvttps_epi32(_mm256_round_ps(xo, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)),
+        tested);
+    const __m256i fy = _mm256_and_si256(
+        _mm256_cvttps_epi32(_mm256_round_ps(yo, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)),
+        tested);
+    const __m256i qx0 = _mm256_max_epi32(zero, fx);
+    const __m256i qx1 = _mm256_min_epi32(lastX, _mm256_add_epi32(fx, one));
+    const __m256i qy0 = _mm256_max_epi32(zero, fy);
+    const __m256i qy1 = _mm256_min_epi32(lastY, _mm256_add_epi32(fy, one));
+    const __m256i rowD0 = _mm256_mullo_epi32(qy0, stepD), rowD1 = _mm256_mullo_epi32(qy1, stepD);
+    const __m256i rowS0 = _mm256_mullo_epi32(qy0, stepS), rowS1 = _mm256_mullo_epi32(qy1, stepS);
+    const int passed = nearNeighbour(otherD, otherS, rowD0, rowS0, qx0, dx, shift, tol2) |
+                       nearNeighbour(otherD, otherS, rowD0, rowS0, qx1, dx, shift, tol2) |
+                       nearNeighbour(otherD, otherS, rowD1, rowS1, qx0, dx, shift, tol2) |
+                       nearNeighbour(otherD, otherS, rowD1, rowS1, qx1, dx, shift, tol2);
+    // NaN: finite lanes outside the other map, and tested lanes no neighbour passed.
+    const int finiteBits = _mm256_movemask_ps(_mm256_castsi256_ps(finite));
+    const int testedBits = _mm256_movemask_ps(_mm256_castsi256_ps(tested));
+    const int rejected = (finiteBits & ~testedBits) | (testedBits & ~passed);
+    if (rejected == 0) continue;
+    const __m256i bits =
+        _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(rejected), lanes), one);
+    _mm256_storeu_ps(d + x,
+                     _mm256_blendv_ps(dx, nan, _mm256_castsi256_ps(_mm256_cmpeq_epi32(bits, one))));
+  }
+  validateRow(d, dy, x, y, W, H, sign, tolerance2, otherD, otherStep, otherS, shiftStep);
+}
+#endif
+
 // Keeps the matches of `map` (with line shifts) whose match in the other map points back
 // within `tolerance` for at least one of the four floor/ceil neighbours. `sign`: +1 when `map` is
 // the left map (x_other = x - d), -1 for the right map (x_other = x + d).
@@ -135,6 +276,14 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
   const auto* otherD = other.disparity.ptr<float>(0);
   const auto* otherS = other.lineShift.ptr<float>(0);
   const size_t otherStep = other.disparity.step1(), shiftStep = other.lineShift.step1();
+#ifdef DELINEO_MATCH_X86
+  // The AVX2 rows gather with int32 indices.
+  const bool avx2 =
+      cpuHasAvx2() &&
+      static_cast<double>(H) * static_cast<double>(std::max(otherStep, shiftStep)) < 2e9;
+#else
+  const bool avx2 = false;
+#endif
   forRowBands(
       H, threads,
       [&, W, H, sign, tolerance2, otherD, otherS, otherStep, shiftStep](int rowStart, int rowEnd) {
@@ -142,36 +291,15 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
           float* d = out.ptr<float>(y);
           std::copy_n(map.disparity.ptr<float>(y), W, d);
           const float* dy = map.lineShift.ptr<float>(y);
-          for (int x = 0; x < W; ++x) {
-            const float dx = d[x];
-            if (!std::isfinite(dx)) continue;
-            // Where the match lands in the other map (float, as the map's values).
-            const float xo = static_cast<float>(x) - static_cast<float>(sign) * dx;
-            const float yo = static_cast<float>(y) + dy[x];
-            const int fx = static_cast<int>(std::floor(xo)), fy = static_cast<int>(std::floor(yo));
-            if (fx + 1 < 0 || fx > W - 1 || fy + 1 < 0 || fy > H - 1) {
-              d[x] = kNaN;  // no neighbour inside the other map
-              continue;
-            }
-            // The four floor/ceil neighbours, clamped to the map: a clamped one repeats an inside
-            // one, which leaves the "any of them" test unchanged. No branches, no early exit (a NaN
-            // neighbour fails the test by itself).
-            const int qx0 = std::max(0, fx), qx1 = std::min(W - 1, fx + 1);
-            const int qy0 = std::max(0, fy), qy1 = std::min(H - 1, fy + 1);
-            const float* d0 = otherD + static_cast<size_t>(qy0) * otherStep;
-            const float* d1 = otherD + static_cast<size_t>(qy1) * otherStep;
-            const float* s0 = otherS + static_cast<size_t>(qy0) * shiftStep;
-            const float* s1 = otherS + static_cast<size_t>(qy1) * shiftStep;
-            const float shift = dy[x];
-            auto near = [dx, shift, tolerance2](float dq, float sq) {
-              const double ex = dx - dq;  // differences in float, their squares in double
-              const double ey = shift + sq;
-              return ex * ex + ey * ey <= tolerance2;
-            };
-            const bool consistent = near(d0[qx0], s0[qx0]) | near(d0[qx1], s0[qx1]) |
-                                    near(d1[qx0], s1[qx0]) | near(d1[qx1], s1[qx1]);
-            if (!consistent) d[x] = kNaN;
+#ifdef DELINEO_MATCH_X86
+          if (avx2) {
+            validateRowAvx2(d, dy, y, W, H, static_cast<float>(sign), tolerance2, otherD, otherStep,
+                            otherS, shiftStep);
+            continue;
           }
+#endif
+          validateRow(d, dy, 0, y, W, H, static_cast<float>(sign), tolerance2, otherD, otherStep,
+                      otherS, shiftStep);
         }
       });
   return out;
@@ -182,6 +310,27 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
 // source rows whose line shift (|dy| <= lineShift + 1) can reach it and writes only its own rows.
 // Bands of 64 rows: each scans 2 · (lineShift + 2) rows beyond its own.
 constexpr int kPointedBandRows = 64;
+// One source row of pointedTo(): marks the pointed pixels in output rows rowStart..rowEnd − 1
+// (`needed` is row 0 of the map). Also built for AVX2 (floor in one instruction).
+__attribute__((target_clones("avx2", "default"))) void pointedRow(const float* d, const float* dy,
+                                                                  int y, int W, int rowStart,
+                                                                  int rowEnd, uchar* needed,
+                                                                  size_t step) {
+  const auto yf = static_cast<float>(y);
+  for (int x = 0; x < W; ++x) {
+    if (!std::isfinite(d[x])) continue;
+    const int fx = static_cast<int>(std::floor(static_cast<float>(x) - d[x]));
+    const int fy = static_cast<int>(std::floor(yf + dy[x]));
+    for (int m = 0; m <= 1; ++m) {
+      const int qy = fy + m;
+      if (qy < rowStart || qy >= rowEnd) continue;
+      uchar* row = needed + static_cast<size_t>(qy) * step;
+      if (fx >= 0 && fx < W) row[fx] = 1;
+      if (fx + 1 >= 0 && fx + 1 < W) row[fx + 1] = 1;
+    }
+  }
+}
+
 cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
   cv::Mat needed = cv::Mat::zeros(map.disparity.size(), CV_8U);
   const int reach = lineShift + 2;
@@ -190,21 +339,8 @@ cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
       [&](int rowStart, int rowEnd) {
         for (int y = std::max(0, rowStart - reach); y < std::min(needed.rows, rowEnd + reach);
              ++y) {
-          const float* d = map.disparity.ptr<float>(y);
-          const float* dy = map.lineShift.ptr<float>(y);
-          for (int x = 0; x < needed.cols; ++x) {
-            if (!std::isfinite(d[x])) continue;
-            const int fx = static_cast<int>(std::floor(static_cast<float>(x) - d[x]));
-            const int fy = static_cast<int>(std::floor(static_cast<float>(y) + dy[x]));
-            for (int m = 0; m <= 1; ++m) {
-              const int qy = fy + m;
-              if (qy < rowStart || qy >= rowEnd) continue;
-              for (int n = 0; n <= 1; ++n) {
-                const int qx = fx + n;
-                if (qx >= 0 && qx < needed.cols) needed.at<uchar>(qy, qx) = 1;
-              }
-            }
-          }
+          pointedRow(map.disparity.ptr<float>(y), map.lineShift.ptr<float>(y), y, needed.cols,
+                     rowStart, rowEnd, needed.ptr<uchar>(0), needed.step1());
         }
       },
       kPointedBandRows);
@@ -224,6 +360,26 @@ cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
 // density 84.6 → 85.2 %, bad-1 1.55 → 1.43 %; 8+ raised the 600² roofRMS1 to 0.250–0.252 px).
 constexpr int kWideRadius = 4;
 constexpr int kWideExtraMargin = 7;  // px, at the finer level
+
+// One coarse row of intervalsFromCoarse(): from the 3x3 min/max (n0, n1) or, where the 3x3
+// neighbourhood holds no valid disparity, the wide one (w0, w1). Also built for AVX2 (floor and
+// ceil in one instruction each).
+__attribute__((target_clones("avx2", "default"))) void coarseIntervalRow(
+    const float* n0, const float* n1, const float* w0, const float* w1, int cw, int dmin, int dmax,
+    int margin, int* l, int* h) {
+  for (int x = 0; x < cw; ++x) {
+    const bool isNear = n0[x] <= n1[x];
+    if (isNear || w0[x] <= w1[x]) {
+      const float mn = isNear ? n0[x] : w0[x], mx = isNear ? n1[x] : w1[x];
+      const int m = isNear ? margin : margin + kWideExtraMargin;
+      l[x] = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - m);
+      h[x] = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + m);
+    } else {
+      l[x] = dmin;
+      h[x] = dmax;
+    }
+  }
+}
 
 void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
                          int threads, cv::Mat& lo, cv::Mat& hi) {
@@ -249,23 +405,14 @@ void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dma
             [&] { minFilter(wide, mnWide); }, [&] { maxFilter(wide, mxWide); }},
            threads);
   cv::Mat clo(coarse.size(), CV_32S), chi(coarse.size(), CV_32S);
-  for (int y = 0; y < ch; ++y) {
-    const float *n0 = mn1.ptr<float>(y), *n1 = mx1.ptr<float>(y);
-    const float *w0 = mnWide.ptr<float>(y), *w1 = mxWide.ptr<float>(y);
-    int *l = clo.ptr<int>(y), *h = chi.ptr<int>(y);
-    for (int x = 0; x < cw; ++x) {
-      const bool isNear = n0[x] <= n1[x];
-      if (isNear || w0[x] <= w1[x]) {
-        const float mn = isNear ? n0[x] : w0[x], mx = isNear ? n1[x] : w1[x];
-        const int m = isNear ? margin : margin + kWideExtraMargin;
-        l[x] = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - m);
-        h[x] = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + m);
-      } else {
-        l[x] = dmin;
-        h[x] = dmax;
-      }
+  // By bands of rows on the level's threads (serial, ~0.3 % of the run's instructions).
+  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      coarseIntervalRow(mn1.ptr<float>(y), mx1.ptr<float>(y), mnWide.ptr<float>(y),
+                        mxWide.ptr<float>(y), cw, dmin, dmax, margin, clo.ptr<int>(y),
+                        chi.ptr<int>(y));
     }
-  }
+  });
   lo.create(size, CV_32S);
   hi.create(size, CV_32S);
   forRowBands(size.height, threads, [&](int rowStart, int rowEnd) {

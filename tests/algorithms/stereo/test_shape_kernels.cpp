@@ -290,4 +290,57 @@ TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) 
 #endif
 }
 
+// The AVX2 flood fill of a window of ≤ 15 columns against a breadth-first fill: the
+// 4-connected component of the centre in the free cells plus the centre, on random boards of
+// every window size (densities from mostly blocked to mostly free; the rows past the window
+// hold random cells, as the column-major copy of the matcher gives them: the fill ignores them).
+TEST(ShapeKernels, Avx2FillMatchesABreadthFirstFill) {
+#ifdef DELINEO_STEREO_X86
+  if (!cpuHasAvx2()) GTEST_SKIP() << "no AVX2";
+  std::mt19937 rng(1234);
+  for (int r = 1; r <= 7; ++r) {
+    const int w = 2 * r + 1;
+    alignas(32) uint64_t inWindow[4] = {0, 0, 0, 0};
+    for (int v = 0; v < w; ++v) inWindow[v >> 2] |= uint64_t{0xFFFF} << (16 * (v & 3));
+    const auto columns = static_cast<uint16_t>((1U << w) - 1U);
+    for (int trial = 0; trial < 3000; ++trial) {
+      const unsigned density = 2 + trial % 13;  // a cell is blocked with probability 1/density
+      alignas(32) uint16_t rows[16];
+      for (int v = 0; v < 16; ++v) {
+        uint16_t word = 0;
+        for (int u = 0; u < 15; ++u) {
+          if (rng() % density != 0) word = static_cast<uint16_t>(word | (1U << u));
+        }
+        rows[v] = v < w ? static_cast<uint16_t>(word & columns) : word;
+      }
+      // Reference: breadth-first from the centre over free window cells.
+      uint16_t expect[16] = {};
+      expect[r] = static_cast<uint16_t>(1U << r);
+      std::vector<std::pair<int, int>> queue{{r, r}};
+      for (size_t k = 0; k < queue.size(); ++k) {
+        const auto [u, v] = queue[k];
+        const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+        for (int n = 0; n < 4; ++n) {
+          const int uu = u + du[n], vv = v + dv[n];
+          if (uu < 0 || uu >= w || vv < 0 || vv >= w) continue;
+          if ((rows[vv] >> uu & 1U) == 0 || (expect[vv] >> uu & 1U) != 0) continue;
+          expect[vv] = static_cast<uint16_t>(expect[vv] | (1U << uu));
+          queue.emplace_back(uu, vv);
+        }
+      }
+      bool expectCut = false;
+      for (int v = 0; v < w; ++v) expectCut |= (rows[v] & ~expect[v] & columns) != 0;
+      alignas(32) uint16_t reach[16];
+      const bool cut = fillWindow15Avx2(rows, inWindow, r, reach);
+      ASSERT_EQ(cut, expectCut) << "r " << r << " trial " << trial;
+      for (int v = 0; v < 16; ++v) {
+        ASSERT_EQ(reach[v], expect[v]) << "r " << r << " trial " << trial << " row " << v;
+      }
+    }
+  }
+#else
+  GTEST_SKIP() << "x86 only";
+#endif
+}
+
 }  // namespace
