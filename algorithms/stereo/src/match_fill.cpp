@@ -362,9 +362,10 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
 // contour, not flat enough for the fill and not textured enough for NCC, stay unmatched. From
 // the filled pixels (`grown`), the fill goes on over unmatched pixels, 4-connected and at most
 // `extendReach` px, while the window around each matches at the region's disparity and at no
-// other (see matchesAt). The flat regions the fill decides on itself (`ownFill`) are not
-// entered. A window that reaches across the contour meets, in the right view, another part of
-// the surface beyond it: the fill stops 1 px short of the contour (the snapping's work).
+// other (see matchesAt), passing over the matches within `extendAgree` px of it. The flat
+// regions the fill decides on itself (`ownFill`) are not entered. A window that reaches across the
+// contour meets, in the right view, another part of the surface beyond it: the fill stops 1 px
+// short of the contour (the snapping's work).
 int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rect& box,
                         const cv::Mat& grown, const FillPlane& plane, double gain, double offset,
                         double sigma, int dmin, int dmax, const RegionFillSettings& settings,
@@ -475,6 +476,12 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
         distance.at<int>(q) = step;
         const int x = outer.x + q.x, y = outer.y + q.y;
         float& d = disparity.at<float>(y, x);
+        // Matches that agree with the fill are passed over (a weakly textured roof's matched
+        // patches between the filled region and the unmatched pixels beyond).
+        if (std::isfinite(d) && std::abs(d - plane.at(x, y)) <= settings.extendAgree) {
+          next.push_back(q);
+          continue;
+        }
         if (std::isfinite(d) || ownFill[static_cast<size_t>(labels.at<int>(y, x))]) continue;
         if (!matchesAt(x, y)) continue;
         d = static_cast<float>(plane.at(x, y));

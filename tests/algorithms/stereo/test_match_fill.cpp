@@ -328,5 +328,30 @@ TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
   EXPECT_EQ(spilledOntoTheGround(extended), 0);
 }
 
+TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
+  // The band's first 5 columns matched at the roof's disparity (a weakly textured roof's matched
+  // patch): between the filled region and the unmatched rest of the band.
+  const auto withMatchedColumns = [] {
+    Scene s = stripedBandScene();
+    s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, 5, s.roof.height)).setTo(kRoof);
+    return s;
+  };
+  Scene passed = withMatchedColumns();
+  fill(passed, RegionFillSettings{}, 32);
+  Scene stopped = withMatchedColumns();
+  RegionFillSettings noPassing;
+  noPassing.extendAgree = -1;
+  fill(stopped, noPassing, 32);
+  const cv::Rect rest(passed.roof.br().x - 7, passed.roof.y + 3, 7, passed.roof.height - 6);
+  const auto onTheRoof = [&](const Scene& s) {
+    return pixelsWithin(
+        s.disparity, rest, [](int, int) { return kRoof; }, 0.5);
+  };
+  EXPECT_LT(onTheRoof(stopped), rest.area() / 3);
+  EXPECT_GE(onTheRoof(passed), rest.area() * 3 / 5)
+      << " of " << rest.area() << ", stopped " << onTheRoof(stopped);
+  EXPECT_EQ(spilledOntoTheGround(passed), 0);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
