@@ -357,6 +357,144 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
   return true;
 }
 
+// A filled region ends where the flat test ends, but a weakly textured roof is flat only in
+// patches (its tiles between their joints): the pixels between the patches and up to the
+// contour, not flat enough for the fill and not textured enough for NCC, stay unmatched. From
+// the filled pixels (`grown`), the fill goes on over unmatched pixels, 4-connected and at most
+// `extendReach` px, while the window around each matches at the region's disparity and at no
+// other (see matchesAt), passing over the matches within `extendAgree` px of it. The flat
+// regions the fill decides on itself (`ownFill`) are not entered. A window that reaches across the
+// contour meets, in the right view, another part of the surface beyond it: the fill stops 1 px
+// short of the contour (the snapping's work).
+int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rect& box,
+                        const cv::Mat& grown, const FillPlane& plane, double gain, double offset,
+                        double sigma, int dmin, int dmax, const RegionFillSettings& settings,
+                        float fillScore, const cv::Mat& labels, const std::vector<uchar>& ownFill,
+                        cv::Mat& disparity, cv::Mat& score) {
+  const int reach = settings.extendReach;
+  const cv::Rect image(0, 0, left.cols, left.rows);
+  const cv::Rect outer =
+      cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) & image;
+  // The surface's own brightness offset between the views (a facet lit or seen differently): the
+  // mean difference over the filled pixels.
+  double bias = 0, biasCount = 0;
+  for (int y = 0; y < box.height; ++y) {
+    const uchar* m = grown.ptr<uchar>(y);
+    for (int x = 0; x < box.width; ++x) {
+      const int u = box.x + x, v = box.y + y;
+      const int xr = u - static_cast<int>(std::lround(plane.at(u, v)));
+      if (!m[x] || xr < 0 || xr >= right.cols) continue;
+      const float a = left.at<float>(v, u), b = right.at<float>(v, xr);
+      if (!std::isfinite(a) || !std::isfinite(b)) continue;
+      bias += a - (gain * b + offset);
+      biasCount += 1;
+    }
+  }
+  if (biasCount > 0) bias /= biasCount;
+  const auto matchesAt = [&](int x, int y) {
+    const double value = plane.at(x, y);
+    const int w = settings.extendWindow / 2;
+    if (value < dmin || value > dmax || x < w || y < w || x + w >= left.cols ||
+        y + w >= left.rows) {
+      return false;
+    }
+    // Every pixel of the window within extendPixelSigmas noise sigmas of its counterpart (the
+    // right view interpolated, the surface's offset added), and their mean within
+    // extendPhotometric.
+    const int whole = static_cast<int>(std::floor(value));
+    const auto t = static_cast<float>(value - whole);
+    double sum = 0;
+    for (int v = y - w; v <= y + w; ++v) {
+      for (int u = x - w; u <= x + w; ++u) {
+        const int xr = u - whole;  // u − value lies in [xr − 1, xr]
+        if (xr - 1 < 0 || xr >= right.cols) return false;
+        const float a = left.at<float>(v, u);
+        const float b = (1 - t) * right.at<float>(v, xr) + t * right.at<float>(v, xr - 1);
+        if (!std::isfinite(a) || !std::isfinite(b)) return false;
+        const double error = std::abs(a - (gain * b + offset + bias));
+        if (error > settings.extendPixelSigmas * sigma) return false;
+        sum += error;
+      }
+    }
+    const double error = sum / ((2 * w + 1) * (2 * w + 1));
+    if (error > settings.extendPhotometric * sigma) return false;
+    // The right pixel it maps to must not be another left pixel's match: there the right view
+    // shows that pixel's surface (an occluded ground pixel's window can match the ground nearby).
+    const double target = x - value;
+    const float* row = disparity.ptr<float>(y);
+    for (int u = std::max(0, static_cast<int>(target) + dmin - 1);
+         u <= std::min(left.cols - 1, static_cast<int>(target) + dmax + 1); ++u) {
+      if (u != x && std::isfinite(row[u]) && std::abs(row[u] - value) >= 1.0 &&
+          std::abs(u - row[u] - target) < 0.5) {
+        return false;
+      }
+    }
+    // And the window matches there clearly better than at any disparity 2 px or more away (a
+    // ground pixel's window matches at the ground's disparity as well).
+    if (settings.extendContrast <= 0) return true;
+    for (int other = dmin; other <= dmax; ++other) {
+      if (std::abs(other - value) < 2.0) continue;
+      double e = 0;
+      for (int v = y - w; v <= y + w && e < 1e29; ++v) {
+        for (int u = x - w; u <= x + w; ++u) {
+          const int xr = u - other;
+          if (xr < 0 || xr >= right.cols || !std::isfinite(right.at<float>(v, xr))) {
+            e = 1e30;
+            break;
+          }
+          e += std::abs(left.at<float>(v, u) - (gain * right.at<float>(v, xr) + offset));
+        }
+      }
+      if (error > settings.extendContrast * e / ((2 * w + 1) * (2 * w + 1))) return false;
+    }
+    return true;
+  };
+  // Breadth-first from the filled pixels, `outer` coordinates.
+  cv::Mat distance(outer.size(), CV_32S, cv::Scalar(-1));
+  std::vector<cv::Point> front;
+  for (int y = 0; y < box.height; ++y) {
+    const uchar* m = grown.ptr<uchar>(y);
+    const float* d = disparity.ptr<float>(box.y + y) + box.x;
+    for (int x = 0; x < box.width; ++x) {
+      if (m[x] && std::isfinite(d[x])) {
+        const cv::Point p(box.x + x - outer.x, box.y + y - outer.y);
+        distance.at<int>(p) = 0;
+        front.push_back(p);
+      }
+    }
+  }
+  int extended = 0;
+  for (int step = 1; step <= reach && !front.empty(); ++step) {
+    std::vector<cv::Point> next;
+    for (const cv::Point& p : front) {
+      for (const cv::Point& q :
+           {p + cv::Point(1, 0), p - cv::Point(1, 0), p + cv::Point(0, 1), p - cv::Point(0, 1)}) {
+        if (q.x < 0 || q.y < 0 || q.x >= outer.width || q.y >= outer.height ||
+            distance.at<int>(q) >= 0) {
+          continue;
+        }
+        distance.at<int>(q) = step;
+        const int x = outer.x + q.x, y = outer.y + q.y;
+        float& d = disparity.at<float>(y, x);
+        // Matches that agree with the fill are passed over (a weakly textured roof's matched
+        // patches between the filled region and the unmatched pixels beyond).
+        if (std::isfinite(d) && std::abs(d - plane.at(x, y)) <= settings.extendAgree) {
+          next.push_back(q);
+          continue;
+        }
+        if (std::isfinite(d) || ownFill[static_cast<size_t>(labels.at<int>(y, x))]) continue;
+        if (!matchesAt(x, y)) continue;
+        d = static_cast<float>(plane.at(x, y));
+        score.at<float>(y, x) = fillScore;
+        ++extended;
+        next.push_back(q);
+      }
+    }
+    front = std::move(next);
+  }
+  return extended;
+}
+
 // The fill itself; `rightFlatRegionsOf()` gives the right view's flat regions.
 template <class RightFlat>
 int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
@@ -384,7 +522,19 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
   const auto [gain, offset] = radiometricMap(left, right, dmin, dmax);
   const double maxArea = settings.maxShare * static_cast<double>(left.total());
   const cv::Rect image(0, 0, left.cols, left.rows);
+  // The flat regions the fill decides on itself (the extension does not enter them).
+  std::vector<uchar> ownFill(static_cast<size_t>(count), 0);
+  for (int r = 1; r < count; ++r) {
+    ownFill[static_cast<size_t>(r)] = unmatched[static_cast<size_t>(r)] >= settings.minUnmatched &&
+                                      stats.at<int>(r, cv::CC_STAT_AREA) <= maxArea;
+  }
   int filled = 0;
+  struct FilledRegion {
+    cv::Rect box;
+    cv::Mat grown;
+    FillPlane plane;
+  };
+  std::vector<FilledRegion> filledRegions;
   for (int r = 1; r < count; ++r) {
     if (unmatched[static_cast<size_t>(r)] < settings.minUnmatched ||
         stats.at<int>(r, cv::CC_STAT_AREA) > maxArea) {
@@ -540,6 +690,13 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         ++filled;
       }
     }
+    if (settings.extendReach > 0) filledRegions.push_back({box, grown, plane});
+  }
+  // Once every region is filled (the extension's pixels do not become another region's
+  // candidates).
+  for (const FilledRegion& f : filledRegions) {
+    filled += extendOverUnmatched(left, right, f.box, f.grown, f.plane, gain, offset, sigma, dmin,
+                                  dmax, settings, fillScore, labels, ownFill, disparity, score);
   }
   return filled;
 }

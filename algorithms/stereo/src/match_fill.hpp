@@ -29,6 +29,14 @@ struct RegionFillSettings {
   double planeInlier = 1.0;      // px: a row end agrees with the plane within this
   double planeMinShare = 0.7;    // share of the row ends that must agree
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
+  // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
+  int extendReach = 32;            // px (4-connected steps) from the filled pixels; 0 = off
+  double extendAgree = 1.0;        // px: matches this close to the fill are passed over (< 0: none)
+  int extendWindow = 3;            // px: side of the square window tested
+  double extendPhotometric = 2.0;  // × noise sigma: the window's mean |left − mapped right|
+  double extendPixelSigmas = 4.0;  // × noise sigma: |left − mapped right| of each window pixel
+  double extendContrast = 0.8;     // the window's mean error below this × the one at any
+                                   //   disparity 2 px or more away (0 = off)
 };
 
 // Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is
@@ -56,6 +64,18 @@ struct RegionFillSettings {
 // whole region's ring. Then
 // the thin parts, joined through the roof's grey (a facade's plain bands between its window
 // rows), no longer decide whether the roof is filled, and are not filled with it.
+// Once every region is filled, the fill goes on from each over the unmatched pixels next to it
+// that are not flat enough for it (a weakly textured roof is flat only in patches, between them
+// and up to its contour NCC finds too little), at most `extendReach` px, passing over the
+// matches within `extendAgree` px of the fill (the roof's matched parts): a pixel is taken when
+// its extendWindow² window matches at the region's disparity — every pixel within
+// `extendPixelSigmas`, the mean within `extendPhotometric` noise sigmas of the mapped right view,
+// plus the region's own mean brightness offset between the views — and clearly better
+// (`extendContrast`) than at any disparity 2 px or more away, and when the right pixel it maps
+// to is no other pixel's match (an occluded pixel beside the roof). A window across the contour
+// meets another part of the scene in the right view: the extension stops 1 px short of it.
+// Seed 3 600²: edge 85.4 → 88.1 %, passing over the agreeing matches 90.6 % (a ring-shaped
+// tiled roof).
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
 // `threads` > 1: the right view's flat regions are made on a second worker, which then runs
 // `alongside` (the caller's own work, independent of the fill) while the fill goes on; else

@@ -288,5 +288,70 @@ TEST(FillFlatRegions, AFacetAConstantLinesUpTakesItsPlaneWhenTheRowEndsDisagreeW
   EXPECT_GE(constantPixels, (flat.facet.height - 4) * flat.facet.width * 95 / 100);
 }
 
+// The scene of `scene()` whose roof carries, along its right side, a 12 px band of weak random
+// texture (a few grey levels: not flat, and left unmatched, as a window matcher that finds its
+// NCC too weak would), and is seen 6 grey levels darker in the right view.
+Scene stripedBandScene() {
+  Scene s = scene();
+  const cv::Rect band(s.roof.br().x - 12, s.roof.y, 12, s.roof.height);
+  const cv::Mat weak = (testing::texture(s.left.size(), 7, 0.7) - 128.0) * 0.15;
+  for (int y = band.y; y < band.br().y; ++y) {
+    for (int x = band.x; x < band.br().x; ++x) {
+      // The roof point at left x is at right x − 20.
+      s.left.at<float>(y, x) += weak.at<float>(y, x);
+      s.right.at<float>(y, x - 20) += weak.at<float>(y, x);
+    }
+  }
+  s.right(cv::Rect(s.roof.x - 20, s.roof.y, s.roof.width, s.roof.height)) -= 6.0f;
+  s.disparity(band).setTo(kNaN);
+  return s;
+}
+
+TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
+  Scene extended = stripedBandScene();
+  fill(extended, RegionFillSettings{}, 32);
+  Scene plain = stripedBandScene();
+  RegionFillSettings noExtension;
+  noExtension.extendReach = 0;
+  fill(plain, noExtension, 32);
+  // The band's pixels left unmatched up to the outline (rows away from the top and bottom).
+  const cv::Rect band(extended.roof.br().x - 12, extended.roof.y + 3, 12, extended.roof.height - 6);
+  const auto onTheRoof = [&](const Scene& s) {
+    return pixelsWithin(
+        s.disparity, band, [](int, int) { return kRoof; }, 0.5);
+  };
+  // Without the extension, the region's growth takes at most its first 3 columns.
+  EXPECT_LT(onTheRoof(plain), band.area() / 5);
+  // With it, most of the band (not the last column, whose window meets the ground beyond the
+  // outline, nor the pixels whose window the texture leaves ambiguous).
+  EXPECT_GE(onTheRoof(extended), band.area() * 3 / 5) << " of " << band.area();
+  EXPECT_EQ(spilledOntoTheGround(extended), 0);
+}
+
+TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
+  // The band's first 5 columns matched at the roof's disparity (a weakly textured roof's matched
+  // patch): between the filled region and the unmatched rest of the band.
+  const auto withMatchedColumns = [] {
+    Scene s = stripedBandScene();
+    s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, 5, s.roof.height)).setTo(kRoof);
+    return s;
+  };
+  Scene passed = withMatchedColumns();
+  fill(passed, RegionFillSettings{}, 32);
+  Scene stopped = withMatchedColumns();
+  RegionFillSettings noPassing;
+  noPassing.extendAgree = -1;
+  fill(stopped, noPassing, 32);
+  const cv::Rect rest(passed.roof.br().x - 7, passed.roof.y + 3, 7, passed.roof.height - 6);
+  const auto onTheRoof = [&](const Scene& s) {
+    return pixelsWithin(
+        s.disparity, rest, [](int, int) { return kRoof; }, 0.5);
+  };
+  EXPECT_LT(onTheRoof(stopped), rest.area() / 3);
+  EXPECT_GE(onTheRoof(passed), rest.area() * 3 / 5)
+      << " of " << rest.area() << ", stopped " << onTheRoof(stopped);
+  EXPECT_EQ(spilledOntoTheGround(passed), 0);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
