@@ -432,20 +432,27 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     // And the window matches there clearly better than at any disparity 2 px or more away (a
     // ground pixel's window matches at the ground's disparity as well).
     if (settings.extendContrast <= 0) return true;
+    const int cells = (2 * w + 1) * (2 * w + 1);
     for (int other = dmin; other <= dmax; ++other) {
       if (std::abs(other - value) < 2.0) continue;
+      // The sum only grows row by row: once its part already clears the window's error, the
+      // whole does too, and the rest of the window is not read.
       double e = 0;
-      for (int v = y - w; v <= y + w && e < 1e29; ++v) {
+      bool cleared = false;
+      for (int v = y - w; v <= y + w && !cleared; ++v) {
+        const float* l = left.ptr<float>(v);
+        const float* rr = right.ptr<float>(v);
         for (int u = x - w; u <= x + w; ++u) {
           const int xr = u - other;
-          if (xr < 0 || xr >= right.cols || !std::isfinite(right.at<float>(v, xr))) {
+          if (xr < 0 || xr >= right.cols || !std::isfinite(rr[xr])) {
             e = 1e30;
             break;
           }
-          e += std::abs(left.at<float>(v, u) - (gain * right.at<float>(v, xr) + offset));
+          e += std::abs(l[u] - (gain * rr[xr] + offset));
         }
+        cleared = !(error > settings.extendContrast * e / cells);
       }
-      if (error > settings.extendContrast * e / ((2 * w + 1) * (2 * w + 1))) return false;
+      if (!cleared) return false;
     }
     return true;
   };
