@@ -127,6 +127,35 @@ cv::Mat flipped(const cv::Mat& m) {
   return out;
 }
 
+// The right view's search intervals, mirrored like its images: out(y, x) = in(y, W − 1 − x). With
+// `needed` (0/1, unmirrored), the pixels it does not mark get hi = lo − 1 (not searched). One
+// pass instead of a clone, a masked copy and two flips.
+void mirrorIntervals(const cv::Mat& lo, const cv::Mat& hi, const cv::Mat& needed, cv::Mat& outLo,
+                     cv::Mat& outHi) {
+  const int W = lo.cols;
+  outLo.create(lo.size(), CV_32S);
+  outHi.create(lo.size(), CV_32S);
+  for (int y = 0; y < lo.rows; ++y) {
+    const int* __restrict l = lo.ptr<int>(y);
+    const int* __restrict h = hi.ptr<int>(y);
+    int* __restrict ol = outLo.ptr<int>(y);
+    int* __restrict oh = outHi.ptr<int>(y);
+    if (needed.empty()) {
+      for (int x = 0; x < W; ++x) {
+        ol[x] = l[W - 1 - x];
+        oh[x] = h[W - 1 - x];
+      }
+    } else {
+      const uchar* __restrict n = needed.ptr<uchar>(y);
+      for (int x = 0; x < W; ++x) {
+        const int xs = W - 1 - x;
+        ol[x] = l[xs];
+        oh[x] = n[xs] != 0 ? h[xs] : l[xs] - 1;
+      }
+    }
+  }
+}
+
 // One row of validate(): `d` holds the row's disparities (a copy of the map's row), `dy` its
 // line shifts; the inconsistent ones are set to NaN. Also built for AVX2 (one rounding
 // instruction per floor instead of a library call; no FMA, so the same arithmetic).
@@ -532,21 +561,16 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       return result;
     }
     core::setStage(progress, core::StageId::MatchingLevelRightView, levelNumber, levels);
-    if (k == 0) {
-      // At the finest level the right map only validates the left one: only the right pixels
-      // that a left match points to (the floor/ceil neighbours the validation reads) are
-      // matched. The result is the same, at the cost of the unmatched and occluded areas less.
-      const cv::Mat needed = pointedTo(leftOut, p.lineShift, threads);
-      hiR = hiR.clone();  // may share its data with the left intervals
-      cv::Mat notSearched = loR - 1;
-      notSearched.copyTo(hiR, needed == 0);
-    }
+    // At the finest level the right map only validates the left one: only the right pixels
+    // that a left match points to (the floor/ceil neighbours the validation reads) are
+    // matched. The result is the same, at the cost of the unmatched and occluded areas less.
+    const cv::Mat needed = k == 0 ? pointedTo(leftOut, p.lineShift, threads) : cv::Mat();
     // Right -> left: mirrored images turn x_left = x_right + d into x'_other = x'_ref - d.
     runTasks({[&] { inR.ref = flipped(lv.right); }, [&] { inR.other = flipped(lv.left); },
               [&] { inR.refValid = flipped(lv.rightValid); },
               [&] { inR.otherValid = flipped(lv.leftValid); },
-              [&] { inR.refEdges = flipped(lv.rightEdges); }, [&] { inR.lo = flipped(loR); },
-              [&] { inR.hi = flipped(hiR); }},
+              [&] { inR.refEdges = flipped(lv.rightEdges); },
+              [&] { mirrorIntervals(loR, hiR, needed, inR.lo, inR.hi); }},
              threads);
 
     core::Progress::Range rightRange(progress, done + 0.5 * w, done + w);
@@ -559,9 +583,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     done += w;
     core::setStage(progress, core::StageId::ValidatingLevel, levelNumber, levels);
     auto unmirror = [&] {
+      // (The right scores are not used: validate() reads disparities and line shifts.)
       runTasks({[&] { rightOut.disparity = flipped(mirrored.disparity); },
-                [&] { rightOut.lineShift = flipped(mirrored.lineShift); },
-                [&] { rightOut.score = flipped(mirrored.score); }},
+                [&] { rightOut.lineShift = flipped(mirrored.lineShift); }},
                threads);
     };
     unmirror();
