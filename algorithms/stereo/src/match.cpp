@@ -107,6 +107,42 @@ void prepare(const cv::Mat& src, const GreyMapping& g, cv::Mat& values, cv::Mat&
   }
 }
 
+// The validity (0/1) of the next coarser level: a coarse pixel holds data only when the whole
+// 5x5 footprint of cv::pyrDown did, i.e. the AND of fine rows 2y − 2..2y + 2 and columns
+// 2x − 2..2x + 2 clipped to the image (every kernel weight is positive, and the reflected border
+// repeats only pixels of that clipped footprint). The same as pyrDown of the mask as floats
+// > 0.999 (exact sums: one missing pixel leaves at most 255/256) without the float passes.
+cv::Mat coarseValid(const cv::Mat& fine) {
+  const int fw = fine.cols, fh = fine.rows, cw = (fw + 1) / 2, ch = (fh + 1) / 2;
+  cv::Mat out(ch, cw, CV_8U);
+  std::vector<uchar> rows(static_cast<size_t>(fw));
+  for (int y = 0; y < ch; ++y) {
+    const int y0 = std::max(0, 2 * y - 2), y1 = std::min(fh - 1, 2 * y + 2);
+    uchar* __restrict acc = rows.data();
+    std::copy_n(fine.ptr<uchar>(y0), fw, acc);
+    for (int v = y0 + 1; v <= y1; ++v) {
+      const uchar* __restrict f = fine.ptr<uchar>(v);
+      for (int x = 0; x < fw; ++x) acc[x] &= f[x];
+    }
+    uchar* __restrict o = out.ptr<uchar>(y);
+    // Inside the row, the AND of acc[2x − 2 .. 2x + 2]: unrolled; at its ends, clipped.
+    auto clipped = [&](int x) {
+      const int x0 = std::max(0, 2 * x - 2), x1 = std::min(fw - 1, 2 * x + 2);
+      uchar a = 1;
+      for (int u = x0; u <= x1; ++u) a &= acc[u];
+      o[x] = a;
+    };
+    const int inner0 = std::min(cw, 1), inner1 = std::max(inner0, (fw - 3) / 2 + 1);
+    for (int x = 0; x < inner0; ++x) clipped(x);
+    for (int x = inner0; x < inner1; ++x) {
+      const uchar* a = acc + 2 * x - 2;
+      o[x] = a[0] & a[1] & a[2] & a[3] & a[4];
+    }
+    for (int x = inner1; x < cw; ++x) clipped(x);
+  }
+  return out;
+}
+
 cv::Mat edgeMap(const cv::Mat& values, const MatchParams& p) {
   cv::Mat grey;
   values.convertTo(grey, CV_8U, 1.0, 127.5);
@@ -487,12 +523,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       Level& coarse = pyramid[static_cast<size_t>(k)];
       cv::pyrDown(isLeft ? fine.left : fine.right, isLeft ? coarse.left : coarse.right);
       // A coarse pixel holds data only when its whole footprint did.
-      cv::Mat f, c;
-      (isLeft ? fine.leftValid : fine.rightValid).convertTo(f, CV_32F);
-      cv::pyrDown(f, c);
-      cv::Mat& dst = isLeft ? coarse.leftValid : coarse.rightValid;
-      dst = c > 0.999F;
-      dst /= 255;
+      (isLeft ? coarse.leftValid : coarse.rightValid) =
+          coarseValid(isLeft ? fine.leftValid : fine.rightValid);
     }
   };
   runTasks({[&] { buildSide(true); }, [&] { buildSide(false); }}, threads);
