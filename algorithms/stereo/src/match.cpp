@@ -453,10 +453,20 @@ void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dma
   // morphology's separable float path), rejected pixels at +inf for the minimum and -inf for the
   // maximum; the border does not extend the neighbourhood (+inf/-inf there too).
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  const cv::Mat invalid = core::nanMask(coarse);
-  cv::Mat forMin = coarse.clone(), forMax = coarse.clone();
-  forMin.setTo(kInf, invalid);
-  forMax.setTo(-kInf, invalid);
+  // (Both in one pass by bands of rows, not a NaN mask, two clones and two masked sets.)
+  cv::Mat forMin(coarse.size(), CV_32F), forMax(coarse.size(), CV_32F);
+  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* __restrict c = coarse.ptr<float>(y);
+      float* __restrict mn = forMin.ptr<float>(y);
+      float* __restrict mx = forMax.ptr<float>(y);
+      for (int x = 0; x < cw; ++x) {
+        const bool isNumber = c[x] == c[x];  // false only for NaN
+        mn[x] = isNumber ? c[x] : kInf;
+        mx[x] = isNumber ? c[x] : -kInf;
+      }
+    }
+  });
   cv::Mat mn1, mx1, mnWide, mxWide;
   const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
   const cv::Mat wide = cv::Mat::ones(2 * kWideRadius + 1, 2 * kWideRadius + 1, CV_8U);
