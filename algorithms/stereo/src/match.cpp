@@ -648,10 +648,15 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                leftOut);
       // At the finest level the right map only validates the left one: its pixels that no left
       // match points to are not matched again (the result is the same).
-      const cv::Mat rightNeeded =
-          k == 0 ? flipped(pointedTo(leftOut, p.lineShift, threads)) : cv::Mat();
-      detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid,
-                               flipped(coarseRight), rs, mirrored, rightNeeded);
+      const cv::Mat pointed = k == 0 ? pointedTo(leftOut, p.lineShift, threads) : cv::Mat();
+      cv::Mat rightNeeded, rightValidated;  // mirrored, both flipped at once
+      runTasks({[&] {
+                  if (!pointed.empty()) rightNeeded = flipped(pointed);
+                },
+                [&] { rightValidated = flipped(coarseRight); }},
+               threads);
+      detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid, rightValidated, rs,
+                               mirrored, rightNeeded);
       unmirror();
       coarseLeft = validate(leftOut, rightOut, +1, p.tolerance, threads);
       // The validated right map guides the next finer level only.
@@ -671,8 +676,16 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   };
   if (reachedButCanceled(0.85)) return result;
   result.disparity = coarseLeft;
-  result.score = leftOut.score.clone();
-  result.score.setTo(kNaN, core::nanMask(result.disparity));
+  // The left scores where the disparity is a number (NaN elsewhere), in one pass by bands.
+  result.score.create(leftOut.score.size(), CV_32F);
+  forRowBands(result.score.rows, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* __restrict d = result.disparity.ptr<float>(y);
+      const float* __restrict sc = leftOut.score.ptr<float>(y);
+      float* __restrict out = result.score.ptr<float>(y);
+      for (int x = 0; x < result.score.cols; ++x) out[x] = d[x] == d[x] ? sc[x] : kNaN;
+    }
+  });
   // The fill runs on one worker; the snapping's contrast map (images only) is prepared on the
   // other meanwhile, after the fill's right-view flat regions.
   core::setStage(progress, core::StageId::FillingFlatRegions);
