@@ -107,6 +107,42 @@ void prepare(const cv::Mat& src, const GreyMapping& g, cv::Mat& values, cv::Mat&
   }
 }
 
+// The validity (0/1) of the next coarser level: a coarse pixel holds data only when the whole
+// 5x5 footprint of cv::pyrDown did, i.e. the AND of fine rows 2y − 2..2y + 2 and columns
+// 2x − 2..2x + 2 clipped to the image (every kernel weight is positive, and the reflected border
+// repeats only pixels of that clipped footprint). The same as pyrDown of the mask as floats
+// > 0.999 (exact sums: one missing pixel leaves at most 255/256) without the float passes.
+cv::Mat coarseValid(const cv::Mat& fine) {
+  const int fw = fine.cols, fh = fine.rows, cw = (fw + 1) / 2, ch = (fh + 1) / 2;
+  cv::Mat out(ch, cw, CV_8U);
+  std::vector<uchar> rows(static_cast<size_t>(fw));
+  for (int y = 0; y < ch; ++y) {
+    const int y0 = std::max(0, 2 * y - 2), y1 = std::min(fh - 1, 2 * y + 2);
+    uchar* __restrict acc = rows.data();
+    std::copy_n(fine.ptr<uchar>(y0), fw, acc);
+    for (int v = y0 + 1; v <= y1; ++v) {
+      const uchar* __restrict f = fine.ptr<uchar>(v);
+      for (int x = 0; x < fw; ++x) acc[x] &= f[x];
+    }
+    uchar* __restrict o = out.ptr<uchar>(y);
+    // Inside the row, the AND of acc[2x − 2 .. 2x + 2]: unrolled; at its ends, clipped.
+    auto clipped = [&](int x) {
+      const int x0 = std::max(0, 2 * x - 2), x1 = std::min(fw - 1, 2 * x + 2);
+      uchar a = 1;
+      for (int u = x0; u <= x1; ++u) a &= acc[u];
+      o[x] = a;
+    };
+    const int inner0 = std::min(cw, 1), inner1 = std::max(inner0, (fw - 3) / 2 + 1);
+    for (int x = 0; x < inner0; ++x) clipped(x);
+    for (int x = inner0; x < inner1; ++x) {
+      const uchar* a = acc + 2 * x - 2;
+      o[x] = a[0] & a[1] & a[2] & a[3] & a[4];
+    }
+    for (int x = inner1; x < cw; ++x) clipped(x);
+  }
+  return out;
+}
+
 cv::Mat edgeMap(const cv::Mat& values, const MatchParams& p) {
   cv::Mat grey;
   values.convertTo(grey, CV_8U, 1.0, 127.5);
@@ -125,6 +161,35 @@ cv::Mat flipped(const cv::Mat& m) {
   cv::Mat out;
   cv::flip(m, out, 1);
   return out;
+}
+
+// The right view's search intervals, mirrored like its images: out(y, x) = in(y, W − 1 − x). With
+// `needed` (0/1, unmirrored), the pixels it does not mark get hi = lo − 1 (not searched). One
+// pass instead of a clone, a masked copy and two flips.
+void mirrorIntervals(const cv::Mat& lo, const cv::Mat& hi, const cv::Mat& needed, cv::Mat& outLo,
+                     cv::Mat& outHi) {
+  const int W = lo.cols;
+  outLo.create(lo.size(), CV_32S);
+  outHi.create(lo.size(), CV_32S);
+  for (int y = 0; y < lo.rows; ++y) {
+    const int* __restrict l = lo.ptr<int>(y);
+    const int* __restrict h = hi.ptr<int>(y);
+    int* __restrict ol = outLo.ptr<int>(y);
+    int* __restrict oh = outHi.ptr<int>(y);
+    if (needed.empty()) {
+      for (int x = 0; x < W; ++x) {
+        ol[x] = l[W - 1 - x];
+        oh[x] = h[W - 1 - x];
+      }
+    } else {
+      const uchar* __restrict n = needed.ptr<uchar>(y);
+      for (int x = 0; x < W; ++x) {
+        const int xs = W - 1 - x;
+        ol[x] = l[xs];
+        oh[x] = n[xs] != 0 ? h[xs] : l[xs] - 1;
+      }
+    }
+  }
 }
 
 // One row of validate(): `d` holds the row's disparities (a copy of the map's row), `dy` its
@@ -388,10 +453,20 @@ void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dma
   // morphology's separable float path), rejected pixels at +inf for the minimum and -inf for the
   // maximum; the border does not extend the neighbourhood (+inf/-inf there too).
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  const cv::Mat invalid = core::nanMask(coarse);
-  cv::Mat forMin = coarse.clone(), forMax = coarse.clone();
-  forMin.setTo(kInf, invalid);
-  forMax.setTo(-kInf, invalid);
+  // (Both in one pass by bands of rows, not a NaN mask, two clones and two masked sets.)
+  cv::Mat forMin(coarse.size(), CV_32F), forMax(coarse.size(), CV_32F);
+  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* __restrict c = coarse.ptr<float>(y);
+      float* __restrict mn = forMin.ptr<float>(y);
+      float* __restrict mx = forMax.ptr<float>(y);
+      for (int x = 0; x < cw; ++x) {
+        const bool isNumber = c[x] == c[x];  // false only for NaN
+        mn[x] = isNumber ? c[x] : kInf;
+        mx[x] = isNumber ? c[x] : -kInf;
+      }
+    }
+  });
   cv::Mat mn1, mx1, mnWide, mxWide;
   const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
   const cv::Mat wide = cv::Mat::ones(2 * kWideRadius + 1, 2 * kWideRadius + 1, CV_8U);
@@ -458,12 +533,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       Level& coarse = pyramid[static_cast<size_t>(k)];
       cv::pyrDown(isLeft ? fine.left : fine.right, isLeft ? coarse.left : coarse.right);
       // A coarse pixel holds data only when its whole footprint did.
-      cv::Mat f, c;
-      (isLeft ? fine.leftValid : fine.rightValid).convertTo(f, CV_32F);
-      cv::pyrDown(f, c);
-      cv::Mat& dst = isLeft ? coarse.leftValid : coarse.rightValid;
-      dst = c > 0.999F;
-      dst /= 255;
+      (isLeft ? coarse.leftValid : coarse.rightValid) =
+          coarseValid(isLeft ? fine.leftValid : fine.rightValid);
     }
   };
   runTasks({[&] { buildSide(true); }, [&] { buildSide(false); }}, threads);
@@ -532,21 +603,16 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       return result;
     }
     core::setStage(progress, core::StageId::MatchingLevelRightView, levelNumber, levels);
-    if (k == 0) {
-      // At the finest level the right map only validates the left one: only the right pixels
-      // that a left match points to (the floor/ceil neighbours the validation reads) are
-      // matched. The result is the same, at the cost of the unmatched and occluded areas less.
-      const cv::Mat needed = pointedTo(leftOut, p.lineShift, threads);
-      hiR = hiR.clone();  // may share its data with the left intervals
-      cv::Mat notSearched = loR - 1;
-      notSearched.copyTo(hiR, needed == 0);
-    }
+    // At the finest level the right map only validates the left one: only the right pixels
+    // that a left match points to (the floor/ceil neighbours the validation reads) are
+    // matched. The result is the same, at the cost of the unmatched and occluded areas less.
+    const cv::Mat needed = k == 0 ? pointedTo(leftOut, p.lineShift, threads) : cv::Mat();
     // Right -> left: mirrored images turn x_left = x_right + d into x'_other = x'_ref - d.
     runTasks({[&] { inR.ref = flipped(lv.right); }, [&] { inR.other = flipped(lv.left); },
               [&] { inR.refValid = flipped(lv.rightValid); },
               [&] { inR.otherValid = flipped(lv.leftValid); },
-              [&] { inR.refEdges = flipped(lv.rightEdges); }, [&] { inR.lo = flipped(loR); },
-              [&] { inR.hi = flipped(hiR); }},
+              [&] { inR.refEdges = flipped(lv.rightEdges); },
+              [&] { mirrorIntervals(loR, hiR, needed, inR.lo, inR.hi); }},
              threads);
 
     core::Progress::Range rightRange(progress, done + 0.5 * w, done + w);
@@ -559,9 +625,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     done += w;
     core::setStage(progress, core::StageId::ValidatingLevel, levelNumber, levels);
     auto unmirror = [&] {
+      // (The right scores are not used: validate() reads disparities and line shifts.)
       runTasks({[&] { rightOut.disparity = flipped(mirrored.disparity); },
-                [&] { rightOut.lineShift = flipped(mirrored.lineShift); },
-                [&] { rightOut.score = flipped(mirrored.score); }},
+                [&] { rightOut.lineShift = flipped(mirrored.lineShift); }},
                threads);
     };
     unmirror();
@@ -582,10 +648,15 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                leftOut);
       // At the finest level the right map only validates the left one: its pixels that no left
       // match points to are not matched again (the result is the same).
-      const cv::Mat rightNeeded =
-          k == 0 ? flipped(pointedTo(leftOut, p.lineShift, threads)) : cv::Mat();
-      detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid,
-                               flipped(coarseRight), rs, mirrored, rightNeeded);
+      const cv::Mat pointed = k == 0 ? pointedTo(leftOut, p.lineShift, threads) : cv::Mat();
+      cv::Mat rightNeeded, rightValidated;  // mirrored, both flipped at once
+      runTasks({[&] {
+                  if (!pointed.empty()) rightNeeded = flipped(pointed);
+                },
+                [&] { rightValidated = flipped(coarseRight); }},
+               threads);
+      detail::refineDepthSteps(inR.ref, inR.other, inR.refValid, inR.otherValid, rightValidated, rs,
+                               mirrored, rightNeeded);
       unmirror();
       coarseLeft = validate(leftOut, rightOut, +1, p.tolerance, threads);
       // The validated right map guides the next finer level only.
@@ -605,8 +676,16 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   };
   if (reachedButCanceled(0.85)) return result;
   result.disparity = coarseLeft;
-  result.score = leftOut.score.clone();
-  result.score.setTo(kNaN, core::nanMask(result.disparity));
+  // The left scores where the disparity is a number (NaN elsewhere), in one pass by bands.
+  result.score.create(leftOut.score.size(), CV_32F);
+  forRowBands(result.score.rows, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* __restrict d = result.disparity.ptr<float>(y);
+      const float* __restrict sc = leftOut.score.ptr<float>(y);
+      float* __restrict out = result.score.ptr<float>(y);
+      for (int x = 0; x < result.score.cols; ++x) out[x] = d[x] == d[x] ? sc[x] : kNaN;
+    }
+  });
   // The fill runs on one worker; the snapping's contrast map (images only) is prepared on the
   // other meanwhile, after the fill's right-view flat regions.
   core::setStage(progress, core::StageId::FillingFlatRegions);
