@@ -307,6 +307,12 @@ Scene stripedBandScene() {
   return s;
 }
 
+// Pixels of `area` that hold the roof's disparity (within 0.5 px).
+int roofPixelsIn(const Scene& s, const cv::Rect& area) {
+  return pixelsWithin(
+      s.disparity, area, [](int, int) { return kRoof; }, 0.5);
+}
+
 TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
   Scene extended = stripedBandScene();
   fill(extended, RegionFillSettings{}, 32);
@@ -316,10 +322,7 @@ TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
   fill(plain, noExtension, 32);
   // The band's pixels left unmatched up to the outline (rows away from the top and bottom).
   const cv::Rect band(extended.roof.br().x - 12, extended.roof.y + 3, 12, extended.roof.height - 6);
-  const auto onTheRoof = [&](const Scene& s) {
-    return pixelsWithin(
-        s.disparity, band, [](int, int) { return kRoof; }, 0.5);
-  };
+  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, band); };
   // Without the extension, the region's growth takes at most its first 3 columns.
   EXPECT_LT(onTheRoof(plain), band.area() / 5);
   // With it, most of the band (not the last column, whose window meets the ground beyond the
@@ -343,10 +346,7 @@ TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   noPassing.extendAgree = -1;
   fill(stopped, noPassing, 32);
   const cv::Rect rest(passed.roof.br().x - 7, passed.roof.y + 3, 7, passed.roof.height - 6);
-  const auto onTheRoof = [&](const Scene& s) {
-    return pixelsWithin(
-        s.disparity, rest, [](int, int) { return kRoof; }, 0.5);
-  };
+  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, rest); };
   EXPECT_LT(onTheRoof(stopped), rest.area() / 3);
   EXPECT_GE(onTheRoof(passed), rest.area() * 3 / 5)
       << " of " << rest.area() << ", stopped " << onTheRoof(stopped);
