@@ -88,9 +88,14 @@ int pixelsWithin(const cv::Mat& disparity, const cv::Rect& area, Expected&& expe
   return n;
 }
 
-int roofPixelsWithTheRoofsDisparity(const Scene& s) {
+// Pixels of `area` that hold the roof's disparity (within 0.5 px).
+int roofPixelsIn(const Scene& s, const cv::Rect& area) {
   return pixelsWithin(
-      s.disparity, s.roof, [](int, int) { return kRoof; }, 0.5);
+      s.disparity, area, [](int, int) { return kRoof; }, 0.5);
+}
+
+int roofPixelsWithTheRoofsDisparity(const Scene& s) {
+  return roofPixelsIn(s, s.roof);
 }
 
 TEST(FillFlatRegions, ReachesTheImageContourAndStopsThere) {
@@ -305,12 +310,6 @@ Scene stripedBandScene() {
   s.right(cv::Rect(s.roof.x - 20, s.roof.y, s.roof.width, s.roof.height)) -= 6.0f;
   s.disparity(band).setTo(kNaN);
   return s;
-}
-
-// Pixels of `area` that hold the roof's disparity (within 0.5 px).
-int roofPixelsIn(const Scene& s, const cv::Rect& area) {
-  return pixelsWithin(
-      s.disparity, area, [](int, int) { return kRoof; }, 0.5);
 }
 
 TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
