@@ -17,10 +17,7 @@
 #include <cstdint>
 #include <limits>
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#define DELINEO_STEREO_X86 1
-#endif
+#include "cpu_features.hpp"
 
 namespace delineo::stereo::detail {
 
@@ -40,24 +37,6 @@ struct ShapeNccTerms {
   float invNormA = 0;
   float flatN = 0;
 };
-
-inline bool cpuHasAvx2() {
-#ifdef DELINEO_STEREO_X86
-  static const bool has = __builtin_cpu_supports("avx2") != 0;
-  return has;
-#else
-  return false;
-#endif
-}
-inline bool cpuHasAvx512Vl() {
-#ifdef DELINEO_STEREO_X86
-  static const bool has = cpuHasAvx2() && __builtin_cpu_supports("avx512vl") != 0 &&
-                          __builtin_cpu_supports("avx512bw") != 0;
-  return has;
-#else
-  return false;
-#endif
-}
 
 // Most windows one call of shapeScoresInt scores at full speed (the vector registers hold
 // their accumulators); it accepts up to kShapeMaxWindows.

@@ -12,14 +12,10 @@
 #include <thread>
 #include <vector>
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#define DELINEO_MATCH_X86 1
-#endif
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "cpu_features.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/core/nan_mask.hpp"
 #include "level_matcher.hpp"
@@ -234,12 +230,7 @@ __attribute__((target_clones("avx2", "default"))) void validateRow(
   }
 }
 
-#ifdef DELINEO_MATCH_X86
-bool cpuHasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2") != 0;
-  return has;
-}
-
+#ifdef DELINEO_STEREO_X86
 // Bit k set when lane k of the 4 float pairs (ex, ey) has ex² + ey² <= tolerance2, the squares
 // and their sum in double as in validateRow().
 __attribute__((target("avx2"), always_inline)) inline int nearLanes4(__m128 ex, __m128 ey,
@@ -341,10 +332,10 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
   const auto* otherD = other.disparity.ptr<float>(0);
   const auto* otherS = other.lineShift.ptr<float>(0);
   const size_t otherStep = other.disparity.step1(), shiftStep = other.lineShift.step1();
-#ifdef DELINEO_MATCH_X86
+#ifdef DELINEO_STEREO_X86
   // The AVX2 rows gather with int32 indices.
   const bool avx2 =
-      cpuHasAvx2() &&
+      detail::cpuHasAvx2() &&
       static_cast<double>(H) * static_cast<double>(std::max(otherStep, shiftStep)) < 2e9;
 #else
   const bool avx2 = false;
@@ -356,7 +347,7 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
           float* d = out.ptr<float>(y);
           std::copy_n(map.disparity.ptr<float>(y), W, d);
           const float* dy = map.lineShift.ptr<float>(y);
-#ifdef DELINEO_MATCH_X86
+#ifdef DELINEO_STEREO_X86
           if (avx2) {
             validateRowAvx2(d, dy, y, W, H, static_cast<float>(sign), tolerance2, otherD, otherStep,
                             otherS, shiftStep);

@@ -1,0 +1,30 @@
+#pragma once
+// What the CPU offers to the stereo kernels built for several instruction sets (internal to
+// delineo_stereo): the x86 check done once, shared by every file that picks a build at run time.
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define DELINEO_STEREO_X86 1
+#endif
+
+namespace delineo::stereo::detail {
+
+inline bool cpuHasAvx2() {
+#ifdef DELINEO_STEREO_X86
+  static const bool has = __builtin_cpu_supports("avx2") != 0;
+  return has;
+#else
+  return false;
+#endif
+}
+
+inline bool cpuHasAvx512Vl() {
+#ifdef DELINEO_STEREO_X86
+  static const bool has = cpuHasAvx2() && __builtin_cpu_supports("avx512vl") != 0 &&
+                          __builtin_cpu_supports("avx512bw") != 0;
+  return has;
+#else
+  return false;
+#endif
+}
+
+}  // namespace delineo::stereo::detail
