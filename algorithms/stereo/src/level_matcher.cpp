@@ -430,6 +430,7 @@ struct ShapeTemplate {
   ShapeNccTerms terms;  // n, Σ_S A, ... (quantised)
   std::vector<float> templ, mask;
   ShapeSpans spans;                // S as spans of its window rows (windows ≤ 15 columns)
+  ShapeSpanTerms spanTerms;        // the spans as prefix offsets (when hasSpans)
   bool hasSpans = false;           // false: a row has more gaps than the spans hold
   uint32_t rowBits[32] = {};       // S as bits: bit u of row v = window cell (u, v)
   int rowFirst = 0, rowLast = -1;  // window rows holding part of S
@@ -526,6 +527,7 @@ class LevelMatcher {
     otherStride_ = in.other.step1();
     invalidStride_ = static_cast<ptrdiff_t>(otherInvalidBits_.step1());
     if (useSpans_) prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
+    for (int v = 0; v < 16; ++v) prefixRowOffsets_[v] = static_cast<int32_t>(v * prefixStride_);
     for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
   }
 
@@ -871,6 +873,9 @@ class LevelMatcher {
       t.terms.sumA = sumA;
       t.terms.invNormA = static_cast<float>(1.0 / std::sqrt(varN));
       t.terms.flatN = static_cast<float>(flatQ_ * n * n);
+#ifdef DELINEO_STEREO_X86
+      if (t.hasSpans) shapeSpanTermsAvx2(t.spans, t.rowFirst, rows, prefixRowOffsets_, t.spanTerms);
+#endif
       return true;
     }
     t.count = 0;
@@ -975,7 +980,7 @@ class LevelMatcher {
       shapeScoresSpansAvx2Dispatch(
           otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_,
           otherPrefixB_.ptr<int32_t>(top) + xb - r_, otherPrefixBB_.ptr<int32_t>(top) + xb - r_,
-          prefixStride_, t.spans, t.rowFirst, &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
+          t.spanTerms, &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
       return true;
     }
 #endif
@@ -1196,6 +1201,7 @@ class LevelMatcher {
   cv::Mat otherSq_;
   cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
   ptrdiff_t otherQStride_ = 0, prefixStride_ = 0;  // their row strides, in elements
+  int32_t prefixRowOffsets_[16] = {};  // v · prefixStride_: the span terms' row offsets
   // cv::Mat::step1 is a library call, not inlined: the strides the per-pixel paths use.
   ptrdiff_t refQStride_ = 0;
   size_t refStride_ = 0, otherStride_ = 0;

@@ -415,35 +415,113 @@ __attribute__((target("avx2"), always_inline)) inline __m256i addDotAvx2(__m256i
       acc, _mm256_madd_epi16(a, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(x))));
 }
 
-// NCC of the K (1..8) main-line windows at b, b − 1, ..., b − (K − 1) (window k = disparity d + k)
-// over the shape given by its spans (window rows firstRow ..) and its rows of A (0 off S). `pb` / `pbb`: the prefix rows of
-// B and B² at the column of b (same rows as b), `pStride` entries apart; they must be readable
-// from −(K − 1) to 16 + 8.
-template <int K>
-__attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
-    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb, ptrdiff_t pStride,
-    const ShapeSpans& spans, int firstRow, const int16_t* am, int rows,
-    const ShapeNccTerms& terms, float* scores) {
-  // Lane j of the span sums holds window K − 1 − j. Every row has a level-0 term (rows ≥ 1; the
-  // sums start from the first row's: starting from zero, GCC copied both sums at every row); the
-  // gap levels visit only their rows with a gap.
-  __m256i sb, sbb;
-  {
-    const int16_t* plus = spans.plus[0] + firstRow;
-    const int16_t* minus = spans.minus[0] + firstRow;
-    sb = addSpanAvx2(_mm256_setzero_si256(), pb - (K - 1), plus[0], minus[0]);
-    sbb = addSpanAvx2(_mm256_setzero_si256(), pbb - (K - 1), plus[0], minus[0]);
-    for (int v = 1; v < rows; ++v) {
-      sb = addSpanAvx2(sb, pb + v * pStride - (K - 1), plus[v], minus[v]);
-      sbb = addSpanAvx2(sbb, pbb + v * pStride - (K - 1), plus[v], minus[v]);
+// The span terms of a shape as one list: per term, the prefix entries it adds (plus) and takes
+// away (minus) as offsets from the prefix at the window's left column on its first row (row v
+// of the window at (v − firstRow) · pStride). The rows' level-0 terms first, then the non-empty
+// gap terms. Built once per shape: the kernel's passes then run one plain loop (visiting the gap
+// levels row by row, with their offsets computed anew at every pass, cost a third of it).
+struct ShapeSpanTerms {
+  static constexpr int kFirst = 16;  // the list starts here (room for the level-0 stores)
+  // (8 more: the gap terms are stored 8 lanes at a time.)
+  alignas(32) int32_t plus[kFirst + 16 + 16 * (kSpanLevels - 1) + 8];
+  alignas(32) int32_t minus[kFirst + 16 + 16 * (kSpanLevels - 1) + 8];
+  int count = 0;
+};
+
+// out[v] = level[v] + the row offset of row v (16 rows: row0 holds rows 0..7, row8 rows 8..15).
+__attribute__((target("avx2"), always_inline)) inline void storeSpanLevelAvx2(const int16_t* level,
+                                                                             __m256i row0,
+                                                                             __m256i row8,
+                                                                             int32_t* out) {
+  const __m128i* in = reinterpret_cast<const __m128i*>(level);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
+                      _mm256_add_epi32(_mm256_cvtepi16_epi32(_mm_load_si128(in)), row0));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 8),
+                      _mm256_add_epi32(_mm256_cvtepi16_epi32(_mm_load_si128(in + 1)), row8));
+}
+
+// For each 8-bit set of lanes: the lanes in order, packed to the front (a permutation of 8
+// 32-bit lanes), and how many they are.
+struct SpanTermsPacking {
+  alignas(32) int32_t order[256][8];
+  uint8_t count[256];
+};
+constexpr SpanTermsPacking spanTermsPacking() {
+  SpanTermsPacking p{};
+  for (int set = 0; set < 256; ++set) {
+    int n = 0;
+    for (int lane = 0; lane < 8; ++lane) {
+      if ((set >> lane) & 1) p.order[set][n++] = lane;
+    }
+    p.count[set] = static_cast<uint8_t>(n);
+  }
+  return p;
+}
+inline constexpr SpanTermsPacking kSpanTermsPacking = spanTermsPacking();
+
+// `rowOffsets[v]` = v · pStride (v = 0..15); rows firstRow .. firstRow + rows − 1 hold S.
+__attribute__((target("avx2"))) inline void shapeSpanTermsAvx2(const ShapeSpans& spans,
+                                                               int firstRow, int rows,
+                                                               const int32_t* rowOffsets,
+                                                               ShapeSpanTerms& terms) {
+  // Level 0 of all 16 rows in vector lanes, stored so that row firstRow lands on kFirst (the
+  // entries past the last row are overwritten by the gap terms or not read).
+  const __m256i base = _mm256_set1_epi32(rowOffsets[firstRow]);
+  const __m256i row0 =
+      _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(rowOffsets)), base);
+  const __m256i row8 =
+      _mm256_sub_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(rowOffsets + 8)), base);
+  storeSpanLevelAvx2(spans.plus[0], row0, row8, terms.plus + ShapeSpanTerms::kFirst - firstRow);
+  storeSpanLevelAvx2(spans.minus[0], row0, row8, terms.minus + ShapeSpanTerms::kFirst - firstRow);
+  // The gap levels, 8 rows at a time: the non-empty terms packed to the front of the lanes by a
+  // permutation from a table (the scalar loop over each level's rows cost ~10 instructions a
+  // term, ~13 terms a shape).
+  int n = ShapeSpanTerms::kFirst + rows;
+  for (int g = 1; g < spans.levels; ++g) {
+    for (int half = 0; half < 2; ++half) {
+      const __m128i plus = _mm_load_si128(reinterpret_cast<const __m128i*>(spans.plus[g]) + half);
+      const __m128i minus = _mm_load_si128(reinterpret_cast<const __m128i*>(spans.minus[g]) + half);
+      const unsigned used =
+          ~static_cast<unsigned>(_mm_movemask_epi8(
+              _mm_packs_epi16(_mm_cmpeq_epi16(plus, minus), _mm_setzero_si128()))) & 0xFFU;
+      if (used == 0) continue;
+      const __m256i rowOffset = half == 0 ? row0 : row8;
+      const __m256i order =
+          _mm256_load_si256(reinterpret_cast<const __m256i*>(kSpanTermsPacking.order[used]));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(terms.plus + n),
+                          _mm256_permutevar8x32_epi32(
+                              _mm256_add_epi32(_mm256_cvtepi16_epi32(plus), rowOffset), order));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(terms.minus + n),
+                          _mm256_permutevar8x32_epi32(
+                              _mm256_add_epi32(_mm256_cvtepi16_epi32(minus), rowOffset), order));
+      n += kSpanTermsPacking.count[used];
     }
   }
-  for (int g = 1; g < spans.levels; ++g) {
-    for (uint32_t m = spans.gapRows[g]; m != 0; m &= m - 1) {
-      const int v = __builtin_ctz(m) >> 1;  // window row
-      const ptrdiff_t row = (v - firstRow) * pStride - (K - 1);
-      sb = addSpanAvx2(sb, pb + row, spans.plus[g][v], spans.minus[g][v]);
-      sbb = addSpanAvx2(sbb, pbb + row, spans.plus[g][v], spans.minus[g][v]);
+  terms.count = n - ShapeSpanTerms::kFirst;
+}
+
+// NCC of the K (1..8) main-line windows at b, b − 1, ..., b − (K − 1) (window k = disparity d + k)
+// over the shape given by its span terms and its rows of A (0 off S, `rows` rows from the
+// first). `pb` / `pbb`: the prefix rows of B and B² at the column of b (same rows as b), the
+// terms' offsets from there; they must be readable from −(K − 1) to 16 + 8.
+template <int K>
+__attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
+    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb,
+    const ShapeSpanTerms& spanTerms, const int16_t* am, int rows, const ShapeNccTerms& terms,
+    float* scores) {
+  // Lane j of the span sums holds window K − 1 − j. Every shape has a level-0 term (the sums
+  // start from the first one's: starting from zero, GCC copied both sums at every term).
+  __m256i sb, sbb;
+  {
+    const int32_t* plus = spanTerms.plus + ShapeSpanTerms::kFirst;
+    const int32_t* minus = spanTerms.minus + ShapeSpanTerms::kFirst;
+    const int32_t* pbK = pb - (K - 1);
+    const int32_t* pbbK = pbb - (K - 1);
+    sb = addSpanAvx2(_mm256_setzero_si256(), pbK, plus[0], minus[0]);
+    sbb = addSpanAvx2(_mm256_setzero_si256(), pbbK, plus[0], minus[0]);
+    for (int i = 1; i < spanTerms.count; ++i) {
+      sb = addSpanAvx2(sb, pbK, plus[i], minus[i]);
+      sbb = addSpanAvx2(sbb, pbbK, plus[i], minus[i]);
     }
   }
   // The dot products last: their 8 accumulators then go straight to the reductions (before
@@ -484,12 +562,12 @@ __attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
 }
 
 __attribute__((target("avx2"))) inline void shapeScoresSpansAvx2Dispatch(
-    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb, ptrdiff_t pStride,
-    const ShapeSpans& spans, int firstRow, const int16_t* am, int rows, int count,
+    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb,
+    const ShapeSpanTerms& spanTerms, const int16_t* am, int rows, int count,
     const ShapeNccTerms& terms, float* scores) {
-#define DELINEO_STEREO_SPANS_CASE(K)                                                               \
-  case K:                                                                                         \
-    shapeScoresSpansAvx2<K>(b, stride, pb, pbb, pStride, spans, firstRow, am, rows, terms, scores);  \
+#define DELINEO_STEREO_SPANS_CASE(K)                                                           \
+  case K:                                                                                     \
+    shapeScoresSpansAvx2<K>(b, stride, pb, pbb, spanTerms, am, rows, terms, scores);          \
     break;
   switch (count) {
     DELINEO_STEREO_SPANS_CASE(1)
@@ -500,8 +578,7 @@ __attribute__((target("avx2"))) inline void shapeScoresSpansAvx2Dispatch(
     DELINEO_STEREO_SPANS_CASE(6)
     DELINEO_STEREO_SPANS_CASE(7)
     default:
-      shapeScoresSpansAvx2<8>(b, stride, pb, pbb, pStride, spans, firstRow, am, rows, terms,
-                             scores);
+      shapeScoresSpansAvx2<8>(b, stride, pb, pbb, spanTerms, am, rows, terms, scores);
       break;
   }
 #undef DELINEO_STEREO_SPANS_CASE

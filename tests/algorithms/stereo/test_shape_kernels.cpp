@@ -271,8 +271,12 @@ TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) 
                             rowCount, &sums);
       nccFromIntSums(&sums, 1, shape.terms, expected + k);
     }
+    int32_t rowOffsets[16];
+    for (int v = 0; v < 16; ++v) rowOffsets[v] = v * prefixStride;
+    ShapeSpanTerms spanTerms;
+    shapeSpanTermsAvx2(vectorSpans, firstRow, rowCount, rowOffsets, spanTerms);
     shapeScoresSpansAvx2Dispatch(b.data() + x0, kStride, prefixB.data() + x0, prefixBB.data() + x0,
-                                 prefixStride, vectorSpans, firstRow, shape.am.data(), rowCount,
+                                 spanTerms, shape.am.data(), rowCount,
                                  count, shape.terms, got);
     for (int k = 0; k < count; ++k) {
       ASSERT_TRUE(sameFloat(expected[k], got[k])) << "trial " << trial << " window " << k;
