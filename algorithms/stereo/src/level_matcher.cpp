@@ -697,6 +697,22 @@ class LevelMatcher {
     sc.product.assign(static_cast<size_t>(gw) * gh, 0.0F);
     sc.cols.resize(static_cast<size_t>(gw));
     const float invN = 1.0F / static_cast<float>(n_);
+    // Per tile row, the disparities its swept pixels search: the row's running window sums are
+    // skipped at the others (the sweep covers the tile's union of intervals).
+    int rowLo[kTileRows], rowHi[kTileRows];
+    for (int ty = 0; ty < tile.height; ++ty) {
+      const int y = tile.y + ty;
+      const int* lo = in_.lo.ptr<int>(y);
+      const int* hi = in_.hi.ptr<int>(y);
+      const uchar* swept = &sc.swept[static_cast<size_t>(ty) * tile.width];
+      rowLo[ty] = std::numeric_limits<int>::max();
+      rowHi[ty] = std::numeric_limits<int>::min();
+      for (int tx = 0; tx < tile.width; ++tx) {
+        if (!swept[tx]) continue;
+        rowLo[ty] = std::min(rowLo[ty], lo[tile.x + tx]);
+        rowHi[ty] = std::max(rowHi[ty], hi[tile.x + tx]);
+      }
+    }
     for (int d = dLo; d <= dHi; ++d) {
       // Product rows (0 outside either image: such windows are never scored).
       for (int j = 0; j < gh; ++j) {
@@ -725,6 +741,7 @@ class LevelMatcher {
           const float* sub = &sc.product[static_cast<size_t>(ty - 1) * gw];
           for (int c = 0; c < gw; ++c) cols[c] += add[c] - sub[c];
         }
+        if (d < rowLo[ty] || d > rowHi[ty]) continue;
         const int y = tile.y + ty;
         const int* lo = in_.lo.ptr<int>(y);
         const int* hi = in_.hi.ptr<int>(y);
