@@ -978,18 +978,41 @@ class LevelMatcher {
   // Main-line scores for d .. d + count - 1 (count ≤ kShapeMaxWindows) in one pass over the
   // shape; false when one of the windows is not a plain inside-the-image, nodata-free one (then
   // scored one by one).
-  bool shapeScoresBatch(int x, int y, int d, const ShapeTemplate& t, float* scores,
-                        int count) const {
-    if (rowStride_ != 16) return false;
-    const int xb = x - d;
+  // Whether the main-line windows xb − count + 1 .. xb (count ≤ 8) of row y are plain ones:
+  // inside the image, nodata-free, not flat.
+  bool plainMainLine(int y, int xb, int count) const {
     if (y < r_ || y >= H_ - r_ || xb - (count - 1) < r_ || xb >= W_ - r_) return false;
-    // The `count` ok flags (0 or 1) of windows xb − count + 1 .. xb as one 8-byte word: the 8
-    // bytes stay inside the image's rows (y + 1 is a row of it).
+    // The `count` ok flags (0 or 1) as one 8-byte word: the 8 bytes stay inside the image's
+    // rows (y + 1 is a row of it).
     static_assert(kShapeMaxWindows <= 8);
     uint64_t flags;
     __builtin_memcpy(&flags, otherStats_.ok.ptr<uchar>(y) + xb - (count - 1), sizeof flags);
     const uint64_t all = 0x0101010101010101ULL >> (8 * (kShapeMaxWindows - count));
-    if ((flags & all) != all) return false;
+    return (flags & all) == all;
+  }
+
+#ifdef DELINEO_STEREO_X86
+  // Main-line scores for d .. d + count + count2 − 1 as two passes that read the span terms once
+  // (the same scores as two calls of shapeScoresBatch); false when not all are plain windows.
+  bool shapeScoresTwoBatches(int x, int y, int d, const ShapeTemplate& t, float* scores,
+                             int count, int count2) const {
+    const int xb = x - d;
+    if (!plainMainLine(y, xb, count) || !plainMainLine(y, xb - count, count2)) return false;
+    const int top = y + t.rowFirst - r_;
+    shapeScoresSpansTwiceAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_,
+                              otherPrefixB_.ptr<int32_t>(top) + xb - r_,
+                              otherPrefixBB_.ptr<int32_t>(top) + xb - r_, t.spanTerms,
+                              &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, count, count2,
+                              t.terms, scores);
+    return true;
+  }
+#endif
+
+  bool shapeScoresBatch(int x, int y, int d, const ShapeTemplate& t, float* scores,
+                        int count) const {
+    if (rowStride_ != 16) return false;
+    const int xb = x - d;
+    if (!plainMainLine(y, xb, count)) return false;
     const int top = y + t.rowFirst - r_;
     const int rows = t.rowLast - t.rowFirst + 1;
 #ifdef DELINEO_STEREO_X86
@@ -1051,13 +1074,27 @@ class LevelMatcher {
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
     // As few passes as the batch size allows, of balanced sizes (an interval of 7 with batches
     // of 6: 4 + 3, not 6 + 1).
-    float batch[kShapeMaxWindows];
+    float batch[2 * kShapeMaxWindows];
     const int perPass = t.hasSpans ? kShapeMaxWindows : batchWindows_;
-    for (int d = lo; d <= hi;) {
-      const int left = hi - d + 1;
+    auto passSize = [perPass](int left) {
       // (Most intervals take one pass: no integer divisions for them.)
       const int passes = left <= perPass ? 1 : (left + perPass - 1) / perPass;
-      const int count = passes == 1 ? left : (left + passes - 1) / passes;
+      return passes == 1 ? left : (left + passes - 1) / passes;
+    };
+    for (int d = lo; d <= hi;) {
+      const int left = hi - d + 1;
+      const int count = passSize(left);
+#ifdef DELINEO_STEREO_X86
+      if (t.hasSpans && count < left) {
+        const int count2 = passSize(left - count);
+        if (shapeScoresTwoBatches(x, y, d, t, batch, count, count2)) {
+          peak.updatePass(d, batch, count);
+          peak.updatePass(d + count, batch + count, count2);
+          d += count + count2;
+          continue;
+        }
+      }
+#endif
       if (shapeScoresBatch(x, y, d, t, batch, count)) {
         peak.updatePass(d, batch, count);
       } else {

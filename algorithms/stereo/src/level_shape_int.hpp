@@ -500,32 +500,49 @@ __attribute__((target("avx2"))) inline void shapeSpanTermsAvx2(const ShapeSpans&
   terms.count = n - ShapeSpanTerms::kFirst;
 }
 
-// NCC of the K (1..8) main-line windows at b, b − 1, ..., b − (K − 1) (window k = disparity d + k)
-// over the shape given by its span terms and its rows of A (0 off S, `rows` rows from the
-// first). `pb` / `pbb`: the prefix rows of B and B² at the column of b (same rows as b), the
-// terms' offsets from there; they must be readable from −(K − 1) to 16 + 8.
-template <int K>
-__attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
-    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb,
-    const ShapeSpanTerms& spanTerms, const int16_t* am, int rows, const ShapeNccTerms& terms,
-    float* scores) {
-  // Lane j of the span sums holds window K − 1 − j. Every shape has a level-0 term (the sums
-  // start from the first one's: starting from zero, GCC copied both sums at every term).
-  __m256i sb, sbb;
-  {
-    const int32_t* plus = spanTerms.plus + ShapeSpanTerms::kFirst;
-    const int32_t* minus = spanTerms.minus + ShapeSpanTerms::kFirst;
-    const int32_t* pbK = pb - (K - 1);
-    const int32_t* pbbK = pbb - (K - 1);
-    sb = addSpanAvx2(_mm256_setzero_si256(), pbK, plus[0], minus[0]);
-    sbb = addSpanAvx2(_mm256_setzero_si256(), pbbK, plus[0], minus[0]);
-    for (int i = 1; i < spanTerms.count; ++i) {
-      sb = addSpanAvx2(sb, pbK, plus[i], minus[i]);
-      sbb = addSpanAvx2(sbb, pbbK, plus[i], minus[i]);
-    }
+// Σ_S B and Σ_S B² of the 8 windows whose prefix rows start at pb − 7 .. pb (lane j: the
+// window at pb − 7 + j) and, when `pb2` is not null, the same of those at pb2 − 7 .. pb2, from the
+// shape's span terms: one loop over the terms for both sets (their offsets read once).
+__attribute__((target("avx2"), always_inline)) inline void spanSumsAvx2(
+    const ShapeSpanTerms& spanTerms, const int32_t* pb, const int32_t* pbb, __m256i& sb,
+    __m256i& sbb) {
+  // Every shape has a level-0 term (the sums start from the first one's: starting from zero, GCC
+  // copied both sums at every term).
+  const int32_t* plus = spanTerms.plus + ShapeSpanTerms::kFirst;
+  const int32_t* minus = spanTerms.minus + ShapeSpanTerms::kFirst;
+  sb = addSpanAvx2(_mm256_setzero_si256(), pb, plus[0], minus[0]);
+  sbb = addSpanAvx2(_mm256_setzero_si256(), pbb, plus[0], minus[0]);
+  for (int i = 1; i < spanTerms.count; ++i) {
+    sb = addSpanAvx2(sb, pb, plus[i], minus[i]);
+    sbb = addSpanAvx2(sbb, pbb, plus[i], minus[i]);
   }
-  // The dot products last: their 8 accumulators then go straight to the reductions (before
-  // the span sums, GCC copied each accumulator at every row).
+}
+__attribute__((target("avx2"), always_inline)) inline void spanSumsTwiceAvx2(
+    const ShapeSpanTerms& spanTerms, const int32_t* pb, const int32_t* pbb, const int32_t* pb2,
+    const int32_t* pbb2, __m256i& sb, __m256i& sbb, __m256i& sb2, __m256i& sbb2) {
+  const int32_t* plus = spanTerms.plus + ShapeSpanTerms::kFirst;
+  const int32_t* minus = spanTerms.minus + ShapeSpanTerms::kFirst;
+  sb = addSpanAvx2(_mm256_setzero_si256(), pb, plus[0], minus[0]);
+  sbb = addSpanAvx2(_mm256_setzero_si256(), pbb, plus[0], minus[0]);
+  sb2 = addSpanAvx2(_mm256_setzero_si256(), pb2, plus[0], minus[0]);
+  sbb2 = addSpanAvx2(_mm256_setzero_si256(), pbb2, plus[0], minus[0]);
+  for (int i = 1; i < spanTerms.count; ++i) {
+    sb = addSpanAvx2(sb, pb, plus[i], minus[i]);
+    sbb = addSpanAvx2(sbb, pbb, plus[i], minus[i]);
+    sb2 = addSpanAvx2(sb2, pb2, plus[i], minus[i]);
+    sbb2 = addSpanAvx2(sbb2, pbb2, plus[i], minus[i]);
+  }
+}
+
+// NCC of the K (1..8) main-line windows at b, b − 1, ..., b − (K − 1) (window k = disparity d + k)
+// over the shape given by its rows of A (0 off S, `rows` rows from the first), from their Σ_S B
+// and Σ_S B² (lane j: window K − 1 − j; spanSumsAvx2 from the prefixes at b's column − (K − 1)).
+template <int K>
+__attribute__((target("avx2"), always_inline)) inline void spanScoresAvx2(
+    const int16_t* b, ptrdiff_t stride, __m256i sb, __m256i sbb, const int16_t* am, int rows,
+    const ShapeNccTerms& terms, float* scores) {
+  // The dot products after the span sums: their 8 accumulators then go straight to the
+  // reductions (before the span sums, GCC copied each accumulator at every row).
   const __m256i zero = _mm256_setzero_si256();
   __m256i ab0 = zero, ab1 = zero, ab2 = zero, ab3 = zero, ab4 = zero, ab5 = zero, ab6 = zero,
           ab7 = zero;
@@ -561,27 +578,46 @@ __attribute__((target("avx2"), always_inline)) inline void shapeScoresSpansAvx2(
   }
 }
 
+__attribute__((target("avx2"), always_inline)) inline void spanScoresAvx2Dispatch(
+    const int16_t* b, ptrdiff_t stride, __m256i sb, __m256i sbb, const int16_t* am, int rows,
+    int count, const ShapeNccTerms& terms, float* scores) {
+  switch (count) {
+    case 1: spanScoresAvx2<1>(b, stride, sb, sbb, am, rows, terms, scores); break;
+    case 2: spanScoresAvx2<2>(b, stride, sb, sbb, am, rows, terms, scores); break;
+    case 3: spanScoresAvx2<3>(b, stride, sb, sbb, am, rows, terms, scores); break;
+    case 4: spanScoresAvx2<4>(b, stride, sb, sbb, am, rows, terms, scores); break;
+    case 5: spanScoresAvx2<5>(b, stride, sb, sbb, am, rows, terms, scores); break;
+    case 6: spanScoresAvx2<6>(b, stride, sb, sbb, am, rows, terms, scores); break;
+    case 7: spanScoresAvx2<7>(b, stride, sb, sbb, am, rows, terms, scores); break;
+    default: spanScoresAvx2<8>(b, stride, sb, sbb, am, rows, terms, scores); break;
+  }
+}
+
+// NCC of the `count` (1..8) main-line windows at b, b − 1, ... over the shape given by its span
+// terms and its rows of A. `pb` / `pbb`: the prefix rows of B and B² at the column of b (same
+// rows as b), the terms' offsets from there; they must be readable from −7 to 16 + 8.
 __attribute__((target("avx2"))) inline void shapeScoresSpansAvx2Dispatch(
     const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb,
     const ShapeSpanTerms& spanTerms, const int16_t* am, int rows, int count,
     const ShapeNccTerms& terms, float* scores) {
-#define DELINEO_STEREO_SPANS_CASE(K)                                                           \
-  case K:                                                                                     \
-    shapeScoresSpansAvx2<K>(b, stride, pb, pbb, spanTerms, am, rows, terms, scores);          \
-    break;
-  switch (count) {
-    DELINEO_STEREO_SPANS_CASE(1)
-    DELINEO_STEREO_SPANS_CASE(2)
-    DELINEO_STEREO_SPANS_CASE(3)
-    DELINEO_STEREO_SPANS_CASE(4)
-    DELINEO_STEREO_SPANS_CASE(5)
-    DELINEO_STEREO_SPANS_CASE(6)
-    DELINEO_STEREO_SPANS_CASE(7)
-    default:
-      shapeScoresSpansAvx2<8>(b, stride, pb, pbb, spanTerms, am, rows, terms, scores);
-      break;
-  }
-#undef DELINEO_STEREO_SPANS_CASE
+  __m256i sb, sbb;
+  spanSumsAvx2(spanTerms, pb - (count - 1), pbb - (count - 1), sb, sbb);
+  spanScoresAvx2Dispatch(b, stride, sb, sbb, am, rows, count, terms, scores);
+}
+
+// Two passes in one: the `count` windows at b, b − 1, ... then the `count2` ones that follow
+// (scores + count onwards); the span terms are read once for both (a pixel's interval wider than
+// 8 takes several passes; the terms cost about half of a pass). Readable as above, from −15.
+__attribute__((target("avx2"))) inline void shapeScoresSpansTwiceAvx2(
+    const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb,
+    const ShapeSpanTerms& spanTerms, const int16_t* am, int rows, int count, int count2,
+    const ShapeNccTerms& terms, float* scores) {
+  __m256i sb, sbb, sb2, sbb2;
+  const int last = count + count2 - 1;  // the second pass's last window
+  spanSumsTwiceAvx2(spanTerms, pb - (count - 1), pbb - (count - 1), pb - last, pbb - last, sb, sbb,
+                    sb2, sbb2);
+  spanScoresAvx2Dispatch(b, stride, sb, sbb, am, rows, count, terms, scores);
+  spanScoresAvx2Dispatch(b - count, stride, sb2, sbb2, am, rows, count2, terms, scores + count);
 }
 
 // Dense rows of a shape from its row bits (bit u of row v = cell (u, v)): mask, A on S, and
