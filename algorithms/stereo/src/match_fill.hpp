@@ -28,6 +28,8 @@ struct RegionFillSettings {
   double planeGreySigmas = 3.0;  // × noise sigma: counterpart's mean grey vs the region's
   double planeInlier = 1.0;      // px: a row end agrees with the plane within this
   double planeMinShare = 0.7;    // share of the row ends that must agree
+  double planeSideShare = 0.9;   // or: share of one side's row ends that agree (> 1 = off)
+  double planeOtherSideShare = 0.33;  //   with this share of the other side's (a hip facet)
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
   // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
   int extendReach = 32;            // px (4-connected steps) from the filled pixels; 0 = off
