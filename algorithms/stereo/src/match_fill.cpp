@@ -242,7 +242,7 @@ bool fitPlane(const std::vector<cv::Point3d>& points, FillPlane& plane) {
 // 1 px of the plane, 10 of 27 eave-side ones; the region was left unmatched). `points` holds
 // each row's two ends in turn (the region's first pixel, then its last): the plane is kept when
 // the ends of one side agree with it on planeSideShare of the rows and those of the other side on
-// planeOtherSideShare (they fix the slope across the rows).
+// planeEaveShare (they fix the slope across the rows).
 bool oneSideAgrees(const std::vector<cv::Point3d>& points, const FillPlane& plane,
                    const RegionFillSettings& settings) {
   if (settings.planeSideShare > 1 || points.empty()) return false;
@@ -256,7 +256,7 @@ bool oneSideAgrees(const std::vector<cv::Point3d>& points, const FillPlane& plan
   const double rows = static_cast<double>(points.size() / 2);
   const double high = static_cast<double>(std::max(agree[0], agree[1]));
   const double low = static_cast<double>(std::min(agree[0], agree[1]));
-  return high >= settings.planeSideShare * rows && low >= settings.planeOtherSideShare * rows;
+  return high >= settings.planeSideShare * rows && low >= settings.planeEaveShare * rows;
 }
 
 bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,

@@ -29,7 +29,7 @@ struct RegionFillSettings {
   double planeInlier = 1.0;      // px: a row end agrees with the plane within this
   double planeMinShare = 0.7;    // share of the row ends that must agree
   double planeSideShare = 0.9;   // or: share of one side's row ends that agree (> 1 = off)
-  double planeOtherSideShare = 0.33;  //   with this share of the other side's (a hip facet)
+  double planeEaveShare = 0.33;  //   with this share of the other side's (a hip facet's eave)
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
   // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
   int extendReach = 32;            // px (4-connected steps) from the filled pixels; 0 = off
@@ -59,7 +59,10 @@ struct RegionFillSettings {
 // with it within `planeInlier` px (see slopedFacetPlane in match_fill.cpp). A region a constant
 // lines up takes that plane too when the constant disagrees with most row ends, lies within the
 // plane's range over the region and lines the outline up less well than the plane (a hip roof's
-// facet, which a constant fills as a step).
+// facet, which a constant fills as a step). A hip facet's eave-side row ends scatter in the right
+// view (the facade beside it): the plane is also kept when one side's ends agree with it on
+// planeSideShare of the rows and the other side's on planeEaveShare, its offset then set where
+// the outline lines up best, within planeInlier of the fit.
 // A region's core is the region without its parts thinner than `coreOpening` (a morphological
 // opening): the core takes the region's place when it keeps at least `coreMinShare` of it and
 // the best candidate's error on the core's ring is below `coreErrorRatio` × the best one on the

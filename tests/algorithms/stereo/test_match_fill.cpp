@@ -293,6 +293,44 @@ TEST(FillFlatRegions, AFacetAConstantLinesUpTakesItsPlaneWhenTheRowEndsDisagreeW
   EXPECT_GE(constantPixels, (flat.facet.height - 4) * flat.facet.width * 95 / 100);
 }
 
+// The sloped facet of `slopedFacet()` seen in the right view with its eave side ragged from row
+// 50 down (a hip facet beside which the right view sees the facade): 10 rows reach 4 px too far,
+// the next 10 stop 3 px short, and so on. The hip-side row ends all agree with the facet's plane,
+// the eave-side ones on 20 rows of the region's 56: 68 % of the row ends in all.
+FacetScene facetWithARaggedEaveInTheRightView() {
+  FacetScene s = slopedFacet();
+  cv::RNG rng(9);
+  const double c = 20.0 - s.perColumn * s.facet.x - s.perRow * s.facet.y;
+  for (int y = 50; y < s.facet.br().y; ++y) {
+    int last = -1;  // the right view's last facet column on the row
+    for (int x = 0; x < s.right.cols; ++x) {
+      const double xf = (x + c + s.perRow * y) / (1.0 - s.perColumn);
+      if (xf >= s.facet.x - 0.5 && xf < s.facet.br().x - 0.5) last = x;
+    }
+    float* r = s.right.ptr<float>(y);
+    if ((y - 50) / 10 % 2 == 0) {
+      for (int k = 1; k <= 4; ++k) r[last + k] = 180.0f + static_cast<float>(rng.gaussian(2.0));
+    } else {
+      for (int k = 0; k < 3; ++k) r[last - k] = r[last + 6 + k];
+    }
+  }
+  return s;
+}
+
+TEST(FillFlatRegions, AFacetWhoseHipSideRowEndsAgreeTakesTheirPlaneOverARaggedEave) {
+  FacetScene hip = facetWithARaggedEaveInTheRightView();
+  fill(hip, RegionFillSettings{}, 40);
+  FacetScene bothSides = facetWithARaggedEaveInTheRightView();
+  RegionFillSettings noOneSide;
+  noOneSide.planeSideShare = 2.0;
+  fill(bothSides, noOneSide, 40);
+  const int area = hip.facet.area();
+  // Too few row ends agree for the plane of both sides: unfilled.
+  EXPECT_LT(facetPixelsOnItsPlane(bothSides, 0.5), area / 10) << " of " << area;
+  // One side's ends agree and the other's fix the slope: the facet takes the plane.
+  EXPECT_GE(facetPixelsOnItsPlane(hip, 0.5), area * 9 / 10) << " of " << area;
+}
+
 // The scene of `scene()` whose roof carries, along its right side, a 12 px band of weak random
 // texture (a few grey levels: not flat, and left unmatched, as a window matcher that finds its
 // NCC too weak would), and is seen 6 grey levels darker in the right view.
