@@ -259,10 +259,41 @@ bool oneSideAgrees(const std::vector<cv::Point3d>& points, const FillPlane& plan
   return high >= settings.planeSideShare * rows && low >= settings.planeEaveShare * rows;
 }
 
+// A facet merged in the left view with a surface of its grey beyond one of its ends (a hip
+// roof's facet beside ground of its grey) has, on those rows, row ends far from its plane, which
+// pull the least-squares fit off before the inliers are kept. When the plain fit is not kept, the
+// worst planeTrimShare of the points are dropped and the plane fitted again, until every point
+// left agrees with it within planeInlier (at least 2 · planeMinRows points left).
+bool trimmedPlane(const std::vector<cv::Point3d>& points, const RegionFillSettings& settings,
+                  FillPlane& plane) {
+  if (settings.planeTrimShare <= 0) return false;
+  std::vector<cv::Point3d> kept = points;
+  while (static_cast<int>(kept.size()) >= 2 * settings.planeMinRows && fitPlane(kept, plane)) {
+    std::vector<std::pair<double, size_t>> residuals;
+    for (size_t k = 0; k < kept.size(); ++k) {
+      const cv::Point3d& p = kept[k];
+      residuals.emplace_back(std::abs(p.z - (plane.c + plane.a * p.x + plane.b * p.y)), k);
+    }
+    std::sort(residuals.rbegin(), residuals.rend());
+    if (residuals.front().first <= settings.planeInlier) return true;
+    const size_t drop = std::max<size_t>(
+        1, static_cast<size_t>(settings.planeTrimShare * static_cast<double>(kept.size())));
+    std::vector<uchar> dropped(kept.size(), 0);
+    for (size_t k = 0; k < drop && k < residuals.size(); ++k) dropped[residuals[k].second] = 1;
+    std::vector<cv::Point3d> next;
+    for (size_t k = 0; k < kept.size(); ++k) {
+      if (!dropped[k]) next.push_back(kept[k]);
+    }
+    kept = std::move(next);
+  }
+  return false;
+}
+
 bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
                       double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
                       const RegionFillSettings& settings, const std::optional<float>& constant,
-                      FillPlane& plane, bool* oneSided = nullptr) {
+                      FillPlane& plane, bool* oneSided = nullptr,
+                      std::vector<cv::Vec2i>* rowSpans = nullptr) {
   struct RowEnds {
     int y, l0, l1;
   };
@@ -312,6 +343,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
   std::vector<cv::Point3d> bestPoints;
   for (const auto& [count, label] : candidates) {
     std::vector<cv::Point3d> points;
+    std::vector<cv::Vec2i> rightEnds;  // each row's (r0, r1), as its two points
     for (const RowEnds& r : rows) {
       const int* l = right.labels.ptr<int>(r.y);
       const auto [x0, x1] = band(r);
@@ -328,6 +360,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
       // surface points in the two views).
       points.emplace_back(r.l0 - kFlatReach, r.y, r.l0 - r0);
       points.emplace_back(r.l1 + kFlatReach, r.y, r.l1 - r1);
+      rightEnds.emplace_back(r0, r1);
     }
     // Fit, keep the points within planeInlier px, fit again (twice).
     FillPlane fitted;
@@ -342,8 +375,25 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
       inliers = std::move(kept);
       ok = fitPlane(inliers, fitted);
     }
-    const bool bothSides =
+    bool bothSides =
         ok && static_cast<double>(inliers.size()) >= settings.planeMinShare * points.size();
+    // Failing that, when no constant lines the outline up, the trimmed fit (see trimmedPlane).
+    bool trimmed = false;
+    if (ok && !constant && !bothSides && !oneSideAgrees(points, fitted, settings)) {
+      FillPlane t;
+      if (trimmedPlane(points, settings, t)) {
+        std::vector<cv::Point3d> kept;
+        for (const auto& p : points) {
+          if (std::abs(p.z - (t.c + t.a * p.x + t.b * p.y)) <= settings.planeInlier) {
+            kept.push_back(p);
+          }
+        }
+        fitted = t;
+        inliers = std::move(kept);
+        bothSides = static_cast<double>(inliers.size()) >= settings.planeMinShare * points.size();
+        trimmed = true;
+      }
+    }
     if (!ok || !(bothSides || oneSideAgrees(points, fitted, settings)) ||
         static_cast<int>(inliers.size()) < 2 * settings.planeMinRows ||
         std::abs(fitted.a) > settings.planeMaxSlope ||
@@ -357,9 +407,42 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     });
     if (!inRange) continue;
     bestInliers = inliers.size();
-    bestPoints = std::move(points);
     plane = fitted;
     if (oneSided != nullptr) *oneSided = !bothSides;
+    if (rowSpans != nullptr) {
+      // A trimmed plane fills only the rows one of whose ends agrees with it (a row whose ends
+      // both disagree is another surface of the facet's grey joined to it), and a row whose
+      // left region runs past the counterpart's end (that end beyond the plane by more than
+      // planeInlier) only where the counterpart maps: x − d(x) within [r0, r1] widened by
+      // kFlatReach, x = (xr + c + b·y) / (1 − a).
+      rowSpans->assign(static_cast<size_t>(box.height),
+                       trimmed ? cv::Vec2i(1, 0) : cv::Vec2i(0, box.width - 1));
+      for (size_t k = 0; trimmed && k + 1 < points.size(); k += 2) {
+        const cv::Point3d& first = points[k];
+        const cv::Point3d& last = points[k + 1];
+        const int y = static_cast<int>(first.y);
+        const double firstResidual = first.z - fitted.at(static_cast<int>(first.x), y);
+        const double lastResidual = last.z - fitted.at(static_cast<int>(last.x), y);
+        if (std::abs(firstResidual) > settings.planeInlier &&
+            std::abs(lastResidual) > settings.planeInlier) {
+          continue;
+        }
+        const double denominator = 1.0 - fitted.a;
+        cv::Vec2i& span = (*rowSpans)[static_cast<size_t>(y - box.y)];
+        span = cv::Vec2i(0, box.width - 1);
+        if (firstResidual < -settings.planeInlier) {
+          const double x =
+              (rightEnds[k / 2][0] - kFlatReach + fitted.c + fitted.b * y) / denominator;
+          span[0] = std::max(span[0], static_cast<int>(std::ceil(x)) - box.x);
+        }
+        if (lastResidual > settings.planeInlier) {
+          const double x =
+              (rightEnds[k / 2][1] + kFlatReach + fitted.c + fitted.b * y) / denominator;
+          span[1] = std::min(span[1], static_cast<int>(std::floor(x)) - box.x);
+        }
+      }
+    }
+    bestPoints = std::move(points);
   }
   if (bestInliers == 0) return false;
   // A constant that explains the row ends as well keeps the region (a flat roof's plane has a
@@ -679,8 +762,19 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       const RightFlatRegions& rightFlat = rightFlatRegionsOf();
       const double leftMean = cv::mean(left(box), region)[0];
       bool oneSided = false;
-      const bool sloped = slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma,
-                                           dmin, dmax, settings, constant, plane, &oneSided);
+      std::vector<cv::Vec2i> rowSpans;
+      const bool sloped =
+          slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma, dmin, dmax,
+                           settings, constant, plane, &oneSided, &rowSpans);
+      if (sloped) {
+        for (int y = 0; y < box.height; ++y) {
+          uchar* m = region.ptr<uchar>(y);
+          const cv::Vec2i span = rowSpans[static_cast<size_t>(y)];
+          for (int x = 0; x < box.width; ++x) {
+            if (x < span[0] || x > span[1]) m[x] = 0;
+          }
+        }
+      }
       // A plane fixed mostly by one side's row ends carries their bias (the facet above: +1 px,
       // the ring error's minimum at c − 1): its offset is set where the outline lines up best,
       // within planeInlier of the fit.

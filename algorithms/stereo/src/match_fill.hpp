@@ -31,6 +31,7 @@ struct RegionFillSettings {
   double planeSideShare = 0.9;   // or: share of one side's row ends that agree (> 1 = off)
   double planeEaveShare = 0.33;  //   with this share of the other side's (a hip facet's eave)
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
+  double planeTrimShare = 0.1;   // worst share of row ends dropped per trimmed refit (0 = off)
   // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
   int extendReach = 32;            // px (4-connected steps) from the filled pixels; 0 = off
   double extendAgree = 1.0;        // px: matches this close to the fill are passed over (< 0: none)
