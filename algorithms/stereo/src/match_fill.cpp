@@ -410,14 +410,15 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     plane = fitted;
     if (oneSided != nullptr) *oneSided = !bothSides;
     if (rowSpans != nullptr) {
-      // A trimmed plane fills only the rows one of whose ends agrees with it (a row whose ends
-      // both disagree is another surface of the facet's grey joined to it), and a row whose
-      // left region runs past the counterpart's end (that end beyond the plane by more than
-      // planeInlier) only where the counterpart maps: x − d(x) within [r0, r1] widened by
-      // kFlatReach, x = (xr + c + b·y) / (1 − a).
+      // A plane not kept on both sides' ends (one side's, or a trimmed fit) fills only the rows
+      // one of whose ends agrees with it (a row whose ends both disagree is another surface of
+      // the facet's grey joined to it), and a row whose left region runs past the counterpart's
+      // end (that end beyond the plane by more than planeInlier) only where the counterpart
+      // maps: x − d(x) within [r0, r1] widened by kFlatReach, x = (xr + c + b·y) / (1 − a).
+      const bool limited = trimmed || !bothSides;
       rowSpans->assign(static_cast<size_t>(box.height),
-                       trimmed ? cv::Vec2i(1, 0) : cv::Vec2i(0, box.width - 1));
-      for (size_t k = 0; trimmed && k + 1 < points.size(); k += 2) {
+                       limited ? cv::Vec2i(1, 0) : cv::Vec2i(0, box.width - 1));
+      for (size_t k = 0; limited && k + 1 < points.size(); k += 2) {
         const cv::Point3d& first = points[k];
         const cv::Point3d& last = points[k + 1];
         const int y = static_cast<int>(first.y);

@@ -63,7 +63,11 @@ struct RegionFillSettings {
 // facet, which a constant fills as a step). A hip facet's eave-side row ends scatter in the right
 // view (the facade beside it): the plane is also kept when one side's ends agree with it on
 // planeSideShare of the rows and the other side's on planeEaveShare, its offset then set where
-// the outline lines up best, within planeInlier of the fit.
+// the outline lines up best, within planeInlier of the fit. When the plane through all the row
+// ends is not kept and no constant lines the outline up, a trimmed fit (the worst planeTrimShare
+// of the ends dropped per refit) is tried: a facet joined in the left view to a surface of its
+// grey. A plane not kept on both sides' ends fills only the rows one of whose ends agrees, up to
+// where the right view's counterpart maps.
 // A region's core is the region without its parts thinner than `coreOpening` (a morphological
 // opening): the core takes the region's place when it keeps at least `coreMinShare` of it and
 // the best candidate's error on the core's ring is below `coreErrorRatio` × the best one on the

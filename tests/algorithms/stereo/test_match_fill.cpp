@@ -331,6 +331,37 @@ TEST(FillFlatRegions, AFacetWhoseHipSideRowEndsAgreeTakesTheirPlaneOverARaggedEa
   EXPECT_GE(facetPixelsOnItsPlane(hip, 0.5), area * 9 / 10) << " of " << area;
 }
 
+// The sloped facet of `slopedFacet()` with, beyond its +x end on rows 66–89, a 12 px strip of
+// ground of its grey (at the ground's disparity, 4 px, in both views) that the window matcher
+// left unmatched: in the left view one flat region with the facet, in the right view apart from
+// it (the facet is seen 26–31 px to the left, the strip 4 px). Those rows' +x ends lie 12 px
+// past the facet's plane.
+TEST(FillFlatRegions, AFacetJoinedToGroundOfItsGreyIsFilledOnlyWhereItsCounterpartMaps) {
+  FacetScene s = slopedFacet();
+  cv::RNG rng(11);
+  const cv::Rect strip(s.facet.br().x, s.facet.y + 36, 12, 24);
+  for (int y = strip.y; y < strip.br().y; ++y) {
+    for (int x = strip.x; x < strip.br().x; ++x) {
+      s.left.at<float>(y, x) = 180.0f + static_cast<float>(rng.gaussian(2.0));
+      s.right.at<float>(y, x - 4) = 180.0f + static_cast<float>(rng.gaussian(2.0));
+    }
+  }
+  s.disparity(cv::Rect(strip.x, strip.y, strip.width + 3, strip.height)).setTo(kNaN);
+  fill(s, RegionFillSettings{}, 40);
+  // The facet takes its plane (its −x ends agree with it, and the +x ends of the rows above).
+  const int area = s.facet.area();
+  EXPECT_GE(facetPixelsOnItsPlane(s, 0.5), area * 9 / 10) << " of " << area;
+  // The strip beyond its counterpart's end does not (its first 2 px: the growth's reach).
+  int onStrip = 0;
+  for (int y = strip.y; y < strip.br().y; ++y) {
+    for (int x = strip.x + 2; x < strip.br().x; ++x) {
+      const float d = s.disparity.at<float>(y, x);
+      onStrip += std::isfinite(d) && d > kGround + 2.0f ? 1 : 0;
+    }
+  }
+  EXPECT_LE(onStrip, strip.height) << " of " << (strip.width - 2) * strip.height;
+}
+
 // The scene of `scene()` whose roof carries, along its right side, a 12 px band of weak random
 // texture (a few grey levels: not flat, and left unmatched, as a window matcher that finds its
 // NCC too weak would), and is seen 6 grey levels darker in the right view.
