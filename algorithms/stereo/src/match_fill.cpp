@@ -235,10 +235,65 @@ bool fitPlane(const std::vector<cv::Point3d>& points, FillPlane& plane) {
 // rows agree with it within a pixel (a facet partly hidden in the right view or merged there with a
 // surface of the same grey gives rows that do not), fills the region. Of the right regions of about
 // the region's grey level in its search band, the one with the most agreeing points is taken.
+// A hip roof's facet has its row ends on two kinds of contours: on one side the hips it shares
+// with the other facets (the same crease in both views: the ends agree), on the other its eave,
+// beside which the right view sees the facade, where the right region's ends scatter by a few
+// pixels (seed 5 600², the dark facet at x 130–185, y 334–361: 26 of 27 hip-side ends within
+// 1 px of the plane, 10 of 27 eave-side ones; the region was left unmatched). `points` holds
+// each row's two ends in turn (the region's first pixel, then its last): the plane is kept when
+// the ends of one side agree with it on planeSideShare of the rows and those of the other side on
+// planeEaveShare (they fix the slope across the rows).
+bool oneSideAgrees(const std::vector<cv::Point3d>& points, const FillPlane& plane,
+                   const RegionFillSettings& settings) {
+  if (settings.planeSideShare > 1 || points.empty()) return false;
+  size_t agree[2] = {0, 0};
+  for (size_t k = 0; k < points.size(); ++k) {
+    const cv::Point3d& p = points[k];
+    if (std::abs(p.z - (plane.c + plane.a * p.x + plane.b * p.y)) <= settings.planeInlier) {
+      ++agree[k % 2];
+    }
+  }
+  const double rows = static_cast<double>(points.size() / 2);
+  const double high = static_cast<double>(std::max(agree[0], agree[1]));
+  const double low = static_cast<double>(std::min(agree[0], agree[1]));
+  return high >= settings.planeSideShare * rows && low >= settings.planeEaveShare * rows;
+}
+
+// A facet merged in the left view with a surface of its grey beyond one of its ends (a hip
+// roof's facet beside ground of its grey) has, on those rows, row ends far from its plane, which
+// pull the least-squares fit off before the inliers are kept. When the plain fit is not kept, the
+// worst planeTrimShare of the points are dropped and the plane fitted again, until every point
+// left agrees with it within planeInlier (at least 2 · planeMinRows points left).
+bool trimmedPlane(const std::vector<cv::Point3d>& points, const RegionFillSettings& settings,
+                  FillPlane& plane) {
+  if (settings.planeTrimShare <= 0) return false;
+  std::vector<cv::Point3d> kept = points;
+  while (static_cast<int>(kept.size()) >= 2 * settings.planeMinRows && fitPlane(kept, plane)) {
+    std::vector<std::pair<double, size_t>> residuals;
+    for (size_t k = 0; k < kept.size(); ++k) {
+      const cv::Point3d& p = kept[k];
+      residuals.emplace_back(std::abs(p.z - (plane.c + plane.a * p.x + plane.b * p.y)), k);
+    }
+    std::sort(residuals.rbegin(), residuals.rend());
+    if (residuals.front().first <= settings.planeInlier) return true;
+    const size_t drop = std::max<size_t>(
+        1, static_cast<size_t>(settings.planeTrimShare * static_cast<double>(kept.size())));
+    std::vector<uchar> dropped(kept.size(), 0);
+    for (size_t k = 0; k < drop && k < residuals.size(); ++k) dropped[residuals[k].second] = 1;
+    std::vector<cv::Point3d> next;
+    for (size_t k = 0; k < kept.size(); ++k) {
+      if (!dropped[k]) next.push_back(kept[k]);
+    }
+    kept = std::move(next);
+  }
+  return false;
+}
+
 bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
                       double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
                       const RegionFillSettings& settings, const std::optional<float>& constant,
-                      FillPlane& plane) {
+                      FillPlane& plane, bool* oneSided = nullptr,
+                      std::vector<cv::Vec2i>* rowSpans = nullptr) {
   struct RowEnds {
     int y, l0, l1;
   };
@@ -288,6 +343,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
   std::vector<cv::Point3d> bestPoints;
   for (const auto& [count, label] : candidates) {
     std::vector<cv::Point3d> points;
+    std::vector<cv::Vec2i> rightEnds;  // each row's (r0, r1), as its two points
     for (const RowEnds& r : rows) {
       const int* l = right.labels.ptr<int>(r.y);
       const auto [x0, x1] = band(r);
@@ -304,6 +360,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
       // surface points in the two views).
       points.emplace_back(r.l0 - kFlatReach, r.y, r.l0 - r0);
       points.emplace_back(r.l1 + kFlatReach, r.y, r.l1 - r1);
+      rightEnds.emplace_back(r0, r1);
     }
     // Fit, keep the points within planeInlier px, fit again (twice).
     FillPlane fitted;
@@ -318,7 +375,26 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
       inliers = std::move(kept);
       ok = fitPlane(inliers, fitted);
     }
-    if (!ok || static_cast<double>(inliers.size()) < settings.planeMinShare * points.size() ||
+    bool bothSides =
+        ok && static_cast<double>(inliers.size()) >= settings.planeMinShare * points.size();
+    // Failing that, when no constant lines the outline up, the trimmed fit (see trimmedPlane).
+    bool trimmed = false;
+    if (ok && !constant && !bothSides && !oneSideAgrees(points, fitted, settings)) {
+      FillPlane t;
+      if (trimmedPlane(points, settings, t)) {
+        std::vector<cv::Point3d> kept;
+        for (const auto& p : points) {
+          if (std::abs(p.z - (t.c + t.a * p.x + t.b * p.y)) <= settings.planeInlier) {
+            kept.push_back(p);
+          }
+        }
+        fitted = t;
+        inliers = std::move(kept);
+        bothSides = static_cast<double>(inliers.size()) >= settings.planeMinShare * points.size();
+        trimmed = true;
+      }
+    }
+    if (!ok || !(bothSides || oneSideAgrees(points, fitted, settings)) ||
         static_cast<int>(inliers.size()) < 2 * settings.planeMinRows ||
         std::abs(fitted.a) > settings.planeMaxSlope ||
         std::abs(fitted.b) > settings.planeMaxSlope || inliers.size() <= bestInliers) {
@@ -331,8 +407,43 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     });
     if (!inRange) continue;
     bestInliers = inliers.size();
-    bestPoints = std::move(points);
     plane = fitted;
+    if (oneSided != nullptr) *oneSided = !bothSides;
+    if (rowSpans != nullptr) {
+      // A plane not kept on both sides' ends (one side's, or a trimmed fit) fills only the rows
+      // one of whose ends agrees with it (a row whose ends both disagree is another surface of
+      // the facet's grey joined to it), and a row whose left region runs past the counterpart's
+      // end (that end beyond the plane by more than planeInlier) only where the counterpart
+      // maps: x − d(x) within [r0, r1] widened by kFlatReach, x = (xr + c + b·y) / (1 − a).
+      const bool limited = trimmed || !bothSides;
+      rowSpans->assign(static_cast<size_t>(box.height),
+                       limited ? cv::Vec2i(1, 0) : cv::Vec2i(0, box.width - 1));
+      for (size_t k = 0; limited && k + 1 < points.size(); k += 2) {
+        const cv::Point3d& first = points[k];
+        const cv::Point3d& last = points[k + 1];
+        const int y = static_cast<int>(first.y);
+        const double firstResidual = first.z - fitted.at(static_cast<int>(first.x), y);
+        const double lastResidual = last.z - fitted.at(static_cast<int>(last.x), y);
+        if (std::abs(firstResidual) > settings.planeInlier &&
+            std::abs(lastResidual) > settings.planeInlier) {
+          continue;
+        }
+        const double denominator = 1.0 - fitted.a;
+        cv::Vec2i& span = (*rowSpans)[static_cast<size_t>(y - box.y)];
+        span = cv::Vec2i(0, box.width - 1);
+        if (firstResidual < -settings.planeInlier) {
+          const double x =
+              (rightEnds[k / 2][0] - kFlatReach + fitted.c + fitted.b * y) / denominator;
+          span[0] = std::max(span[0], static_cast<int>(std::ceil(x)) - box.x);
+        }
+        if (lastResidual > settings.planeInlier) {
+          const double x =
+              (rightEnds[k / 2][1] + kFlatReach + fitted.c + fitted.b * y) / denominator;
+          span[1] = std::min(span[1], static_cast<int>(std::floor(x)) - box.x);
+        }
+      }
+    }
+    bestPoints = std::move(points);
   }
   if (bestInliers == 0) return false;
   // A constant that explains the row ends as well keeps the region (a flat roof's plane has a
@@ -651,8 +762,36 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     if (settings.planeMinRows > 0) {
       const RightFlatRegions& rightFlat = rightFlatRegionsOf();
       const double leftMean = cv::mean(left(box), region)[0];
-      const bool sloped = slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma,
-                                           dmin, dmax, settings, constant, plane);
+      bool oneSided = false;
+      std::vector<cv::Vec2i> rowSpans;
+      const bool sloped =
+          slopedFacetPlane(region, box, rightFlat, leftMean, gain, offset, sigma, dmin, dmax,
+                           settings, constant, plane, &oneSided, &rowSpans);
+      if (sloped) {
+        for (int y = 0; y < box.height; ++y) {
+          uchar* m = region.ptr<uchar>(y);
+          const cv::Vec2i span = rowSpans[static_cast<size_t>(y)];
+          for (int x = 0; x < box.width; ++x) {
+            if (x < span[0] || x > span[1]) m[x] = 0;
+          }
+        }
+      }
+      // A plane fixed mostly by one side's row ends carries their bias (the facet above: +1 px,
+      // the ring error's minimum at c − 1): its offset is set where the outline lines up best,
+      // within planeInlier of the fit.
+      if (sloped && oneSided) {
+        const FillPlane fitted = plane;
+        double lowest = planeRingError(plane);
+        for (double shift = -settings.planeInlier; shift <= settings.planeInlier + 1e-9;
+             shift += 0.25) {
+          const FillPlane shifted{fitted.c + shift, fitted.a, fitted.b};
+          const double e = planeRingError(shifted);
+          if (e < lowest) {
+            lowest = e;
+            plane = shifted;
+          }
+        }
+      }
       // Over a constant the outline lines up at, the plane must line it up better.
       if (!sloped || (constant && !(planeRingError(plane) < constantError))) {
         if (!constant) continue;

@@ -28,7 +28,10 @@ struct RegionFillSettings {
   double planeGreySigmas = 3.0;  // × noise sigma: counterpart's mean grey vs the region's
   double planeInlier = 1.0;      // px: a row end agrees with the plane within this
   double planeMinShare = 0.7;    // share of the row ends that must agree
+  double planeSideShare = 0.9;   // or: share of one side's row ends that agree (> 1 = off)
+  double planeEaveShare = 0.33;  //   with this share of the other side's (a hip facet's eave)
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
+  double planeTrimShare = 0.1;   // worst share of row ends dropped per trimmed refit (0 = off)
   // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
   int extendReach = 32;            // px (4-connected steps) from the filled pixels; 0 = off
   double extendAgree = 1.0;        // px: matches this close to the fill are passed over (< 0: none)
@@ -57,7 +60,14 @@ struct RegionFillSettings {
 // with it within `planeInlier` px (see slopedFacetPlane in match_fill.cpp). A region a constant
 // lines up takes that plane too when the constant disagrees with most row ends, lies within the
 // plane's range over the region and lines the outline up less well than the plane (a hip roof's
-// facet, which a constant fills as a step).
+// facet, which a constant fills as a step). A hip facet's eave-side row ends scatter in the right
+// view (the facade beside it): the plane is also kept when one side's ends agree with it on
+// planeSideShare of the rows and the other side's on planeEaveShare, its offset then set where
+// the outline lines up best, within planeInlier of the fit. When the plane through all the row
+// ends is not kept and no constant lines the outline up, a trimmed fit (the worst planeTrimShare
+// of the ends dropped per refit) is tried: a facet joined in the left view to a surface of its
+// grey. A plane not kept on both sides' ends fills only the rows one of whose ends agrees, up to
+// where the right view's counterpart maps.
 // A region's core is the region without its parts thinner than `coreOpening` (a morphological
 // opening): the core takes the region's place when it keeps at least `coreMinShare` of it and
 // the best candidate's error on the core's ring is below `coreErrorRatio` × the best one on the

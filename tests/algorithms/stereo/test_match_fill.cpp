@@ -293,6 +293,75 @@ TEST(FillFlatRegions, AFacetAConstantLinesUpTakesItsPlaneWhenTheRowEndsDisagreeW
   EXPECT_GE(constantPixels, (flat.facet.height - 4) * flat.facet.width * 95 / 100);
 }
 
+// The sloped facet of `slopedFacet()` seen in the right view with its eave side ragged from row
+// 50 down (a hip facet beside which the right view sees the facade): 10 rows reach 4 px too far,
+// the next 10 stop 3 px short, and so on. The hip-side row ends all agree with the facet's plane,
+// the eave-side ones on 20 rows of the region's 56: 68 % of the row ends in all.
+FacetScene facetWithARaggedEaveInTheRightView() {
+  FacetScene s = slopedFacet();
+  cv::RNG rng(9);
+  const double c = 20.0 - s.perColumn * s.facet.x - s.perRow * s.facet.y;
+  for (int y = 50; y < s.facet.br().y; ++y) {
+    int last = -1;  // the right view's last facet column on the row
+    for (int x = 0; x < s.right.cols; ++x) {
+      const double xf = (x + c + s.perRow * y) / (1.0 - s.perColumn);
+      if (xf >= s.facet.x - 0.5 && xf < s.facet.br().x - 0.5) last = x;
+    }
+    float* r = s.right.ptr<float>(y);
+    if ((y - 50) / 10 % 2 == 0) {
+      for (int k = 1; k <= 4; ++k) r[last + k] = 180.0f + static_cast<float>(rng.gaussian(2.0));
+    } else {
+      for (int k = 0; k < 3; ++k) r[last - k] = r[last + 6 + k];
+    }
+  }
+  return s;
+}
+
+TEST(FillFlatRegions, AFacetWhoseHipSideRowEndsAgreeTakesTheirPlaneOverARaggedEave) {
+  FacetScene hip = facetWithARaggedEaveInTheRightView();
+  fill(hip, RegionFillSettings{}, 40);
+  FacetScene bothSides = facetWithARaggedEaveInTheRightView();
+  RegionFillSettings noOneSide;
+  noOneSide.planeSideShare = 2.0;
+  fill(bothSides, noOneSide, 40);
+  const int area = hip.facet.area();
+  // Too few row ends agree for the plane of both sides: unfilled.
+  EXPECT_LT(facetPixelsOnItsPlane(bothSides, 0.5), area / 10) << " of " << area;
+  // One side's ends agree and the other's fix the slope: the facet takes the plane.
+  EXPECT_GE(facetPixelsOnItsPlane(hip, 0.5), area * 9 / 10) << " of " << area;
+}
+
+// The sloped facet of `slopedFacet()` with, beyond its +x end on rows 66–89, a 12 px strip of
+// ground of its grey (at the ground's disparity, 4 px, in both views) that the window matcher
+// left unmatched: in the left view one flat region with the facet, in the right view apart from
+// it (the facet is seen 26–31 px to the left, the strip 4 px). Those rows' +x ends lie 12 px
+// past the facet's plane.
+TEST(FillFlatRegions, AFacetJoinedToGroundOfItsGreyIsFilledOnlyWhereItsCounterpartMaps) {
+  FacetScene s = slopedFacet();
+  cv::RNG rng(11);
+  const cv::Rect strip(s.facet.br().x, s.facet.y + 36, 12, 24);
+  for (int y = strip.y; y < strip.br().y; ++y) {
+    for (int x = strip.x; x < strip.br().x; ++x) {
+      s.left.at<float>(y, x) = 180.0f + static_cast<float>(rng.gaussian(2.0));
+      s.right.at<float>(y, x - 4) = 180.0f + static_cast<float>(rng.gaussian(2.0));
+    }
+  }
+  s.disparity(cv::Rect(strip.x, strip.y, strip.width + 3, strip.height)).setTo(kNaN);
+  fill(s, RegionFillSettings{}, 40);
+  // The facet takes its plane (its −x ends agree with it, and the +x ends of the rows above).
+  const int area = s.facet.area();
+  EXPECT_GE(facetPixelsOnItsPlane(s, 0.5), area * 9 / 10) << " of " << area;
+  // The strip beyond its counterpart's end does not (its first 2 px: the growth's reach).
+  int onStrip = 0;
+  for (int y = strip.y; y < strip.br().y; ++y) {
+    for (int x = strip.x + 2; x < strip.br().x; ++x) {
+      const float d = s.disparity.at<float>(y, x);
+      onStrip += std::isfinite(d) && d > kGround + 2.0f ? 1 : 0;
+    }
+  }
+  EXPECT_LE(onStrip, strip.height) << " of " << (strip.width - 2) * strip.height;
+}
+
 // The scene of `scene()` whose roof carries, along its right side, a 12 px band of weak random
 // texture (a few grey levels: not flat, and left unmatched, as a window matcher that finds its
 // NCC too weak would), and is seen 6 grey levels darker in the right view.
