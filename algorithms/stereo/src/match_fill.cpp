@@ -502,7 +502,9 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     }
   }
   if (biasCount > 0) bias /= biasCount;
-  const auto matchesAt = [&](int x, int y) {
+  // `photometric` (when given): set when the window matches at the fill's disparity and only the
+  // test against the other disparities is left.
+  const auto matchesAt = [&](int x, int y, bool* photometric = nullptr) {
     const double value = plane.at(x, y);
     const int w = settings.extendWindow / 2;
     if (value < dmin || value > dmax || x < w || y < w || x + w >= left.cols ||
@@ -542,6 +544,7 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     }
     // And the window matches there clearly better than at any disparity 2 px or more away (a
     // ground pixel's window matches at the ground's disparity as well).
+    if (photometric != nullptr) *photometric = true;
     if (settings.extendContrast <= 0) return true;
     const int cells = (2 * w + 1) * (2 * w + 1);
     for (int other = dmin; other <= dmax; ++other) {
@@ -582,6 +585,13 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     }
   }
   int extended = 0;
+  // Rows of windows passed over across a seam since the last pixel taken, along the column.
+  cv::Mat seamRows(outer.size(), CV_8U, cv::Scalar(0));
+  const auto take = [&](int x, int y) {
+    disparity.at<float>(y, x) = static_cast<float>(plane.at(x, y));
+    score.at<float>(y, x) = fillScore;
+    ++extended;
+  };
   for (int step = 1; step <= reach && !front.empty(); ++step) {
     std::vector<cv::Point> next;
     for (const cv::Point& p : front) {
@@ -601,11 +611,25 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
           continue;
         }
         if (std::isfinite(d) || ownFill[static_cast<size_t>(labels.at<int>(y, x))]) continue;
-        if (!matchesAt(x, y)) continue;
-        d = static_cast<float>(plane.at(x, y));
-        score.at<float>(y, x) = fillScore;
-        ++extended;
+        bool photometric = false;
+        if (!matchesAt(x, y, &photometric)) {
+          // A roof's seam or joint along the row (a dark line across the roof) matches at every
+          // disparity along it: its windows fail only the test against the others. Crossed
+          // along the column, at most extendSeamRows rows of them are passed over, and taken
+          // once a window past them is.
+          const int rows = seamRows.at<uchar>(p) + 1;
+          if (photometric && q.x == p.x && rows <= settings.extendSeamRows) {
+            seamRows.at<uchar>(q) = static_cast<uchar>(rows);
+            next.push_back(q);
+          }
+          continue;
+        }
+        take(x, y);
         next.push_back(q);
+        for (cv::Point s = p; q.x == p.x && seamRows.at<uchar>(s) > 0; s.y -= q.y - p.y) {
+          seamRows.at<uchar>(s) = 0;
+          take(outer.x + s.x, outer.y + s.y);
+        }
       }
     }
     front = std::move(next);

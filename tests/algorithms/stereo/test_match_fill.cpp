@@ -412,6 +412,9 @@ TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   Scene stopped = withMatchedColumns();
   RegionFillSettings noPassing;
   noPassing.extendAgree = -1;
+  // (Passing along columns over windows that fail only the test against other disparities, the
+  // extension reaches 153 of the rest's pixels without passing over the matches.)
+  noPassing.extendSeamRows = 0;
   fill(stopped, noPassing, 32);
   const cv::Rect rest(passed.roof.br().x - 7, passed.roof.y + 3, 7, passed.roof.height - 6);
   const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, rest); };
@@ -419,6 +422,45 @@ TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   EXPECT_GE(onTheRoof(passed), rest.area() * 3 / 5)
       << " of " << rest.area() << ", stopped " << onTheRoof(stopped);
   EXPECT_EQ(spilledOntoTheGround(passed), 0);
+}
+
+TEST(FillFlatRegions, GoesOnAcrossASeamAlongTheRoof) {
+  // The roof's lower 18 rows carry weak random texture (left unmatched), cut off from its plain
+  // upper part by a dark seam of 2 rows across the roof, in both views: a window on the seam
+  // matches at every disparity along it, and failed the test against the others.
+  const auto withSeam = [] {
+    Scene s = scene();
+    const cv::Rect band(s.roof.x, s.roof.y + 22, s.roof.width, s.roof.height - 22);
+    const cv::Mat weak = (testing::texture(s.left.size(), 7, 0.7) - 128.0) * 0.15;
+    for (int y = band.y; y < band.br().y; ++y) {
+      for (int x = band.x; x < band.br().x; ++x) {
+        s.left.at<float>(y, x) += weak.at<float>(y, x);
+        s.right.at<float>(y, x - 20) += weak.at<float>(y, x);
+      }
+    }
+    const cv::Rect seam(s.roof.x, s.roof.y + 20, s.roof.width, 2);
+    s.left(seam) -= 40.0f;
+    s.right(seam - cv::Point(20, 0)) -= 40.0f;
+    s.disparity(band).setTo(kNaN);
+    return s;
+  };
+  // The extension reaches 12 px: the seam's ends, where it gives evidence along the row, are
+  // 15 px or more from the pixels counted.
+  RegionFillSettings seams;
+  seams.extendReach = 12;
+  Scene crossed = withSeam();
+  fill(crossed, seams, 32);
+  Scene stopped = withSeam();
+  RegionFillSettings noSeams = seams;
+  noSeams.extendSeamRows = 0;
+  fill(stopped, noSeams, 32);
+  // The textured rows just below the seam, away from the roof's sides.
+  const cv::Rect below(crossed.roof.x + 15, crossed.roof.y + 23, crossed.roof.width - 30, 6);
+  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, below); };
+  EXPECT_LT(onTheRoof(stopped), below.area() / 4);
+  EXPECT_GE(onTheRoof(crossed), below.area() * 3 / 4)
+      << " of " << below.area() << ", stopped " << onTheRoof(stopped);
+  EXPECT_EQ(spilledOntoTheGround(crossed), 0);
 }
 
 }  // namespace
