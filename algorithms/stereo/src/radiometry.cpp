@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -91,6 +92,53 @@ std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& rig
   if (!(varL > 1e-12) || !(varR > 1e-12)) return {1.0, 0.0};
   const double gain = std::sqrt(varL / varR);
   return {gain, meanL - gain * meanR};
+}
+
+// Every 2nd row and column: a quarter of the matches gives the moments to well under a grey level.
+// The moments are then taken again twice over the pairs within 2.5 RMS of the map: a few wrong
+// matches (an occluded pixel paired with the roof that hides it) are far off and would pull them.
+std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv::Mat& right,
+                                                  const cv::Mat& disparity,
+                                                  std::pair<double, double> fallback,
+                                                  int minPairs) {
+  std::vector<cv::Vec2f> pairs;  // (left, right) grey levels
+  for (int y = 0; y < left.rows; y += 2) {
+    const float* pl = left.ptr<float>(y);
+    const float* pr = right.ptr<float>(y);
+    const float* d = disparity.ptr<float>(y);
+    for (int x = 0; x < left.cols; x += 2) {
+      if (!std::isfinite(d[x])) continue;
+      const int xr = x - static_cast<int>(std::lround(d[x]));
+      if (xr < 0 || xr >= right.cols || !std::isfinite(pl[x]) || !std::isfinite(pr[xr])) continue;
+      pairs.emplace_back(pl[x], pr[xr]);
+    }
+  }
+  std::pair<double, double> map = fallback;
+  double limit = std::numeric_limits<double>::infinity();
+  for (int pass = 0; pass < 3; ++pass) {
+    double sumL = 0, sumLL = 0, sumR = 0, sumRR = 0, count = 0;
+    for (const cv::Vec2f& p : pairs) {
+      if (pass > 0 && !(std::abs(p[0] - (map.first * p[1] + map.second)) <= limit)) continue;
+      sumL += p[0];
+      sumLL += static_cast<double>(p[0]) * p[0];
+      sumR += p[1];
+      sumRR += static_cast<double>(p[1]) * p[1];
+      count += 1;
+    }
+    if (count < minPairs) return fallback;
+    const double meanL = sumL / count, meanR = sumR / count;
+    const double varL = sumLL / count - meanL * meanL, varR = sumRR / count - meanR * meanR;
+    if (!(varL > 1e-12) || !(varR > 1e-12)) return fallback;
+    const double gain = std::sqrt(varL / varR);
+    map = {gain, meanL - gain * meanR};
+    double squares = 0;
+    for (const cv::Vec2f& p : pairs) {
+      const double r = p[0] - (map.first * p[1] + map.second);
+      if (pass == 0 || std::abs(r) <= limit) squares += r * r;
+    }
+    limit = 2.5 * std::sqrt(squares / count);
+  }
+  return map;
 }
 
 }  // namespace delineo::stereo::detail

@@ -15,4 +15,12 @@ double noiseSigma(const cv::Mat& image);
 std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& right, int dmin,
                                          int dmax);
 
+// The same map from the pixel pairs a disparity map matches (left x, right x - d rounded; NaN =
+// unmatched): the moments of the grey levels both views give the same surface points. `fallback`
+// when fewer than `minPairs` pairs or either side is flat.
+std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv::Mat& right,
+                                                  const cv::Mat& disparity,
+                                                  std::pair<double, double> fallback,
+                                                  int minPairs = 1000);
+
 }  // namespace delineo::stereo::detail

@@ -1,0 +1,58 @@
+// The grey-level map between the views (internal radiometry): from the matched pixel pairs it is
+// the exposures' map even where the views see different things; from the images' moments it is
+// not.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include <opencv2/core.hpp>
+
+#include "radiometry.hpp"
+
+namespace delineo::stereo::detail {
+namespace {
+
+TEST(Radiometry, MatchedPairsGiveTheExposureMapWhereTheViewsSeeDifferentThings) {
+  // Right = 0.92 · left + 6 on the surfaces both views see (disparity 10), noise sigma 2; the
+  // left view's leftmost 60 columns hold a bright facade the right view does not see (there, a
+  // dark one), which skews both images' moments but no matched pair.
+  const int rows = 120, cols = 240, shift = 10;
+  const double rightGain = 0.92, rightOffset = 6.0;
+  cv::RNG rng(7);
+  cv::Mat surface(rows, cols + shift, CV_32F);
+  rng.fill(surface, cv::RNG::UNIFORM, 40.0, 160.0);
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(static_cast<float>(shift)));
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      left.at<float>(y, x) = surface.at<float>(y, x) + static_cast<float>(rng.gaussian(2.0));
+      right.at<float>(y, x) = static_cast<float>(rightGain * surface.at<float>(y, x + shift) +
+                                                 rightOffset + rng.gaussian(2.0));
+    }
+  }
+  left(cv::Rect(0, 0, 60, rows)).setTo(230.0);
+  right(cv::Rect(0, 0, 60 - shift, rows)).setTo(20.0);
+  disparity(cv::Rect(0, 0, 60, rows)).setTo(std::numeric_limits<float>::quiet_NaN());
+
+  // left ≈ gain · right + offset: the inverse of the right view's exposure map.
+  const double gain = 1.0 / rightGain, offset = -rightOffset / rightGain;
+  const auto [matchedGain, matchedOffset] =
+      radiometricMapOfMatches(left, right, disparity, {1.0, 0.0});
+  EXPECT_NEAR(matchedGain, gain, 0.01);
+  EXPECT_NEAR(matchedOffset, offset, 1.0);
+  // A grey level of 60 in the right view: where each map puts it in the left's levels.
+  const double truth = gain * 60.0 + offset;
+  EXPECT_NEAR(matchedGain * 60.0 + matchedOffset, truth, 0.5);
+  const auto [imageGain, imageOffset] = radiometricMap(left, right, shift, shift);
+  EXPECT_GT(std::abs(imageGain * 60.0 + imageOffset - truth), 3.0);
+
+  // Too few matches: the fallback.
+  cv::Mat none(rows, cols, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  const auto fallback = radiometricMapOfMatches(left, right, none, {1.5, 2.5});
+  EXPECT_EQ(fallback.first, 1.5);
+  EXPECT_EQ(fallback.second, 2.5);
+}
+
+}  // namespace
+}  // namespace delineo::stereo::detail
