@@ -992,18 +992,21 @@ class LevelMatcher {
   }
 
 #ifdef DELINEO_STEREO_X86
-  // Main-line scores for d .. d + count + count2 − 1 as two passes that read the span terms once
-  // (the same scores as two calls of shapeScoresBatch); false when not all are plain windows.
-  bool shapeScoresTwoBatches(int x, int y, int d, const ShapeTemplate& t, float* scores,
-                             int count, int count2) const {
+  // Main-line scores from d on as `passes` (2..kSpanPassesMax) passes of counts[n] windows that
+  // read the span terms once (the same scores as a call of shapeScoresBatch per pass); false
+  // when not all are plain windows.
+  bool shapeScoresBatches(int x, int y, int d, const ShapeTemplate& t, float* scores,
+                          const int* counts, int passes) const {
     const int xb = x - d;
-    if (!plainMainLine(y, xb, count) || !plainMainLine(y, xb - count, count2)) return false;
+    for (int n = 0, k = 0; n < passes; k += counts[n], ++n) {
+      if (!plainMainLine(y, xb - k, counts[n])) return false;
+    }
     const int top = y + t.rowFirst - r_;
-    shapeScoresSpansTwiceAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_,
-                              otherPrefixB_.ptr<int32_t>(top) + xb - r_,
-                              otherPrefixBB_.ptr<int32_t>(top) + xb - r_, t.spanTerms,
-                              &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, count, count2,
-                              t.terms, scores);
+    shapeScoresSpansPassesAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_,
+                               otherPrefixB_.ptr<int32_t>(top) + xb - r_,
+                               otherPrefixBB_.ptr<int32_t>(top) + xb - r_, t.spanTerms,
+                               &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, counts, passes,
+                               t.terms, scores);
     return true;
   }
 #endif
@@ -1074,7 +1077,7 @@ class LevelMatcher {
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
     // As few passes as the batch size allows, of balanced sizes (an interval of 7 with batches
     // of 6: 4 + 3, not 6 + 1).
-    float batch[2 * kShapeMaxWindows];
+    float batch[kSpanPassesMax * kShapeMaxWindows];
     const int perPass = t.hasSpans ? kShapeMaxWindows : batchWindows_;
     auto passSize = [perPass](int left) {
       // (Most intervals take one pass: no integer divisions for them.)
@@ -1086,11 +1089,18 @@ class LevelMatcher {
       const int count = passSize(left);
 #ifdef DELINEO_STEREO_X86
       if (t.hasSpans && count < left) {
-        const int count2 = passSize(left - count);
-        if (shapeScoresTwoBatches(x, y, d, t, batch, count, count2)) {
-          peak.updatePass(d, batch, count);
-          peak.updatePass(d + count, batch + count, count2);
-          d += count + count2;
+        // The next passes, as the loop would size them.
+        int counts[kSpanPassesMax] = {count};
+        int passes = 1, taken = count;
+        for (; passes < kSpanPassesMax && taken < left; ++passes) {
+          counts[passes] = passSize(left - taken);
+          taken += counts[passes];
+        }
+        if (shapeScoresBatches(x, y, d, t, batch, counts, passes)) {
+          for (int n = 0, k = 0; n < passes; k += counts[n], ++n) {
+            peak.updatePass(d + k, batch + k, counts[n]);
+          }
+          d += taken;
           continue;
         }
       }
