@@ -975,8 +975,8 @@ class LevelMatcher {
         return score;
       }
 #endif
-      shapeScoresInt(otherQRow(top) + xb - r_, otherQStride_, &here,
-                     &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, 1, t.terms, &score);
+      shapeScoresInt(otherQRow(top) + xb - r_, otherQStride_, &here, &t.maskQ[16 * t.rowFirst],
+                     &t.aQ[16 * t.rowFirst], rows, 1, t.terms, &score);
       return score;
     }
     const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
@@ -1023,11 +1023,9 @@ class LevelMatcher {
       if (!plainMainLine(y, xb - k, counts[n])) return false;
     }
     const int top = y + t.rowFirst - r_;
-    shapeScoresSpansPassesAvx2(otherQRow(top) + xb - r_, otherQStride_,
-                               prefixBRow(top) + xb - r_,
-                               prefixBBRow(top) + xb - r_, t.spanTerms,
-                               &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, counts, passes,
-                               t.terms, scores);
+    shapeScoresSpansPassesAvx2(otherQRow(top) + xb - r_, otherQStride_, prefixBRow(top) + xb - r_,
+                               prefixBBRow(top) + xb - r_, t.spanTerms, &t.aQ[16 * t.rowFirst],
+                               t.rowLast - t.rowFirst + 1, counts, passes, t.terms, scores);
     return true;
   }
 #endif
@@ -1041,15 +1039,15 @@ class LevelMatcher {
     const int rows = t.rowLast - t.rowFirst + 1;
 #ifdef DELINEO_STEREO_X86
     if (t.hasSpans) {
-      shapeScoresSpansAvx2Dispatch(
-          otherQRow(top) + xb - r_, otherQStride_,
-          prefixBRow(top) + xb - r_, prefixBBRow(top) + xb - r_,
-          t.spanTerms, &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
+      shapeScoresSpansAvx2Dispatch(otherQRow(top) + xb - r_, otherQStride_,
+                                   prefixBRow(top) + xb - r_, prefixBBRow(top) + xb - r_,
+                                   t.spanTerms, &t.aQ[16 * t.rowFirst], rows, count, t.terms,
+                                   scores);
       return true;
     }
 #endif
-    shapeScoresInt(otherQRow(top) + xb - r_, otherQStride_, kMainLine,
-                   &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
+    shapeScoresInt(otherQRow(top) + xb - r_, otherQStride_, kMainLine, &t.maskQ[16 * t.rowFirst],
+                   &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
     return true;
   }
 
