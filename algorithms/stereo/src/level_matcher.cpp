@@ -1284,7 +1284,7 @@ class LevelMatcher {
   cv::Mat otherSq_;
   cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
   ptrdiff_t otherQStride_ = 0, prefixStride_ = 0;  // their row strides, in elements
-  int32_t prefixRowOffsets_[16] = {};  // v · prefixStride_: the span terms' row offsets
+  int32_t prefixRowOffsets_[16] = {};     // v · prefixStride_: the span terms' row offsets
   const int32_t* prefixBData_ = nullptr;  // row 0 of otherPrefixB_, otherPrefixBB_
   const int32_t* prefixBBData_ = nullptr;
   const uchar* otherOk_ = nullptr;  // row 0 of otherStats_.ok

@@ -284,8 +284,7 @@ TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) 
     ShapeSpanTerms spanTerms;
     shapeSpanTermsAvx2(vectorSpans, firstRow, rowCount, rowOffsets, spanTerms);
     shapeScoresSpansAvx2Dispatch(b.data() + x0, kStride, prefixB.data() + x0, prefixBB.data() + x0,
-                                 spanTerms, shape.am.data(), rowCount,
-                                 count, shape.terms, got);
+                                 spanTerms, shape.am.data(), rowCount, count, shape.terms, got);
     for (int k = 0; k < count; ++k) {
       ASSERT_TRUE(sameFloat(expected[k], got[k])) << "trial " << trial << " window " << k;
     }
