@@ -526,9 +526,30 @@ class LevelMatcher {
     refStride_ = in.ref.step1();
     otherStride_ = in.other.step1();
     invalidStride_ = static_cast<ptrdiff_t>(otherInvalidBits_.step1());
-    if (useSpans_) prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
+    if (useSpans_) {
+      prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
+      prefixBData_ = otherPrefixB_.ptr<int32_t>(0);
+      prefixBBData_ = otherPrefixBB_.ptr<int32_t>(0);
+    }
+    otherOk_ = otherStats_.ok.ptr<uchar>(0);
+    okStride_ = static_cast<ptrdiff_t>(otherStats_.ok.step1());
+    otherQData_ = otherQ_.ptr<int16_t>(0);
     for (int v = 0; v < 16; ++v) prefixRowOffsets_[v] = static_cast<int32_t>(v * prefixStride_);
     for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
+  }
+
+  // Rows of the other image's buffers by plain arithmetic (cv::Mat::ptr reads the data pointer
+  // and the step at every call: ~0.5 % of the match).
+  const uchar* otherOkRow(int y) const { return otherOk_ + static_cast<ptrdiff_t>(y) * okStride_; }
+  uchar otherOk(int y, int x) const { return otherOkRow(y)[x]; }
+  const int16_t* otherQRow(int y) const {
+    return otherQData_ + static_cast<ptrdiff_t>(y) * otherQStride_;
+  }
+  const int32_t* prefixBRow(int y) const {
+    return prefixBData_ + static_cast<ptrdiff_t>(y) * prefixStride_;
+  }
+  const int32_t* prefixBBRow(int y) const {
+    return prefixBBData_ + static_cast<ptrdiff_t>(y) * prefixStride_;
   }
 
   // Per pixel, the row of its window as one word: bit u set when (x - r + u, y) is marked in
@@ -605,7 +626,7 @@ class LevelMatcher {
   // missing or flat.
   float squareScore(int x, int y, int d, int dy) const {
     const int yb = y + dy, xb = x - d;
-    if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherStats_.ok.at<uchar>(yb, xb)) return kNaN;
+    if (yb < 0 || yb >= H_ || xb < 0 || xb >= W_ || !otherOk(yb, xb)) return kNaN;
     float sab = 0;
     if (s_.window <= 16) {
       // Reads 16 columns: the inputs are padded on the right.
@@ -749,7 +770,7 @@ class LevelMatcher {
         const float* sdA = refStats_.sd.ptr<float>(y);
         const float* meanB = otherStats_.mean.ptr<float>(y);
         const float* sdB = otherStats_.sd.ptr<float>(y);
-        const uchar* okB = otherStats_.ok.ptr<uchar>(y);
+        const uchar* okB = otherOkRow(y);
         const uchar* swept = &sc.swept[static_cast<size_t>(ty) * tile.width];
         LinePeak* peaks = &sc.peaks[static_cast<size_t>(ty) * tile.width];
         double window = 0;  // running row sum: double keeps it exact enough over a tile row
@@ -934,7 +955,7 @@ class LevelMatcher {
   float shapeScore(int x, int y, int d, int dy, const ShapeTemplate& t) const {
     const int yb = y + dy, xb = x - d;
     if (yb < r_ || yb >= H_ - r_ || xb < r_ || xb >= W_ - r_) return kNaN;
-    if (!otherStats_.ok.at<uchar>(yb, xb)) {
+    if (!otherOk(yb, xb)) {
       // Window partly nodata (or flat: the variance test below decides): S must avoid nodata.
       // Most such windows lie on the padding, where the first row of S already touches it.
       const int* invalid = otherInvalidBits_.ptr<int>(yb + t.rowFirst - r_) + xb;
@@ -949,13 +970,13 @@ class LevelMatcher {
       float score;
 #ifdef DELINEO_STEREO_X86
       if (avx2_) {
-        shapeScoreIntAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, here, &t.maskQ[16 * t.rowFirst],
+        shapeScoreIntAvx2(otherQRow(top) + xb - r_, here, &t.maskQ[16 * t.rowFirst],
                           &t.aQ[16 * t.rowFirst], otherQStride_, rows, t.terms, &score);
         return score;
       }
 #endif
-      shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_, &here,
-                     &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, 1, t.terms, &score);
+      shapeScoresInt(otherQRow(top) + xb - r_, otherQStride_, &here, &t.maskQ[16 * t.rowFirst],
+                     &t.aQ[16 * t.rowFirst], rows, 1, t.terms, &score);
       return score;
     }
     const size_t first = static_cast<size_t>(t.rowFirst * rowStride_);
@@ -986,24 +1007,25 @@ class LevelMatcher {
     // rows (y + 1 is a row of it).
     static_assert(kShapeMaxWindows <= 8);
     uint64_t flags;
-    __builtin_memcpy(&flags, otherStats_.ok.ptr<uchar>(y) + xb - (count - 1), sizeof flags);
+    __builtin_memcpy(&flags, otherOkRow(y) + xb - (count - 1), sizeof flags);
     const uint64_t all = 0x0101010101010101ULL >> (8 * (kShapeMaxWindows - count));
     return (flags & all) == all;
   }
 
 #ifdef DELINEO_STEREO_X86
-  // Main-line scores for d .. d + count + count2 − 1 as two passes that read the span terms once
-  // (the same scores as two calls of shapeScoresBatch); false when not all are plain windows.
-  bool shapeScoresTwoBatches(int x, int y, int d, const ShapeTemplate& t, float* scores,
-                             int count, int count2) const {
+  // Main-line scores from d on as `passes` (2..kSpanPassesMax) passes of counts[n] windows that
+  // read the span terms once (the same scores as a call of shapeScoresBatch per pass); false
+  // when not all are plain windows.
+  bool shapeScoresBatches(int x, int y, int d, const ShapeTemplate& t, float* scores,
+                          const int* counts, int passes) const {
     const int xb = x - d;
-    if (!plainMainLine(y, xb, count) || !plainMainLine(y, xb - count, count2)) return false;
+    for (int n = 0, k = 0; n < passes; k += counts[n], ++n) {
+      if (!plainMainLine(y, xb - k, counts[n])) return false;
+    }
     const int top = y + t.rowFirst - r_;
-    shapeScoresSpansTwiceAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_,
-                              otherPrefixB_.ptr<int32_t>(top) + xb - r_,
-                              otherPrefixBB_.ptr<int32_t>(top) + xb - r_, t.spanTerms,
-                              &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, count, count2,
-                              t.terms, scores);
+    shapeScoresSpansPassesAvx2(otherQRow(top) + xb - r_, otherQStride_, prefixBRow(top) + xb - r_,
+                               prefixBBRow(top) + xb - r_, t.spanTerms, &t.aQ[16 * t.rowFirst],
+                               t.rowLast - t.rowFirst + 1, counts, passes, t.terms, scores);
     return true;
   }
 #endif
@@ -1017,15 +1039,15 @@ class LevelMatcher {
     const int rows = t.rowLast - t.rowFirst + 1;
 #ifdef DELINEO_STEREO_X86
     if (t.hasSpans) {
-      shapeScoresSpansAvx2Dispatch(
-          otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_,
-          otherPrefixB_.ptr<int32_t>(top) + xb - r_, otherPrefixBB_.ptr<int32_t>(top) + xb - r_,
-          t.spanTerms, &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
+      shapeScoresSpansAvx2Dispatch(otherQRow(top) + xb - r_, otherQStride_,
+                                   prefixBRow(top) + xb - r_, prefixBBRow(top) + xb - r_,
+                                   t.spanTerms, &t.aQ[16 * t.rowFirst], rows, count, t.terms,
+                                   scores);
       return true;
     }
 #endif
-    shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, otherQStride_, kMainLine,
-                   &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
+    shapeScoresInt(otherQRow(top) + xb - r_, otherQStride_, kMainLine, &t.maskQ[16 * t.rowFirst],
+                   &t.aQ[16 * t.rowFirst], rows, count, t.terms, scores);
     return true;
   }
 
@@ -1034,9 +1056,9 @@ class LevelMatcher {
     if (rowStride_ != 16) return false;
     const int xb = x - d, yb = y + dy;  // windows xb, xb − 1, xb − 2
     if (yb < r_ || yb >= H_ - r_ || xb - 2 < r_ || xb >= W_ - r_) return false;
-    const uchar* ok = otherStats_.ok.ptr<uchar>(yb);
+    const uchar* ok = otherOkRow(yb);
     if (!ok[xb] || !ok[xb - 1] || !ok[xb - 2]) return false;
-    shapeScoresInt(otherQ_.ptr<int16_t>(yb + t.rowFirst - r_) + xb - r_, otherQStride_, kMainLine,
+    shapeScoresInt(otherQRow(yb + t.rowFirst - r_) + xb - r_, otherQStride_, kMainLine,
                    &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 3,
                    t.terms, scores);
     return true;
@@ -1048,13 +1070,13 @@ class LevelMatcher {
     if (rowStride_ != 16) return false;
     const int xb = x - d;
     if (y - 1 < r_ || y + 1 >= H_ - r_ || xb < r_ || xb >= W_ - r_) return false;
-    if (!otherStats_.ok.at<uchar>(y - 1, xb) || !otherStats_.ok.at<uchar>(y + 1, xb)) return false;
+    if (!otherOk(y - 1, xb) || !otherOk(y + 1, xb)) return false;
     const int top = y + t.rowFirst - r_;
     const ptrdiff_t stride = otherQStride_;
     float scores[2];
 #ifdef DELINEO_STEREO_X86
     if (avx2_) {
-      shapeScoresPairAvx2(otherQ_.ptr<int16_t>(top) + xb - r_, stride, &t.maskQ[16 * t.rowFirst],
+      shapeScoresPairAvx2(otherQRow(top) + xb - r_, stride, &t.maskQ[16 * t.rowFirst],
                           &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, t.terms, scores);
       minus = scores[0];
       plus = scores[1];
@@ -1062,7 +1084,7 @@ class LevelMatcher {
     }
 #endif
     const ptrdiff_t lines[2] = {-stride, stride};
-    shapeScoresInt(otherQ_.ptr<int16_t>(top) + xb - r_, stride, lines, &t.maskQ[16 * t.rowFirst],
+    shapeScoresInt(otherQRow(top) + xb - r_, stride, lines, &t.maskQ[16 * t.rowFirst],
                    &t.aQ[16 * t.rowFirst], t.rowLast - t.rowFirst + 1, 2, t.terms, scores);
     minus = scores[0];
     plus = scores[1];
@@ -1074,7 +1096,7 @@ class LevelMatcher {
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
     // As few passes as the batch size allows, of balanced sizes (an interval of 7 with batches
     // of 6: 4 + 3, not 6 + 1).
-    float batch[2 * kShapeMaxWindows];
+    float batch[kSpanPassesMax * kShapeMaxWindows];
     const int perPass = t.hasSpans ? kShapeMaxWindows : batchWindows_;
     auto passSize = [perPass](int left) {
       // (Most intervals take one pass: no integer divisions for them.)
@@ -1086,11 +1108,18 @@ class LevelMatcher {
       const int count = passSize(left);
 #ifdef DELINEO_STEREO_X86
       if (t.hasSpans && count < left) {
-        const int count2 = passSize(left - count);
-        if (shapeScoresTwoBatches(x, y, d, t, batch, count, count2)) {
-          peak.updatePass(d, batch, count);
-          peak.updatePass(d + count, batch + count, count2);
-          d += count + count2;
+        // The next passes, as the loop would size them.
+        int counts[kSpanPassesMax] = {count};
+        int passes = 1, taken = count;
+        for (; passes < kSpanPassesMax && taken < left; ++passes) {
+          counts[passes] = passSize(left - taken);
+          taken += counts[passes];
+        }
+        if (shapeScoresBatches(x, y, d, t, batch, counts, passes)) {
+          for (int n = 0, k = 0; n < passes; k += counts[n], ++n) {
+            peak.updatePass(d + k, batch + k, counts[n]);
+          }
+          d += taken;
           continue;
         }
       }
@@ -1255,7 +1284,12 @@ class LevelMatcher {
   cv::Mat otherSq_;
   cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
   ptrdiff_t otherQStride_ = 0, prefixStride_ = 0;  // their row strides, in elements
-  int32_t prefixRowOffsets_[16] = {};  // v · prefixStride_: the span terms' row offsets
+  int32_t prefixRowOffsets_[16] = {};     // v · prefixStride_: the span terms' row offsets
+  const int32_t* prefixBData_ = nullptr;  // row 0 of otherPrefixB_, otherPrefixBB_
+  const int32_t* prefixBBData_ = nullptr;
+  const uchar* otherOk_ = nullptr;  // row 0 of otherStats_.ok
+  ptrdiff_t okStride_ = 0;
+  const int16_t* otherQData_ = nullptr;  // row 0 of otherQ_
   // cv::Mat::step1 is a library call, not inlined: the strides the per-pixel paths use.
   ptrdiff_t refQStride_ = 0;
   size_t refStride_ = 0, otherStride_ = 0;

@@ -517,21 +517,46 @@ __attribute__((target("avx2"), always_inline)) inline void spanSumsAvx2(
     sbb = addSpanAvx2(sbb, pbb, plus[i], minus[i]);
   }
 }
-__attribute__((target("avx2"), always_inline)) inline void spanSumsTwiceAvx2(
-    const ShapeSpanTerms& spanTerms, const int32_t* pb, const int32_t* pbb, const int32_t* pb2,
-    const int32_t* pbb2, __m256i& sb, __m256i& sbb, __m256i& sb2, __m256i& sbb2) {
+// The same for N (2..4) sets of 8 windows, at pb[n] − 7 .. pb[n] (their prefixes of B² at
+// pbb[n]), in one loop over the terms.
+template <int N>
+__attribute__((target("avx2"), always_inline)) inline void spanSumsManyAvx2(
+    const ShapeSpanTerms& spanTerms, const int32_t* const* pb, const int32_t* const* pbb,
+    __m256i* sb, __m256i* sbb) {
   const int32_t* plus = spanTerms.plus + ShapeSpanTerms::kFirst;
   const int32_t* minus = spanTerms.minus + ShapeSpanTerms::kFirst;
-  sb = addSpanAvx2(_mm256_setzero_si256(), pb, plus[0], minus[0]);
-  sbb = addSpanAvx2(_mm256_setzero_si256(), pbb, plus[0], minus[0]);
-  sb2 = addSpanAvx2(_mm256_setzero_si256(), pb2, plus[0], minus[0]);
-  sbb2 = addSpanAvx2(_mm256_setzero_si256(), pbb2, plus[0], minus[0]);
-  for (int i = 1; i < spanTerms.count; ++i) {
-    sb = addSpanAvx2(sb, pb, plus[i], minus[i]);
-    sbb = addSpanAvx2(sbb, pbb, plus[i], minus[i]);
-    sb2 = addSpanAvx2(sb2, pb2, plus[i], minus[i]);
-    sbb2 = addSpanAvx2(sbb2, pbb2, plus[i], minus[i]);
+  // Named accumulators (GCC kept arrays of vectors partly on the stack).
+  const __m256i zero = _mm256_setzero_si256();
+  __m256i b0 = addSpanAvx2(zero, pb[0], plus[0], minus[0]);
+  __m256i bb0 = addSpanAvx2(zero, pbb[0], plus[0], minus[0]);
+  __m256i b1 = addSpanAvx2(zero, pb[1], plus[0], minus[0]);
+  __m256i bb1 = addSpanAvx2(zero, pbb[1], plus[0], minus[0]);
+  __m256i b2 = zero, bb2 = zero, b3 = zero, bb3 = zero;
+  if constexpr (N > 2) {
+    b2 = addSpanAvx2(zero, pb[2], plus[0], minus[0]);
+    bb2 = addSpanAvx2(zero, pbb[2], plus[0], minus[0]);
   }
+  if constexpr (N > 3) {
+    b3 = addSpanAvx2(zero, pb[3], plus[0], minus[0]);
+    bb3 = addSpanAvx2(zero, pbb[3], plus[0], minus[0]);
+  }
+  for (int i = 1; i < spanTerms.count; ++i) {
+    b0 = addSpanAvx2(b0, pb[0], plus[i], minus[i]);
+    bb0 = addSpanAvx2(bb0, pbb[0], plus[i], minus[i]);
+    b1 = addSpanAvx2(b1, pb[1], plus[i], minus[i]);
+    bb1 = addSpanAvx2(bb1, pbb[1], plus[i], minus[i]);
+    if constexpr (N > 2) {
+      b2 = addSpanAvx2(b2, pb[2], plus[i], minus[i]);
+      bb2 = addSpanAvx2(bb2, pbb[2], plus[i], minus[i]);
+    }
+    if constexpr (N > 3) {
+      b3 = addSpanAvx2(b3, pb[3], plus[i], minus[i]);
+      bb3 = addSpanAvx2(bb3, pbb[3], plus[i], minus[i]);
+    }
+  }
+  sb[0] = b0, sbb[0] = bb0, sb[1] = b1, sbb[1] = bb1;
+  if constexpr (N > 2) sb[2] = b2, sbb[2] = bb2;
+  if constexpr (N > 3) sb[3] = b3, sbb[3] = bb3;
 }
 
 // NCC of the K (1..8) main-line windows at b, b − 1, ..., b − (K − 1) (window k = disparity d + k)
@@ -605,19 +630,34 @@ __attribute__((target("avx2"))) inline void shapeScoresSpansAvx2Dispatch(
   spanScoresAvx2Dispatch(b, stride, sb, sbb, am, rows, count, terms, scores);
 }
 
-// Two passes in one: the `count` windows at b, b − 1, ... then the `count2` ones that follow
-// (scores + count onwards); the span terms are read once for both (a pixel's interval wider than
-// 8 takes several passes; the terms cost about half of a pass). Readable as above, from −15.
-__attribute__((target("avx2"))) inline void shapeScoresSpansTwiceAvx2(
+// Up to kSpanPassesMax passes in one: passes n = 0 .. passes − 1 of counts[n] (1..8) windows
+// each, following each other from b, b − 1, ... (the scores one after the other); the span
+// terms are read once for all (a pixel's interval wider than 8 takes several passes; the terms
+// cost about half of a pass). Readable as above, from −(Σ counts − 1).
+constexpr int kSpanPassesMax = 4;
+__attribute__((target("avx2"))) inline void shapeScoresSpansPassesAvx2(
     const int16_t* b, ptrdiff_t stride, const int32_t* pb, const int32_t* pbb,
-    const ShapeSpanTerms& spanTerms, const int16_t* am, int rows, int count, int count2,
+    const ShapeSpanTerms& spanTerms, const int16_t* am, int rows, const int* counts, int passes,
     const ShapeNccTerms& terms, float* scores) {
-  __m256i sb, sbb, sb2, sbb2;
-  const int last = count + count2 - 1;  // the second pass's last window
-  spanSumsTwiceAvx2(spanTerms, pb - (count - 1), pbb - (count - 1), pb - last, pbb - last, sb, sbb,
-                    sb2, sbb2);
-  spanScoresAvx2Dispatch(b, stride, sb, sbb, am, rows, count, terms, scores);
-  spanScoresAvx2Dispatch(b - count, stride, sb2, sbb2, am, rows, count2, terms, scores + count);
+  const int32_t* pbs[kSpanPassesMax];
+  const int32_t* pbbs[kSpanPassesMax];
+  int first[kSpanPassesMax];  // each pass's first window
+  for (int n = 0, k = 0; n < passes; k += counts[n], ++n) {
+    first[n] = k;
+    pbs[n] = pb - (k + counts[n] - 1);
+    pbbs[n] = pbb - (k + counts[n] - 1);
+  }
+  __m256i sb[kSpanPassesMax], sbb[kSpanPassesMax];
+  switch (passes) {
+    case 1: spanSumsAvx2(spanTerms, pbs[0], pbbs[0], sb[0], sbb[0]); break;
+    case 2: spanSumsManyAvx2<2>(spanTerms, pbs, pbbs, sb, sbb); break;
+    case 3: spanSumsManyAvx2<3>(spanTerms, pbs, pbbs, sb, sbb); break;
+    default: spanSumsManyAvx2<4>(spanTerms, pbs, pbbs, sb, sbb); break;
+  }
+  for (int n = 0; n < passes; ++n) {
+    spanScoresAvx2Dispatch(b - first[n], stride, sb[n], sbb[n], am, rows, counts[n], terms,
+                           scores + first[n]);
+  }
 }
 
 // Dense rows of a shape from its row bits (bit u of row v = cell (u, v)): mask, A on S, and

@@ -262,11 +262,17 @@ TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) 
                     &prefixBB[y * prefixStride]);
     }
     const int count = std::uniform_int_distribution<int>(1, kShapeMaxWindows)(rng);
-    // A second pass of count2 windows after the first (the two-pass kernel).
-    const int count2 = std::uniform_int_distribution<int>(1, kShapeMaxWindows)(rng);
-    const int x0 = std::uniform_int_distribution<int>(count + count2 - 1, kStride - 16)(rng);
-    float expected[2 * kShapeMaxWindows], got[2 * kShapeMaxWindows];
-    for (int k = 0; k < count + count2; ++k) {
+    // More passes after the first (the several-pass kernel).
+    const int passes = std::uniform_int_distribution<int>(1, kSpanPassesMax)(rng);
+    int counts[kSpanPassesMax] = {count};
+    int total = count;
+    for (int n = 1; n < passes; ++n) {
+      counts[n] = std::uniform_int_distribution<int>(1, kShapeMaxWindows)(rng);
+      total += counts[n];
+    }
+    const int x0 = std::uniform_int_distribution<int>(total - 1, kStride - 16)(rng);
+    float expected[kSpanPassesMax * kShapeMaxWindows], got[kSpanPassesMax * kShapeMaxWindows];
+    for (int k = 0; k < total; ++k) {
       const ptrdiff_t offset = x0 - k;
       ShapeSumsInt sums;
       shapeSumsIntScalar<1>(b.data(), kStride, &offset, shape.mask.data(), shape.am.data(),
@@ -278,17 +284,17 @@ TEST(ShapeKernels, SpansOfAShapeSumItsCellsAndTheSpanKernelMatchesTheReference) 
     ShapeSpanTerms spanTerms;
     shapeSpanTermsAvx2(vectorSpans, firstRow, rowCount, rowOffsets, spanTerms);
     shapeScoresSpansAvx2Dispatch(b.data() + x0, kStride, prefixB.data() + x0, prefixBB.data() + x0,
-                                 spanTerms, shape.am.data(), rowCount,
-                                 count, shape.terms, got);
+                                 spanTerms, shape.am.data(), rowCount, count, shape.terms, got);
     for (int k = 0; k < count; ++k) {
       ASSERT_TRUE(sameFloat(expected[k], got[k])) << "trial " << trial << " window " << k;
     }
     windows += count;
-    shapeScoresSpansTwiceAvx2(b.data() + x0, kStride, prefixB.data() + x0, prefixBB.data() + x0,
-                              spanTerms, shape.am.data(), rowCount, count, count2, shape.terms,
-                              got);
-    for (int k = 0; k < count + count2; ++k) {
-      ASSERT_TRUE(sameFloat(expected[k], got[k])) << "trial " << trial << " two passes, window " << k;
+    shapeScoresSpansPassesAvx2(b.data() + x0, kStride, prefixB.data() + x0, prefixBB.data() + x0,
+                               spanTerms, shape.am.data(), rowCount, counts, passes, shape.terms,
+                               got);
+    for (int k = 0; k < total; ++k) {
+      ASSERT_TRUE(sameFloat(expected[k], got[k]))
+          << "trial " << trial << " " << passes << " passes, window " << k;
     }
 #endif
     ++shapes;
