@@ -331,6 +331,27 @@ TEST(FillFlatRegions, AFacetWhoseHipSideRowEndsAgreeTakesTheirPlaneOverARaggedEa
   EXPECT_GE(facetPixelsOnItsPlane(hip, 0.5), area * 9 / 10) << " of " << area;
 }
 
+// The sloped facet of `slopedFacet()` with the right view exposed differently (right = 0.92 ·
+// left + 6) and, over the left view's first 40 columns, a bright surface (grey 235) the right
+// view does not see (it sees a dark one, grey 15, over its first 36): the images' moments then
+// map the facet's grey 6+ levels off its counterpart's, the matched pixel pairs do not.
+TEST(FillFlatRegions, ASlopedFacetFindsItsCounterpartUnderTheMatchedPairsGreyMap) {
+  FacetScene s = slopedFacet();
+  s.right = 0.92 * s.right + 6.0;
+  cv::RNG rng(12);
+  for (int y = 0; y < s.left.rows; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      s.left.at<float>(y, x) = 235.0f + static_cast<float>(rng.gaussian(2.0));
+      if (x < 36) s.right.at<float>(y, x) = 15.0f + static_cast<float>(rng.gaussian(2.0));
+    }
+  }
+  s.disparity(cv::Rect(0, 0, 40, s.left.rows)).setTo(kNaN);
+  fill(s, RegionFillSettings{}, 40);
+  // Under the images' map no counterpart passes the grey test: the facet stays unfilled.
+  const int area = s.facet.area();
+  EXPECT_GE(facetPixelsOnItsPlane(s, 0.5), area * 9 / 10) << " of " << area;
+}
+
 // The sloped facet of `slopedFacet()` with, beyond its +x end on rows 66–89, a 12 px strip of
 // ground of its grey (at the ground's disparity, 4 px, in both views) that the window matcher
 // left unmatched: in the left view one flat region with the facet, in the right view apart from
