@@ -502,9 +502,55 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     }
   }
   if (biasCount > 0) bias /= biasCount;
-  // `photometric` (when given): set when the window matches at the fill's disparity and only the
-  // test against the other disparities is left.
-  const auto matchesAt = [&](int x, int y, bool* photometric = nullptr) {
+  // A weakly textured surface's small window can match about as well a few px along the row (on
+  // the same surface): the wider window (extendWideWindow, holding more of its texture) decides
+  // then, by the same test: its mean error at the fill's disparity below extendContrast × the one
+  // at any disparity 2 px or more away. Across the contour it meets another surface in the right
+  // view, and fails.
+  // `first`: the disparity the small window failed at, tried first (most wide windows fail there
+  // too, and the rest is not read).
+  const auto clearInAWiderWindow = [&](int x, int y, double value, int first) {
+    const int w = settings.extendWideWindow / 2;
+    if (w <= settings.extendWindow / 2 || x < w || y < w || x + w >= left.cols ||
+        y + w >= left.rows) {
+      return false;
+    }
+    const int whole = static_cast<int>(std::floor(value));
+    const auto t = static_cast<float>(value - whole);
+    double sum = 0;
+    for (int v = y - w; v <= y + w; ++v) {
+      for (int u = x - w; u <= x + w; ++u) {
+        const int xr = u - whole;
+        if (xr - 1 < 0 || xr >= right.cols) return false;
+        const float a = left.at<float>(v, u);
+        const float b = (1 - t) * right.at<float>(v, xr) + t * right.at<float>(v, xr - 1);
+        if (!std::isfinite(a) || !std::isfinite(b)) return false;
+        sum += std::abs(a - (gain * b + offset + bias));
+      }
+    }
+    for (int k = dmin - 1; k <= dmax; ++k) {
+      const int other = k < dmin ? first : k;
+      if (std::abs(other - value) < 2.0 || (k >= dmin && other == first)) continue;
+      double e = 0;
+      bool cleared = false;
+      for (int v = y - w; v <= y + w && !cleared; ++v) {
+        const float* l = left.ptr<float>(v);
+        const float* rr = right.ptr<float>(v);
+        for (int u = x - w; u <= x + w; ++u) {
+          const int xr = u - other;
+          if (xr < 0 || xr >= right.cols || !std::isfinite(rr[xr])) {
+            e = 1e30;
+            break;
+          }
+          e += std::abs(l[u] - (gain * rr[xr] + offset));
+        }
+        cleared = !(sum > settings.extendContrast * e);
+      }
+      if (!cleared) return false;
+    }
+    return true;
+  };
+  const auto matchesAt = [&](int x, int y) {
     const double value = plane.at(x, y);
     const int w = settings.extendWindow / 2;
     if (value < dmin || value > dmax || x < w || y < w || x + w >= left.cols ||
@@ -544,7 +590,6 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     }
     // And the window matches there clearly better than at any disparity 2 px or more away (a
     // ground pixel's window matches at the ground's disparity as well).
-    if (photometric != nullptr) *photometric = true;
     if (settings.extendContrast <= 0) return true;
     const int cells = (2 * w + 1) * (2 * w + 1);
     for (int other = dmin; other <= dmax; ++other) {
@@ -566,7 +611,7 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
         }
         cleared = !(error > settings.extendContrast * e / cells);
       }
-      if (!cleared) return false;
+      if (!cleared) return clearInAWiderWindow(x, y, value, other);
     }
     return true;
   };
@@ -585,13 +630,6 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     }
   }
   int extended = 0;
-  // Rows of windows passed over across a seam since the last pixel taken, along the column.
-  cv::Mat seamRows(outer.size(), CV_8U, cv::Scalar(0));
-  const auto take = [&](int x, int y) {
-    disparity.at<float>(y, x) = static_cast<float>(plane.at(x, y));
-    score.at<float>(y, x) = fillScore;
-    ++extended;
-  };
   for (int step = 1; step <= reach && !front.empty(); ++step) {
     std::vector<cv::Point> next;
     for (const cv::Point& p : front) {
@@ -611,25 +649,11 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
           continue;
         }
         if (std::isfinite(d) || ownFill[static_cast<size_t>(labels.at<int>(y, x))]) continue;
-        bool photometric = false;
-        if (!matchesAt(x, y, &photometric)) {
-          // A roof's seam or joint along the row (a dark line across the roof) matches at every
-          // disparity along it: its windows fail only the test against the others. Crossed
-          // along the column, at most extendSeamRows rows of them are passed over, and taken
-          // once a window past them is.
-          const int rows = seamRows.at<uchar>(p) + 1;
-          if (photometric && q.x == p.x && rows <= settings.extendSeamRows) {
-            seamRows.at<uchar>(q) = static_cast<uchar>(rows);
-            next.push_back(q);
-          }
-          continue;
-        }
-        take(x, y);
+        if (!matchesAt(x, y)) continue;
+        d = static_cast<float>(plane.at(x, y));
+        score.at<float>(y, x) = fillScore;
+        ++extended;
         next.push_back(q);
-        for (cv::Point s = p; q.x == p.x && seamRows.at<uchar>(s) > 0; s.y -= q.y - p.y) {
-          seamRows.at<uchar>(s) = 0;
-          take(outer.x + s.x, outer.y + s.y);
-        }
       }
     }
     front = std::move(next);

@@ -40,8 +40,8 @@ struct RegionFillSettings {
   double extendPixelSigmas = 4.0;  // × noise sigma: |left − mapped right| of each window pixel
   double extendContrast = 0.8;     // the window's mean error below this × the one at any
                                    //   disparity 2 px or more away (0 = off)
-  int extendSeamRows = 4;          // px: rows of windows that fail only extendContrast (a seam
-                                   //   along the row) crossed along a column; 0 = off
+  int extendWideWindow = 5;        // px: side of the wider window that decides where the
+                                   //   extendWindow one is not clearly best (≤ extendWindow: off)
 };
 
 // Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is

@@ -386,10 +386,10 @@ TEST(FillFlatRegions, AFacetJoinedToGroundOfItsGreyIsFilledOnlyWhereItsCounterpa
 // The scene of `scene()` whose roof carries, along its right side, a 12 px band of weak random
 // texture (a few grey levels: not flat, and left unmatched, as a window matcher that finds its
 // NCC too weak would), and is seen 6 grey levels darker in the right view.
-Scene stripedBandScene() {
+Scene stripedBandScene(double amplitude = 0.15) {
   Scene s = scene();
   const cv::Rect band(s.roof.br().x - 12, s.roof.y, 12, s.roof.height);
-  const cv::Mat weak = (testing::texture(s.left.size(), 7, 0.7) - 128.0) * 0.15;
+  const cv::Mat weak = (testing::texture(s.left.size(), 7, 0.7) - 128.0) * amplitude;
   for (int y = band.y; y < band.br().y; ++y) {
     for (int x = band.x; x < band.br().x; ++x) {
       // The roof point at left x is at right x − 20.
@@ -420,6 +420,23 @@ TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
   EXPECT_EQ(spilledOntoTheGround(extended), 0);
 }
 
+TEST(FillFlatRegions, AWiderWindowDecidesWhereTheSmallOneIsNotClearlyBest) {
+  // The band's texture a little weaker (0.12 of the ground's): more of its 3x3 windows match
+  // about as well 2 px or more along the row, at the noise's level; their 5x5 windows tell.
+  Scene wide = stripedBandScene(0.12);
+  fill(wide, RegionFillSettings{}, 32);
+  Scene small = stripedBandScene(0.12);
+  RegionFillSettings smallOnly;
+  smallOnly.extendWideWindow = 0;
+  fill(small, smallOnly, 32);
+  const cv::Rect band(wide.roof.br().x - 12, wide.roof.y + 3, 12, wide.roof.height - 6);
+  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, band); };
+  // (Measured: 279 and 304 of 408.)
+  EXPECT_LT(onTheRoof(small), band.area() * 70 / 100);
+  EXPECT_GE(onTheRoof(wide), band.area() * 73 / 100) << " of " << band.area();
+  EXPECT_EQ(spilledOntoTheGround(wide), 0);
+}
+
 TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   // The band's first 5 columns matched at the roof's disparity (a weakly textured roof's matched
   // patch): between the filled region and the unmatched rest of the band.
@@ -433,9 +450,9 @@ TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   Scene stopped = withMatchedColumns();
   RegionFillSettings noPassing;
   noPassing.extendAgree = -1;
-  // (Passing along columns over windows that fail only the test against other disparities, the
-  // extension reaches 153 of the rest's pixels without passing over the matches.)
-  noPassing.extendSeamRows = 0;
+  // (With the wider windows, the extension reaches 159 of the rest's pixels without passing over
+  // the matches.)
+  noPassing.extendWideWindow = 0;
   fill(stopped, noPassing, 32);
   const cv::Rect rest(passed.roof.br().x - 7, passed.roof.y + 3, 7, passed.roof.height - 6);
   const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, rest); };
@@ -445,10 +462,10 @@ TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   EXPECT_EQ(spilledOntoTheGround(passed), 0);
 }
 
-TEST(FillFlatRegions, GoesOnAcrossASeamAlongTheRoof) {
+TEST(FillFlatRegions, AWiderWindowCrossesASeamAlongTheRoof) {
   // The roof's lower 18 rows carry weak random texture (left unmatched), cut off from its plain
-  // upper part by a dark seam of 2 rows across the roof, in both views: a window on the seam
-  // matches at every disparity along it, and failed the test against the others.
+  // upper part by a dark seam of 2 rows across the roof, in both views: a 3x3 window on the seam
+  // matches at every disparity along it; a 5x5 one reaches the texture beside it.
   const auto withSeam = [] {
     Scene s = scene();
     const cv::Rect band(s.roof.x, s.roof.y + 22, s.roof.width, s.roof.height - 22);
@@ -467,19 +484,19 @@ TEST(FillFlatRegions, GoesOnAcrossASeamAlongTheRoof) {
   };
   // The extension reaches 12 px: the seam's ends, where it gives evidence along the row, are
   // 15 px or more from the pixels counted.
-  RegionFillSettings seams;
-  seams.extendReach = 12;
+  RegionFillSettings wide;
+  wide.extendReach = 12;
   Scene crossed = withSeam();
-  fill(crossed, seams, 32);
+  fill(crossed, wide, 32);
   Scene stopped = withSeam();
-  RegionFillSettings noSeams = seams;
-  noSeams.extendSeamRows = 0;
-  fill(stopped, noSeams, 32);
+  RegionFillSettings smallOnly = wide;
+  smallOnly.extendWideWindow = 0;
+  fill(stopped, smallOnly, 32);
   // The textured rows just below the seam, away from the roof's sides.
   const cv::Rect below(crossed.roof.x + 15, crossed.roof.y + 23, crossed.roof.width - 30, 6);
   const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, below); };
   EXPECT_LT(onTheRoof(stopped), below.area() / 4);
-  EXPECT_GE(onTheRoof(crossed), below.area() * 3 / 4)
+  EXPECT_GE(onTheRoof(crossed), below.area() * 3 / 5)
       << " of " << below.area() << ", stopped " << onTheRoof(stopped);
   EXPECT_EQ(spilledOntoTheGround(crossed), 0);
 }
