@@ -33,7 +33,9 @@ struct RegionFillSettings {
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
   double planeTrimShare = 0.1;   // worst share of row ends dropped per trimmed refit (0 = off)
   // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
-  int extendReach = 32;            // px (4-connected steps) from the filled pixels; 0 = off
+  int extendReach = 32;             // px (4-connected steps) from the filled pixels; 0 = off
+  double extendRestartAgree = 0.5;  // px: extendReach counts from the matches this close to
+                                    //   the fill too (the surface itself; < 0: none)
   double extendAgree = 1.0;        // px: matches this close to the fill are passed over (< 0: none)
   int extendWindow = 3;            // px: side of the square window tested
   double extendPhotometric = 2.0;  // × noise sigma: the window's mean |left − mapped right|
@@ -79,12 +81,14 @@ struct RegionFillSettings {
 // Once every region is filled, the fill goes on from each over the unmatched pixels next to it
 // that are not flat enough for it (a weakly textured roof is flat only in patches, between them
 // and up to its contour NCC finds too little), at most `extendReach` px, passing over the
-// matches within `extendAgree` px of the fill (the roof's matched parts): a pixel is taken when
-// its extendWindow² window matches at the region's disparity — every pixel within
-// `extendPixelSigmas`, the mean within `extendPhotometric` noise sigmas of the mapped right view,
-// plus the region's own mean brightness offset between the views — and clearly better
-// (`extendContrast`) than at any disparity 2 px or more away, and when the right pixel it maps
-// to is no other pixel's match (an occluded pixel beside the roof). A window across the contour
+// matches within `extendAgree` px of the fill (the roof's matched parts); a second walk counts
+// the reach from the matches within `extendRestartAgree` px of the fill too, and fills only where
+// no passed-over match beside the pixel is off the fill by more (2000² edge 89.3 -> 89.6 %).
+// A pixel is taken when its extendWindow² window matches at the region's disparity — every
+// pixel within `extendPixelSigmas`, the mean within `extendPhotometric` noise sigmas of the
+// mapped right view, plus the region's own mean brightness offset between the views — and
+// clearly better (`extendContrast`) than at any disparity 2 px or more away, and when the right
+// pixel it maps to is no other pixel's match (an occluded pixel beside the roof). A window across the contour
 // meets another part of the scene in the right view: the extension stops 1 px short of it.
 // Seed 3 600²: edge 85.4 → 88.1 %, passing over the agreeing matches 90.6 % (a ring-shaped
 // tiled roof).

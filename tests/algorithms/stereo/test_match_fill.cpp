@@ -462,6 +462,31 @@ TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   EXPECT_EQ(spilledOntoTheGround(passed), 0);
 }
 
+TEST(FillFlatRegions, CountsItsReachFromTheMatchesOnItsSurfaceToo) {
+  // The band's first 7 columns matched at the roof's disparity, the extension's reach 4 px: the
+  // unmatched rest of the band lies farther than that from the filled pixels, not from the
+  // matches on the roof.
+  const auto withMatchedColumns = [] {
+    Scene s = stripedBandScene();
+    s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, 7, s.roof.height)).setTo(kRoof);
+    return s;
+  };
+  RegionFillSettings restarted;
+  restarted.extendReach = 4;
+  Scene reached = withMatchedColumns();
+  fill(reached, restarted, 32);
+  RegionFillSettings fromTheFillOnly = restarted;
+  fromTheFillOnly.extendRestartAgree = -1;
+  Scene stopped = withMatchedColumns();
+  fill(stopped, fromTheFillOnly, 32);
+  const cv::Rect rest(reached.roof.br().x - 5, reached.roof.y + 3, 5, reached.roof.height - 6);
+  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, rest); };
+  EXPECT_LT(onTheRoof(stopped), rest.area() / 5);
+  EXPECT_GE(onTheRoof(reached), rest.area() / 2)
+      << " of " << rest.area() << ", stopped " << onTheRoof(stopped);
+  EXPECT_EQ(spilledOntoTheGround(reached), 0);
+}
+
 TEST(FillFlatRegions, AWiderWindowCrossesASeamAlongTheRoof) {
   // The roof's lower 18 rows carry weak random texture (left unmatched), cut off from its plain
   // upper part by a dark seam of 2 rows across the roof, in both views: a 3x3 window on the seam
