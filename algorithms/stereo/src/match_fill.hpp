@@ -88,8 +88,9 @@ struct RegionFillSettings {
 // pixel within `extendPixelSigmas`, the mean within `extendPhotometric` noise sigmas of the
 // mapped right view, plus the region's own mean brightness offset between the views — and
 // clearly better (`extendContrast`) than at any disparity 2 px or more away, and when the right
-// pixel it maps to is no other pixel's match (an occluded pixel beside the roof). A window across the contour
-// meets another part of the scene in the right view: the extension stops 1 px short of it.
+// pixel it maps to is no other pixel's match (an occluded pixel beside the roof). A window
+// across the contour meets another part of the scene in the right view: the extension stops 1 px
+// short of it.
 // Seed 3 600²: edge 85.4 → 88.1 %, passing over the agreeing matches 90.6 % (a ring-shaped
 // tiled roof).
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.

@@ -487,6 +487,38 @@ TEST(FillFlatRegions, CountsItsReachFromTheMatchesOnItsSurfaceToo) {
   EXPECT_EQ(spilledOntoTheGround(reached), 0);
 }
 
+TEST(FillFlatRegions, ReachedThroughItsMatchesStopsWhereTheSurfaceLeavesIt) {
+  // As above, with every other row of the band's unmatched rest matched 0.8 px off the roof's
+  // disparity (still passed over: the surface there leaves the fill's constant, as a gently
+  // sloped facet does): the second walk adds no pixel beside those matches.
+  const auto withOffMatches = [] {
+    Scene s = stripedBandScene();
+    s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, 7, s.roof.height)).setTo(kRoof);
+    for (int y = s.roof.y + 3; y < s.roof.br().y - 3; y += 2) {
+      s.disparity(cv::Rect(s.roof.br().x - 5, y, 5, 1)).setTo(kRoof + 0.8f);
+    }
+    return s;
+  };
+  const auto filledAtTheRoof = [](const Scene& s) {
+    int n = 0;
+    for (int y = s.roof.y + 4; y < s.roof.br().y - 3; y += 2) {
+      for (int x = s.roof.br().x - 5; x < s.roof.br().x; ++x) {
+        n += std::abs(s.disparity.at<float>(y, x) - kRoof) < 0.01f ? 1 : 0;
+      }
+    }
+    return n;
+  };
+  RegionFillSettings restarted;
+  restarted.extendReach = 4;
+  Scene second = withOffMatches();
+  fill(second, restarted, 32);
+  RegionFillSettings firstOnly = restarted;
+  firstOnly.extendRestartAgree = -1;
+  Scene first = withOffMatches();
+  fill(first, firstOnly, 32);
+  EXPECT_EQ(filledAtTheRoof(second), filledAtTheRoof(first));
+}
+
 TEST(FillFlatRegions, AWiderWindowCrossesASeamAlongTheRoof) {
   // The roof's lower 18 rows carry weak random texture (left unmatched), cut off from its plain
   // upper part by a dark seam of 2 rows across the roof, in both views: a 3x3 window on the seam
