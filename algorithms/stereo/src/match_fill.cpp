@@ -504,6 +504,45 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     }
   }
   if (biasCount > 0) bias /= biasCount;
+  // The summed error of the window of half-side w at (x, y) at the fill's disparity `value` (the
+  // right view interpolated, the surface's offset added); false where it leaves either view or a
+  // pixel's error exceeds `pixelLimit`.
+  const auto errorAtTheFill = [&](int x, int y, int w, double value, double pixelLimit,
+                                  double& sum) {
+    const int whole = static_cast<int>(std::floor(value));
+    const auto t = static_cast<float>(value - whole);
+    sum = 0;
+    for (int v = y - w; v <= y + w; ++v) {
+      for (int u = x - w; u <= x + w; ++u) {
+        const int xr = u - whole;  // u − value lies in [xr − 1, xr]
+        if (xr - 1 < 0 || xr >= right.cols) return false;
+        const float a = left.at<float>(v, u);
+        const float b = (1 - t) * right.at<float>(v, xr) + t * right.at<float>(v, xr - 1);
+        if (!std::isfinite(a) || !std::isfinite(b)) return false;
+        const double error = std::abs(a - (gain * b + offset + bias));
+        if (error > pixelLimit) return false;
+        sum += error;
+      }
+    }
+    return true;
+  };
+  // Whether that window, of error `sum` at the fill's disparity, matches there clearly better
+  // than at the integer disparity `other`: sum below extendContrast × its error there. That error
+  // only grows row by row: once a part of it clears `sum`, the rest of the window is not read.
+  const auto clearerThanAt = [&](int x, int y, int w, double sum, int other) {
+    double e = 0;
+    for (int v = y - w; v <= y + w; ++v) {
+      const float* l = left.ptr<float>(v);
+      const float* rr = right.ptr<float>(v);
+      for (int u = x - w; u <= x + w; ++u) {
+        const int xr = u - other;
+        if (xr < 0 || xr >= right.cols || !std::isfinite(rr[xr])) return true;
+        e += std::abs(l[u] - (gain * rr[xr] + offset));
+      }
+      if (!(sum > settings.extendContrast * e)) return true;
+    }
+    return false;
+  };
   // A weakly textured surface's small window can match about as well a few px along the row (on
   // the same surface): the wider window (extendWideWindow, holding more of its texture) decides
   // then, by the same test: its mean error at the fill's disparity below extendContrast × the one
@@ -513,42 +552,16 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
   // too, and the rest is not read).
   const auto clearInAWiderWindow = [&](int x, int y, double value, int first) {
     const int w = settings.extendWideWindow / 2;
-    if (w <= settings.extendWindow / 2 || x < w || y < w || x + w >= left.cols ||
-        y + w >= left.rows) {
-      return false;
-    }
-    const int whole = static_cast<int>(std::floor(value));
-    const auto t = static_cast<float>(value - whole);
     double sum = 0;
-    for (int v = y - w; v <= y + w; ++v) {
-      for (int u = x - w; u <= x + w; ++u) {
-        const int xr = u - whole;
-        if (xr - 1 < 0 || xr >= right.cols) return false;
-        const float a = left.at<float>(v, u);
-        const float b = (1 - t) * right.at<float>(v, xr) + t * right.at<float>(v, xr - 1);
-        if (!std::isfinite(a) || !std::isfinite(b)) return false;
-        sum += std::abs(a - (gain * b + offset + bias));
-      }
+    if (w <= settings.extendWindow / 2 || x < w || y < w || x + w >= left.cols ||
+        y + w >= left.rows ||
+        !errorAtTheFill(x, y, w, value, std::numeric_limits<double>::infinity(), sum)) {
+      return false;
     }
     for (int k = dmin - 1; k <= dmax; ++k) {
       const int other = k < dmin ? first : k;
       if (std::abs(other - value) < 2.0 || (k >= dmin && other == first)) continue;
-      double e = 0;
-      bool cleared = false;
-      for (int v = y - w; v <= y + w && !cleared; ++v) {
-        const float* l = left.ptr<float>(v);
-        const float* rr = right.ptr<float>(v);
-        for (int u = x - w; u <= x + w; ++u) {
-          const int xr = u - other;
-          if (xr < 0 || xr >= right.cols || !std::isfinite(rr[xr])) {
-            e = 1e30;
-            break;
-          }
-          e += std::abs(l[u] - (gain * rr[xr] + offset));
-        }
-        cleared = !(sum > settings.extendContrast * e);
-      }
-      if (!cleared) return false;
+      if (!clearerThanAt(x, y, w, sum, other)) return false;
     }
     return true;
   };
@@ -562,21 +575,8 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     // Every pixel of the window within extendPixelSigmas noise sigmas of its counterpart (the
     // right view interpolated, the surface's offset added), and their mean within
     // extendPhotometric.
-    const int whole = static_cast<int>(std::floor(value));
-    const auto t = static_cast<float>(value - whole);
     double sum = 0;
-    for (int v = y - w; v <= y + w; ++v) {
-      for (int u = x - w; u <= x + w; ++u) {
-        const int xr = u - whole;  // u − value lies in [xr − 1, xr]
-        if (xr - 1 < 0 || xr >= right.cols) return false;
-        const float a = left.at<float>(v, u);
-        const float b = (1 - t) * right.at<float>(v, xr) + t * right.at<float>(v, xr - 1);
-        if (!std::isfinite(a) || !std::isfinite(b)) return false;
-        const double error = std::abs(a - (gain * b + offset + bias));
-        if (error > settings.extendPixelSigmas * sigma) return false;
-        sum += error;
-      }
-    }
+    if (!errorAtTheFill(x, y, w, value, settings.extendPixelSigmas * sigma, sum)) return false;
     const double error = sum / ((2 * w + 1) * (2 * w + 1));
     if (error > settings.extendPhotometric * sigma) return false;
     // The right pixel it maps to must not be another left pixel's match: there the right view
@@ -593,27 +593,9 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
     // And the window matches there clearly better than at any disparity 2 px or more away (a
     // ground pixel's window matches at the ground's disparity as well).
     if (settings.extendContrast <= 0) return true;
-    const int cells = (2 * w + 1) * (2 * w + 1);
     for (int other = dmin; other <= dmax; ++other) {
       if (std::abs(other - value) < 2.0) continue;
-      // The sum only grows row by row: once its part already clears the window's error, the
-      // whole does too, and the rest of the window is not read.
-      double e = 0;
-      bool cleared = false;
-      for (int v = y - w; v <= y + w && !cleared; ++v) {
-        const float* l = left.ptr<float>(v);
-        const float* rr = right.ptr<float>(v);
-        for (int u = x - w; u <= x + w; ++u) {
-          const int xr = u - other;
-          if (xr < 0 || xr >= right.cols || !std::isfinite(rr[xr])) {
-            e = 1e30;
-            break;
-          }
-          e += std::abs(l[u] - (gain * rr[xr] + offset));
-        }
-        cleared = !(error > settings.extendContrast * e / cells);
-      }
-      if (!cleared) return clearInAWiderWindow(x, y, value, other);
+      if (!clearerThanAt(x, y, w, sum, other)) return clearInAWiderWindow(x, y, value, other);
     }
     return true;
   };
