@@ -402,6 +402,14 @@ Scene stripedBandScene(double amplitude = 0.15) {
   return s;
 }
 
+// stripedBandScene() with the band's first `columns` columns matched at the roof's disparity (a
+// weakly textured roof's matched patch between the filled region and the band's unmatched rest).
+Scene stripedBandWithMatchedColumns(int columns) {
+  Scene s = stripedBandScene();
+  s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, columns, s.roof.height)).setTo(kRoof);
+  return s;
+}
+
 TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
   Scene extended = stripedBandScene();
   fill(extended, RegionFillSettings{}, 32);
@@ -440,11 +448,7 @@ TEST(FillFlatRegions, AWiderWindowDecidesWhereTheSmallOneIsNotClearlyBest) {
 TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   // The band's first 5 columns matched at the roof's disparity (a weakly textured roof's matched
   // patch): between the filled region and the unmatched rest of the band.
-  const auto withMatchedColumns = [] {
-    Scene s = stripedBandScene();
-    s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, 5, s.roof.height)).setTo(kRoof);
-    return s;
-  };
+  const auto withMatchedColumns = [] { return stripedBandWithMatchedColumns(5); };
   Scene passed = withMatchedColumns();
   fill(passed, RegionFillSettings{}, 32);
   Scene stopped = withMatchedColumns();
@@ -466,11 +470,7 @@ TEST(FillFlatRegions, CountsItsReachFromTheMatchesOnItsSurfaceToo) {
   // The band's first 7 columns matched at the roof's disparity, the extension's reach 4 px: the
   // unmatched rest of the band lies farther than that from the filled pixels, not from the
   // matches on the roof.
-  const auto withMatchedColumns = [] {
-    Scene s = stripedBandScene();
-    s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, 7, s.roof.height)).setTo(kRoof);
-    return s;
-  };
+  const auto withMatchedColumns = [] { return stripedBandWithMatchedColumns(7); };
   RegionFillSettings restarted;
   restarted.extendReach = 4;
   Scene reached = withMatchedColumns();
@@ -492,8 +492,7 @@ TEST(FillFlatRegions, ReachedThroughItsMatchesStopsWhereTheSurfaceLeavesIt) {
   // disparity (still passed over: the surface there leaves the fill's constant, as a gently
   // sloped facet does): the second walk adds no pixel beside those matches.
   const auto withOffMatches = [] {
-    Scene s = stripedBandScene();
-    s.disparity(cv::Rect(s.roof.br().x - 12, s.roof.y, 7, s.roof.height)).setTo(kRoof);
+    Scene s = stripedBandWithMatchedColumns(7);
     for (int y = s.roof.y + 3; y < s.roof.br().y - 3; y += 2) {
       s.disparity(cv::Rect(s.roof.br().x - 5, y, 5, 1)).setTo(kRoof + 0.8f);
     }
