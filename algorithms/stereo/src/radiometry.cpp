@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -58,6 +59,31 @@ double noiseSigma(const cv::Mat& image) {
   return std::sqrt(*q / 36.0);
 }
 
+namespace {
+
+// Sums of the left and right grey levels of pixel pairs and of their squares; map(): the gain and
+// offset that give the left ones the right ones' mean and standard deviation (none when either
+// side is flat).
+struct GreyMoments {
+  double sumL = 0, sumLL = 0, sumR = 0, sumRR = 0, count = 0;
+  void add(float l, float r) {
+    sumL += l;
+    sumLL += static_cast<double>(l) * l;
+    sumR += r;
+    sumRR += static_cast<double>(r) * r;
+    count += 1;
+  }
+  std::optional<std::pair<double, double>> map() const {
+    const double meanL = sumL / count, meanR = sumR / count;
+    const double varL = sumLL / count - meanL * meanL, varR = sumRR / count - meanR * meanR;
+    if (!(varL > 1e-12) || !(varR > 1e-12)) return std::nullopt;
+    const double gain = std::sqrt(varL / varR);
+    return std::pair{gain, meanL - gain * meanR};
+  }
+};
+
+}  // namespace
+
 // Gain and offset mapping the right view's grey levels to the left's, from the moments of the
 // overlapping parts of the whole images (columns seen by both for a typical disparity). The two
 // views see nearly the same scene, so their histograms differ by the exposures; a fit on one
@@ -73,25 +99,17 @@ std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& rig
                   left.step[0] * rowStep);
   const cv::Mat r(rows, width, CV_32F, const_cast<float*>(right.ptr<float>(0, std::max(0, -shift))),
                   right.step[0] * rowStep);
-  double sumL = 0, sumLL = 0, sumR = 0, sumRR = 0, count = 0;
+  GreyMoments moments;
   for (int y = 0; y < rows; ++y) {
     const float* pl = l.ptr<float>(y);
     const float* pr = r.ptr<float>(y);
     for (int x = 0; x < width; ++x) {
       if (!std::isfinite(pl[x]) || !std::isfinite(pr[x])) continue;
-      sumL += pl[x];
-      sumLL += static_cast<double>(pl[x]) * pl[x];
-      sumR += pr[x];
-      sumRR += static_cast<double>(pr[x]) * pr[x];
-      count += 1;
+      moments.add(pl[x], pr[x]);
     }
   }
-  if (count < 2) return {1.0, 0.0};
-  const double meanL = sumL / count, meanR = sumR / count;
-  const double varL = sumLL / count - meanL * meanL, varR = sumRR / count - meanR * meanR;
-  if (!(varL > 1e-12) || !(varR > 1e-12)) return {1.0, 0.0};
-  const double gain = std::sqrt(varL / varR);
-  return {gain, meanL - gain * meanR};
+  if (moments.count < 2) return {1.0, 0.0};
+  return moments.map().value_or(std::pair{1.0, 0.0});
 }
 
 // Every 2nd row and column: a quarter of the matches gives the moments to well under a grey level.
@@ -116,27 +134,21 @@ std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv:
   std::pair<double, double> map = fallback;
   double limit = std::numeric_limits<double>::infinity();
   for (int pass = 0; pass < 3; ++pass) {
-    double sumL = 0, sumLL = 0, sumR = 0, sumRR = 0, count = 0;
+    GreyMoments moments;
     for (const cv::Vec2f& p : pairs) {
       if (pass > 0 && !(std::abs(p[0] - (map.first * p[1] + map.second)) <= limit)) continue;
-      sumL += p[0];
-      sumLL += static_cast<double>(p[0]) * p[0];
-      sumR += p[1];
-      sumRR += static_cast<double>(p[1]) * p[1];
-      count += 1;
+      moments.add(p[0], p[1]);
     }
-    if (count < minPairs) return fallback;
-    const double meanL = sumL / count, meanR = sumR / count;
-    const double varL = sumLL / count - meanL * meanL, varR = sumRR / count - meanR * meanR;
-    if (!(varL > 1e-12) || !(varR > 1e-12)) return fallback;
-    const double gain = std::sqrt(varL / varR);
-    map = {gain, meanL - gain * meanR};
+    if (moments.count < minPairs) return fallback;
+    const auto fitted = moments.map();
+    if (!fitted) return fallback;
+    map = *fitted;
     double squares = 0;
     for (const cv::Vec2f& p : pairs) {
       const double r = p[0] - (map.first * p[1] + map.second);
       if (pass == 0 || std::abs(r) <= limit) squares += r * r;
     }
-    limit = 2.5 * std::sqrt(squares / count);
+    limit = 2.5 * std::sqrt(squares / moments.count);
   }
   return map;
 }
