@@ -24,7 +24,19 @@ namespace {
 struct FillPlane {
   double c = 0, a = 0, b = 0;
   double at(int x, int y) const { return c + a * x + b * y; }
+  // How far a row-end point (x, y, disparity) lies from the plane, signed.
+  double residual(const cv::Point3d& p) const { return p.z - (c + a * p.x + b * p.y); }
 };
+
+// The points within `within` px of the plane.
+std::vector<cv::Point3d> pointsNear(const std::vector<cv::Point3d>& points, const FillPlane& plane,
+                                    double within) {
+  std::vector<cv::Point3d> near;
+  for (const auto& p : points) {
+    if (std::abs(plane.residual(p)) <= within) near.push_back(p);
+  }
+  return near;
+}
 
 // Mean value of the matches within 1.5 px of `centre`.
 float clusterMean(const std::vector<float>& values, float centre) {
@@ -251,7 +263,7 @@ bool oneSideAgrees(const std::vector<cv::Point3d>& points, const FillPlane& plan
   size_t agree[2] = {0, 0};
   for (size_t k = 0; k < points.size(); ++k) {
     const cv::Point3d& p = points[k];
-    if (std::abs(p.z - (plane.c + plane.a * p.x + plane.b * p.y)) <= settings.planeInlier) {
+    if (std::abs(plane.residual(p)) <= settings.planeInlier) {
       ++agree[k % 2];
     }
   }
@@ -274,7 +286,7 @@ bool trimmedPlane(const std::vector<cv::Point3d>& points, const RegionFillSettin
     std::vector<std::pair<double, size_t>> residuals;
     for (size_t k = 0; k < kept.size(); ++k) {
       const cv::Point3d& p = kept[k];
-      residuals.emplace_back(std::abs(p.z - (plane.c + plane.a * p.x + plane.b * p.y)), k);
+      residuals.emplace_back(std::abs(plane.residual(p)), k);
     }
     std::sort(residuals.rbegin(), residuals.rend());
     if (residuals.front().first <= settings.planeInlier) return true;
@@ -369,12 +381,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     std::vector<cv::Point3d> inliers = points;
     bool ok = fitPlane(inliers, fitted);
     for (int pass = 0; pass < 2 && ok; ++pass) {
-      std::vector<cv::Point3d> kept;
-      for (const auto& p : points) {
-        const double res = p.z - (fitted.c + fitted.a * p.x + fitted.b * p.y);
-        if (std::abs(res) <= settings.planeInlier) kept.push_back(p);
-      }
-      inliers = std::move(kept);
+      inliers = pointsNear(points, fitted, settings.planeInlier);
       ok = fitPlane(inliers, fitted);
     }
     bool bothSides =
@@ -384,14 +391,8 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     if (ok && !constant && !bothSides && !oneSideAgrees(points, fitted, settings)) {
       FillPlane t;
       if (trimmedPlane(points, settings, t)) {
-        std::vector<cv::Point3d> kept;
-        for (const auto& p : points) {
-          if (std::abs(p.z - (t.c + t.a * p.x + t.b * p.y)) <= settings.planeInlier) {
-            kept.push_back(p);
-          }
-        }
         fitted = t;
-        inliers = std::move(kept);
+        inliers = pointsNear(points, fitted, settings.planeInlier);
         bothSides = static_cast<double>(inliers.size()) >= settings.planeMinShare * points.size();
         trimmed = true;
       }
