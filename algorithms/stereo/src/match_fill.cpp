@@ -622,7 +622,16 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
   // textured roof's matched patches, which can hold the filled pixels far from its unmatched
   // strips), and the pixels it adds must agree with the surface's matches beside them.
   // What a pixel is to the extension, decided on its first visit (kept for the second walk).
-  enum : uchar { kUnseen, kPassedOver, kRestarts, kUnmatched, kMatchesHere, kExtended, kStops };
+  enum : uchar {
+    kUnseen,
+    kPassedOver,
+    kRestarts,
+    kUnmatched,
+    kDisagrees,
+    kMatchesHere,
+    kExtended,
+    kStops
+  };
   cv::Mat kind(outer.size(), CV_8U, cv::Scalar(kUnseen));
   int extended = 0;
   const auto walk = [&](bool restarts) {
@@ -660,6 +669,13 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
             k = kRestarts;
           } else if (std::isfinite(d) && off <= settings.extendAgree) {
             k = kPassedOver;
+          } else if (std::isfinite(d) && settings.extendReplaceOff > 0 &&
+                     off >= settings.extendReplaceOff &&
+                     !ownFill[static_cast<size_t>(labels.at<int>(y, x))]) {
+            // Far off the fill: a window that met another surface as plain as the roof (the
+            // facade the right view sees beside it, the ground beyond the outline). Tested as an
+            // unmatched pixel, where the fill's window must also beat the match's own disparity.
+            k = kDisagrees;
           } else if (std::isfinite(d) || ownFill[static_cast<size_t>(labels.at<int>(y, x))]) {
             k = kStops;
           } else {
@@ -669,7 +685,7 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
         if (k == kStops) continue;
         const int reached = restarts && k == kRestarts ? 0 : step;
         if (reached > reach || reached >= distance.at<int>(q)) continue;
-        if (k == kUnmatched) {
+        if (k == kUnmatched || k == kDisagrees) {
           if (!matchesAt(x, y)) {
             k = kStops;
             continue;

@@ -557,5 +557,30 @@ TEST(FillFlatRegions, AWiderWindowCrossesASeamAlongTheRoof) {
   EXPECT_EQ(spilledOntoTheGround(crossed), 0);
 }
 
+TEST(FillFlatRegions, ReplacesMatchesOfTheFarSurfaceWhereItsWindowIsClearlyBest) {
+  // Columns 4-6 of the band matched at the ground's disparity (windows that met the ground beyond
+  // the outline, or another surface of the right view as plain as the roof), beyond the reach of
+  // the region's growth: they stand between the filled pixels and the band's unmatched rest.
+  const auto withGroundColumns = [] {
+    Scene s = stripedBandScene();
+    s.disparity(cv::Rect(s.roof.br().x - 8, s.roof.y, 3, s.roof.height)).setTo(kGround);
+    return s;
+  };
+  Scene replaced = withGroundColumns();
+  fill(replaced, RegionFillSettings{}, 32);
+  Scene stopped = withGroundColumns();
+  RegionFillSettings noReplacing;
+  noReplacing.extendReplaceOff = 0;
+  fill(stopped, noReplacing, 32);
+  // The ground-valued columns and the rest beyond them.
+  const cv::Rect beyond(replaced.roof.br().x - 8, replaced.roof.y + 3, 8, replaced.roof.height - 6);
+  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, beyond); };
+  // (Measured: 2 and 186 of 272.)
+  EXPECT_LT(onTheRoof(stopped), beyond.area() / 5);
+  EXPECT_GE(onTheRoof(replaced), beyond.area() * 3 / 5)
+      << " of " << beyond.area() << ", stopped " << onTheRoof(stopped);
+  // The ground beside the roof, matched at its own disparity, keeps it.
+  EXPECT_EQ(spilledOntoTheGround(replaced), 0);
+}
 }  // namespace
 }  // namespace delineo::stereo::detail
