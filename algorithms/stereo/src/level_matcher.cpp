@@ -712,8 +712,8 @@ class LevelMatcher {
     sc.peaks.assign(area, LinePeak{});
     sc.swept.assign(area, 0);
     // Which square pixels the box-filter sweep serves: the sweep costs ~5 operations per tile
-    // pixel and disparity of the union of the served intervals, a direct correlation n_ per
-    // disparity of the pixel's own interval. Pixels are added by increasing interval width
+    // pixel and disparity of the union of the served intervals, a direct correlation (below)
+    // per disparity of the pixel's own interval. Pixels are added by increasing interval width
     // while that keeps the total cheaper.
     std::vector<std::pair<int, int>> byWidth;  // (width, tile index)
     for (size_t i = 0; i < area; ++i) {
@@ -725,8 +725,12 @@ class LevelMatcher {
     if (byWidth.empty()) return;
     std::sort(byWidth.begin(), byWidth.end());
     const double sweepUnit = 5.0 * (tile.width + 2 * r_) * (tile.height + 2 * r_);
+    // A direct correlation: n_ / 2 per disparity, as the four windows of a pass share the loads
+    // of the template rows (squareScores4; with n_ the sweep served more pixels than paid off:
+    // 600² match 4.158 G instructions, 4.118 G with n_ / 2, 4.113 G with 0.3 n_).
+    const double directUnit = 0.5 * n_;
     double directRemaining = 0;
-    for (const auto& [width, i] : byWidth) directRemaining += static_cast<double>(n_) * width;
+    for (const auto& [width, i] : byWidth) directRemaining += directUnit * width;
     int uLo = std::numeric_limits<int>::max(), uHi = std::numeric_limits<int>::min();
     double bestTotal = directRemaining;  // nothing swept
     size_t bestCount = 0;
@@ -735,7 +739,7 @@ class LevelMatcher {
       const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
       uLo = std::min(uLo, in_.lo.at<int>(y, x));
       uHi = std::max(uHi, in_.hi.at<int>(y, x));
-      directRemaining -= static_cast<double>(n_) * byWidth[k].first;
+      directRemaining -= directUnit * byWidth[k].first;
       const double total = sweepUnit * (uHi - uLo + 1) + directRemaining;
       if (total <= bestTotal) {
         bestTotal = total;
