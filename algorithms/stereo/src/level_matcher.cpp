@@ -601,11 +601,18 @@ class LevelMatcher {
       const uchar* b = marked.ptr<uchar>(y);
       int* bits = out.ptr<int>(y);
       uint32_t word = w == 32 ? ~0U : (1U << w) - 1U;  // columns left of the image: marked
-      for (int x = -r_; x < W_; ++x) {
-        // After this step, word covers columns x - r .. x + r.
-        const int incoming = x + r_;
-        const uint32_t entering = incoming >= W_ || b[incoming] ? 1U : 0U;
-        word = (word >> 1) | (entering << (w - 1));
+      // After the step at x, word covers columns x - r .. x + r. Three loops: the column
+      // entering at x lies in the image up to x = W - r - 1, and x < 0 stores nothing (one
+      // loop with both tests cost ~20 instructions a pixel).
+      const int inside = W_ - r_;
+      int x = -r_;
+      for (; x < std::min(0, inside); ++x) word = (word >> 1) | ((b[x + r_] ? 1U : 0U) << (w - 1));
+      for (; x < inside; ++x) {
+        word = (word >> 1) | ((b[x + r_] ? 1U : 0U) << (w - 1));
+        bits[x] = static_cast<int>(word);
+      }
+      for (; x < W_; ++x) {
+        word = (word >> 1) | (1U << (w - 1));
         if (x >= 0) bits[x] = static_cast<int>(word);
       }
     }
