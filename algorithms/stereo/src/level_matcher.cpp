@@ -689,9 +689,13 @@ class LevelMatcher {
         sab += acc;
       }
     }
-    return (sab / static_cast<float>(n_) - refStats_.mean.at<float>(y, x) *
-                                               otherStats_.mean.at<float>(yb, xb)) /
-           (refStats_.sd.at<float>(y, x) * otherStats_.sd.at<float>(yb, xb));
+    return squareNcc(sab, refStats_.mean.at<float>(y, x), refStats_.sd.at<float>(y, x),
+                     otherStats_.mean.at<float>(yb, xb), otherStats_.sd.at<float>(yb, xb));
+  }
+
+  // NCC of a square window from its sum of products and both windows' means and deviations.
+  float squareNcc(float sab, float meanA, float sdA, float meanB, float sdB) const {
+    return (sab / static_cast<float>(n_) - meanA * meanB) / (sdA * sdB);
   }
 
   // squareScore(x, y, d + j, 0) for j = 0..3 (windows ≤ 16 columns) in one pass over the rows;
@@ -709,7 +713,7 @@ class LevelMatcher {
     const float* meanB = otherStats_.mean.ptr<float>(y);
     const float* sdB = otherStats_.sd.ptr<float>(y);
     for (int j = 0; j < 4; ++j) {
-      scores[j] = (sab[j] / static_cast<float>(n_) - meanA * meanB[xb - j]) / (sdA * sdB[xb - j]);
+      scores[j] = squareNcc(sab[j], meanA, sdA, meanB[xb - j], sdB[xb - j]);
     }
     return true;
   }
