@@ -81,7 +81,8 @@ WindowStats windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
   const int r = window / 2;
   const double n = static_cast<double>(window) * window;
   const int W = img.cols, H = img.rows;
-  WindowStats s{cv::Mat(img.size(), CV_32F, cv::Scalar(0)), cv::Mat(img.size(), CV_32F, cv::Scalar(0)),
+  WindowStats s{cv::Mat(img.size(), CV_32F, cv::Scalar(0)),
+                cv::Mat(img.size(), CV_32F, cv::Scalar(0)),
                 cv::Mat(img.size(), CV_8U, cv::Scalar(0))};
   if (W < window || H < window) return s;
   std::vector<double> colSum(static_cast<size_t>(W), 0.0), colSq(static_cast<size_t>(W), 0.0);
@@ -175,14 +176,16 @@ void shapeSums32(const float* b, const float* b2, size_t stride, const float* ma
 using Float8 = float __attribute__((vector_size(32)));
 
 // By reference: returning a 32-byte vector from a function built without AVX changes the ABI.
-__attribute__((always_inline)) inline void load8(Float8& v, const float* p) { __builtin_memcpy(&v, p, sizeof v); }
+__attribute__((always_inline)) inline void load8(Float8& v, const float* p) {
+  __builtin_memcpy(&v, p, sizeof v);
+}
 
 using Float4 = float __attribute__((vector_size(16)));
 
 // Sum of the 8 lanes by halving (3 vector adds instead of 7 scalar ones).
 __attribute__((always_inline)) inline float laneSum(const Float8& v) {
-  const Float4 h = __builtin_shufflevector(v, v, 0, 1, 2, 3) +
-                   __builtin_shufflevector(v, v, 4, 5, 6, 7);
+  const Float4 h =
+      __builtin_shufflevector(v, v, 0, 1, 2, 3) + __builtin_shufflevector(v, v, 4, 5, 6, 7);
   const Float4 q = h + __builtin_shufflevector(h, h, 2, 3, 0, 1);
   return q[0] + q[1];
 }
@@ -491,8 +494,16 @@ class LevelMatcher {
   // `in` is padded; the outputs cover `inner`, the unpadded image, and are written at
   // (x, y) − inner.tl() (only inner pixels are searched: the padding's intervals are empty).
   LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out, cv::Rect inner)
-      : in_(in), s_(s), out_(out), W_(in.ref.cols), H_(in.ref.rows), r_(s.window / 2),
-        n_(s.window * s.window), L_(s.lineShift), outX_(inner.x), outY_(inner.y),
+      : in_(in),
+        s_(s),
+        out_(out),
+        W_(in.ref.cols),
+        H_(in.ref.rows),
+        r_(s.window / 2),
+        n_(s.window * s.window),
+        L_(s.lineShift),
+        outX_(inner.x),
+        outY_(inner.y),
         rowStride_(s.window <= 16 ? 16 : 32) {
     // Independent preparations, run on the level's threads (serial, they took ~12 % of the
     // matcher's time).
@@ -505,8 +516,8 @@ class LevelMatcher {
       double refMin = 0, refMax = 0, otherMin = 0, otherMax = 0;
       cv::minMaxLoc(in.ref, &refMin, &refMax);
       cv::minMaxLoc(in.other, &otherMin, &otherMax);
-      const double maxAbs = std::max({std::abs(refMin), std::abs(refMax), std::abs(otherMin),
-                                      std::abs(otherMax), 1e-6});
+      const double maxAbs = std::max(
+          {std::abs(refMin), std::abs(refMax), std::abs(otherMin), std::abs(otherMax), 1e-6});
       const double scale = std::floor(kShapeQuantMax / maxAbs * 1e6) / 1e6;  // round(scale·v) ≤ max
       in.ref.convertTo(refQ_, CV_16S, scale);
       in.other.convertTo(otherQ_, CV_16S, scale);
@@ -882,17 +893,25 @@ class LevelMatcher {
     const uint32_t full = w == 32 ? ~0U : (1U << w) - 1U;
     auto fillRow = [full](uint32_t seeds, uint32_t open) {
       uint32_t up = seeds, g = open;
-      up |= g & (up << 1); g &= g << 1;
-      up |= g & (up << 2); g &= g << 2;
-      up |= g & (up << 4); g &= g << 4;
-      up |= g & (up << 8); g &= g << 8;
+      up |= g & (up << 1);
+      g &= g << 1;
+      up |= g & (up << 2);
+      g &= g << 2;
+      up |= g & (up << 4);
+      g &= g << 4;
+      up |= g & (up << 8);
+      g &= g << 8;
       up |= g & (up << 16);
       uint32_t down = seeds;
       g = open;
-      down |= g & (down >> 1); g &= g >> 1;
-      down |= g & (down >> 2); g &= g >> 2;
-      down |= g & (down >> 4); g &= g >> 4;
-      down |= g & (down >> 8); g &= g >> 8;
+      down |= g & (down >> 1);
+      g &= g >> 1;
+      down |= g & (down >> 2);
+      g &= g >> 2;
+      down |= g & (down >> 4);
+      g &= g >> 4;
+      down |= g & (down >> 8);
+      g &= g >> 8;
       down |= g & (down >> 16);
       return (up | down) & full;
     };
@@ -1067,7 +1086,6 @@ class LevelMatcher {
                 in_.other.step1(), &t.mask[first], &t.templ[first], rows, sums);
     return scoreFromSums(sums, t.count);
   }
-
 
   static float scoreFromSums(const float sums[3], int count) {
     const float sB = sums[0], sBB = sums[1], sTB = sums[2];
@@ -1353,7 +1371,7 @@ class LevelMatcher {
   LevelOutput& out_;
   const int W_, H_, r_, n_, L_;
   const int outX_, outY_;  // the outputs' origin in the padded input
-  const int rowStride_;  // floats per dense shape row (16 or 32, ≥ window)
+  const int rowStride_;    // floats per dense shape row (16 or 32, ≥ window)
   // The main-line span kernel (AVX2, windows ≤ 15 columns): 8 windows a pass.
   const bool useSpans_ = cpuHasAvx2() && s_.window <= 15;
   const bool avx2_ = cpuHasAvx2();  // single windows and the ±1 pair straight to AVX2
@@ -1376,15 +1394,15 @@ class LevelMatcher {
   ptrdiff_t refQStride_ = 0;
   size_t refStride_ = 0, otherStride_ = 0;
   ptrdiff_t invalidStride_ = 0;  // of otherInvalidBits_
-  double flatQ_ = 0;       // kFlatVariance in quantised units
-  float squareLanes_[16] = {};  // 1 for the columns of a square window, 0 past it
+  double flatQ_ = 0;             // kFlatVariance in quantised units
+  float squareLanes_[16] = {};   // 1 for the columns of a square window, 0 past it
   cv::Mat nearEdge_;
   cv::Mat blocked_;      // CV_8U, non-zero on contour and nodata pixels of ref
   cv::Mat blockedBits_;  // CV_32S, blocked pixels of the window row centred on each pixel
   std::vector<uint16_t> freeColumns_;  // windows ≤ 15: ~blockedBits_, column-major
   size_t columnStride_ = 0;
   uint64_t windowRows_[4] = {0, 0, 0, 0};  // the rows v < window of a 16-row board
-  cv::Mat otherInvalidBits_;  // CV_32S, nodata pixels of the other image's window rows
+  cv::Mat otherInvalidBits_;               // CV_32S, nodata pixels of the other image's window rows
 };
 
 }  // namespace
@@ -1405,8 +1423,7 @@ bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelO
   // The padded copies run on the level's threads too (serial, the copies in and out were ~4 %
   // of the level's wall time with two threads).
   LevelInput padded = in;
-  runTasks({[&] { padded.ref = pad(in.ref, 0); },
-            [&] { padded.other = pad(in.other, 0); },
+  runTasks({[&] { padded.ref = pad(in.ref, 0); }, [&] { padded.other = pad(in.other, 0); },
             [&] { padded.refValid = pad(in.refValid, 0); },
             [&] { padded.otherValid = pad(in.otherValid, 0); },
             [&] { padded.refEdges = pad(in.refEdges, 0); },
