@@ -425,8 +425,8 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
         const cv::Point3d& first = points[k];
         const cv::Point3d& last = points[k + 1];
         const int y = static_cast<int>(first.y);
-        const double firstResidual = first.z - fitted.at(static_cast<int>(first.x), y);
-        const double lastResidual = last.z - fitted.at(static_cast<int>(last.x), y);
+        const double firstResidual = fitted.residual(first);
+        const double lastResidual = fitted.residual(last);
         if (std::abs(firstResidual) > settings.planeInlier &&
             std::abs(lastResidual) > settings.planeInlier) {
           continue;
