@@ -663,23 +663,22 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
         if (k == kUnseen) {
           // Matches that agree with the fill are passed over (a weakly textured roof's matched
           // patches between the filled region and the unmatched pixels beyond).
+          const bool ownRegion = ownFill[static_cast<size_t>(labels.at<int>(y, x))] != 0;
           const double off = std::abs(d - plane.at(x, y));
-          if (std::isfinite(d) &&
-              off <= std::min(settings.extendAgree, settings.extendRestartAgree)) {
+          if (!std::isfinite(d)) {
+            k = ownRegion ? kStops : kUnmatched;
+          } else if (off <= std::min(settings.extendAgree, settings.extendRestartAgree)) {
             k = kRestarts;
-          } else if (std::isfinite(d) && off <= settings.extendAgree) {
+          } else if (off <= settings.extendAgree) {
             k = kPassedOver;
-          } else if (std::isfinite(d) && settings.extendReplaceOff > 0 &&
-                     off >= settings.extendReplaceOff &&
-                     !ownFill[static_cast<size_t>(labels.at<int>(y, x))]) {
+          } else if (settings.extendReplaceOff > 0 && off >= settings.extendReplaceOff &&
+                     !ownRegion) {
             // Far off the fill: a window that met another surface as plain as the roof (the
             // facade the right view sees beside it, the ground beyond the outline). Tested as an
             // unmatched pixel, where the fill's window must also beat the match's own disparity.
             k = kDisagrees;
-          } else if (std::isfinite(d) || ownFill[static_cast<size_t>(labels.at<int>(y, x))]) {
-            k = kStops;
           } else {
-            k = kUnmatched;
+            k = kStops;
           }
         }
         if (k == kStops) continue;
