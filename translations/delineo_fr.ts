@@ -294,6 +294,14 @@
         <source>Speckle range</source>
         <translation>Écart des îlots</translation>
     </message>
+    <message>
+        <source>Surface smoothing</source>
+        <translation>Lissage des surfaces</translation>
+    </message>
+    <message>
+        <source>Smoothing tolerance</source>
+        <translation>Tolérance du lissage</translation>
+    </message>
 </context>
 <context>
     <name>Stages</name>

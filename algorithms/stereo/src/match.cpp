@@ -22,6 +22,7 @@
 #include "match_fill.hpp"
 #include "match_snap.hpp"
 #include "match_steps.hpp"
+#include "smoothing.hpp"
 #include "speckles.hpp"
 #include "workers.hpp"
 
@@ -715,6 +716,12 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     core::setStage(progress, core::StageId::RemovingSnappingSpeckles);
     detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
   }
+  // Last: on the final map, where the fill, the snapping and the speckle removal have set the
+  // steps that the smoothing must not cross. (Flat-roof RMS of the matches within 1 px, 5x5 and
+  // 1 px: sim seed 6 600² 0.255 -> 0.220, 600² 0.233 -> 0.205; see docs/stereo.md.)
+  if (p.smoothWindow > 0) {
+    detail::smoothSurfaces(result.disparity, p.smoothWindow, p.smoothTolerance, threads);
+  }
   core::report(progress, 1.0);
   return result;
 }
@@ -813,6 +820,10 @@ void MatchParams::validate() const {
   }
   if (window % 2 == 0) {
     throw Error(ErrorCode::InvalidParameter, "window = " + std::to_string(window) + " must be odd");
+  }
+  if (smoothWindow != 0 && (smoothWindow < 3 || smoothWindow % 2 == 0)) {
+    throw Error(ErrorCode::InvalidParameter, "smooth-window = " + std::to_string(smoothWindow) +
+                                                 " must be 0 (off) or odd and >= 3");
   }
   if (edgeLow > edgeHigh) {
     throw Error(ErrorCode::InvalidParameter, "edge-low must not exceed edge-high");

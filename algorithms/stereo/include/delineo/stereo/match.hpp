@@ -37,6 +37,8 @@ struct MatchParams {
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
   int speckleSize = 20;              // px, matched regions smaller than this are removed (0 = off)
   int speckleRange = 2;              // px, largest disparity difference within one such region
+  int smoothWindow = 5;              // px, odd side of the surface-smoothing window (0 = off)
+  double smoothTolerance = 1.0;      // px, largest difference to the centre within that window
   int threads = 0;                   // worker threads, 0 = all cores
 
   template <class V>
@@ -115,6 +117,17 @@ struct MatchParams {
                       "Largest disparity difference between neighbours of one speckle region", 1,
                       1000},
       speckleRange);
+    v(core::ParamInfo{"smooth-window", "Surface smoothing", "px",
+                      "Last, a matched pixel whose whole N x N neighbourhood is matched and "
+                      "within smooth-tolerance of it takes the neighbourhood's mean disparity "
+                      "(averages the sub-pixel noise of flat and sloped surfaces; steps larger "
+                      "than the tolerance are not touched); odd, 0 = off (adaptive method)",
+                      0, 31},
+      smoothWindow);
+    v(core::ParamInfo{"smooth-tolerance", "Smoothing tolerance", "px",
+                      "Largest disparity difference to the centre within a smoothed window", 0,
+                      100},
+      smoothTolerance);
     v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
       threads);
   }
