@@ -69,5 +69,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),
     QT_TRANSLATE_NOOP("Parameters", "Speckle size"),
     QT_TRANSLATE_NOOP("Parameters", "Speckle range"),
+    QT_TRANSLATE_NOOP("Parameters", "Surface smoothing"),
+    QT_TRANSLATE_NOOP("Parameters", "Smoothing tolerance"),
 };
 }  // namespace
