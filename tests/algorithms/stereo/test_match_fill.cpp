@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
@@ -410,81 +411,80 @@ Scene stripedBandWithMatchedColumns(int columns) {
   return s;
 }
 
+// The scene `make()` builds, filled (range 0..32) with `settings` and, on a second copy, with
+// `without`: the same settings with one rule turned off. Returns {with the rule, without it}.
+template <class MakeScene>
+std::pair<Scene, Scene> filledWithAndWithout(const MakeScene& make,
+                                             const RegionFillSettings& settings,
+                                             const RegionFillSettings& without) {
+  std::pair<Scene, Scene> filled{make(), make()};
+  fill(filled.first, settings, 32);
+  fill(filled.second, without, 32);
+  return filled;
+}
+
+// A rule's effect on `area`: without it, fewer than `withoutBelow` of the area's pixels hold the
+// roof's disparity; with it, at least `withAtLeast`, and nothing spills onto the ground.
+void expectTheRuleFills(const Scene& with, const Scene& without, const cv::Rect& area,
+                        double withoutBelow, double withAtLeast) {
+  const int filledWith = roofPixelsIn(with, area), filledWithout = roofPixelsIn(without, area);
+  EXPECT_LT(filledWithout, withoutBelow * area.area()) << " of " << area.area();
+  EXPECT_GE(filledWith, withAtLeast * area.area())
+      << " of " << area.area() << ", without the rule " << filledWithout;
+  EXPECT_EQ(spilledOntoTheGround(with), 0);
+}
+
 TEST(FillFlatRegions, GoesOnOverUnmatchedPixelsThatMatchAtItsDisparity) {
-  Scene extended = stripedBandScene();
-  fill(extended, RegionFillSettings{}, 32);
-  Scene plain = stripedBandScene();
   RegionFillSettings noExtension;
   noExtension.extendReach = 0;
-  fill(plain, noExtension, 32);
+  const auto [extended, plain] =
+      filledWithAndWithout([] { return stripedBandScene(); }, {}, noExtension);
   // The band's pixels left unmatched up to the outline (rows away from the top and bottom).
   const cv::Rect band(extended.roof.br().x - 12, extended.roof.y + 3, 12, extended.roof.height - 6);
-  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, band); };
-  // Without the extension, the region's growth takes at most its first 3 columns.
-  EXPECT_LT(onTheRoof(plain), band.area() / 5);
-  // With it, most of the band (not the last column, whose window meets the ground beyond the
-  // outline, nor the pixels whose window the texture leaves ambiguous).
-  EXPECT_GE(onTheRoof(extended), band.area() * 3 / 5) << " of " << band.area();
-  EXPECT_EQ(spilledOntoTheGround(extended), 0);
+  // Without the extension, the region's growth takes at most its first 3 columns. With it, most
+  // of the band (not the last column, whose window meets the ground beyond the outline, nor the
+  // pixels whose window the texture leaves ambiguous).
+  expectTheRuleFills(extended, plain, band, 0.2, 0.6);
 }
 
 TEST(FillFlatRegions, AWiderWindowDecidesWhereTheSmallOneIsNotClearlyBest) {
   // The band's texture a little weaker (0.12 of the ground's): more of its 3x3 windows match
   // about as well 2 px or more along the row, at the noise's level; their 5x5 windows tell.
-  Scene wide = stripedBandScene(0.12);
-  fill(wide, RegionFillSettings{}, 32);
-  Scene small = stripedBandScene(0.12);
   RegionFillSettings smallOnly;
   smallOnly.extendWideWindow = 0;
-  fill(small, smallOnly, 32);
+  const auto [wide, small] =
+      filledWithAndWithout([] { return stripedBandScene(0.12); }, {}, smallOnly);
   const cv::Rect band(wide.roof.br().x - 12, wide.roof.y + 3, 12, wide.roof.height - 6);
-  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, band); };
   // (Measured: 279 and 304 of 408.)
-  EXPECT_LT(onTheRoof(small), band.area() * 70 / 100);
-  EXPECT_GE(onTheRoof(wide), band.area() * 73 / 100) << " of " << band.area();
-  EXPECT_EQ(spilledOntoTheGround(wide), 0);
+  expectTheRuleFills(wide, small, band, 0.70, 0.73);
 }
 
 TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   // The band's first 5 columns matched at the roof's disparity (a weakly textured roof's matched
   // patch): between the filled region and the unmatched rest of the band.
-  const auto withMatchedColumns = [] { return stripedBandWithMatchedColumns(5); };
-  Scene passed = withMatchedColumns();
-  fill(passed, RegionFillSettings{}, 32);
-  Scene stopped = withMatchedColumns();
   RegionFillSettings noPassing;
   noPassing.extendAgree = -1;
   // (With the wider windows, the extension reaches 159 of the rest's pixels without passing over
   // the matches.)
   noPassing.extendWideWindow = 0;
-  fill(stopped, noPassing, 32);
+  const auto [passed, stopped] =
+      filledWithAndWithout([] { return stripedBandWithMatchedColumns(5); }, {}, noPassing);
   const cv::Rect rest(passed.roof.br().x - 7, passed.roof.y + 3, 7, passed.roof.height - 6);
-  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, rest); };
-  EXPECT_LT(onTheRoof(stopped), rest.area() / 3);
-  EXPECT_GE(onTheRoof(passed), rest.area() * 3 / 5)
-      << " of " << rest.area() << ", stopped " << onTheRoof(stopped);
-  EXPECT_EQ(spilledOntoTheGround(passed), 0);
+  expectTheRuleFills(passed, stopped, rest, 1.0 / 3, 0.6);
 }
 
 TEST(FillFlatRegions, CountsItsReachFromTheMatchesOnItsSurfaceToo) {
   // The band's first 7 columns matched at the roof's disparity, the extension's reach 4 px: the
   // unmatched rest of the band lies farther than that from the filled pixels, not from the
   // matches on the roof.
-  const auto withMatchedColumns = [] { return stripedBandWithMatchedColumns(7); };
   RegionFillSettings restarted;
   restarted.extendReach = 4;
-  Scene reached = withMatchedColumns();
-  fill(reached, restarted, 32);
   RegionFillSettings fromTheFillOnly = restarted;
   fromTheFillOnly.extendRestartAgree = -1;
-  Scene stopped = withMatchedColumns();
-  fill(stopped, fromTheFillOnly, 32);
+  const auto [reached, stopped] = filledWithAndWithout(
+      [] { return stripedBandWithMatchedColumns(7); }, restarted, fromTheFillOnly);
   const cv::Rect rest(reached.roof.br().x - 5, reached.roof.y + 3, 5, reached.roof.height - 6);
-  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, rest); };
-  EXPECT_LT(onTheRoof(stopped), rest.area() / 5);
-  EXPECT_GE(onTheRoof(reached), rest.area() / 2)
-      << " of " << rest.area() << ", stopped " << onTheRoof(stopped);
-  EXPECT_EQ(spilledOntoTheGround(reached), 0);
+  expectTheRuleFills(reached, stopped, rest, 0.2, 0.5);
 }
 
 TEST(FillFlatRegions, ReachedThroughItsMatchesStopsWhereTheSurfaceLeavesIt) {
@@ -509,12 +509,9 @@ TEST(FillFlatRegions, ReachedThroughItsMatchesStopsWhereTheSurfaceLeavesIt) {
   };
   RegionFillSettings restarted;
   restarted.extendReach = 4;
-  Scene second = withOffMatches();
-  fill(second, restarted, 32);
   RegionFillSettings firstOnly = restarted;
   firstOnly.extendRestartAgree = -1;
-  Scene first = withOffMatches();
-  fill(first, firstOnly, 32);
+  const auto [second, first] = filledWithAndWithout(withOffMatches, restarted, firstOnly);
   EXPECT_EQ(filledAtTheRoof(second), filledAtTheRoof(first));
 }
 
@@ -542,19 +539,12 @@ TEST(FillFlatRegions, AWiderWindowCrossesASeamAlongTheRoof) {
   // 15 px or more from the pixels counted.
   RegionFillSettings wide;
   wide.extendReach = 12;
-  Scene crossed = withSeam();
-  fill(crossed, wide, 32);
-  Scene stopped = withSeam();
   RegionFillSettings smallOnly = wide;
   smallOnly.extendWideWindow = 0;
-  fill(stopped, smallOnly, 32);
+  const auto [crossed, stopped] = filledWithAndWithout(withSeam, wide, smallOnly);
   // The textured rows just below the seam, away from the roof's sides.
   const cv::Rect below(crossed.roof.x + 15, crossed.roof.y + 23, crossed.roof.width - 30, 6);
-  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, below); };
-  EXPECT_LT(onTheRoof(stopped), below.area() / 4);
-  EXPECT_GE(onTheRoof(crossed), below.area() * 3 / 5)
-      << " of " << below.area() << ", stopped " << onTheRoof(stopped);
-  EXPECT_EQ(spilledOntoTheGround(crossed), 0);
+  expectTheRuleFills(crossed, stopped, below, 0.25, 0.6);
 }
 
 TEST(FillFlatRegions, ReplacesMatchesOfTheFarSurfaceWhereItsWindowIsClearlyBest) {
@@ -566,21 +556,14 @@ TEST(FillFlatRegions, ReplacesMatchesOfTheFarSurfaceWhereItsWindowIsClearlyBest)
     s.disparity(cv::Rect(s.roof.br().x - 8, s.roof.y, 3, s.roof.height)).setTo(kGround);
     return s;
   };
-  Scene replaced = withGroundColumns();
-  fill(replaced, RegionFillSettings{}, 32);
-  Scene stopped = withGroundColumns();
   RegionFillSettings noReplacing;
   noReplacing.extendReplaceOff = 0;
-  fill(stopped, noReplacing, 32);
+  const auto [replaced, stopped] = filledWithAndWithout(withGroundColumns, {}, noReplacing);
   // The ground-valued columns and the rest beyond them.
   const cv::Rect beyond(replaced.roof.br().x - 8, replaced.roof.y + 3, 8, replaced.roof.height - 6);
-  const auto onTheRoof = [&](const Scene& s) { return roofPixelsIn(s, beyond); };
-  // (Measured: 2 and 186 of 272.)
-  EXPECT_LT(onTheRoof(stopped), beyond.area() / 5);
-  EXPECT_GE(onTheRoof(replaced), beyond.area() * 3 / 5)
-      << " of " << beyond.area() << ", stopped " << onTheRoof(stopped);
-  // The ground beside the roof, matched at its own disparity, keeps it.
-  EXPECT_EQ(spilledOntoTheGround(replaced), 0);
+  // (Measured: 2 and 186 of 272.) The ground beside the roof, matched at its own disparity, keeps
+  // it.
+  expectTheRuleFills(replaced, stopped, beyond, 0.2, 0.6);
 }
 }  // namespace
 }  // namespace delineo::stereo::detail
