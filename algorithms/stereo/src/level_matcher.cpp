@@ -214,6 +214,18 @@ float windowDot16(const float* a, size_t aStride, const float* b, size_t bStride
   return laneSum(acc0 * w0 + acc1 * w1);
 }
 
+// The products of a 16-column template row (a0, a1) with the row of the other image at `b`,
+// added to (sum0, sum1).
+__attribute__((always_inline)) inline void addRowProducts(const Float8& a0, const Float8& a1,
+                                                          const float* b, Float8& sum0,
+                                                          Float8& sum1) {
+  Float8 b0, b1;
+  load8(b0, b);
+  load8(b1, b + 8);
+  sum0 += a0 * b0;
+  sum1 += a1 * b1;
+}
+
 // windowDot16 of the 4 windows b, b − 1, b − 2, b − 3 (main-line disparities d .. d + 3) in
 // one pass: the rows of `a` are loaded once for the four (the same sums, in the same order, as
 // four calls).
@@ -225,25 +237,13 @@ void windowDots16x4(const float* a, size_t aStride, const float* b, size_t bStri
   for (int v = 0; v < rows; ++v) {
     const float* av = a + static_cast<size_t>(v) * aStride;
     const float* bv = b + static_cast<size_t>(v) * bStride;
-    Float8 a0, a1, b0, b1;
+    Float8 a0, a1;
     load8(a0, av);
     load8(a1, av + 8);
-    load8(b0, bv);
-    load8(b1, bv + 8);
-    p0 += a0 * b0;
-    p1 += a1 * b1;
-    load8(b0, bv - 1);
-    load8(b1, bv + 7);
-    q0 += a0 * b0;
-    q1 += a1 * b1;
-    load8(b0, bv - 2);
-    load8(b1, bv + 6);
-    r0 += a0 * b0;
-    r1 += a1 * b1;
-    load8(b0, bv - 3);
-    load8(b1, bv + 5);
-    s0 += a0 * b0;
-    s1 += a1 * b1;
+    addRowProducts(a0, a1, bv, p0, p1);
+    addRowProducts(a0, a1, bv - 1, q0, q1);
+    addRowProducts(a0, a1, bv - 2, r0, r1);
+    addRowProducts(a0, a1, bv - 3, s0, s1);
   }
   Float8 w0, w1;
   load8(w0, lanes);
