@@ -77,7 +77,8 @@ struct Case {
 };
 
 struct Row {
-  double density = 0, bad1 = 0, bad2 = 0, bad2All = 0, roofRms = NAN, roofRmsInliers = NAN, edge = NAN, seconds = 0;
+  double density = 0, bad1 = 0, bad2 = 0, bad2All = 0, roofRms = NAN, roofRmsInliers = NAN,
+         edge = NAN, seconds = 0;
 };
 
 constexpr int kOutlineWalk = 7;
@@ -99,14 +100,18 @@ int predictedRoofStart(const cv::Mat& disparity, const Case::OutlinePixel& o) {
 }
 
 // Whether edge% counts outline pixel o as located, from its predicted roof start x.
-bool outlineLocated(const Case::OutlinePixel& o, int x) { return x >= 0 && std::abs(x - o.xb) <= 1; }
+bool outlineLocated(const Case::OutlinePixel& o, int x) {
+  return x >= 0 && std::abs(x - o.xb) <= 1;
+}
 
 // Diagnostic only (not part of the metric): histogram of the predicted roof start relative to
 // the true outline, in px towards the ground (positive: roof fattened), as edge% walks it.
 void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
   long outside = 0, inside = 0, missed = 0, located = 0;
   long insideBy[2][2] = {};
-  long outsideBy[2] = {}, missedBy[2] = {};  // [ground on −x / on +x]  // [unmatched only / ground value][ground on −x / on +x]
+  long outsideBy[2] = {},
+       missedBy[2] =
+           {};  // [ground on −x / on +x]  // [unmatched only / ground value][ground on −x / on +x]
   // Outline pixels whose ground neighbour the other view does not see (a narrow street or
   // courtyard hidden by the next roof): [located / not located].
   long hiddenGround[2] = {};
@@ -120,7 +125,8 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
     }
     if (x >= 0) {
       const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
-      if (std::abs(off) <= 1) ++located;
+      if (std::abs(off) <= 1)
+        ++located;
       else if (off > 1) {
         ++outside;
         ++outsideBy[o.dir > 0 ? 0 : 1];
@@ -138,8 +144,7 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
           }
           std::printf("\n");
         }
-      }
-      else {
+      } else {
         ++inside;
         // What covers the roof pixels before the start: no match, or the ground's value.
         bool groundValue = false;
@@ -170,16 +175,19 @@ void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
       ++missedBy[o.dir > 0 ? 0 : 1];
     }
   }
-  std::printf("    outline diag: %zu pixels, located %ld, roof starts >=2 px outside %ld, "
-              ">=2 px inside %ld, missed %ld\n", c.outline.size(), located, outside, inside,
-              missed);
-  std::printf("    inside: unmatched only %ld (ground -x %ld, +x %ld), ground value %ld "
-              "(ground -x %ld, +x %ld)\n", insideBy[0][0] + insideBy[0][1], insideBy[0][0],
-              insideBy[0][1], insideBy[1][0] + insideBy[1][1], insideBy[1][0], insideBy[1][1]);
+  std::printf(
+      "    outline diag: %zu pixels, located %ld, roof starts >=2 px outside %ld, "
+      ">=2 px inside %ld, missed %ld\n",
+      c.outline.size(), located, outside, inside, missed);
+  std::printf(
+      "    inside: unmatched only %ld (ground -x %ld, +x %ld), ground value %ld "
+      "(ground -x %ld, +x %ld)\n",
+      insideBy[0][0] + insideBy[0][1], insideBy[0][0], insideBy[0][1],
+      insideBy[1][0] + insideBy[1][1], insideBy[1][0], insideBy[1][1]);
   std::printf("    outside: ground -x %ld, +x %ld; missed: ground -x %ld, +x %ld\n", outsideBy[0],
               outsideBy[1], missedBy[0], missedBy[1]);
-  std::printf("    ground beside hidden in the other view: %ld located, %ld not\n",
-              hiddenGround[0], hiddenGround[1]);
+  std::printf("    ground beside hidden in the other view: %ld located, %ld not\n", hiddenGround[0],
+              hiddenGround[1]);
 }
 
 double outlineScore(const cv::Mat& disparity, const Case& c) {
@@ -214,10 +222,10 @@ void dumpErrors(const cv::Mat& disparity, const Case& c, const std::string& path
   for (const Case::OutlinePixel& o : c.outline) {
     const int x = predictedRoofStart(disparity, o);
     const int off = (o.xb - x) * o.dir;  // > 0: roof side found on the ground
-    img.at<cv::Vec3b>(o.y, o.xb) = x < 0            ? cv::Vec3b(0, 128, 255)
+    img.at<cv::Vec3b>(o.y, o.xb) = x < 0                ? cv::Vec3b(0, 128, 255)
                                    : std::abs(off) <= 1 ? cv::Vec3b(255, 255, 255)
-                                   : off > 1          ? cv::Vec3b(255, 255, 0)
-                                                      : cv::Vec3b(255, 0, 255);
+                                   : off > 1            ? cv::Vec3b(255, 255, 0)
+                                                        : cv::Vec3b(255, 0, 255);
   }
   cv::imwrite(path, img);
 }
@@ -351,8 +359,8 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
              const nlohmann::json& overrides, int repeat, bool printCpu) {
   std::printf("\n%s: %dx%d, range %d..%d\n", c.name.c_str(), c.left.cols, c.left.rows, c.dmin,
               c.dmax);
-  std::printf("  %-10s %8s %8s %8s %10s %9s %9s %7s %8s\n", "method", "density%", "bad1%",
-              "bad2%", "bad2+unm%", "roofRMS", "roofRMS1", "edge%", "time s");
+  std::printf("  %-10s %8s %8s %8s %10s %9s %9s %7s %8s\n", "method", "density%", "bad1%", "bad2%",
+              "bad2+unm%", "roofRMS", "roofRMS1", "edge%", "time s");
   auto paramsFor = [&](const std::string& m) {
     stereo::MatchParams p;
     p.dmin = c.dmin;
@@ -389,9 +397,8 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
   for (size_t i = 0; i < methods.size(); ++i) {
     const std::string& m = methods[i];
     const Row r = score(disparity[i], c, best[i]);
-    std::printf("  %-10s %8.1f %8.2f %8.2f %10.2f %9.3f %9.3f %7.1f %8.2f\n", m.c_str(),
-                r.density, r.bad1, r.bad2, r.bad2All, r.roofRms, r.roofRmsInliers, r.edge,
-                r.seconds);
+    std::printf("  %-10s %8.1f %8.2f %8.2f %10.2f %9.4f %9.4f %7.1f %8.2f\n", m.c_str(), r.density,
+                r.bad1, r.bad2, r.bad2All, r.roofRms, r.roofRmsInliers, r.edge, r.seconds);
     if (gOutlineDiagnosis && !c.outline.empty()) {
       outlineDiagnosis(disparity[i], c);
       roofErrorDiagnosis(disparity[i], c);
@@ -477,8 +484,9 @@ Case simulated(int size, int seed) {
 }
 #endif
 
-
-cv::Mat readFloat(const fs::path& p) { return io::readGreyFloat(p.string()); }
+cv::Mat readFloat(const fs::path& p) {
+  return io::readGreyFloat(p.string());
+}
 
 // Grey values as float without the nodata → NaN conversion: Cones_LEFT/RIGHT.tif declare
 // nodata = 255, which would turn every white pixel into a hole.
@@ -523,7 +531,8 @@ std::vector<Case> realCases(const fs::path& data) {
     cases.push_back(c);
   }
   const fs::path dublin = data / "aerial-dublin";
-  if (fs::exists(dublin / "dublin_0004_left.png") && fs::exists(dublin / "dublin_0004_left_gt_disp.png")) {
+  if (fs::exists(dublin / "dublin_0004_left.png") &&
+      fs::exists(dublin / "dublin_0004_left_gt_disp.png")) {
     Case c;
     c.name = "DublinCity aerial tile (LiDAR GT, scored where valid)";
     c.left = readFloat(dublin / "dublin_0004_left.png");
@@ -595,8 +604,9 @@ int main(int argc, char** argv) {
     }
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
-  std::printf("bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
-              "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
+  std::printf(
+      "bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
+      "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
 #ifdef DELINEO_BENCH_HAVE_SIM
   Case sim = simulated(size, seed);
   if (range > sim.dmax - sim.dmin + 1) sim.dmax = sim.dmin + range - 1;
