@@ -50,16 +50,23 @@ float clusterMean(const std::vector<float>& values, float centre) {
   return static_cast<float>(n > 0 ? sum / n : centre);
 }
 
-// Median of the matches within 1.5 px of `centre` (`centre` when there are none).
-float clusterMedian(const std::vector<float>& values, float centre) {
+// Median of the matches within `reach` px of `centre` (`centre` when there are none).
+float medianNear(const std::vector<float>& values, float centre, float reach) {
   std::vector<float> within;
   for (const float v : values) {
-    if (std::abs(v - centre) <= 1.5F) within.push_back(v);
+    if (std::abs(v - centre) <= reach) within.push_back(v);
   }
   if (within.empty()) return centre;
   const auto middle = within.begin() + static_cast<std::ptrdiff_t>(within.size() / 2);
   std::nth_element(within.begin(), middle, within.end());
   return *middle;
+}
+
+// The value filled for the cluster around `centre`: the median of its matches (within 1.5 px),
+// then, with `refocus` > 0, the median of those within `refocus` px of that median.
+float clusterMedian(const std::vector<float>& values, float centre, double refocus) {
+  const float median = medianNear(values, centre, 1.5F);
+  return refocus > 0 ? medianNear(values, median, static_cast<float>(refocus)) : median;
 }
 
 // Centres (integer disparities) of the two largest clusters of ±1 px among `values`; the second
@@ -874,10 +881,11 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         return std::nullopt;
       }
       // The candidates are ranked by their clusters' means; the value filled in is the chosen
-      // cluster's median. The matches next to a plain roof's outline are skewed: some windows
-      // along it match 1-1.7 px too far (seed 5's plain roof, filled +0.57 px off with the mean;
-      // see docs/stereo.md, session 17).
-      const float value = clusterMedian(matches, best);
+      // cluster's median, refocused (see refocusReach). The matches next to a plain roof's
+      // outline are skewed: some windows along it match 1-1.7 px too far (seed 5's plain roof,
+      // filled +0.57 px off with the mean, +0.39 with the median; see docs/stereo.md, sessions
+      // 17 and 18).
+      const float value = clusterMedian(matches, best, settings.refocusReach);
       constantError = ringError(value);
       return value;
     }();
@@ -915,8 +923,12 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
           }
         }
       }
-      // Over a constant the outline lines up at, the plane must line it up better.
-      if (!sloped || (constant && !(planeRingError(plane) < constantError))) {
+      // Over a constant the outline lines up at, the plane must line it up clearly better: a
+      // nearly level plane through a flat roof's row ends can edge out the constant by noise
+      // (seed 3 1000²: 4.3475 against 4.3573 once the constant is refocused; sloped facets win
+      // by 7 % or more on the simulated scenes).
+      if (!sloped ||
+          (constant && !(planeRingError(plane) < settings.planeMargin * constantError))) {
         if (!constant) continue;
         plane = FillPlane{*constant, 0, 0};
       }
@@ -924,6 +936,31 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       if (!constant) continue;
       plane.c = *constant;
     }
+    // Whether the fill's value explains the inRegionWindow² window at (x, y) (image
+    // coordinates) about as well as the pixel's own disparity `own`: mean |left − mapped right|,
+    // both at whole disparities, at most inRegionRatio × the own one. False where the window
+    // leaves either view or meets nodata.
+    const auto fillExplainsAsWell = [&](int x, int y, float own, double value) {
+      const int w = settings.inRegionWindow / 2;
+      const int atOwn = static_cast<int>(std::lround(own));
+      const int atFill = static_cast<int>(std::lround(value));
+      const int lowest = std::min(atOwn, atFill), highest = std::max(atOwn, atFill);
+      if (x - w < 0 || y - w < 0 || x + w >= left.cols || y + w >= left.rows ||
+          x - w - highest < 0 || x + w - lowest >= right.cols) {
+        return false;
+      }
+      double errorAtFill = 0, errorAtOwn = 0;
+      for (int v = y - w; v <= y + w; ++v) {
+        const float* a = left.ptr<float>(v);
+        const float* b = right.ptr<float>(v);
+        for (int u = x - w; u <= x + w; ++u) {
+          errorAtFill += std::abs(a[u] - (gain * b[u - atFill] + offset));
+          errorAtOwn += std::abs(a[u] - (gain * b[u - atOwn] + offset));
+        }
+      }
+      // (NaN, from nodata, fails the comparison.)
+      return errorAtFill <= settings.inRegionRatio * errorAtOwn;
+    };
     cv::Mat grown = region.clone();
     if (settings.growReach > 0) {
       growToContour(left, right, box, region, plane, gain, offset, sigma, settings, grown);
@@ -943,10 +980,23 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         const int xr = box.x + x - static_cast<int>(std::lround(value));
         if (xr < 0 || xr >= right.cols || !std::isfinite(b[xr])) continue;
         if (std::isfinite(d[x])) {
+          // A region pixel matched far off the fill: a window that reached another surface's
+          // texture (see inRegionReplaceOff).
+          if (inRegion[x]) {
+            if (settings.inRegionReplaceOff <= 0 ||
+                std::abs(d[x] - value) < settings.inRegionReplaceOff ||
+                !fillExplainsAsWell(box.x + x, box.y + y, d[x], value)) {
+              continue;
+            }
+            d[x] = static_cast<float>(value);
+            s[x] = fillScore;
+            ++filled;
+            continue;
+          }
           // A grown pixel matched elsewhere (the far side's disparity carried over the outline
           // by a window that reached across it) is taken when the region's disparity explains
           // its grey level better than its own.
-          if (inRegion[x] || std::abs(d[x] - value) < 2.0) continue;
+          if (std::abs(d[x] - value) < 2.0) continue;
           const int xo = box.x + x - static_cast<int>(std::lround(d[x]));
           if (xo < 0 || xo >= right.cols || !std::isfinite(b[xo])) continue;
           if (!(std::abs(a[x] - (gain * b[xo] + offset)) >

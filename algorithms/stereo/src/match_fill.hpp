@@ -16,6 +16,8 @@ struct RegionFillSettings {
   double contrast = 0.5;     // the best candidate's outline error must be below this × the other's
   double scanAgreement = 0.93;   // a full-range scan confirming the best candidate (0 = off)
   double scanReach = 1.5;        // px: the scan's minimum this close to the candidate confirms it
+  double refocusReach = 1.0;     // px: the value filled is the median of the matches this close
+                                 //   to the cluster's median (0: the cluster's median)
   int growReach = 3;             // px: the filled region grows back to its contour by at most this
   double growSigmas = 3.0;       // × noise sigma: grown pixel vs the region's local mean grey
   double growPhotometric = 4.0;  // × noise sigma: a grown pixel's |left − mapped right|
@@ -32,6 +34,8 @@ struct RegionFillSettings {
   double planeEaveShare = 0.33;  //   with this share of the other side's (a hip facet's eave)
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
   double planeTrimShare = 0.1;   // worst share of row ends dropped per trimmed refit (0 = off)
+  double planeMargin = 0.97;     // a plane replaces a constant the outline lines up at only when
+                                 //   its outline error is below this × the constant's
   // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
   int extendReach = 40;             // px (4-connected steps) from the filled pixels; 0 = off
   double extendRestartAgree = 0.5;  // px: extendReach counts from the matches this close to
@@ -46,6 +50,11 @@ struct RegionFillSettings {
                                    //   extendWindow one is not clearly best (≤ extendWindow: off)
   double extendReplaceOff = 4.0;   // px: matches off the fill by this much or more are replaced
                                    //   where its window matches clearly best (≤ 0: off)
+  // Matches inside a filled region that carry another surface's disparity.
+  double inRegionReplaceOff = 8.0;  // px: a region's matches off its fill by this much or more
+                                    //   are replaced (≤ 0: off)
+  double inRegionRatio = 1.25;      //   when the fill's window error is below this × their own
+  int inRegionWindow = 5;           // px: side of that window
 };
 
 // Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is
@@ -101,6 +110,19 @@ struct RegionFillSettings {
 // beside it; 2000² edge 89.6 -> 89.9 %). The reach, 40 px (32 until session 16): 2000² edge
 // 89.9 -> 90.1 %, a roof whose one filled patch lies about 40 steps from its outline's
 // unmatched end; 48 px cost seed 5 0.2 points.
+// A region's own matches off its fill by `inRegionReplaceOff` px or more take the fill when its
+// inRegionWindow² window explains them about as well as their own disparity: mean |left − mapped
+// right| at the fill at most `inRegionRatio` × the one at their disparity. Inside a flat region
+// NCC finds no texture of the region's own: its matches come from windows that reached texture
+// beyond, across gaps of the contour, and a band along an outline that runs with the rows can
+// carry the far side's disparity (seed 3 600²: 469 of 37 240 roof matches > 5 px off, roof RMS
+// 5.38 px). A plain pixel is explained alike at both disparities, so the region's fill wins;
+// where its own disparity explains it clearly better it is kept. Smaller offsets are left alone:
+// a plain slanted surface (Aloe's leaves) differs from its constant fill by a few px and its
+// matches are right.
+// The constant filled in is the median of the cluster's matches within `refocusReach` px of the
+// cluster's median: the tail of windows matched 1-2 px too far along an outline (seed 5's plain
+// roof, beside raised boxes) no longer pulls it (+0.39 -> about 0 px).
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
 // `threads` > 1: the right view's flat regions are made on a second worker, which then runs
 // `alongside` (the caller's own work, independent of the fill) while the fill goes on; else
