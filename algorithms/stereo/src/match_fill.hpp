@@ -122,7 +122,7 @@ struct RegionFillSettings {
 // matches are right.
 // The constant filled in is the median of the cluster's matches within `refocusReach` px of the
 // cluster's median: the tail of windows matched 1-2 px too far along an outline (seed 5's plain
-// roof, beside raised boxes) no longer pulls it (+0.39 -> about 0 px).
+// roof, beside raised boxes) no longer pulls it (+0.39 -> +0.035 px).
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
 // `threads` > 1: the right view's flat regions are made on a second worker, which then runs
 // `alongside` (the caller's own work, independent of the fill) while the fill goes on; else
