@@ -108,10 +108,8 @@ bool outlineLocated(const Case::OutlinePixel& o, int x) {
 // the true outline, in px towards the ground (positive: roof fattened), as edge% walks it.
 void outlineDiagnosis(const cv::Mat& disparity, const Case& c) {
   long outside = 0, inside = 0, missed = 0, located = 0;
-  long insideBy[2][2] = {};
-  long outsideBy[2] = {},
-       missedBy[2] =
-           {};  // [ground on −x / on +x]  // [unmatched only / ground value][ground on −x / on +x]
+  long insideBy[2][2] = {};                  // [unmatched only / ground value][ground −x / +x]
+  long outsideBy[2] = {}, missedBy[2] = {};  // [ground on −x / on +x]
   // Outline pixels whose ground neighbour the other view does not see (a narrow street or
   // courtyard hidden by the next roof): [located / not located].
   long hiddenGround[2] = {};
