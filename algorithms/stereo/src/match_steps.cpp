@@ -51,8 +51,7 @@ struct CutRowSums {
       const bool onSegment = sd[j] == sd[j];
       const bool nearSide = std::abs(sd[j] - side) <= 1.0F;
       const bool nearValidated = std::abs(val[j] - side) <= 1.5F;
-      const float mj =
-          (onSegment & nearSide) | (!onSegment & nearValidated) ? inWindow[j] : 0.0F;
+      const float mj = (onSegment & nearSide) | (!onSegment & nearValidated) ? inWindow[j] : 0.0F;
       const float c = grey[j] - centre;
       m[j] = mj;
       n[j] += mj;
@@ -157,11 +156,9 @@ void buildCutWindow(const cv::Mat& ref, const cv::Mat& refValid, const cv::Mat& 
     case 8:
       return buildCutWindowPadded<8>(ref, refValid, sideD, validated, side, x, y, r, minPixels, w);
     case 16:
-      return buildCutWindowPadded<16>(ref, refValid, sideD, validated, side, x, y, r, minPixels,
-                                      w);
+      return buildCutWindowPadded<16>(ref, refValid, sideD, validated, side, x, y, r, minPixels, w);
     case 24:
-      return buildCutWindowPadded<24>(ref, refValid, sideD, validated, side, x, y, r, minPixels,
-                                      w);
+      return buildCutWindowPadded<24>(ref, refValid, sideD, validated, side, x, y, r, minPixels, w);
     default:
       return buildCutWindowPadded<kMaxStride>(ref, refValid, sideD, validated, side, x, y, r,
                                               minPixels, w);
@@ -334,6 +331,70 @@ Hypothesis bestNear(const CutWindow& w, const cv::Mat& other, const cv::Mat& oth
   return best;
 }
 
+// A step of a line (row or column) of the validated map between its consecutive validated
+// pixels p < q: the segment [s0, s1] re-decided and the two sides' disparities da, db read at
+// the first validated pixels beyond it (ua, ub). The validated step may sit up to half a window
+// (h) off the true one (fattening): the segment spans h beyond both ends of the step, from
+// `done` + 1 at least (the previous segment's end). False when the line has no step there, no
+// side beyond the segment, or a validated value on neither side inside it (a third surface).
+struct StepSegment {
+  int s0 = 0, s1 = 0, ua = -1, ub = -1;
+  float da = 0, db = 0;
+};
+
+bool stepSegment(const float* val, int length, int p, int q, int h, int done, float minStep,
+                 StepSegment& seg) {
+  if (std::abs(val[p] - val[q]) < minStep) return false;
+  seg.s0 = std::max(p - h, done + 1);
+  seg.s1 = std::min(q + h, length - 1);
+  if (seg.s1 - seg.s0 < 1) return false;
+  seg.ua = seg.ub = -1;
+  for (int u = seg.s0 - 1; u >= std::max(0, seg.s0 - 2 * h); --u) {
+    if (std::isfinite(val[u])) {
+      seg.ua = u;
+      break;
+    }
+  }
+  for (int u = seg.s1 + 1; u <= std::min(length - 1, seg.s1 + 2 * h); ++u) {
+    if (std::isfinite(val[u])) {
+      seg.ub = u;
+      break;
+    }
+  }
+  if (seg.ua < 0 || seg.ub < 0) return false;
+  seg.da = val[seg.ua];
+  seg.db = val[seg.ub];
+  if (std::abs(seg.da - seg.db) < minStep) return false;
+  for (int u = seg.s0; u <= seg.s1; ++u) {
+    if (std::isfinite(val[u]) && std::abs(val[u] - seg.da) > 1.0F &&
+        std::abs(val[u] - seg.db) > 1.0F) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Boundary β of a segment starting at s0: positions ≤ β on side A, > β + strip on side B, at
+// the least total photometric error (both hypotheses scored on the same pixels, so texture
+// strength does not bias the choice as it does when two windows' NCCs are compared). The
+// `strip` positions after β belong to neither side; every β scores the same n − strip ones.
+int stepBoundary(const std::vector<float>& costA, const std::vector<float>& costB, int s0,
+                 int strip) {
+  const int n = static_cast<int>(costA.size());
+  float total = 0;
+  for (int k = strip; k < n; ++k) total += costB[static_cast<size_t>(k)];
+  float bestTotal = total;
+  int beta = s0 - 1;
+  for (int k = 0; k + strip < n; ++k) {
+    total += costA[static_cast<size_t>(k)] - costB[static_cast<size_t>(k + strip)];
+    if (total < bestTotal) {
+      bestTotal = total;
+      beta = s0 + k;
+    }
+  }
+  return beta;
+}
+
 }  // namespace
 
 long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
@@ -349,53 +410,43 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
   // band of the first pass initialises its own rows).
   cv::Mat sideD(ref.size(), CV_32F);
   cv::Mat sideDy(ref.size(), CV_8S);
+  cv::Mat inStrip(ref.size(), CV_8U);  // occluded strips of the rows' segments
+  // Pixels with a step of their row (consecutive validated pixels ≥ minStep apart) within half a
+  // window on both sides: the column pass leaves the steps those pixels lie on to the rows.
+  cv::Mat rowStepNear(ref.size(), CV_8U);
   auto chooseSides = [&](int rowStart, int rowEnd) {
     std::vector<int> valid;
     std::vector<float> costA, costB;
     for (int y = rowStart; y < rowEnd; ++y) {
       std::fill_n(sideD.ptr<float>(y), W, kNaN);
       std::fill_n(sideDy.ptr<schar>(y), W, schar{0});
+      std::fill_n(inStrip.ptr<uchar>(y), W, uchar{0});
       const float* val = validated.ptr<float>(y);
       const float* shift = shifts.ptr<float>(y);
       valid.clear();
       for (int x = 0; x < W; ++x) {
         if (std::isfinite(val[x])) valid.push_back(x);
       }
-      int done = -1;  // last column re-decided in this row
+      uchar* near = rowStepNear.ptr<uchar>(y);
+      std::fill_n(near, W, uchar{0});
       for (size_t i = 0; i + 1 < valid.size(); ++i) {
         const int p = valid[i], q = valid[i + 1];
-        if (std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
-        // The validated step may sit up to half a window off the true one (fattening): the
-        // segment re-decided spans half a window beyond both ends of the step.
-        const int s0 = std::max(p - h, done + 1), s1 = std::min(q + h, W - 1);
-        if (s1 - s0 < 1) continue;
-        int ua = -1, ub = -1;
-        for (int u = s0 - 1; u >= std::max(0, s0 - 2 * h); --u) {
-          if (std::isfinite(val[u])) {
-            ua = u;
-            break;
-          }
+        if (q - p > 2 * h || std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
+        // x − h ≤ p and q ≤ x + h.
+        for (int x = std::max(0, q - h); x <= std::min(W - 1, p + h); ++x) near[x] = 1;
+      }
+      int done = -1;  // last column re-decided in this row
+      for (size_t i = 0; i + 1 < valid.size(); ++i) {
+        StepSegment seg;
+        if (!stepSegment(val, W, valid[i], valid[i + 1], h, done, static_cast<float>(s.minStep),
+                         seg)) {
+          continue;
         }
-        for (int u = s1 + 1; u <= std::min(W - 1, s1 + 2 * h); ++u) {
-          if (std::isfinite(val[u])) {
-            ub = u;
-            break;
-          }
-        }
-        if (ua < 0 || ub < 0) continue;
-        const float da = val[ua], db = val[ub];
-        if (std::abs(da - db) < static_cast<float>(s.minStep)) continue;
-        bool thirdSurface = false;
-        for (int x = s0; x <= s1 && !thirdSurface; ++x) {
-          thirdSurface = std::isfinite(val[x]) && std::abs(val[x] - da) > 1.0F &&
-                         std::abs(val[x] - db) > 1.0F;
-        }
-        if (thirdSurface) continue;
-        const int dyA = roundHalfAway(shift[ua]);
-        const int dyB = roundHalfAway(shift[ub]);
-        // Boundary β: columns ≤ β on the −x surface, > β on the +x one, at the least total
-        // photometric error (both hypotheses scored on the same pixels, so texture strength
-        // does not bias the choice as it does when two windows' NCCs are compared).
+        const int s0 = seg.s0, s1 = seg.s1;
+        const float da = seg.da, db = seg.db;
+        const int dyA = roundHalfAway(shift[seg.ua]);
+        const int dyB = roundHalfAway(shift[seg.ub]);
+        // Boundary β: columns ≤ β on the −x surface, > β on the +x one.
         const int n = s1 - s0 + 1;
         costA.resize(static_cast<size_t>(n));
         costB.resize(static_cast<size_t>(n));
@@ -406,25 +457,15 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
           continue;
         }
         // Occluded strip: when the +x surface is nearer, the `strip` columns before it are not
-        // seen in the other view; the boundary then has the strip between the two sides, and
-        // every position scores the same number of columns (n - strip).
+        // seen in the other view; the boundary then has the strip between the two sides.
         const int strip = s.occlusionStrip && db > da ? roundHalfAway(db - da) : 0;
         if (n - strip < 2) continue;
-        float total = 0;
-        for (int k = strip; k < n; ++k) total += costB[static_cast<size_t>(k)];
-        float bestTotal = total;
-        int beta = s0 - 1;  // last column of the −x surface
-        for (int k = 0; k + strip < n; ++k) {
-          total += costA[static_cast<size_t>(k)] - costB[static_cast<size_t>(k + strip)];
-          if (total < bestTotal) {
-            bestTotal = total;
-            beta = s0 + k;
-          }
-        }
+        const int beta = stepBoundary(costA, costB, s0, strip);
         float* rawRow = raw.disparity.ptr<float>(y);
         for (int x = s0; x <= s1; ++x) {
           if (x > beta && x <= beta + strip) {
-            rawRow[x] = kNaN;  // occluded in the other view
+            rawRow[x] = kNaN;             // occluded in the other view
+            inStrip.at<uchar>(y, x) = 1;  // decided: the column pass leaves it
             continue;
           }
           const bool sideA = x <= beta;
@@ -463,40 +504,122 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
     tasks.emplace_back([&, y0] { chooseSides(y0, std::min(H, y0 + kBandRows)); });
   }
   runTasks(tasks, s.threads);
-  // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
-  // own side (same side value), and the validated pixels off the segments on that surface.
-  forRowBands(H, s.threads, [&](int rowStart, int rowEnd) {
-    CutWindow window;
-    for (int y = rowStart; y < rowEnd; ++y) {
-      float* outD = raw.disparity.ptr<float>(y);
-      float* outS = raw.lineShift.ptr<float>(y);
-      float* outScore = raw.score.ptr<float>(y);
-      const float* sides = sideD.ptr<float>(y);
-      const float* val = validated.ptr<float>(y);
-      const schar* sideShift = sideDy.ptr<schar>(y);
-      const uchar* wanted = matchOnly.empty() ? nullptr : matchOnly.ptr<uchar>(y);
-      for (int x = 0; x < W; ++x) {
-        const float side = sides[x];
-        if (!std::isfinite(side) || (wanted != nullptr && !wanted[x])) continue;
-        // A validated value already on this side stays: re-matching it costs the most (most
-        // segment pixels) and changed little.
-        const float kept = val[x];
-        if (std::isfinite(kept) && std::abs(kept - side) <= 1.0F) continue;
-        const int dy = sideShift[x];
-        buildCutWindow(ref, refValid, sideD, validated, side, x, y, h, s.minShape, window);
-        const Hypothesis hyp = bestNear(window, other, otherValid, otherInvalidSum, side, dy);
-        const float before = outD[x];
-        if (hyp.score >= static_cast<float>(s.minScore)) {
-          outD[x] = hyp.disparity;
-          outS[x] = static_cast<float>(dy);
-          outScore[x] = hyp.score;
-        } else {
-          outD[x] = kNaN;
-        }
-        if (!(before == outD[x])) ++changed;
+  // Steps along the columns (outlines that run with the rows: no row crosses them), after the
+  // rows' segments, which keep their sides. The same boundary search on the pixel's own error;
+  // no occluded strip (the views are displaced along the rows only).
+  // A row's pixel alone was too noisy to place a boundary across the rows; the pixels x ± 2 of
+  // the row lie on the same side of an outline that runs with the rows.
+  constexpr int kColumnCostHalf = 2;
+  auto chooseColumnSides = [&](int colStart, int colEnd) {
+    // The band's columns, each contiguous (one pass over the rows).
+    const int bandWidth = colEnd - colStart;
+    std::vector<float> columns(static_cast<size_t>(bandWidth) * H), costA, costB;
+    for (int y = 0; y < H; ++y) {
+      const float* row = validated.ptr<float>(y);
+      for (int c = 0; c < bandWidth; ++c) {
+        columns[static_cast<size_t>(c) * H + y] = row[colStart + c];
       }
     }
-  }, /*bandRows=*/8);
+    std::vector<int> valid;
+    for (int x = colStart; x < colEnd; ++x) {
+      const float* val = &columns[static_cast<size_t>(x - colStart) * H];
+      valid.clear();
+      for (int y = 0; y < H; ++y) {
+        if (std::isfinite(val[y])) valid.push_back(y);
+      }
+      int done = -1;
+      for (size_t i = 0; i + 1 < valid.size(); ++i) {
+        const int p = valid[i], q = valid[i + 1];
+        StepSegment seg;
+        if (!stepSegment(val, H, p, q, h, done, static_cast<float>(s.minStep), seg)) {
+          continue;
+        }
+        const int s0 = seg.s0, s1 = seg.s1;
+        const float da = seg.da, db = seg.db;
+        // Only outlines that run with the rows: where a row steps within half a window of the
+        // column's step, the outline crosses the rows and the rows decided it (a diagonal
+        // outline decided by both passes moved by 2-8 px).
+        bool crossesRows = false;
+        for (int y = p; y <= q && !crossesRows; ++y) crossesRows = rowStepNear.at<uchar>(y, x) != 0;
+        if (crossesRows) continue;
+        const int dyA = roundHalfAway(shifts.at<float>(seg.ua, x));
+        const int dyB = roundHalfAway(shifts.at<float>(seg.ub, x));
+        const int n = s1 - s0 + 1;
+        costA.resize(static_cast<size_t>(n));
+        costB.resize(static_cast<size_t>(n));
+        bool scored = x - kColumnCostHalf >= 0 && x + kColumnCostHalf < W;
+        float rowErr[2 * kColumnCostHalf + 1];
+        auto rowCost = [&](int y, float d, int dy, float& cost) {
+          if (!columnErrors(ref, other, refValid, otherValid, x - kColumnCostHalf,
+                            2 * kColumnCostHalf + 1, y, 0, d, dy, rowErr)) {
+            return false;
+          }
+          cost = 0;
+          for (float e : rowErr) cost += e;
+          return true;
+        };
+        for (int k = 0; k < n && scored; ++k) {
+          scored = rowCost(s0 + k, da, dyA, costA[static_cast<size_t>(k)]) &&
+                   rowCost(s0 + k, db, dyB, costB[static_cast<size_t>(k)]);
+        }
+        if (!scored) continue;
+        const int beta = stepBoundary(costA, costB, s0, 0);  // last row of the upper side
+        for (int y = s0; y <= s1; ++y) {
+          float& side = sideD.at<float>(y, x);
+          if (!std::isnan(side) || inStrip.at<uchar>(y, x)) continue;  // a row's segment decided it
+          if (!std::isfinite(val[y])) continue;
+          const bool sideA = y <= beta;
+          side = sideA ? da : db;
+          sideDy.at<schar>(y, x) = static_cast<schar>(sideA ? dyA : dyB);
+        }
+        done = s1;
+      }
+    }
+  };
+  if (s.columnSteps) {
+    std::vector<std::function<void()>> columnTasks;
+    for (int x0 = 0; x0 < W; x0 += 16) {
+      columnTasks.emplace_back([&, x0] { chooseColumnSides(x0, std::min(W, x0 + 16)); });
+    }
+    runTasks(columnTasks, s.threads);
+  }
+  // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
+  // own side (same side value), and the validated pixels off the segments on that surface.
+  forRowBands(
+      H, s.threads,
+      [&](int rowStart, int rowEnd) {
+        CutWindow window;
+        for (int y = rowStart; y < rowEnd; ++y) {
+          float* outD = raw.disparity.ptr<float>(y);
+          float* outS = raw.lineShift.ptr<float>(y);
+          float* outScore = raw.score.ptr<float>(y);
+          const float* sides = sideD.ptr<float>(y);
+          const float* val = validated.ptr<float>(y);
+          const schar* sideShift = sideDy.ptr<schar>(y);
+          const uchar* wanted = matchOnly.empty() ? nullptr : matchOnly.ptr<uchar>(y);
+          for (int x = 0; x < W; ++x) {
+            const float side = sides[x];
+            if (!std::isfinite(side) || (wanted != nullptr && !wanted[x])) continue;
+            // A validated value already on this side stays: re-matching it costs the most (most
+            // segment pixels) and changed little.
+            const float kept = val[x];
+            if (std::isfinite(kept) && std::abs(kept - side) <= 1.0F) continue;
+            const int dy = sideShift[x];
+            buildCutWindow(ref, refValid, sideD, validated, side, x, y, h, s.minShape, window);
+            const Hypothesis hyp = bestNear(window, other, otherValid, otherInvalidSum, side, dy);
+            const float before = outD[x];
+            if (hyp.score >= static_cast<float>(s.minScore)) {
+              outD[x] = hyp.disparity;
+              outS[x] = static_cast<float>(dy);
+              outScore[x] = hyp.score;
+            } else {
+              outD[x] = kNaN;
+            }
+            if (!(before == outD[x])) ++changed;
+          }
+        }
+      },
+      /*bandRows=*/8);
   return changed.load();
 }
 

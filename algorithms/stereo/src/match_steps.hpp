@@ -23,6 +23,9 @@ struct StepRefineSettings {
   // are seen by the reference view only (hidden behind it in the other): they are left out of
   // the boundary's cost and of both sides' windows, and left unmatched.
   bool occlusionStrip = true;
+  // Steps along the columns too (outlines that run with the rows), where no row's segment
+  // decided the pixel.
+  bool columnSteps = true;
   int threads = 1;  // worker threads (1: the calling thread only)
 };
 
@@ -42,6 +45,13 @@ struct StepRefineSettings {
 //     pixels outside the segments within 1.5 px of that side (the step acts as a contour, in
 //     2D, so diagonal outlines are cut along their true direction).
 // Segments holding a validated value on neither side (a third surface) are left alone.
+// An outline that runs with the rows has no step along any row: the same is then done along
+// the columns (columnSteps), where no row steps within half a window of the column's step, on
+// the validated pixels no row's segment decided, with each pixel's error summed over x ± 2 of
+// its row (one pixel alone placed the boundary on noise) and no occluded strip (the views are
+// displaced along the rows only). Unmatched pixels are not given a side there: next to a
+// diagonal outline they are mostly the ground hidden in the other view (sim 400² edge 95.8 →
+// 92.1 % when they were).
 // Gaps of one surface (≤ gapFill unmatched pixels of a row between two validated pixels whose
 // values differ by ≤ gapTolerance) are matched again the same way around that surface: their
 // first match failed the left/right check or the score floor with the full adaptive window

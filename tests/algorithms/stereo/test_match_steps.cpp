@@ -1,5 +1,6 @@
-// The step cut (internal refineDepthSteps) on a depth step whose +x side is nearer: the strip
-// before the near surface is seen by the reference view only.
+// The step cut (internal refineDepthSteps): on a depth step whose +x side is nearer, the strip
+// before the near surface is seen by the reference view only; an outline that runs with the
+// rows is cut along the columns.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -81,6 +82,47 @@ TEST(StepCut, LeavesTheStripSeenByOneViewOutOfBothSides) {
   // confirm, which the left/right check may still let through next to the outline.
   EXPECT_GT(without.stripMatched, without.stripTotal / 2)
       << without.stripMatched << " of " << without.stripTotal;
+}
+
+// Left map of a contourless square whose bottom band (the `band` rows above its lower outline)
+// carries the background's disparity, as windows straddling an outline that runs with the rows
+// leave it: no row crosses that outline, so only the columns can see the step. Returns how many
+// band pixels (away from the square's sides) end within 1 px of the square's disparity.
+int bandPixelsOnTheSquare(bool columnSteps, int& total) {
+  const cv::Rect square(60, 30, 70, 40);
+  const int background = 4, foreground = 14, band = 5;
+  const auto scene = testing::squareScene({190, 100}, square, background, foreground, 11, 30.0);
+  cv::Mat validated = scene.truth.clone();
+  const int bandTop = square.br().y - band;
+  for (int y = bandTop; y < square.br().y; ++y) {
+    for (int x = square.x; x < square.br().x; ++x) validated.at<float>(y, x) = float(background);
+  }
+  LevelOutput raw;
+  raw.disparity = validated.clone();
+  raw.lineShift = cv::Mat::zeros(validated.size(), CV_32F);
+  raw.score = cv::Mat::zeros(validated.size(), CV_32F);
+  const cv::Mat valid = cv::Mat::ones(validated.size(), CV_8U);
+  StepRefineSettings settings;
+  settings.columnSteps = columnSteps;
+  refineDepthSteps(scene.left, scene.right, valid, valid, validated, settings, raw);
+  int onSquare = 0;
+  total = 0;
+  // Half a window from the square's sides, where the rows' own segments decide.
+  for (int y = bandTop; y < square.br().y; ++y) {
+    for (int x = square.x + 8; x < square.br().x - 8; ++x) {
+      ++total;
+      onSquare += std::abs(raw.disparity.at<float>(y, x) - foreground) <= 1.0F;
+    }
+  }
+  return onSquare;
+}
+
+TEST(StepCut, CutsAnOutlineThatRunsWithTheRowsAlongTheColumns) {
+  int total = 0;
+  const int with = bandPixelsOnTheSquare(true, total);
+  EXPECT_GT(with, total * 9 / 10) << with << " of " << total;
+  const int without = bandPixelsOnTheSquare(false, total);
+  EXPECT_LT(without, total / 10) << without << " of " << total;
 }
 
 }  // namespace
