@@ -429,7 +429,7 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
       }
       uchar* near = rowStepNear.ptr<uchar>(y);
       std::fill_n(near, W, uchar{0});
-      for (size_t i = 0; i + 1 < valid.size(); ++i) {
+      for (size_t i = 0; s.columnSteps && i + 1 < valid.size(); ++i) {
         const int p = valid[i], q = valid[i + 1];
         if (q - p > 2 * h || std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
         // x − h ≤ p and q ≤ x + h.
@@ -437,11 +437,11 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
       }
       int done = -1;  // last column re-decided in this row
       for (size_t i = 0; i + 1 < valid.size(); ++i) {
+        const int p = valid[i], q = valid[i + 1];
+        // (Most pairs are no step: tested here, the call is made for the others only.)
+        if (std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
         StepSegment seg;
-        if (!stepSegment(val, W, valid[i], valid[i + 1], h, done, static_cast<float>(s.minStep),
-                         seg)) {
-          continue;
-        }
+        if (!stepSegment(val, W, p, q, h, done, static_cast<float>(s.minStep), seg)) continue;
         const int s0 = seg.s0, s1 = seg.s1;
         const float da = seg.da, db = seg.db;
         const int dyA = roundHalfAway(shift[seg.ua]);
@@ -530,10 +530,9 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
       int done = -1;
       for (size_t i = 0; i + 1 < valid.size(); ++i) {
         const int p = valid[i], q = valid[i + 1];
+        if (std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
         StepSegment seg;
-        if (!stepSegment(val, H, p, q, h, done, static_cast<float>(s.minStep), seg)) {
-          continue;
-        }
+        if (!stepSegment(val, H, p, q, h, done, static_cast<float>(s.minStep), seg)) continue;
         const int s0 = seg.s0, s1 = seg.s1;
         const float da = seg.da, db = seg.db;
         // Only outlines that run with the rows: where a row steps within half a window of the
