@@ -15,6 +15,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "coarse_check.hpp"
 #include "cpu_features.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/core/nan_mask.hpp"
@@ -404,6 +405,15 @@ cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
   return needed;
 }
 
+// The matches of `map` that are checked at this level: those `kept` marks made NaN (a copy).
+detail::LevelOutput checkedHere(const detail::LevelOutput& map, const cv::Mat& kept) {
+  if (kept.empty()) return map;
+  detail::LevelOutput out = map;
+  out.disparity = map.disparity.clone();
+  out.disparity.setTo(std::numeric_limits<float>::quiet_NaN(), kept);
+  return out;
+}
+
 // Search intervals of a level from the validated disparities of the next coarser level: the
 // min..max of the valid coarse disparities in the 3x3 neighbourhood of the parent pixel, doubled,
 // ± margin. Where that neighbourhood holds no valid disparity (the parent was rejected), the
@@ -596,9 +606,15 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     }
     core::setStage(progress, core::StageId::MatchingLevelRightView, levelNumber, levels);
     // At the finest level the right map only validates the left one: only the right pixels
-    // that a left match points to (the floor/ceil neighbours the validation reads) are
-    // matched. The result is the same, at the cost of the unmatched and occluded areas less.
-    const cv::Mat needed = k == 0 ? pointedTo(leftOut, p.lineShift, threads) : cv::Mat();
+    // that a left match checked here points to (the floor/ceil neighbours the validation reads)
+    // are matched. The result is the same, at the cost of the unmatched and occluded areas less.
+    // Matches on smooth surfaces may keep the coarser level's check (coarse-check-score).
+    const cv::Mat parentLeft = coarseLeft;
+    const bool inheritChecks = k == 0 && !parentLeft.empty() && p.coarseCheckScore > 0;
+    cv::Mat kept;
+    if (inheritChecks) kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
+    const cv::Mat needed =
+        k == 0 ? pointedTo(checkedHere(leftOut, kept), p.lineShift, threads) : cv::Mat();
     // Right -> left: mirrored images turn x_left = x_right + d into x'_other = x'_ref - d.
     runTasks({[&] { inR.ref = flipped(lv.right); }, [&] { inR.other = flipped(lv.left); },
               [&] { inR.refValid = flipped(lv.rightValid); },
@@ -624,6 +640,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     };
     unmirror();
     coarseLeft = validate(leftOut, rightOut, +1, p.tolerance, threads);
+    if (!kept.empty()) leftOut.disparity.copyTo(coarseLeft, kept);
     coarseRight = validate(rightOut, leftOut, -1, p.tolerance, threads);
     if (p.adaptive && p.stepCut && k <= p.stepCutLevel) {
       // Depth steps of the validated maps (most have no image contour): each pixel near one is
@@ -640,7 +657,10 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                leftOut);
       // At the finest level the right map only validates the left one: its pixels that no left
       // match points to are not matched again (the result is the same).
-      const cv::Mat pointed = k == 0 ? pointedTo(leftOut, p.lineShift, threads) : cv::Mat();
+      // The step cut may have matched kept pixels again: the kept ones are decided anew.
+      if (inheritChecks) kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
+      const cv::Mat pointed =
+          k == 0 ? pointedTo(checkedHere(leftOut, kept), p.lineShift, threads) : cv::Mat();
       cv::Mat rightNeeded, rightValidated;  // mirrored, both flipped at once
       runTasks({[&] {
                   if (!pointed.empty()) rightNeeded = flipped(pointed);
@@ -651,6 +671,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                mirrored, rightNeeded);
       unmirror();
       coarseLeft = validate(leftOut, rightOut, +1, p.tolerance, threads);
+      if (!kept.empty()) leftOut.disparity.copyTo(coarseLeft, kept);
       // The validated right map guides the next finer level only.
       if (k > 0) coarseRight = validate(rightOut, leftOut, -1, p.tolerance, threads);
     }

@@ -157,6 +157,37 @@ TEST(Match, ValidationRejectsTheOccludedStrip) {
   EXPECT_GT(static_cast<double>(visibleGood) / visible, 0.85);
 }
 
+// Matches that keep the coarser level's check (coarse-check-score, on by default) lie on smooth
+// surfaces: the occluded strip is still rejected, and the rest of the map is the one that
+// checking every match at full resolution gives.
+TEST(Match, KeepingTheCoarserCheckOnSmoothSurfacesChangesLittle) {
+  const auto scene = squareScene({160, 120}, cv::Rect(60, 30, 60, 60), 2, 14);
+  MatchParams p;
+  p.dmin = 0;
+  p.dmax = 20;
+  ASSERT_GT(p.coarseCheckScore, 0.0);
+  const MatchResult kept = matchStereo(scene.left, scene.right, p);
+  p.coarseCheckScore = 0;
+  const MatchResult all = matchStereo(scene.left, scene.right, p);
+  int occluded = 0, keptRejected = 0, matched = 0, same = 0;
+  for (int y = 10; y < scene.left.rows - 10; ++y) {
+    for (int x = 25; x < scene.left.cols - 10; ++x) {
+      const float a = kept.disparity.at<float>(y, x), b = all.disparity.at<float>(y, x);
+      if (scene.occluded.at<uchar>(y, x)) {
+        ++occluded;
+        keptRejected += !std::isfinite(a);
+        continue;
+      }
+      if (!std::isfinite(a) && !std::isfinite(b)) continue;
+      ++matched;
+      same += std::abs(a - b) <= 0.05F;
+    }
+  }
+  ASSERT_GT(occluded, 500);
+  EXPECT_GT(static_cast<double>(keptRejected) / occluded, 0.9);
+  EXPECT_GT(static_cast<double>(same) / matched, 0.97) << same << " of " << matched;
+}
+
 // Matched pixels within `band` px of the square's vertical outline: how many, and how many
 // are off by more than 1 px (a step drawn at the wrong place).
 struct OutlineStats {

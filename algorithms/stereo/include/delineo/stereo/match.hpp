@@ -22,6 +22,8 @@ struct MatchParams {
   int levels = 0;                    // pyramid levels, 0 = auto: ceil(1 + log2(range / 20))
   int window = 15;                   // px, odd side of the (maximal) template window
   double tolerance = 1.0;            // px, τ of the symmetric left/right validation
+  double coarseCheckScore = 0.9;     // NCC from which a finest-level match on a smooth surface
+                                     // keeps the coarser level's check (0 = all checked anew)
   bool stepCut = true;               // windows cut at the depth steps of the validated map
   int stepCutLevel = 10;             // coarsest pyramid level it runs on (0 = full resolution only)
   double edgeLow = 40.0;             // Canny low threshold on the 0..255-normalised image
@@ -62,6 +64,15 @@ struct MatchParams {
     v(core::ParamInfo{"tolerance", "Validation tolerance", "px",
                       "Symmetric left/right consistency tolerance τ", 0, 10},
       tolerance);
+    v(core::ParamInfo{"coarse-check-score", "Coarse-check score", "",
+                      "At full resolution, a match whose NCC is at least this, within 1 px of "
+                      "its validated coarser-level disparity, and whose coarser 3x3 "
+                      "neighbourhood is all validated within 1 px (a smooth surface: nothing "
+                      "there is hidden from one view) keeps that level's left/right check "
+                      "instead of being checked again; 0 = every match checked at full "
+                      "resolution",
+                      0, 1},
+      coarseCheckScore);
     v(core::ParamInfo{"step-cut", "Cut windows at depth steps", "",
                       "Near depth steps of the validated map, locate the step along the row and "
                       "match again on windows cut there"},
