@@ -302,6 +302,10 @@
         <source>Smoothing tolerance</source>
         <translation>Tolérance du lissage</translation>
     </message>
+    <message>
+        <source>Coarse-check score</source>
+        <translation>Score du contrôle au niveau grossier</translation>
+    </message>
 </context>
 <context>
     <name>Stages</name>
