@@ -607,12 +607,14 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     core::setStage(progress, core::StageId::MatchingLevelRightView, levelNumber, levels);
     // At the finest level the right map only validates the left one: only the right pixels
     // that a left match checked here points to (the floor/ceil neighbours the validation reads)
-    // are matched. The result is the same, at the cost of the unmatched and occluded areas less.
+    // are matched: the same result as matching them all, the unmatched and occluded areas less.
     // Matches on smooth surfaces may keep the coarser level's check (coarse-check-score).
     const cv::Mat parentLeft = coarseLeft;
     const bool inheritChecks = k == 0 && !parentLeft.empty() && p.coarseCheckScore > 0;
     cv::Mat kept;
-    if (inheritChecks) kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
+    if (inheritChecks) {
+      kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
+    }
     const cv::Mat needed =
         k == 0 ? pointedTo(checkedHere(leftOut, kept), p.lineShift, threads) : cv::Mat();
     // Right -> left: mirrored images turn x_left = x_right + d into x'_other = x'_ref - d.
@@ -658,7 +660,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       // At the finest level the right map only validates the left one: its pixels that no left
       // match points to are not matched again (the result is the same).
       // The step cut may have matched kept pixels again: the kept ones are decided anew.
-      if (inheritChecks) kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
+      if (inheritChecks) {
+        kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
+      }
       const cv::Mat pointed =
           k == 0 ? pointedTo(checkedHere(leftOut, kept), p.lineShift, threads) : cv::Mat();
       cv::Mat rightNeeded, rightValidated;  // mirrored, both flipped at once
