@@ -505,10 +505,10 @@ long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& r
   }
   runTasks(tasks, s.threads);
   // Steps along the columns (outlines that run with the rows: no row crosses them), after the
-  // rows' segments, which keep their sides. The same boundary search on the pixel's own error;
-  // no occluded strip (the views are displaced along the rows only).
-  // A row's pixel alone was too noisy to place a boundary across the rows; the pixels x ± 2 of
-  // the row lie on the same side of an outline that runs with the rows.
+  // rows' segments, which keep their sides. The same boundary search, on each pixel's error
+  // summed over x ± 2 of its row (the pixel alone was too noisy to place a boundary across the
+  // rows; those pixels lie on the same side of an outline that runs with the rows); no occluded
+  // strip (the views are displaced along the rows only).
   constexpr int kColumnCostHalf = 2;
   auto chooseColumnSides = [&](int colStart, int colEnd) {
     // The band's columns, each contiguous (one pass over the rows).

@@ -158,13 +158,14 @@ TEST(Match, ValidationRejectsTheOccludedStrip) {
 }
 
 // Matches that keep the coarser level's check (coarse-check-score, on by default) lie on smooth
-// surfaces: the occluded strip is still rejected, and the rest of the map is the one that
+// surfaces: the occluded strip is still rejected, and the rest of the map is nearly the one that
 // checking every match at full resolution gives.
 TEST(Match, KeepingTheCoarserCheckOnSmoothSurfacesChangesLittle) {
   const auto scene = squareScene({160, 120}, cv::Rect(60, 30, 60, 60), 2, 14);
   MatchParams p;
   p.dmin = 0;
   p.dmax = 20;
+  p.levels = 2;  // the check is kept from a coarser level (auto gives one level for 20 px)
   ASSERT_GT(p.coarseCheckScore, 0.0);
   const MatchResult kept = matchStereo(scene.left, scene.right, p);
   p.coarseCheckScore = 0;
@@ -185,7 +186,10 @@ TEST(Match, KeepingTheCoarserCheckOnSmoothSurfacesChangesLittle) {
   }
   ASSERT_GT(occluded, 500);
   EXPECT_GT(static_cast<double>(keptRejected) / occluded, 0.9);
-  EXPECT_GT(static_cast<double>(same) / matched, 0.97) << same << " of " << matched;
+  // (Measured: 716 of 720 occluded pixels rejected, 11 030 of 11 285 matched pixels unchanged.)
+  EXPECT_GT(static_cast<double>(same) / matched, 0.95) << same << " of " << matched;
+  // Not the same map either: matches the full-resolution check would have rejected are kept.
+  EXPECT_LT(same, matched);
 }
 
 // Matched pixels within `band` px of the square's vertical outline: how many, and how many
