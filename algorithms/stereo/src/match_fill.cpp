@@ -121,6 +121,19 @@ bool scanConfirms(const ErrorAt& errorAt, int dmin, int dmax, float best, double
   return *lowest <= agreement * other;
 }
 
+// Whether the outline lines up clearly better somewhere else than at `best`: some integer
+// disparity more than 2 px from it with a ring error below `ratio` × `bestError`.
+// `errorAt(d, stopAbove)` may give up (any value ≥ stopAbove) once the error is sure to exceed it.
+template <typename ErrorAt>
+bool scanFindsBetterElsewhere(const ErrorAt& errorAt, int dmin, int dmax, float best,
+                              double bestError, double ratio) {
+  const double limit = ratio * bestError;
+  for (int d = dmin; d <= dmax; ++d) {
+    if (std::abs(d - best) > 2 && errorAt(static_cast<float>(d), limit) < limit) return true;
+  }
+  return false;
+}
+
 // The flat region stops 2 px short of its contour (its 5x5 windows reach across it): grow it
 // back, 4-connected and at most `growReach` px, over the pixels that look like the region next to
 // them (within growSigmas noise sigmas of the mean of the region pixels in their 7x7
@@ -802,10 +815,13 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       }
     }
     // Mean |left − mapped right| over the ring at the plane's disparity, the right view read
-    // with linear interpolation (the candidates are sub-pixel).
-    auto planeRingError = [&](const FillPlane& plane) {
+    // with linear interpolation (the candidates are sub-pixel). With `stopAbove`, 1e30 as soon
+    // as the mean is sure to exceed it (the scans of the whole range mostly meet such errors).
+    auto planeRingError = [&](const FillPlane& plane, double stopAbove = 1e30) {
+      const double bound = stopAbove < 1e29 ? stopAbove * cv::countNonZero(ring) : 1e300;
       double sum = 0, n = 0;
       for (int y = 0; y < box.height; ++y) {
+        if (sum > bound) return 1e30;
         const uchar* m = ring.ptr<uchar>(y);
         const float* a = left.ptr<float>(box.y + y) + box.x;
         const float* b = right.ptr<float>(box.y + y);
@@ -825,7 +841,8 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       return n > 0 ? sum / n : 1e30;
     };
     // The constant disparity of the outline's matches, when the outline lines up there.
-    double constantError = 0;  // the constant's error on the (final) ring
+    double constantError = 0;      // the constant's error on the (final) ring
+    double candidateError = 1e30;  // the best candidate's, filled or not
     const auto constant = [&]() -> std::optional<float> {
       if (static_cast<int>(matches.size()) < settings.minMatched) return std::nullopt;
       auto ringError = [&](float value) { return planeRingError(FillPlane{value, 0, 0}); };
@@ -873,11 +890,19 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         }
       }
       const auto [best, bestError, otherError] = ranked;
+      candidateError = bestError;
       if (bestError > settings.photometric * sigma) return std::nullopt;
       if (bestError > settings.contrast * otherError &&
           !(settings.scanAgreement > 0 &&
             scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement,
                          settings.scanReach))) {
+        return std::nullopt;
+      }
+      if (settings.scanVeto > 0 && scanFindsBetterElsewhere(
+                                       [&](float value, double stopAbove) {
+                                         return planeRingError(FillPlane{value, 0, 0}, stopAbove);
+                                       },
+                                       dmin, dmax, best, bestError, settings.scanVeto)) {
         return std::nullopt;
       }
       // The candidates are ranked by their clusters' means; the value filled in is the chosen
@@ -928,7 +953,9 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       // (seed 3 1000²: 4.3475 against 4.3573 once the constant is refocused; sloped facets win
       // by 7 % or more on the simulated scenes).
       if (!sloped ||
-          (constant && !(planeRingError(plane) < settings.planeMargin * constantError))) {
+          (constant && !(planeRingError(plane) < settings.planeMargin * constantError)) ||
+          (!constant && settings.planeCandidateRatio > 0 &&
+           !(planeRingError(plane) < settings.planeCandidateRatio * candidateError))) {
         if (!constant) continue;
         plane = FillPlane{*constant, 0, 0};
       }
