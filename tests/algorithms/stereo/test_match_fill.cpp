@@ -76,6 +76,12 @@ void fill(SceneT& s, const RegionFillSettings& settings, int dmax) {
   fillFlatRegions(s.left, s.right, settings, 0, dmax, 0.3f, s.disparity, s.score);
 }
 
+// `s` after the fill (range 0..32).
+Scene filled(Scene s, const RegionFillSettings& settings) {
+  fill(s, settings, 32);
+  return s;
+}
+
 // Pixels of `area` whose disparity is within `tolerance` px (exclusive) of expected(x, y).
 template <class Expected>
 int pixelsWithin(const cv::Mat& disparity, const cv::Rect& area, Expected&& expected,
@@ -167,12 +173,10 @@ Scene sceneWithItsStripsThreePixelsShort() {
 }
 
 TEST(FillFlatRegions, ACandidateTheOutlineLinesUpClearlyBetterElsewhereIsNotFilled) {
-  Scene vetoed = sceneWithItsStripsThreePixelsShort();
-  fill(vetoed, RegionFillSettings{}, 32);
-  Scene unvetoed = sceneWithItsStripsThreePixelsShort();
   RegionFillSettings noVeto;
   noVeto.scanVeto = 0;
-  fill(unvetoed, noVeto, 32);
+  const Scene vetoed = filled(sceneWithItsStripsThreePixelsShort(), RegionFillSettings{});
+  const Scene unvetoed = filled(sceneWithItsStripsThreePixelsShort(), noVeto);
   const auto shortOfTheRoof = [&](const Scene& s) {
     return pixelsWithin(
         s.disparity, s.roof, [](int, int) { return kRoof - 3.0f; }, 0.5);
@@ -192,12 +196,10 @@ TEST(FillFlatRegions, WhereNoConstantIsFilledAPlaneMustLineTheOutlineUpAboutAsWe
   // not when the plane must do five times better than the candidate. (On the 2000² scene a
   // plain roof strip between two seams took the plane of the next strip over in the right view,
   // 16 px off, whose outline error was 1.2 × the best candidate's.)
-  Scene kept = sceneWithItsStripsThreePixelsShort();
-  fill(kept, RegionFillSettings{}, 32);
-  Scene refused = sceneWithItsStripsThreePixelsShort();
   RegionFillSettings demanding;
   demanding.planeCandidateRatio = 0.2;
-  fill(refused, demanding, 32);
+  const Scene kept = filled(sceneWithItsStripsThreePixelsShort(), RegionFillSettings{});
+  const Scene refused = filled(sceneWithItsStripsThreePixelsShort(), demanding);
   EXPECT_GE(roofPixelsWithTheRoofsDisparity(kept), 1800);
   EXPECT_EQ(roofPixelsWithTheRoofsDisparity(refused), 0);
 }
