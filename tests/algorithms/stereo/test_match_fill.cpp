@@ -76,12 +76,6 @@ void fill(SceneT& s, const RegionFillSettings& settings, int dmax) {
   fillFlatRegions(s.left, s.right, settings, 0, dmax, 0.3f, s.disparity, s.score);
 }
 
-// `s` after the fill (range 0..32).
-Scene filled(Scene s, const RegionFillSettings& settings) {
-  fill(s, settings, 32);
-  return s;
-}
-
 // Pixels of `area` whose disparity is within `tolerance` px (exclusive) of expected(x, y).
 template <class Expected>
 int pixelsWithin(const cv::Mat& disparity, const cv::Rect& area, Expected&& expected,
@@ -159,49 +153,6 @@ TEST(FillFlatRegions, AScanOfTheRangeConfirmsAnUnclearCandidate) {
   // growth take some ground along the outline: less than half a pixel per outline pixel.
   const int perimeter = 2 * (scanned.roof.width + scanned.roof.height);
   EXPECT_LT(spilledOntoTheGround(scanned), perimeter / 2);
-}
-
-// The scene's roof (grey 140) with its matched top and bottom strips 3 px short of it: their
-// cluster is the best candidate, and the ground's lines the outline up worse still, but the
-// outline lines up clearly better at the roof's own disparity.
-Scene sceneWithItsStripsThreePixelsShort() {
-  Scene s = scene(140.0f);
-  const float shortOfIt = kRoof - 3.0f;
-  s.disparity(cv::Rect(s.roof.x + 2, s.roof.y, s.roof.width - 4, 2)).setTo(shortOfIt);
-  s.disparity(cv::Rect(s.roof.x + 2, s.roof.br().y - 2, s.roof.width - 4, 2)).setTo(shortOfIt);
-  return s;
-}
-
-TEST(FillFlatRegions, ACandidateTheOutlineLinesUpClearlyBetterElsewhereIsNotFilled) {
-  RegionFillSettings noVeto;
-  noVeto.scanVeto = 0;
-  const Scene vetoed = filled(sceneWithItsStripsThreePixelsShort(), RegionFillSettings{});
-  const Scene unvetoed = filled(sceneWithItsStripsThreePixelsShort(), noVeto);
-  const auto shortOfTheRoof = [&](const Scene& s) {
-    return pixelsWithin(
-        s.disparity, s.roof, [](int, int) { return kRoof - 3.0f; }, 0.5);
-  };
-  // (Measured: without the veto 1 920 of the 2 000 roof pixels 3 px short, none right; with it,
-  // the constant is not filled and the plane through the row ends of the roof and of its
-  // counterpart fills 1 901 at the roof's disparity, 91 of the strips' pixels keep theirs.)
-  EXPECT_GE(shortOfTheRoof(unvetoed), 1800);
-  EXPECT_EQ(roofPixelsWithTheRoofsDisparity(unvetoed), 0);
-  EXPECT_LE(shortOfTheRoof(vetoed), 184);  // at most the strips
-  EXPECT_GE(roofPixelsWithTheRoofsDisparity(vetoed), 1800);
-}
-
-TEST(FillFlatRegions, WhereNoConstantIsFilledAPlaneMustLineTheOutlineUpAboutAsWell) {
-  // The roof's plane (through its row ends and its counterpart's, at the roof's disparity) lines
-  // the outline up at 0.2-0.3 × the error of the strips' candidate: kept at the default ratio,
-  // not when the plane must do five times better than the candidate. (On the 2000² scene a
-  // plain roof strip between two seams took the plane of the next strip over in the right view,
-  // 16 px off, whose outline error was 1.2 × the best candidate's.)
-  RegionFillSettings demanding;
-  demanding.planeCandidateRatio = 0.2;
-  const Scene kept = filled(sceneWithItsStripsThreePixelsShort(), RegionFillSettings{});
-  const Scene refused = filled(sceneWithItsStripsThreePixelsShort(), demanding);
-  EXPECT_GE(roofPixelsWithTheRoofsDisparity(kept), 1800);
-  EXPECT_EQ(roofPixelsWithTheRoofsDisparity(refused), 0);
 }
 
 TEST(FillFlatRegions, ThinFlatPartsJoinedToARoofDoNotDecideItsFill) {
@@ -688,13 +639,68 @@ TEST(FillFlatRegions, ItsOwnMatchesStayWhereTheirDisparityExplainsThemClearlyBet
             band.area());
 }
 
+TEST(FillFlatRegions, ItsOwnMatchesAFewPixelsOffTheFillTakeItWhereItExplainsThemAsWell) {
+  // 3.5 px above the fill: a raised box's disparity carried onto the plain roof around it by
+  // windows that reached the box's edges (seed 5 600²). Kept with the session-19 offset (8 px).
+  RegionFillSettings farOnly;
+  farOnly.inRegionReplaceOff = 8.0;
+  const auto [replaced, kept] =
+      filledWithAndWithout([] { return sceneWithABandInsideTheRoof(kRoof + 3.5f); }, {}, farOnly);
+  // (Measured: 26 of 36 replaced, 0 with the 8 px offset; the others' windows are explained a
+  // little better at their own disparity by the noise.)
+  expectTheRuleFills(replaced, kept, bandInsideTheRoof(replaced), 0.01, 0.6);
+}
+
+// The scene's roof (grey 140) with its matched top and bottom strips 3 px short of it: their
+// cluster is the best candidate, and the ground's lines the outline up worse still, but the
+// outline lines up clearly better at the roof's own disparity.
+Scene sceneWithItsStripsThreePixelsShort() {
+  Scene s = scene(140.0f);
+  const float shortOfIt = kRoof - 3.0f;
+  s.disparity(cv::Rect(s.roof.x + 2, s.roof.y, s.roof.width - 4, 2)).setTo(shortOfIt);
+  s.disparity(cv::Rect(s.roof.x + 2, s.roof.br().y - 2, s.roof.width - 4, 2)).setTo(shortOfIt);
+  return s;
+}
+
+TEST(FillFlatRegions, ACandidateTheOutlineLinesUpClearlyBetterElsewhereIsNotFilled) {
+  RegionFillSettings noVeto;
+  noVeto.scanVeto = 0;
+  const auto [vetoed, unvetoed] =
+      filledWithAndWithout(sceneWithItsStripsThreePixelsShort, {}, noVeto);
+  const auto shortOfTheRoof = [&](const Scene& s) {
+    return pixelsWithin(
+        s.disparity, s.roof, [](int, int) { return kRoof - 3.0f; }, 0.5);
+  };
+  // (Measured: without the veto 1 920 of the 2 000 roof pixels 3 px short, none right; with it,
+  // the constant is not filled and the plane through the row ends of the roof and of its
+  // counterpart fills 1 901 at the roof's disparity, 91 of the strips' pixels keep theirs.)
+  EXPECT_GE(shortOfTheRoof(unvetoed), 1800);
+  EXPECT_EQ(roofPixelsWithTheRoofsDisparity(unvetoed), 0);
+  EXPECT_LE(shortOfTheRoof(vetoed), 184);  // at most the strips
+  EXPECT_GE(roofPixelsWithTheRoofsDisparity(vetoed), 1800);
+}
+
+TEST(FillFlatRegions, WhereNoConstantIsFilledAPlaneMustLineTheOutlineUpAboutAsWell) {
+  // The roof's plane (through its row ends and its counterpart's, at the roof's disparity) lines
+  // the outline up at 0.2-0.3 × the error of the strips' candidate: kept at the default ratio,
+  // not when the plane must do five times better than the candidate. (On the 2000² scene a
+  // plain roof strip between two seams took the plane of the next strip over in the right view,
+  // 16 px off, whose outline error was 1.2 × the best candidate's.)
+  RegionFillSettings demanding;
+  demanding.planeCandidateRatio = 0.2;
+  const auto [kept, refused] =
+      filledWithAndWithout(sceneWithItsStripsThreePixelsShort, {}, demanding);
+  EXPECT_GE(roofPixelsWithTheRoofsDisparity(kept), 1800);
+  EXPECT_EQ(roofPixelsWithTheRoofsDisparity(refused), 0);
+}
+
 TEST(FillFlatRegions, ItsOwnMatchesCloseToTheFillStay) {
-  // 5 px off the fill (a plain slanted surface's matches, right where a constant fill is not).
-  Scene s = sceneWithABandInsideTheRoof(kRoof - 5.0f);
+  // 2 px off the fill (a plain slanted surface's matches, right where a constant fill is not).
+  Scene s = sceneWithABandInsideTheRoof(kRoof - 2.0f);
   fill(s, RegionFillSettings{}, 32);
   const cv::Rect band = bandInsideTheRoof(s);
   EXPECT_EQ(pixelsWithin(
-                s.disparity, band, [](int, int) { return kRoof - 5.0f; }, 0.01),
+                s.disparity, band, [](int, int) { return kRoof - 2.0f; }, 0.01),
             band.area());
 }
 }  // namespace
