@@ -251,6 +251,10 @@
         <translation>Sauts de profondeur calés sur les contours</translation>
     </message>
     <message>
+        <source>Ordering check</source>
+        <translation>Contrôle de l’ordre</translation>
+    </message>
+    <message>
         <source>Fill flat regions</source>
         <translation>Remplir les régions uniformes</translation>
     </message>

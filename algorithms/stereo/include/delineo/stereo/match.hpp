@@ -37,6 +37,7 @@ struct MatchParams {
   bool adaptive = true;              // contour-adaptive shapes (false: plain square windows)
   bool fillRegions = true;           // flat regions take the disparity lining up their outline
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
+  bool orderingCheck = true;         // matches a nearer one hides in the right view are rejected
   int speckleSize = 20;              // px, matched regions smaller than this are removed (0 = off)
   int speckleRange = 2;              // px, largest disparity difference within one such region
   int smoothWindow = 5;              // px, odd side of the surface-smoothing window (0 = off)
@@ -118,6 +119,12 @@ struct MatchParams {
                       "image there, where the pixels changed match better that way (adaptive "
                       "method only)"},
       snapSteps);
+    v(core::ParamInfo{"ordering-check", "Ordering check", "",
+                      "Along each row, a match that a nearer match to its right hides in the right "
+                      "view (its right-view position beyond that match's by more than 1 px, the "
+                      "other at least 2 px nearer) is rejected: the left/right check passes a "
+                      "far surface's disparity carried alike into a nearer one in both views"},
+      orderingCheck);
     v(core::ParamInfo{"speckle-size", "Speckle size", "px",
                       "Connected matched regions (8-neighbours within speckle-range) smaller "
                       "than this are made unmatched, last; 0 = off (adaptive method; SGBM "

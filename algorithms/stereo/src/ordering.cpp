@@ -1,0 +1,38 @@
+// Matches hidden in the right view by a nearer match to their right (see ordering.hpp).
+#include "ordering.hpp"
+
+#include <limits>
+
+namespace delineo::stereo::detail {
+
+int rejectOrderingViolations(cv::Mat& disparity, cv::Mat& score, const OrderingSettings& settings) {
+  CV_Assert(disparity.type() == CV_32F && (score.empty() || score.size() == disparity.size()));
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  const auto tolerance = static_cast<float>(settings.tolerance);
+  const auto minJump = static_cast<float>(settings.minJump);
+  int rejected = 0;
+  for (int y = 0; y < disparity.rows; ++y) {
+    float* d = disparity.ptr<float>(y);
+    float* s = score.empty() ? nullptr : score.ptr<float>(y);
+    // From the right: the leftmost right-view position of the kept matches so far, and its
+    // disparity. A rejected match hides nothing.
+    float leftmost = std::numeric_limits<float>::infinity(), itsDisparity = 0;
+    for (int x = disparity.cols - 1; x >= 0; --x) {
+      if (!(d[x] == d[x])) continue;
+      const float mapped = static_cast<float>(x) - d[x];
+      if (leftmost < mapped - tolerance && itsDisparity - d[x] >= minJump) {
+        d[x] = kNaN;
+        if (s != nullptr) s[x] = kNaN;
+        ++rejected;
+        continue;
+      }
+      if (mapped < leftmost) {
+        leftmost = mapped;
+        itsDisparity = d[x];
+      }
+    }
+  }
+  return rejected;
+}
+
+}  // namespace delineo::stereo::detail
