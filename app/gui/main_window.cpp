@@ -1215,19 +1215,22 @@ void MainWindow::rejectSelected() {
 
 void MainWindow::readFormsIntoDocument() {
   if (!document_) return;
+  // Both forms are read before either group is written: writing a group reloads both forms from
+  // the project, which would undo an edit of the other form not yet written (the first matching
+  // edit on a project whose stored delineation group lacks a field was lost).
 #ifdef DELINEO_HAVE_DELINEATION
-  {
-    auto params = project::parameters<delineation::DelineationParams>(document_->project(), "delineation");
-    delineationForm_->readInto(params);
-    document_->setParameters("delineation", core::toJson(params));
-  }
+  auto delineationParams = project::parameters<delineation::DelineationParams>(document_->project(), "delineation");
+  delineationForm_->readInto(delineationParams);
 #endif
 #ifdef DELINEO_HAVE_STEREO
-  {
-    auto params = project::parameters<stereo::MatchParams>(document_->project(), "matching");
-    matchingForm_->readInto(params);
-    document_->setParameters("matching", core::toJson(params));
-  }
+  auto matchingParams = project::parameters<stereo::MatchParams>(document_->project(), "matching");
+  matchingForm_->readInto(matchingParams);
+#endif
+#ifdef DELINEO_HAVE_DELINEATION
+  document_->setParameters("delineation", core::toJson(delineationParams));
+#endif
+#ifdef DELINEO_HAVE_STEREO
+  document_->setParameters("matching", core::toJson(matchingParams));
 #endif
 }
 

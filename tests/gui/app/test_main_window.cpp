@@ -3,11 +3,14 @@
 // polygon, drag a vertex, undo, redo, accept, save, reload, export; plus bad inputs, autosave
 // recovery and the French translation.
 #include <QAction>
+#include <QCheckBox>
 #include <QElapsedTimer>
 #include <QFile>
+#include <QScrollArea>
 #include <QSettings>
 #include <QSignalSpy>
 #include <QStandardPaths>
+#include <QTabWidget>
 #include <QTableView>
 #include <QTemporaryDir>
 #include <QTest>
@@ -28,6 +31,7 @@
 #include "delineo/stereo/match.hpp"
 #include "delineo/widgets/disparity_histogram.hpp"
 #include "delineo/widgets/image_view.hpp"
+#include "delineo/widgets/parameter_form.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "delineo/widgets/stage_text.hpp"
 #include "document.hpp"
@@ -550,6 +554,34 @@ class MainWindowTest : public QObject {
     }
     QCoreApplication::removeTranslator(&translator);
     QVERIFY2(stillEnglish.isEmpty(), qPrintable(stillEnglish.join(QStringLiteral(", "))));
+  }
+
+  void orderingCheckIsAMatchingParameterOfTheProject() {
+    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
+    if (!window_->document()) QVERIFY(window_->openProject(projectPath_));
+    auto* box = window_->matchingForm()->findChild<QCheckBox*>(QStringLiteral("ordering-check"));
+    QVERIFY(box);
+    QVERIFY(box->isChecked());
+    QVERIFY(!box->toolTip().isEmpty());
+    const auto stored = [&] {
+      return project::parameters<stereo::MatchParams>(window_->document()->project(), "matching").orderingCheck;
+    };
+    QVERIFY(stored());
+    box->click();
+    QVERIFY(!stored());
+    // Shown on the Matching tab, scrolled to (DELINEO_SCREENSHOT_DIR keeps a rendering).
+    auto* tabs = window_->findChild<QTabWidget*>();
+    QVERIFY(tabs);
+    tabs->setCurrentIndex(1);
+    auto* scroll = qobject_cast<QScrollArea*>(tabs->currentWidget());
+    QVERIFY(scroll);
+    scroll->ensureWidgetVisible(box);
+    QVERIFY(box->isVisible());
+    const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
+    if (!dir.isEmpty()) window_->grab().save(dir + QStringLiteral("/matching-tab.png"));
+    box->click();
+    QVERIFY(stored());
+    tabs->setCurrentIndex(0);
   }
 
   void cleanupTestCase() { window_.reset(); }
