@@ -105,10 +105,11 @@ std::vector<int> twoLargestClusters(const std::vector<float>& values, int dmin, 
 // the lowest error found 3 px or more away: the outline lines up there and nowhere else.
 // (`best` is a sub-pixel cluster mean and a large roof's ring error is flat within a pixel of
 // its minimum: the integer minimum can lie 1.4 px away.)
+// `errors`: out, the ring error of every integer disparity dmin..dmax (the veto reads it again).
 template <typename ErrorAt>
 bool scanConfirms(const ErrorAt& errorAt, int dmin, int dmax, float best, double agreement,
-                  double reach) {
-  std::vector<double> errors(static_cast<size_t>(dmax - dmin + 1));
+                  double reach, std::vector<double>& errors) {
+  errors.resize(static_cast<size_t>(dmax - dmin + 1));
   for (int d = dmin; d <= dmax; ++d)
     errors[static_cast<size_t>(d - dmin)] = errorAt(static_cast<float>(d));
   const auto lowest = std::min_element(errors.begin(), errors.end());
@@ -815,13 +816,13 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       }
     }
     // Mean |left − mapped right| over the ring at the plane's disparity, the right view read
-    // with linear interpolation (the candidates are sub-pixel). With `stopAbove`, 1e30 as soon
-    // as the mean is sure to exceed it (the scans of the whole range mostly meet such errors).
-    auto planeRingError = [&](const FillPlane& plane, double stopAbove = 1e30) {
-      const double bound = stopAbove < 1e29 ? stopAbove * cv::countNonZero(ring) : 1e300;
+    // with linear interpolation (the candidates are sub-pixel). 1e30 as soon as the sum exceeds
+    // `stopAboveSum` (a bound on the mean times the ring's size: the mean is sure to exceed the
+    // bound; the scans of the whole range mostly meet such errors).
+    auto planeRingError = [&](const FillPlane& plane, double stopAboveSum = 1e300) {
       double sum = 0, n = 0;
       for (int y = 0; y < box.height; ++y) {
-        if (sum > bound) return 1e30;
+        if (sum > stopAboveSum) return 1e30;
         const uchar* m = ring.ptr<uchar>(y);
         const float* a = left.ptr<float>(box.y + y) + box.x;
         const float* b = right.ptr<float>(box.y + y);
@@ -892,17 +893,20 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       const auto [best, bestError, otherError] = ranked;
       candidateError = bestError;
       if (bestError > settings.photometric * sigma) return std::nullopt;
+      std::vector<double> scanned;  // the scan of the range, when the contrast test needed it
       if (bestError > settings.contrast * otherError &&
           !(settings.scanAgreement > 0 &&
-            scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement,
-                         settings.scanReach))) {
+            scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement, settings.scanReach,
+                         scanned))) {
         return std::nullopt;
       }
-      if (settings.scanVeto > 0 && scanFindsBetterElsewhere(
-                                       [&](float value, double stopAbove) {
-                                         return planeRingError(FillPlane{value, 0, 0}, stopAbove);
-                                       },
-                                       dmin, dmax, best, bestError, settings.scanVeto)) {
+      const double ringPixels = cv::countNonZero(ring);
+      const auto vetoError = [&](float value, double stopAbove) {
+        if (!scanned.empty()) return scanned[static_cast<size_t>(static_cast<int>(value) - dmin)];
+        return planeRingError(FillPlane{value, 0, 0}, stopAbove * ringPixels);
+      };
+      if (settings.scanVeto > 0 &&
+          scanFindsBetterElsewhere(vetoError, dmin, dmax, best, bestError, settings.scanVeto)) {
         return std::nullopt;
       }
       // The candidates are ranked by their clusters' means; the value filled in is the chosen
