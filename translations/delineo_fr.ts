@@ -874,6 +874,14 @@
         <translation>&amp;Rétablir : %1</translation>
     </message>
     <message>
+        <source>Undo</source>
+        <translation>Annuler</translation>
+    </message>
+    <message>
+        <source>Redo</source>
+        <translation>Rétablir</translation>
+    </message>
+    <message>
         <source>x %1  y %2  grey %3</source>
         <translation>x %1  y %2  gris %3</translation>
     </message>

@@ -343,8 +343,8 @@ void MainWindow::createDocks() {
   matchingForm_->setParams(stereo::MatchParams{});
 #endif
   for (auto* form : {delineationForm_, matchingForm_}) {
-    connect(form, &widgets::ParameterForm::changed, this, [this] {
-      if (!updatingForms_) readFormsIntoDocument();
+    connect(form, &widgets::ParameterForm::changed, this, [this, form] {
+      if (!updatingForms_) readFormIntoDocument(form);
     });
   }
   auto* delineationScroll = new QScrollArea;
@@ -1071,6 +1071,12 @@ void MainWindow::updateActions() {
   redo->setEnabled(stack && stack->canRedo());
   undo->setText(stack && stack->canUndo() ? tr("&Undo %1").arg(stack->undoText()) : tr("&Undo"));
   redo->setText(stack && stack->canRedo() ? tr("&Redo %1").arg(stack->redoText()) : tr("&Redo"));
+  // The toolbar keeps a short label (with the command's name the buttons after it moved into the
+  // overflow menu); the tooltip and the Edit menu name the command.
+  undo->setIconText(tr("Undo"));
+  redo->setIconText(tr("Redo"));
+  undo->setToolTip(QString(undo->text()).remove(QLatin1Char('&')));
+  redo->setToolTip(QString(redo->text()).remove(QLatin1Char('&')));
 }
 
 void MainWindow::updateReadout(QPointF p, bool leftGeometry, const cv::Mat& ownGrey) {
@@ -1213,24 +1219,26 @@ void MainWindow::rejectSelected() {
 // ------------------------------------------------------------------------------------------
 // parameters
 
-void MainWindow::readFormsIntoDocument() {
+void MainWindow::readFormIntoDocument(const widgets::ParameterForm* form) {
+  Q_UNUSED(form);  // (in a build without both algorithms)
   if (!document_) return;
-  // Both forms are read before either group is written: writing a group reloads both forms from
-  // the project, which would undo an edit of the other form not yet written (the first matching
-  // edit on a project whose stored delineation group lacks a field was lost).
+  // Only the edited form's group is written: one edit, one undo entry. Writing a group reloads
+  // both forms from the project, and the other form shows its stored group already (each edit
+  // is written at once), so nothing of it is lost. (Writing both groups made two undo entries
+  // when the stored one lacked a field, and, written in the wrong order, lost the edit.)
 #ifdef DELINEO_HAVE_DELINEATION
-  auto delineationParams = project::parameters<delineation::DelineationParams>(document_->project(), "delineation");
-  delineationForm_->readInto(delineationParams);
+  if (form == delineationForm_) {
+    auto params = project::parameters<delineation::DelineationParams>(document_->project(), "delineation");
+    delineationForm_->readInto(params);
+    document_->setParameters("delineation", core::toJson(params));
+  }
 #endif
 #ifdef DELINEO_HAVE_STEREO
-  auto matchingParams = project::parameters<stereo::MatchParams>(document_->project(), "matching");
-  matchingForm_->readInto(matchingParams);
-#endif
-#ifdef DELINEO_HAVE_DELINEATION
-  document_->setParameters("delineation", core::toJson(delineationParams));
-#endif
-#ifdef DELINEO_HAVE_STEREO
-  document_->setParameters("matching", core::toJson(matchingParams));
+  if (form == matchingForm_) {
+    auto params = project::parameters<stereo::MatchParams>(document_->project(), "matching");
+    matchingForm_->readInto(params);
+    document_->setParameters("matching", core::toJson(params));
+  }
 #endif
 }
 
@@ -1284,7 +1292,7 @@ widgets::JobId MainWindow::startDelineation(int id) {
     showMessage(tr("Active polygon"), tr("Compute the disparity (or choose a roof interval) first."));
     return 0;
   }
-  readFormsIntoDocument();
+  readFormIntoDocument(delineationForm_);
   Building building = *current;
   if (id == selectedId_ && histogram_->sampleCount() > 0) {
     building.roofInterval = project::DisparityInterval{histogram_->lowerBound(), histogram_->upperBound()};

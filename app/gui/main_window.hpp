@@ -145,7 +145,7 @@ class MainWindow : public QMainWindow {
   void rebuildRecentMenu();
   void setLanguage(const QString& code);
   void ensure3DView();
-  void readFormsIntoDocument();
+  void readFormIntoDocument(const widgets::ParameterForm* form);
   void loadFormsFromDocument();
 
   std::unique_ptr<Document> document_;

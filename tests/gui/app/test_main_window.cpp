@@ -14,6 +14,8 @@
 #include <QTableView>
 #include <QTemporaryDir>
 #include <QTest>
+#include <QToolBar>
+#include <QToolButton>
 #include <QTranslator>
 #include <QUndoStack>
 #include <algorithm>
@@ -567,8 +569,28 @@ class MainWindowTest : public QObject {
       return project::parameters<stereo::MatchParams>(window_->document()->project(), "matching").orderingCheck;
     };
     QVERIFY(stored());
+    // One click, one undo entry (the stored delineation group of the sample lacks fields the form
+    // has: it was written too, as a second entry).
+    QUndoStack* undo = window_->document()->undoStack();
+    const int entries = undo->count();
     box->click();
     QVERIFY(!stored());
+    QCOMPARE(undo->count(), entries + 1);
+    QCOMPARE(undo->undoText(), QStringLiteral("Change matching parameters"));
+    // The toolbar button keeps its short label; its tooltip names the command.
+    auto* toolbar = window_->findChild<QToolBar*>();
+    QVERIFY(toolbar);
+    auto* undoButton = qobject_cast<QToolButton*>(
+        toolbar->widgetForAction(window_->findChild<QAction*>(QStringLiteral("actionUndo"))));
+    QVERIFY(undoButton);
+    QCOMPARE(undoButton->text(), QStringLiteral("Undo"));
+    QCOMPARE(undoButton->toolTip(), QStringLiteral("Undo Change matching parameters"));
+    undo->undo();
+    QVERIFY(stored());
+    QVERIFY(box->isChecked());
+    undo->redo();
+    QVERIFY(!stored());
+    QVERIFY(!box->isChecked());
     // Shown on the Matching tab, scrolled to (DELINEO_SCREENSHOT_DIR keeps a rendering).
     auto* tabs = window_->findChild<QTabWidget*>();
     QVERIFY(tabs);
