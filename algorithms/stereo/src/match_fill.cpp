@@ -746,6 +746,28 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
   return extended;
 }
 
+// The matches left of `region` (in `box`) on its rows that `plane` filled in would hide in the
+// right view, as the ordering check counts them: a match at u is hidden by the row's first region
+// pixel x when u − d(u) > x − plane(x) + 1 and d(u) is at least 2 px below the plane. Looked for
+// up to `reach` px left of the region.
+long matchesHiddenBy(const FillPlane& plane, const cv::Mat& region, const cv::Rect& box,
+                     const cv::Mat& disparity, int reach) {
+  long hidden = 0;
+  for (int y = 0; y < box.height; ++y) {
+    const uchar* m = region.ptr<uchar>(y);
+    const uchar* first = std::find_if(m, m + box.width, [](uchar v) { return v != 0; });
+    if (first == m + box.width) continue;
+    const int x = box.x + static_cast<int>(first - m), row = box.y + y;
+    const double mapped = x - plane.at(x, row);
+    const double lowest = plane.at(x, row) - 2.0;
+    const float* d = disparity.ptr<float>(row);
+    for (int u = x - 1; u >= 0 && u >= x - reach; --u) {
+      if (d[u] == d[u] && u - d[u] > mapped + 1.0 && d[u] <= lowest) ++hidden;
+    }
+  }
+  return hidden;
+}
+
 // The fill itself; `rightFlatRegionsOf()` gives the right view's flat regions.
 template <class RightFlat>
 int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
@@ -924,9 +946,19 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       const double leftMean = cv::mean(left(box), region)[0];
       bool oneSided = false;
       std::vector<cv::Vec2i> rowSpans;
-      const bool sloped =
+      bool sloped =
           slopedFacetPlane(region, box, rightFlat, leftMean, matchedGain, matchedOffset, sigma,
                            dmin, dmax, settings, constant, plane, &oneSided, &rowSpans);
+      // A plane's counterpart is found by grey level anywhere in the range: a plain rooftop box
+      // (23 px on a roof at 20, 2000²) took a copy of itself 126 px away, whose outline lines up
+      // as well. Filled there, it would hide in the right view the roof's matches left of it on
+      // its rows, 14 times its area; a real facet hides at most about its own area (the
+      // ground it hides beside a roof is mostly unmatched already).
+      if (sloped && settings.planeHiddenRatio > 0 &&
+          matchesHiddenBy(plane, region, box, disparity, dmax - dmin) >
+              settings.planeHiddenRatio * cv::countNonZero(region)) {
+        sloped = false;
+      }
       if (sloped) {
         for (int y = 0; y < box.height; ++y) {
           uchar* m = region.ptr<uchar>(y);

@@ -40,6 +40,8 @@ struct RegionFillSettings {
                                  //   its outline error is below this × the constant's
   double planeCandidateRatio = 1.1;  // where no constant is filled, a plane only when its outline
                                      //   error is below this × the best candidate's (0 = off)
+  double planeHiddenRatio = 4.0;     // a plane is not filled when it would hide more matches in
+                                     //   the right view than this × the region's area (0 = off)
   // Beyond the filled pixels, over unmatched ones that match at the fill's disparity on their own.
   int extendReach = 40;             // px (4-connected steps) from the filled pixels; 0 = off
   double extendRestartAgree = 0.5;  // px: extendReach counts from the matches this close to

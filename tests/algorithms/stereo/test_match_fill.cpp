@@ -273,6 +273,30 @@ TEST(FillFlatRegions, APlainSlopedFacetTakesThePlaneOfItsRowEndsInBothViews) {
   EXPECT_LE(spilled, 2 * (sloped.facet.width + sloped.facet.height) / 10);
 }
 
+TEST(FillFlatRegions, APlaneThatWouldHideManyMatchesInTheRightViewIsNotFilled) {
+  // Filled, the facet (17-20 px at its left side) would hide in the right view the ground
+  // matches (disparity 4) up to about 15 px left of it: between 0.1 and 0.14 × its flat region's
+  // area (kept at 0.14). Kept at the default ratio (4); refused at 0.1; kept again at 0.1
+  // when those ground pixels are unmatched, as a matcher leaves the ground the right view does
+  // not see. (On the 2000² scene a plain rooftop box at 23 px took a copy of itself 126 px away
+  // and would have hidden 14 × its area.)
+  RegionFillSettings strict;
+  strict.planeHiddenRatio = 0.1;
+  FacetScene kept = slopedFacet();
+  fill(kept, RegionFillSettings{}, 40);
+  FacetScene refused = slopedFacet();
+  fill(refused, strict, 40);
+  const int area = kept.facet.area();
+  EXPECT_GE(facetPixelsOnItsPlane(kept, 0.5), area * 95 / 100) << " of " << area;
+  EXPECT_EQ(facetPixelsOnItsPlane(refused, 0.5), 0);
+  FacetScene occluded = slopedFacet();
+  occluded.disparity(cv::Rect(occluded.facet.x - 20, occluded.facet.y - 3, 20,
+                              occluded.facet.height + 6))
+      .setTo(kNaN);
+  fill(occluded, strict, 40);
+  EXPECT_GE(facetPixelsOnItsPlane(occluded, 0.5), area * 95 / 100) << " of " << area;
+}
+
 TEST(FillFlatRegions, AFacetAConstantLinesUpTakesItsPlaneWhenTheRowEndsDisagreeWithTheConstant) {
   // A facet sloping by 0.03 px per column (2.1 px across it) whose top and bottom rows are
   // matched: their values cluster, and the constant lines the outline up well enough to fill
