@@ -226,6 +226,29 @@ void DisparityHistogramWidget::keyPressEvent(QKeyEvent* event) {
   if (a_ != oldA || b_ != oldB) emit intervalEditingFinished(a_, b_);
 }
 
+QRectF DisparityHistogramWidget::intervalLabelRect() const {
+  const QRectF plot = plotRect();
+  const QFontMetrics fm(font());
+  const double width = fm.horizontalAdvance(tr("[%1, %2] px").arg(a_).arg(b_));
+  const double height = fm.height();
+  const double xa = xOfDisparity(a_ - 0.5), xb = xOfDisparity(b_ + 0.5);
+  // The band with its grips (5 px each side), and the ground's label (drawn 8 px lower).
+  const QRectF band(QPointF(xa - 6, plot.top()), QPointF(xb + 6, plot.top() + height));
+  QRectF ground;
+  if (ground_) {
+    ground = QRectF(xOfDisparity(*ground_) + 3, plot.top() + 8, fm.horizontalAdvance(tr("ground")), height);
+  }
+  const auto at = [&](double left) { return QRectF(left, plot.top(), width, height); };
+  for (const double left : {plot.right() - width, xa - 8 - width, xb + 8, plot.left()}) {
+    const QRectF r = at(left);
+    if (r.left() >= plot.left() && r.right() <= plot.right() + 0.5 && !r.intersects(band) &&
+        !(ground_ && r.intersects(ground))) {
+      return r;
+    }
+  }
+  return at(plot.right() - width);  // no free place: where it always was
+}
+
 void DisparityHistogramWidget::paintEvent(QPaintEvent*) {
   QPainter painter(this);
   painter.fillRect(rect(), palette().color(QPalette::Base));
@@ -291,8 +314,8 @@ void DisparityHistogramWidget::paintEvent(QPaintEvent*) {
     const QString label = QString::number(d);
     painter.drawText(QPointF(x - fm.horizontalAdvance(label) / 2.0, plot.bottom() + 4 + fm.ascent()), label);
   }
-  const QString interval = tr("[%1, %2] px").arg(a_).arg(b_);
-  painter.drawText(QPointF(plot.right() - fm.horizontalAdvance(interval), plot.top() + fm.ascent()), interval);
+  const QRectF label = intervalLabelRect();
+  painter.drawText(QPointF(label.left(), plot.top() + fm.ascent()), tr("[%1, %2] px").arg(a_).arg(b_));
   if (counts_.empty()) {
     painter.drawText(plot, Qt::AlignCenter, tr("No disparities in the ROI"));
   }

@@ -104,3 +104,31 @@ TEST(DisparityHistogram, DragSignalsAreThrottled) {
   EXPECT_LE(changed.count(), 3);
   EXPECT_EQ(changed.last().at(1).toInt(), 36);
 }
+
+TEST(DisparityHistogram, TheIntervalsLabelStaysClearOfTheBand) {
+  DisparityHistogramWidget h;
+  h.resize(360, 150);
+  h.setDisparities(roiDisparities());
+  h.setGroundLevel(10.0);
+  const auto band = [&h] {
+    const double top = h.intervalLabelRect().top();
+    return QRectF(QPointF(h.xOfDisparity(h.lowerBound() - 0.5) - 5, top),
+                  QPointF(h.xOfDisparity(h.upperBound() + 0.5) + 5, top + 1));
+  };
+  // In the middle of the axis: top right, as always.
+  h.setInterval(24, 31);
+  const QRectF topRight = h.intervalLabelRect();
+  EXPECT_FALSE(topRight.intersects(band()));
+  // At the right end of the axis (where the label used to sit on the grips): left of the band.
+  h.setInterval(h.displayMax() - 2, h.displayMax());
+  const QRectF beside = h.intervalLabelRect();
+  EXPECT_FALSE(beside.intersects(band()));
+  EXPECT_LT(beside.right(), h.xOfDisparity(h.lowerBound() - 0.5));
+  EXPECT_LT(beside.left(), topRight.left());
+  EXPECT_GE(beside.left(), 0.0);
+  if (const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR"); !dir.isEmpty()) {
+    h.show();
+    h.grab().save(dir + QStringLiteral("/histogram-interval-at-right-end.png"));
+  }
+}
+

@@ -44,6 +44,9 @@ class DisparityHistogramWidget : public QWidget {
   // Widget x of a disparity value and back (for tests and tooltips).
   double xOfDisparity(double d) const;
   double disparityAtX(double x) const;
+  // Where the "[a, b] px" label is drawn: top right, or beside the interval's band (left of it,
+  // else right of it) when the band or the ground label would cover it there (for tests).
+  QRectF intervalLabelRect() const;
 
   QSize sizeHint() const override;
   QSize minimumSizeHint() const override;
