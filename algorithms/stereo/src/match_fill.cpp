@@ -12,6 +12,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "ordering.hpp"
 #include "radiometry.hpp"
 #include "workers.hpp"
 
@@ -747,22 +748,22 @@ int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rec
 }
 
 // The matches left of `region` (in `box`) on its rows that `plane` filled in would hide in the
-// right view, as the ordering check counts them: a match at u is hidden by the row's first region
-// pixel x when u − d(u) > x − plane(x) + 1 and d(u) is at least 2 px below the plane. Looked for
-// up to `reach` px left of the region.
+// right view by the ordering check's test (hides(), with its default settings: u − d(u) >
+// x − plane(x) + 1 and d(u) at least 2 px below the plane, x the row's first region pixel).
+// Looked for up to `reach` px left of the region.
 long matchesHiddenBy(const FillPlane& plane, const cv::Mat& region, const cv::Rect& box,
                      const cv::Mat& disparity, int reach) {
+  const OrderingSettings ordering;
   long hidden = 0;
   for (int y = 0; y < box.height; ++y) {
     const uchar* m = region.ptr<uchar>(y);
     const uchar* first = std::find_if(m, m + box.width, [](uchar v) { return v != 0; });
     if (first == m + box.width) continue;
     const int x = box.x + static_cast<int>(first - m), row = box.y + y;
-    const double mapped = x - plane.at(x, row);
-    const double lowest = plane.at(x, row) - 2.0;
+    const double value = plane.at(x, row);
     const float* d = disparity.ptr<float>(row);
     for (int u = x - 1; u >= 0 && u >= x - reach; --u) {
-      if (d[u] == d[u] && u - d[u] > mapped + 1.0 && d[u] <= lowest) ++hidden;
+      if (d[u] == d[u] && hides<double>(x - value, value, u - d[u], d[u], ordering)) ++hidden;
     }
   }
   return hidden;

@@ -8,8 +8,6 @@ namespace delineo::stereo::detail {
 int rejectOrderingViolations(cv::Mat& disparity, cv::Mat& score, const OrderingSettings& settings) {
   CV_Assert(disparity.type() == CV_32F && (score.empty() || score.size() == disparity.size()));
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  const auto tolerance = static_cast<float>(settings.tolerance);
-  const auto minJump = static_cast<float>(settings.minJump);
   int rejected = 0;
   for (int y = 0; y < disparity.rows; ++y) {
     float* d = disparity.ptr<float>(y);
@@ -20,7 +18,7 @@ int rejectOrderingViolations(cv::Mat& disparity, cv::Mat& score, const OrderingS
     for (int x = disparity.cols - 1; x >= 0; --x) {
       if (!(d[x] == d[x])) continue;
       const float mapped = static_cast<float>(x) - d[x];
-      if (leftmost < mapped - tolerance && itsDisparity - d[x] >= minJump) {
+      if (hides(leftmost, itsDisparity, mapped, d[x], settings)) {
         d[x] = kNaN;
         if (s != nullptr) s[x] = kNaN;
         ++rejected;

@@ -11,6 +11,16 @@ struct OrderingSettings {
   double minJump = 2.0;    // px: the nearer match must be at least this much nearer
 };
 
+// Whether a match that lies at `nearMapped` in the right view with disparity `nearDisparity`
+// hides one at `farMapped` with `farDisparity` there (the test below; the fill's planes are held
+// to it too). T: float or double, as the caller computes the positions.
+template <typename T>
+bool hides(T nearMapped, T nearDisparity, T farMapped, T farDisparity,
+           const OrderingSettings& settings) {
+  return nearMapped < farMapped - static_cast<T>(settings.tolerance) &&
+         nearDisparity - farDisparity >= static_cast<T>(settings.minJump);
+}
+
 // Along a row of the left view, a match at x (disparity d) maps to x − d in the right view. A
 // match at x' > x with a larger disparity d' that maps to the left of it (x' − d' < x − d −
 // tolerance) hides it: the nearer surface at x' covers, in the right view, the point seen at x.
