@@ -226,6 +226,12 @@ void DisparityHistogramWidget::keyPressEvent(QKeyEvent* event) {
   if (a_ != oldA || b_ != oldB) emit intervalEditingFinished(a_, b_);
 }
 
+QRectF DisparityHistogramWidget::groundLabelRect() const {
+  if (!ground_) return {};
+  const QFontMetrics fm(font());
+  return QRectF(xOfDisparity(*ground_) + 3, plotRect().top() + 8, fm.horizontalAdvance(tr("ground")), fm.height());
+}
+
 QRectF DisparityHistogramWidget::intervalLabelRect() const {
   const QRectF plot = plotRect();
   const QFontMetrics fm(font());
@@ -234,10 +240,7 @@ QRectF DisparityHistogramWidget::intervalLabelRect() const {
   const double xa = xOfDisparity(a_ - 0.5), xb = xOfDisparity(b_ + 0.5);
   // The band with its grips (5 px each side), and the ground's label (drawn 8 px lower).
   const QRectF band(QPointF(xa - 6, plot.top()), QPointF(xb + 6, plot.top() + height));
-  QRectF ground;
-  if (ground_) {
-    ground = QRectF(xOfDisparity(*ground_) + 3, plot.top() + 8, fm.horizontalAdvance(tr("ground")), height);
-  }
+  const QRectF ground = groundLabelRect();
   const auto at = [&](double left) { return QRectF(left, plot.top(), width, height); };
   for (const double left : {plot.right() - width, xa - 8 - width, xb + 8, plot.left()}) {
     const QRectF r = at(left);
@@ -293,7 +296,7 @@ void DisparityHistogramWidget::paintEvent(QPaintEvent*) {
     painter.setPen(QPen(QColor(200, 30, 30), 1.5, Qt::DashLine));
     painter.drawLine(QPointF(xg, plot.top()), QPointF(xg, plot.bottom()));
     painter.setPen(QColor(200, 30, 30));
-    painter.drawText(QPointF(xg + 3, plot.top() + fm.ascent() + 8), tr("ground"));
+    painter.drawText(groundLabelRect().topLeft() + QPointF(0, fm.ascent()), tr("ground"));
   }
 
   // Axis with a few integer ticks.

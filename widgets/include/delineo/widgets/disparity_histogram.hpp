@@ -68,6 +68,7 @@ class DisparityHistogramWidget : public QWidget {
  private:
   enum class DragPart { None, Lower, Upper, Band };
   QRectF plotRect() const;
+  QRectF groundLabelRect() const;  // where "ground" is written; empty without a ground level
   void moveInterval(int a, int b, bool fromDrag);
   void flushPendingSignal();
 
