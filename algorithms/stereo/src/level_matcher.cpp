@@ -402,8 +402,25 @@ struct LinePeak {
   float below = kNaN;  // score at bestD - 1
   float above = kNaN;  // score at bestD + 1
   float prev = kNaN;   // score at the previous d
+  // With `trackSecond`, `second` is the best score 3 or more disparities away from the peak
+  // (the uniqueness test of wide intervals, LevelSettings::uniqueMinInterval). The updates then
+  // must come at consecutive d and are scalar.
+  bool trackSecond = false;
+  float second = kNegInf;
+  float prev2 = kNaN, prev3 = kNaN;  // scores at d − 2 and d − 3
+  float upToPrev3 = kNegInf;         // the best score at d − 3 or below
 
   void update(int d, float s) {
+    if (trackSecond) {
+      upToPrev3 = std::max(upToPrev3, prev3);  // (std::max keeps its first operand for NaN)
+      if (s > best) {
+        second = upToPrev3;
+      } else if (d - bestD >= 3 && s > second) {
+        second = s;
+      }
+      prev3 = prev2;
+      prev2 = prev;
+    }
     if (d == bestD + 1) above = s;
     if (s > best) {  // NaN never wins
       best = s;
@@ -419,6 +436,10 @@ struct LinePeak {
   // ones' effects), and only the scores next to the final peak are kept. `s` holds 8 readable
   // floats (those past `count` are ignored).
   void updatePass(int d, const float* s, int count) {
+    if (trackSecond) {
+      for (int k = 0; k < count; ++k) update(d + k, s[k]);
+      return;
+    }
     int top = -1;
     float topScore = best;
 #ifdef DELINEO_STEREO_X86
@@ -733,6 +754,13 @@ class LevelMatcher {
     const size_t area = static_cast<size_t>(tile.area());
     sc.peaks.assign(area, LinePeak{});
     sc.swept.assign(area, 0);
+    if (s_.uniqueMinInterval > 0) {
+      for (size_t i = 0; i < area; ++i) {
+        const int x = tile.x + static_cast<int>(i) % tile.width;
+        const int y = tile.y + static_cast<int>(i) / tile.width;
+        sc.peaks[i].trackSecond = testsUniqueness(in_.lo.at<int>(y, x), in_.hi.at<int>(y, x));
+      }
+    }
     // Which square pixels the box-filter sweep serves: the sweep costs ~5 operations per tile
     // pixel and disparity of the union of the served intervals, a direct correlation (below)
     // per disparity of the pixel's own interval. Pixels are added by increasing interval width
@@ -1194,6 +1222,7 @@ class LevelMatcher {
   void matchShapePixel(int x, int y, const ShapeTemplate& t) {
     LinePeak peak;
     const int lo = in_.lo.at<int>(y, x), hi = in_.hi.at<int>(y, x);
+    peak.trackSecond = testsUniqueness(lo, hi);
     // As few passes as the batch size allows, of balanced sizes (an interval of 7 with batches
     // of 6: 4 + 3, not 6 + 1).
     float batch[kSpanPassesMax * kShapeMaxWindows];
@@ -1239,6 +1268,10 @@ class LevelMatcher {
 
   // ---- peak ------------------------------------------------------------------------------
 
+  bool testsUniqueness(int lo, int hi) const {
+    return s_.uniqueMinInterval > 0 && hi - lo + 1 >= s_.uniqueMinInterval;
+  }
+
   // From the main-line peak: local ascent over the line shifts (3x3 neighbourhoods of the 2D
   // surface, d within the pixel's interval, |dy| <= lineShift), rejection tests, sub-pixel
   // offset, output.
@@ -1249,6 +1282,10 @@ class LevelMatcher {
   void finish(int x, int y, int lo, int hi, const LinePeak& peak, Score&& score, Pair&& pair,
               Line&& line) {
     if (!(peak.best > kNegInf)) return;
+    if (peak.trackSecond && peak.second > kNegInf &&
+        (1.0F - peak.best) * (1.0F + static_cast<float>(s_.uniqueMargin)) >= 1.0F - peak.second) {
+      return;  // another disparity explains the window about as well
+    }
     int cd = peak.bestD, cdy = 0;
     float best = peak.best;
     float below = peak.below, above = peak.above;

@@ -24,6 +24,14 @@ struct LevelSettings {
   double minScore = 0.3;
   bool subpixel = true;
   bool adaptive = true;
+  // Uniqueness of the peak in wide intervals: a pixel searching at least uniqueMinInterval
+  // disparities is rejected when a score 3 or more disparities from its peak comes within
+  // uniqueMargin of it in 1 − NCC (second ≥ 1 − (1 − best)(1 + uniqueMargin)). Wide intervals
+  // are the coarsest level's and those next to rejected pixels, where repeated structure (a
+  // roof's seams, a tree beside a roof) can line up elsewhere; guided intervals of a few
+  // disparities are not tested. 0 = off.
+  int uniqueMinInterval = 24;
+  double uniqueMargin = 0.1;
   int threads = 1;
 };
 

@@ -827,15 +827,21 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
                  stats.at<int>(r, cv::CC_STAT_HEIGHT) + 8) &
         image;
     cv::Mat region = labels(box) == r;
-    cv::Mat near;
+    cv::Mat near, beside;
     cv::dilate(region, near, cv::getStructuringElement(cv::MORPH_RECT, {7, 7}));
+    cv::dilate(region, beside, cv::getStructuringElement(cv::MORPH_RECT, {7, 1}));
     cv::Mat ring = outlineRing(region);
-    std::vector<float> matches;
+    // The matches within 3 px of the region, and those of them on it or beside it on its rows.
+    std::vector<float> matches, matchesBeside;
     for (int y = 0; y < box.height; ++y) {
       const uchar* n = near.ptr<uchar>(y);
+      const uchar* b = beside.ptr<uchar>(y);
       const float* d = disparity.ptr<float>(box.y + y) + box.x;
       for (int x = 0; x < box.width; ++x) {
-        if (n[x] && std::isfinite(d[x])) matches.push_back(d[x]);
+        if (n[x] && std::isfinite(d[x])) {
+          matches.push_back(d[x]);
+          if (b[x]) matchesBeside.push_back(d[x]);
+        }
       }
     }
     // Mean |left − mapped right| over the ring at the plane's disparity, the right view read
@@ -936,8 +942,14 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       // cluster's median, refocused (see refocusReach). The matches next to a plain roof's
       // outline are skewed: some windows along it match 1-1.7 px too far (seed 5's plain roof,
       // filled +0.57 px off with the mean, +0.39 with the median; see docs/stereo.md, sessions
-      // 17 and 18).
-      const float value = clusterMedian(matches, best, settings.refocusReach);
+      // 17 and 18). It is taken from the matches on the region's rows when there are enough:
+      // above and below it, along an outline parallel to the epipolar lines, the windows hold
+      // no step across the lines to fix them, and those matches ran 0.8-1.8 px high on seed 5's
+      // plain roof (filled 0.54 px high once the wide intervals' uniqueness test had rejected
+      // most of the good matches beside it; docs/stereo.md, session 22).
+      const std::vector<float>& valueFrom =
+          static_cast<int>(matchesBeside.size()) >= settings.minMatched ? matchesBeside : matches;
+      const float value = clusterMedian(valueFrom, best, settings.refocusReach);
       constantError = ringError(value);
       return value;
     }();

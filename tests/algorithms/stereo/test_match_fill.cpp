@@ -625,6 +625,25 @@ TEST(FillFlatRegions, RefocusesTheMedianOnTheBulkOfTheOutlinesMatches) {
   EXPECT_EQ(pixelsWithin(median.disparity, inner, at(kRoof + 0.6f), 0.01), inner.area());
 }
 
+TEST(FillFlatRegions, TakesItsValueFromTheMatchesBesideTheRoofNotAboveOrBelowIt) {
+  // The strips along the roof's top and bottom (windows across an outline that runs with the
+  // rows) matched 1.2 px too far, 184 matches; the roof's first and last two columns (windows
+  // across its sides) at its disparity, 136. The flat region's rows reach the side columns,
+  // not the strips. Among all the matches around the region the strips' value is the median.
+  Scene s = scene();
+  s.disparity(cv::Rect(s.roof.x + 2, s.roof.y, s.roof.width - 4, 2)).setTo(kRoof + 1.2f);
+  s.disparity(cv::Rect(s.roof.x + 2, s.roof.br().y - 2, s.roof.width - 4, 2)).setTo(kRoof + 1.2f);
+  const int sideRows = s.roof.height - 6;
+  s.disparity(cv::Rect(s.roof.x, s.roof.y + 3, 2, sideRows)).setTo(kRoof);
+  s.disparity(cv::Rect(s.roof.br().x - 2, s.roof.y + 3, 2, sideRows)).setTo(kRoof);
+  fill(s, RegionFillSettings{}, 32);
+  const cv::Rect inner(s.roof.x + 5, s.roof.y + 5, s.roof.width - 10, s.roof.height - 10);
+  // (Measured: all 1 200 inner pixels within 0.01 px; 0 with all the matches around.)
+  EXPECT_EQ(pixelsWithin(
+                s.disparity, inner, [](int, int) { return kRoof; }, 0.01),
+            inner.area());
+}
+
 // The band of 3 rows inside the flat roof, 4 px below its top, columns 4 .. 15: the 5x5 windows'
 // counterparts in the right view at the roof's disparity (20) and at the ground's (4) both fall
 // on the roof, and apart.
