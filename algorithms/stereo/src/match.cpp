@@ -22,8 +22,10 @@
 #include "level_matcher.hpp"
 #include "match_fill.hpp"
 #include "match_snap.hpp"
+#include "match_snap_rows.hpp"
 #include "match_steps.hpp"
 #include "ordering.hpp"
+#include "radiometry.hpp"
 #include "smoothing.hpp"
 #include "speckles.hpp"
 #include "workers.hpp"
@@ -751,6 +753,11 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     snap.threads = threads;
     detail::snapStepsToContours(left, right, contrast, snap, static_cast<float>(p.minScore),
                                 result.disparity, result.score);
+    detail::RowStepSnapSettings rows;
+    rows.threads = threads;
+    const auto [gain, offset] = detail::radiometricMap(left, right, p.dmin, p.dmax);
+    detail::snapStepsAcrossRows(left, right, contrast.sigma, gain, offset, rows,
+                                static_cast<float>(p.minScore), result.disparity, result.score);
     if (reachedButCanceled(0.98)) return result;
   }
   if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {

@@ -1,0 +1,136 @@
+#include "match_snap_rows.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "workers.hpp"
+
+namespace delineo::stereo::detail {
+
+namespace {
+// Rows on each side of a cut whose mean grey the contrast compares (as the row-wise snapping's
+// kStepSide: an outline is a step between two grey levels, a 1–2 px line is not).
+constexpr int kStepSide = 2;
+// px: disparities this close are the same surface's.
+constexpr float kSameSurface = 1.5F;
+// Fewest pixels a strip's error is read on.
+constexpr int kMinStripPixels = 4;
+}  // namespace
+
+int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma, double gain,
+                        double offset, const RowStepSnapSettings& settings, float fillScore,
+                        cv::Mat& disparity, cv::Mat& score) {
+  CV_Assert(left.type() == CV_32F && right.type() == CV_32F && disparity.type() == CV_32F &&
+            score.type() == CV_32F && left.size() == right.size() &&
+            left.size() == disparity.size() && left.size() == score.size());
+  const int w = left.cols, h = left.rows;
+  if (h < 2 * kStepSide + 1 || w < 1 || !(sigma > 0)) return 0;
+  const float minContrast = static_cast<float>(settings.edgeSigmas * sigma);
+  const int half = settings.stripHalf;
+  // The map as it was: the strips leave out the pixels that held the new disparity before any
+  // move (and the columns are moved on several workers).
+  const cv::Mat before = disparity.clone();
+  // Mean |left − mapped right| over the row strip of (y, x) at disparity d, in noise sigmas
+  // (right view read with linear interpolation), without the strip's other pixels whose
+  // disparity was within kSameSurface of `other`: where the outline crosses the row (a slanted
+  // one, or a carried run's end) the strip would hold the other surface's pixels, which no
+  // disparity of the run explains (seed 3 600²: a roof's pixels along a 45° outline took the
+  // ground's disparity). +inf when fewer than kMinStripPixels are read.
+  const auto stripError = [&](int y, int x, float d, float other) {
+    const float* a = left.ptr<float>(y);
+    const float* r = right.ptr<float>(y);
+    const float* was = before.ptr<float>(y);
+    double sum = 0;
+    int n = 0;
+    for (int u = std::max(0, x - half); u <= std::min(w - 1, x + half); ++u) {
+      if (u != x && std::abs(was[u] - other) < kSameSurface) continue;
+      const float xr = static_cast<float>(u) - d;
+      const int x0 = static_cast<int>(std::floor(xr));
+      if (x0 < 0 || x0 + 1 >= w) continue;
+      const float t = xr - static_cast<float>(x0);
+      const float b = (1 - t) * r[x0] + t * r[x0 + 1];
+      if (!std::isfinite(a[u]) || !std::isfinite(b)) continue;
+      sum += std::abs(a[u] - (gain * b + offset));
+      ++n;
+    }
+    return n >= kMinStripPixels ? sum / n / sigma : std::numeric_limits<double>::infinity();
+  };
+  // |mean I(c .. c + kStepSide − 1) − mean I(c − kStepSide .. c − 1)| in column x: the contrast
+  // of the cut above row c; -1 where a side leaves the image or meets nodata.
+  const auto contrastAbove = [&](int x, int c) -> float {
+    if (c - kStepSide < 0 || c + kStepSide > h) return -1;
+    float above = 0, below = 0;
+    for (int k = 0; k < kStepSide; ++k) {
+      above += left.at<float>(c - 1 - k, x);
+      below += left.at<float>(c + k, x);
+    }
+    if (!std::isfinite(above) || !std::isfinite(below)) return -1;
+    return std::abs(below - above) / static_cast<float>(kStepSide);
+  };
+  std::vector<int> changedPerColumn(static_cast<size_t>(w), 0);
+  forRowBands(w, settings.threads, [&](int colStart, int colEnd) {
+    for (int x = colStart; x < colEnd; ++x) {
+      int changed = 0;
+      // Pixel y of a carried run takes disparity `to` when that explains its strip clearly
+      // better than its own; an unmatched one (the gap) stays unmatched and is passed over when
+      // `to` explains it. False: the move stops.
+      const auto moveIfExplained = [&](int y, float to) {
+        float& d = disparity.at<float>(y, x);
+        const double atNew = stripError(y, x, to, to);
+        if (!(atNew <= settings.maxErrorSigmas)) return false;
+        if (d != d) return true;
+        if (!(atNew <= settings.winRatio * stripError(y, x, d, to))) return false;
+        d = to;
+        score.at<float>(y, x) = fillScore;
+        ++changed;
+        return true;
+      };
+      int a = -1;  // the last matched row above
+      for (int y = 0; y < h; ++y) {
+        const float db = disparity.at<float>(y, x);
+        if (db != db) continue;
+        const int b = y;
+        if (a >= 0 && b - a - 1 <= settings.maxGap) {
+          const float da = disparity.at<float>(a, x);
+          if (std::abs(db - da) >= settings.minStep) {
+            int cut = -1;
+            float strongest = minContrast;
+            for (int c = std::max(1, a - settings.reach + 1);
+                 c <= std::min(h - 1, b + settings.reach); ++c) {
+              // A local maximum only: the cut next to a stronger outline just outside the
+              // range reads part of it (1000² / 128 d: the top of a plain roof, 7 rows above a
+              // box on it, moved the roof's rows onto the box's disparity).
+              const float contrast = contrastAbove(x, c);
+              if (contrast >= strongest && contrast >= contrastAbove(x, c - 1) &&
+                  contrast >= contrastAbove(x, c + 1)) {
+                strongest = contrast;
+                cut = c;
+              }
+            }
+            if (cut >= 0 && cut <= a) {
+              // The upper side carried below the outline: rows cut .. b − 1 take the lower
+              // side's disparity, from the gap upwards.
+              for (int v = b - 1; v >= cut && moveIfExplained(v, db); --v) {
+              }
+            } else if (cut > b) {
+              // The lower side carried above it: rows a + 1 .. cut − 1, from the gap downwards.
+              const int end = cut - 1;
+              for (int v = a + 1; v <= end && moveIfExplained(v, da); ++v) {
+              }
+              // The rows moved are the upper side's now: the scan goes on after them.
+              y = std::max(y, end);
+            }
+          }
+        }
+        a = disparity.at<float>(y, x) == disparity.at<float>(y, x) ? y : a;
+      }
+      changedPerColumn[static_cast<size_t>(x)] = changed;
+    }
+  });
+  int total = 0;
+  for (const int c : changedPerColumn) total += c;
+  return total;
+}
+
+}  // namespace delineo::stereo::detail

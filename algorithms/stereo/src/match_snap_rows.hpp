@@ -1,0 +1,39 @@
+#pragma once
+// Depth steps between rows (outlines that run with the epipolar lines) moved onto the image
+// contour between them (internal to delineo_stereo).
+#include <opencv2/core.hpp>
+
+namespace delineo::stereo::detail {
+
+struct RowStepSnapSettings {
+  double minStep = 2.0;         // px of disparity: smaller differences are slopes, not steps
+  int maxGap = 8;               // rows: most unmatched pixels between the two sides of a step
+  int reach = 6;                // rows: how far beyond the matched sides the contour is looked for
+  double edgeSigmas = 4.0;      // × noise sigma: weakest contrast taken for the outline
+  int stripHalf = 7;            // px: half-width of the row strip a moved pixel is checked on
+  double winRatio = 0.7;        // most error at the new disparity, × the one at the pixel's own
+  double maxErrorSigmas = 4.0;  // noise sigmas: most error the new disparity may leave
+  int threads = 1;              // workers over bands of columns (same result on any number)
+};
+
+// Along each column, two matched pixels a < b (rows) with only unmatched pixels between them (at
+// most maxGap) and disparities at least minStep apart are the two sides of a step across rows: an
+// outline that runs with the epipolar lines. Windows there mix both surfaces, and the textured
+// side's disparity is carried a few rows into a weakly textured one (seed 2 1000²: a roof's top 4
+// rows took the ground's 4–6 for its 30.7), which no check of the order of the views sees. The
+// outline is the strongest local maximum of the vertical contrast (kStepSide rows on each side)
+// within [a − reach + 1, b + reach], when at least edgeSigmas noise sigmas. When it lies beyond a
+// side's last matched pixel, that side's pixels past it take the other side's disparity, from the
+// gap outwards, while each is explained by it clearly better on its own row: the mean |left −
+// mapped right| over its 1 × (2 stripHalf + 1) strip (one surface only, the outline running with
+// the rows; the strip's pixels that held the new disparity are left out) at most winRatio × the
+// one at its own disparity and at most maxErrorSigmas. The gap's unmatched pixels stay unmatched
+// (passed over when the new disparity explains them within maxErrorSigmas). The first pixel that
+// fails stops the column's move. Moved pixels get `fillScore`.
+// `sigma` is the left image's noise sigma; `gain`, `offset` map the right view's grey levels to
+// the left's. Returns the number of pixels changed.
+int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma, double gain,
+                        double offset, const RowStepSnapSettings& settings, float fillScore,
+                        cv::Mat& disparity, cv::Mat& score);
+
+}  // namespace delineo::stereo::detail
