@@ -18,14 +18,12 @@ constexpr float kSameSurface = 1.5F;
 constexpr int kMinStripPixels = 4;
 }  // namespace
 
-int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma, double gain,
-                        double offset, const RowStepSnapSettings& settings, float fillScore,
-                        cv::Mat& disparity, cv::Mat& score) {
-  CV_Assert(left.type() == CV_32F && right.type() == CV_32F && disparity.type() == CV_32F &&
-            score.type() == CV_32F && left.size() == right.size() &&
-            left.size() == disparity.size() && left.size() == score.size());
+namespace {
+// One pass over the columns (see snapStepsAcrossRows).
+int snapPass(const cv::Mat& left, const cv::Mat& right, double sigma, double gain, double offset,
+             const RowStepSnapSettings& settings, float fillScore, cv::Mat& disparity,
+             cv::Mat& score) {
   const int w = left.cols, h = left.rows;
-  if (h < 2 * kStepSide + 1 || w < 1 || !(sigma > 0)) return 0;
   const float minContrast = static_cast<float>(settings.edgeSigmas * sigma);
   const int half = settings.stripHalf;
   // The map as it was: the strips leave out the pixels that held the new disparity before any
@@ -130,6 +128,24 @@ int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma,
   });
   int total = 0;
   for (const int c : changedPerColumn) total += c;
+  return total;
+}
+}  // namespace
+
+int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma, double gain,
+                        double offset, const RowStepSnapSettings& settings, float fillScore,
+                        cv::Mat& disparity, cv::Mat& score) {
+  CV_Assert(left.type() == CV_32F && right.type() == CV_32F && disparity.type() == CV_32F &&
+            score.type() == CV_32F && left.size() == right.size() &&
+            left.size() == disparity.size() && left.size() == score.size());
+  if (left.rows < 2 * kStepSide + 1 || left.cols < 1 || !(sigma > 0)) return 0;
+  int total = 0;
+  for (int pass = 0; pass < settings.maxPasses; ++pass) {
+    const int moved =
+        snapPass(left, right, sigma, gain, offset, settings, fillScore, disparity, score);
+    if (moved == 0) break;
+    total += moved;
+  }
   return total;
 }
 

@@ -68,10 +68,9 @@ cv::Mat carriedMap(const Pair& p, int top, int carried, int x0, int x1) {
   return d;
 }
 
-int snap(const Pair& p, cv::Mat& disparity) {
+int snap(const Pair& p, cv::Mat& disparity, const RowStepSnapSettings& settings = {}) {
   cv::Mat score(disparity.size(), CV_32F, cv::Scalar(0.9));
-  return snapStepsAcrossRows(p.left, p.right, kNoise, 1.0, 0.0, RowStepSnapSettings{}, 0.3F,
-                             disparity, score);
+  return snapStepsAcrossRows(p.left, p.right, kNoise, 1.0, 0.0, settings, 0.3F, disparity, score);
 }
 
 int pixelsAt(const cv::Mat& disparity, const cv::Rect& area, float value) {
@@ -100,6 +99,26 @@ TEST(SnapStepsAcrossRows, GivesTheRoofBackTheRowsTheGroundCarriedIntoIt) {
   EXPECT_EQ(pixelsAt(disparity, cv::Rect(40, top + 3, 80, 1), kRoof), 80);
   // The ground above keeps its own.
   EXPECT_EQ(pixelsAt(disparity, cv::Rect(40, top - 6, 80, 6), kGround), 80 * 6);
+}
+
+TEST(SnapStepsAcrossRows, ARunCarriedPastTheReachMovesInTwoPasses) {
+  // 7 carried rows: the outline lies 7 rows before the run's last, past the contour search's
+  // 6, and a dark line on the roof 4 rows below the outline is the strongest contrast within
+  // reach. The first pass moves the run's rows past the line; the second sees the outline from
+  // the new step and moves the rest.
+  const int top = 30;
+  const Pair p = roofBelowGround(top, 0, true);
+  const cv::Rect carried(40, top, 80, 7);
+  RowStepSnapSettings onePass;
+  onePass.maxPasses = 1;
+  cv::Mat once = carriedMap(p, top, 7, 40, 120);
+  snap(p, once, onePass);
+  cv::Mat repeated = carriedMap(p, top, 7, 40, 120);
+  snap(p, repeated);
+  // (Measured: 204 and 418 of 560; as in the test above, a column's move stops at the first
+  // pixel its strip does not clearly put on the roof.)
+  EXPECT_LT(pixelsAt(once, carried, kRoof), carried.area() / 2);
+  EXPECT_GE(pixelsAt(repeated, carried, kRoof), carried.area() * 2 / 3);
 }
 
 TEST(SnapStepsAcrossRows, LeavesCorrectRowsAlone) {
