@@ -16,26 +16,17 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kRoof = 20.0F, kGround = 4.0F;
 constexpr double kNoise = 1.5;
 
-// A weakly textured roof (grey 60..80) at disparity 20 below textured ground (grey 80..110) at
-// disparity 4, 160x80: a contrast across the outline of about 25 grey levels, as on seed 2
-// 1000². The roof's top row is `top` at column 0, its outline `slant` px lower per column (0:
-// along the rows); with `darkLine`, a dark line (−30 grey) runs on the roof 4 rows below its
-// outline. Sensor noise kNoise in each view.
 struct Pair {
   cv::Mat left, right, truth;
 };
 
-Pair roofBelowGround(int top, double slant, bool darkLine = false) {
-  const cv::Size size(160, 80);
+// A roof at disparity 20 on textured ground (grey 80..110, seed 11) at disparity 4: `onRoof(x,
+// y)` tells the roof's points (in the left view's geometry of the surface), `roofGrey(x, y)` their
+// grey; the right pixel x shows the roof point x + 20 where there is one (the roof is nearer),
+// the ground point x + 4 elsewhere. Sensor noise kNoise in each view.
+template <class OnRoof, class RoofGrey>
+Pair render(cv::Size size, OnRoof&& onRoof, RoofGrey&& roofGrey) {
   const cv::Mat ground = stereo::testing::texture({size.width + 64, size.height}, 11) * 0.12 + 80.0;
-  const cv::Mat roof = stereo::testing::texture({size.width + 64, size.height}, 12) * 0.08 + 60.0;
-  // Row offset of (x, y) below the outline (x in the left view's geometry of the surface).
-  const auto belowOutline = [&](int x, int y) { return y - (top + slant * x); };
-  const auto roofGrey = [&](int x, int y) {
-    const double below = belowOutline(x, y);
-    const bool onLine = darkLine && below >= 4 && below < 5;
-    return roof.at<float>(y, x + 32) - (onLine ? 30.0F : 0.0F);
-  };
   Pair p;
   p.left.create(size, CV_32F);
   p.right.create(size, CV_32F);
@@ -43,18 +34,34 @@ Pair roofBelowGround(int top, double slant, bool darkLine = false) {
   const int dRoof = static_cast<int>(kRoof), dGround = static_cast<int>(kGround);
   for (int y = 0; y < size.height; ++y) {
     for (int x = 0; x < size.width; ++x) {
-      const bool l = belowOutline(x, y) >= 0;
+      const bool l = onRoof(x, y);
       p.left.at<float>(y, x) = l ? roofGrey(x, y) : ground.at<float>(y, x + 32);
       p.truth.at<float>(y, x) = l ? kRoof : kGround;
-      // The right pixel x shows the roof point x + 20 or the ground point x + 4, whichever is
-      // on its surface (the roof is nearer).
-      const bool r = belowOutline(x + dRoof, y) >= 0;
+      const bool r = onRoof(x + dRoof, y);
       p.right.at<float>(y, x) = r ? roofGrey(x + dRoof, y) : ground.at<float>(y, x + 32 + dGround);
     }
   }
   cv::RNG rng(5);
   stereo::testing::addSensorNoise(p.left, p.right, kNoise, rng);
   return p;
+}
+
+// A weakly textured roof (grey 60..80) below the ground, 160x80: a contrast across the outline
+// of about 25 grey levels, as on seed 2 1000². The roof's top row is `top` at column 0, its
+// outline `slant` px lower per column (0: along the rows); with `darkLine`, a dark line (−30
+// grey) runs on the roof 4 rows below its outline.
+Pair roofBelowGround(int top, double slant, bool darkLine = false) {
+  const cv::Size size(160, 80);
+  const cv::Mat roof = stereo::testing::texture({size.width + 64, size.height}, 12) * 0.08 + 60.0;
+  // Row offset of (x, y) below the outline.
+  const auto belowOutline = [&](int x, int y) { return y - (top + slant * x); };
+  return render(
+      size, [&](int x, int y) { return belowOutline(x, y) >= 0; },
+      [&](int x, int y) {
+        const double below = belowOutline(x, y);
+        const bool onLine = darkLine && below >= 4 && below < 5;
+        return roof.at<float>(y, x + 32) - (onLine ? 30.0F : 0.0F);
+      });
 }
 
 // The map a window matcher leaves: the truth, with the ground's disparity carried `carried`
@@ -148,27 +155,13 @@ TEST(SnapStepsAcrossRows, ChecksAPixelOnItsOwnSurfacesPartOfTheStrip) {
   // the ground's disparity, the wing's own wins: none moves.
   const cv::Size size(160, 60);
   const cv::Rect wing(80, 20, 6, 40);
-  const cv::Mat ground = stereo::testing::texture({size.width + 64, size.height}, 11) * 0.12 + 80.0;
   const cv::Mat roof = stereo::testing::texture({size.width + 64, size.height}, 12) * 0.08 + 85.0;
-  const auto wingGrey = [&](int x, int y) {
-    return roof.at<float>(y, x + 32) - (y == wing.y + 3 ? 40.0F : 0.0F);
-  };
-  Pair p;
-  p.left.create(size, CV_32F);
-  p.right.create(size, CV_32F);
-  p.truth.create(size, CV_32F);
-  const int dRoof = static_cast<int>(kRoof), dGround = static_cast<int>(kGround);
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const bool l = wing.contains({x, y});
-      p.left.at<float>(y, x) = l ? wingGrey(x, y) : ground.at<float>(y, x + 32);
-      p.truth.at<float>(y, x) = l ? kRoof : kGround;
-      const bool r = wing.contains({x + dRoof, y});
-      p.right.at<float>(y, x) = r ? wingGrey(x + dRoof, y) : ground.at<float>(y, x + 32 + dGround);
-    }
-  }
-  cv::RNG rng(5);
-  stereo::testing::addSensorNoise(p.left, p.right, kNoise, rng);
+  const Pair p = render(
+      size,
+      [&](int x, int y) {
+        return wing.contains({x, y});
+      },
+      [&](int x, int y) { return roof.at<float>(y, x + 32) - (y == wing.y + 3 ? 40.0F : 0.0F); });
   cv::Mat disparity = p.truth.clone();
   disparity(cv::Rect(wing.x, wing.y, wing.width, 2)).setTo(kNaN);
   EXPECT_EQ(snap(p, disparity), 0);
