@@ -24,7 +24,7 @@ struct StepSnapSettings {
   int openReach = 5;                // px: farthest contour an open end reaches by the offset
   int openGrowth = 16;              // px: farthest an open end grows over pixels only it explains
   double hardEndPenalty = 2.0;      // × errorCap per px: cut before where the near side fails hard
-  double contourWeight = 1.5;       // error (noise sigmas) traded for one sigma of contour contrast
+  double contourWeight = 0.5;       // error (noise sigmas) traded for one sigma of contour contrast
   double rightContourWeight = 2.0;  // the same for the right view's contrast at x − dNear
   double rightContourCap = 6.0;     // noise sigmas: most right-view contrast counted
   double errorCap = 6.0;            // noise sigmas: most a single pixel's error counts
