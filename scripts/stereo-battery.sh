@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# The stereo matcher's battery of simulated scenes (default noise), adaptive method only: one line
+# per scene (density %, bad-1 %, roof RMS over all flat-roof matches px, RMS1 px, edge %), then,
+# per group, how many scenes meet each target of the stereo issue (density >= 85 %, bad-1 <= 5 %,
+# roof RMS <= 0.25 px, edge >= 90 %).
+#   battery: the 11 scenes the matcher was tuned on (sessions up to 22);
+#   held-out: 9 scenes never used to choose anything up to session 22 (seeds 11-16 600², 6-8
+#             1000²); judge a change on both, and keep them apart.
+# Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
+# About a minute on 2 cores. Not a test: it prints numbers.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="$root/build/default"
+if [[ $# -gt 0 && "$1" != --* ]]; then
+  build="$1"
+  shift
+fi
+bench="$build/tests/bench/bench_stereo"
+if [[ ! -x "$bench" ]]; then
+  echo "stereo-battery: $bench not found; build the 'bench_stereo' target first" >&2
+  exit 2
+fi
+
+battery=("400|--size 400" "600|--size 600" "1000/128|--size 1000 --range 128"
+  "2000/256|--size 2000 --range 256" "s2-600|--size 600 --seed 2" "s2-1000|--size 1000 --seed 2"
+  "s3-600|--size 600 --seed 3" "s3-1000|--size 1000 --seed 3" "s4-600|--size 600 --seed 4"
+  "s5-600|--size 600 --seed 5" "s6-600|--size 600 --seed 6")
+heldout=("s11-600|--size 600 --seed 11" "s12-600|--size 600 --seed 12"
+  "s13-600|--size 600 --seed 13" "s14-600|--size 600 --seed 14" "s15-600|--size 600 --seed 15"
+  "s16-600|--size 600 --seed 16" "s6-1000|--size 1000 --seed 6" "s7-1000|--size 1000 --seed 7"
+  "s8-1000|--size 1000 --seed 8")
+
+run_group() {
+  local name=$1
+  shift
+  local n=0 density=0 bad1=0 rms=0 edge=0
+  printf '%s\n%-10s %9s %7s %9s %8s %7s\n' "== $name" scene density% bad1% roofRMS RMS1 edge%
+  for entry in "$@"; do
+    local label=${entry%%|*} args=${entry#*|} line
+    # shellcheck disable=SC2086  # args is a list of words
+    line=$("$bench" --no-data --methods adaptive $args "${extra[@]}" | awk '/^  adaptive/{print $2, $3, $6, $7, $8}')
+    if [[ -z "$line" ]]; then
+      echo "stereo-battery: no result for $label" >&2
+      exit 1
+    fi
+    read -r d b r r1 e <<<"$line"
+    printf '%-10s %9s %7s %9s %8s %7s\n' "$label" "$d" "$b" "$r" "$r1" "$e"
+    n=$((n + 1))
+    density=$((density + $(awk -v v="$d" 'BEGIN{print (v >= 85) ? 1 : 0}')))
+    bad1=$((bad1 + $(awk -v v="$b" 'BEGIN{print (v <= 5) ? 1 : 0}')))
+    rms=$((rms + $(awk -v v="$r" 'BEGIN{print (v <= 0.25) ? 1 : 0}')))
+    edge=$((edge + $(awk -v v="$e" 'BEGIN{print (v >= 90) ? 1 : 0}')))
+  done
+  printf 'met on %d scenes: density %d, bad-1 %d, roof RMS %d, edge %d\n' \
+    "$n" "$density" "$bad1" "$rms" "$edge"
+}
+
+extra=("$@")
+run_group battery "${battery[@]}"
+run_group held-out "${heldout[@]}"
