@@ -251,6 +251,10 @@
         <translation>Sauts de profondeur calés sur les contours</translation>
     </message>
     <message>
+        <source>Score beside depth steps</source>
+        <translation>Score près des sauts de profondeur</translation>
+    </message>
+    <message>
         <source>Ordering check</source>
         <translation>Contrôle de l’ordre</translation>
     </message>

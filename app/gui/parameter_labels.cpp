@@ -64,6 +64,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Adaptive shapes"),
     QT_TRANSLATE_NOOP("Parameters", "Fill flat regions"),
     QT_TRANSLATE_NOOP("Parameters", "Snap depth steps to contours"),
+    QT_TRANSLATE_NOOP("Parameters", "Score beside depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Threads"),
     QT_TRANSLATE_NOOP("Parameters", "Cut windows at depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),

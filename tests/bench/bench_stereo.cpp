@@ -21,7 +21,8 @@
 //              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored; outline pixels
 //              white located, magenta roof found inside, cyan outside, orange not found;
 //              and outline_METHOD.csv, every scored outline pixel with its outcome;
-//              disparity_METHOD.tif, truth.tif and the views left.tif, right.tif (float32).
+//              disparity_METHOD.tif, score_METHOD.tif, truth.tif and the views left.tif,
+//              right.tif (float32); roof.png, the flat-roof pixels the roof RMS is read on.
 //   --range N  search at least N disparities on the simulated scene (dmax raised)
 //   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 //   --repeat N run the methods N times round-robin, report each one's fastest run (shared
@@ -374,7 +375,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
   // With --repeat, the methods run round-robin and each keeps its fastest run: on a shared
   // machine the load then hits every method alike, and the ratios stay meaningful.
   std::vector<double> best(methods.size(), std::numeric_limits<double>::infinity());
-  std::vector<cv::Mat> disparity(methods.size());
+  std::vector<cv::Mat> disparity(methods.size()), scores(methods.size());
   for (int rep = 0; rep < repeat; ++rep) {
     for (size_t i = 0; i < methods.size(); ++i) {
       const stereo::MatchParams p = paramsFor(methods[i]);
@@ -386,6 +387,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       best[i] = std::min(best[i], std::chrono::duration<double>(end - start).count());
       if (gStageTimes) stages.print(methods[i], start, cpu0, end, std::clock());
       disparity[i] = result.disparity;
+      scores[i] = result.score;
       if (printCpu) {
         std::printf("  cpu %s %.3f s\n", methods[i].c_str(),
                     static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC);
@@ -408,8 +410,10 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       dumpErrors(disparity[i], c, dump + "/errors_" + m + ".png");
       dumpOutline(disparity[i], c, dump + "/outline_" + m + ".csv");
       cv::imwrite(dump + "/disparity_" + m + ".tif", disparity[i]);
+      if (!scores[i].empty()) cv::imwrite(dump + "/score_" + m + ".tif", scores[i]);
       if (i == 0) {
         cv::imwrite(dump + "/truth.tif", c.truth);
+        if (!c.roof.empty()) cv::imwrite(dump + "/roof.png", c.roof * 255);
         cv::imwrite(dump + "/left.tif", c.left);
         cv::imwrite(dump + "/right.tif", c.right);
       }

@@ -1,0 +1,61 @@
+#include "weak_matches.hpp"
+
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "workers.hpp"
+
+namespace delineo::stereo::detail {
+
+int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillScore,
+                                 cv::Mat& disparity, cv::Mat& score) {
+  CV_Assert(disparity.type() == CV_32F && score.type() == CV_32F &&
+            disparity.size() == score.size());
+  if (!(settings.minScore > 0) || disparity.empty()) return 0;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  // Neighbourhood min and max of the valid disparities (unmatched pixels at +inf for the min and
+  // -inf for the max), by the morphology's separable float filters.
+  cv::Mat lowest(disparity.size(), CV_32F), highest(disparity.size(), CV_32F);
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    float* lo = lowest.ptr<float>(y);
+    float* hi = highest.ptr<float>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      const bool valid = d[x] == d[x];
+      lo[x] = valid ? d[x] : kInf;
+      hi[x] = valid ? d[x] : -kInf;
+    }
+  }
+  const int side = 2 * settings.radius + 1;
+  const cv::Mat square = cv::Mat::ones(side, side, CV_8U);
+  cv::erode(lowest, lowest, square, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(kInf));
+  cv::dilate(highest, highest, square, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
+             cv::Scalar(-kInf));
+  const float minScore = static_cast<float>(settings.minScore);
+  const float minStep = static_cast<float>(settings.minStep);
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  std::vector<int> rejectedPerRow(static_cast<size_t>(disparity.rows), 0);
+  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      float* d = disparity.ptr<float>(y);
+      float* s = score.ptr<float>(y);
+      const float* lo = lowest.ptr<float>(y);
+      const float* hi = highest.ptr<float>(y);
+      int rejected = 0;
+      for (int x = 0; x < disparity.cols; ++x) {
+        if (d[x] != d[x] || s[x] == fillScore || !(s[x] < minScore)) continue;
+        if (!(hi[x] - lo[x] >= minStep)) continue;
+        d[x] = kNaN;
+        s[x] = kNaN;
+        ++rejected;
+      }
+      rejectedPerRow[static_cast<size_t>(y)] = rejected;
+    }
+  });
+  int total = 0;
+  for (const int r : rejectedPerRow) total += r;
+  return total;
+}
+
+}  // namespace delineo::stereo::detail

@@ -1,0 +1,104 @@
+// Weak matches beside depth steps rejected (internal rejectWeakMatchesBesideSteps).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/stereo/match.hpp"
+#include "weak_matches.hpp"
+
+namespace delineo::stereo::detail {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kFillScore = 0.3F;
+
+// A roof (disparity 30, x >= 20) beside the ground (10), every match scoring 0.9.
+struct StepScene {
+  cv::Mat disparity{24, 40, CV_32F, cv::Scalar(10.0)};
+  cv::Mat score{24, 40, CV_32F, cv::Scalar(0.9)};
+  StepScene() { disparity(cv::Rect(20, 0, 20, 24)).setTo(30.0F); }
+};
+
+TEST(RejectWeakMatchesBesideSteps, RejectsWeakMatchesWithinTheRadiusOfAStepOnly) {
+  StepScene s;
+  s.disparity.at<float>(10, 21) = 10.5F;  // the ground's value carried onto the roof, weak
+  s.score.at<float>(10, 21) = 0.6F;
+  s.score.at<float>(12, 17) = 0.7F;   // weak, 3 px from the step: rejected
+  s.score.at<float>(14, 16) = 0.7F;   // weak, 4 px from the step: kept
+  s.score.at<float>(16, 22) = 0.85F;  // beside the step, strong enough: kept
+  s.score.at<float>(18, 3) = 0.4F;    // weak, far from any step: kept
+  WeakMatchSettings settings;
+  EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score), 2);
+  EXPECT_TRUE(std::isnan(s.disparity.at<float>(10, 21)));
+  EXPECT_TRUE(std::isnan(s.score.at<float>(10, 21)));
+  EXPECT_TRUE(std::isnan(s.disparity.at<float>(12, 17)));
+  EXPECT_EQ(s.disparity.at<float>(14, 16), 10.0F);
+  EXPECT_EQ(s.disparity.at<float>(16, 22), 30.0F);
+  EXPECT_EQ(s.disparity.at<float>(18, 3), 10.0F);
+}
+
+TEST(RejectWeakMatchesBesideSteps, KeepsFilledPixelsAndIsOffAtZero) {
+  StepScene s;
+  s.score.at<float>(5, 19) = kFillScore;  // set by the fill: not a match
+  s.score.at<float>(6, 20) = 0.5F;
+  WeakMatchSettings settings;
+  settings.minScore = 0;
+  EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score), 0);
+  settings.minScore = 0.8;
+  EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score), 1);
+  EXPECT_EQ(s.disparity.at<float>(5, 19), 10.0F);
+  EXPECT_TRUE(std::isnan(s.disparity.at<float>(6, 20)));
+}
+
+TEST(RejectWeakMatchesBesideSteps, SlopesAndGapsAreNotSteps) {
+  // A facet sloping by 0.4 px per px: 2.4 px over the 7 px neighbourhood, under the 3 px step.
+  cv::Mat disparity(20, 40, CV_32F), score(20, 40, CV_32F, cv::Scalar(0.5));
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) disparity.at<float>(y, x) = 5.0F + 0.4F * x;
+  }
+  // An unmatched gap inside it is no step either.
+  disparity(cv::Rect(15, 5, 4, 6)).setTo(kNaN);
+  score(cv::Rect(15, 5, 4, 6)).setTo(kNaN);
+  WeakMatchSettings settings;
+  settings.threads = 2;
+  EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, disparity, score), 0);
+}
+
+TEST(RejectWeakMatchesBesideSteps, TheSameOnAnyNumberOfThreads) {
+  cv::Mat disparity(97, 61, CV_32F), score(97, 61, CV_32F);
+  cv::RNG rng(7);
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) {
+      disparity.at<float>(y, x) = (x / 9 + y / 11) % 2 ? 25.0F : 8.0F;
+      score.at<float>(y, x) = static_cast<float>(rng.uniform(0.3, 1.0));
+    }
+  }
+  cv::Mat d1 = disparity.clone(), s1 = score.clone(), d2 = disparity.clone(), s2 = score.clone();
+  WeakMatchSettings settings;
+  const int one = rejectWeakMatchesBesideSteps(settings, kFillScore, d1, s1);
+  settings.threads = 3;
+  EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, d2, s2), one);
+  EXPECT_GT(one, 0);
+  // Bit for bit, NaNs included.
+  for (int y = 0; y < d1.rows; ++y) {
+    EXPECT_EQ(std::memcmp(d1.ptr(y), d2.ptr(y), d1.cols * sizeof(float)), 0) << "row " << y;
+  }
+}
+
+TEST(RejectWeakMatchesBesideSteps, ItsParameterIsAScoreBetweenZeroAndOne) {
+  MatchParams p;
+  EXPECT_DOUBLE_EQ(p.stepMinScore, 0.8);
+  p.stepMinScore = 1.5;
+  EXPECT_THROW(p.validate(), std::exception);
+  p.stepMinScore = -0.1;
+  EXPECT_THROW(p.validate(), std::exception);
+  p.stepMinScore = 0;
+  EXPECT_NO_THROW(p.validate());
+}
+
+}  // namespace
+}  // namespace delineo::stereo::detail
