@@ -45,7 +45,8 @@ int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillSc
       int rejected = 0;
       for (int x = 0; x < disparity.cols; ++x) {
         if (d[x] != d[x] || s[x] == fillScore || !(s[x] < minScore)) continue;
-        if (!(hi[x] - lo[x] >= minStep)) continue;
+        // Beside a step, and on its far side (nearer the lowest disparity than the highest).
+        if (!(hi[x] - lo[x] >= minStep) || !(d[x] - lo[x] < hi[x] - d[x])) continue;
         d[x] = kNaN;
         s[x] = kNaN;
         ++rejected;

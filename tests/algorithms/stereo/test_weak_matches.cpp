@@ -23,13 +23,14 @@ struct StepScene {
   StepScene() { disparity(cv::Rect(20, 0, 20, 24)).setTo(30.0F); }
 };
 
-TEST(RejectWeakMatchesBesideSteps, RejectsWeakMatchesWithinTheRadiusOfAStepOnly) {
+TEST(RejectWeakMatchesBesideSteps, RejectsWeakFarSideMatchesWithinTheRadiusOfAStepOnly) {
   StepScene s;
   s.disparity.at<float>(10, 21) = 10.5F;  // the ground's value carried onto the roof, weak
   s.score.at<float>(10, 21) = 0.6F;
   s.score.at<float>(12, 17) = 0.7F;   // weak, 3 px from the step: rejected
   s.score.at<float>(14, 16) = 0.7F;   // weak, 4 px from the step: kept
   s.score.at<float>(16, 22) = 0.85F;  // beside the step, strong enough: kept
+  s.score.at<float>(8, 20) = 0.5F;    // weak, but on the near side (the roof): kept
   s.score.at<float>(18, 3) = 0.4F;    // weak, far from any step: kept
   WeakMatchSettings settings;
   EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score), 2);
@@ -38,20 +39,21 @@ TEST(RejectWeakMatchesBesideSteps, RejectsWeakMatchesWithinTheRadiusOfAStepOnly)
   EXPECT_TRUE(std::isnan(s.disparity.at<float>(12, 17)));
   EXPECT_EQ(s.disparity.at<float>(14, 16), 10.0F);
   EXPECT_EQ(s.disparity.at<float>(16, 22), 30.0F);
+  EXPECT_EQ(s.disparity.at<float>(8, 20), 30.0F);
   EXPECT_EQ(s.disparity.at<float>(18, 3), 10.0F);
 }
 
 TEST(RejectWeakMatchesBesideSteps, KeepsFilledPixelsAndIsOffAtZero) {
   StepScene s;
   s.score.at<float>(5, 19) = kFillScore;  // set by the fill: not a match
-  s.score.at<float>(6, 20) = 0.5F;
+  s.score.at<float>(6, 18) = 0.5F;
   WeakMatchSettings settings;
   settings.minScore = 0;
   EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score), 0);
   settings.minScore = 0.8;
   EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score), 1);
   EXPECT_EQ(s.disparity.at<float>(5, 19), 10.0F);
-  EXPECT_TRUE(std::isnan(s.disparity.at<float>(6, 20)));
+  EXPECT_TRUE(std::isnan(s.disparity.at<float>(6, 18)));
 }
 
 TEST(RejectWeakMatchesBesideSteps, SlopesAndGapsAreNotSteps) {

@@ -36,8 +36,8 @@ struct MatchParams {
   bool subpixel = true;              // sub-pixel peak from the 3x3 correlation neighbourhood
   bool adaptive = true;              // contour-adaptive shapes (false: plain square windows)
   bool fillRegions = true;           // flat regions take the disparity lining up their outline
-  double stepMinScore = 0.8;         // NCC: matches beside a depth step scoring below this are
-                                     // rejected after the fill (0 = off)
+  double stepMinScore = 0.8;         // NCC: far-side matches beside a depth step scoring below
+                                     // this are rejected after the fill (0 = off)
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
   bool orderingCheck = true;         // matches a nearer one hides in the right view are rejected
   int speckleSize = 20;              // px, matched regions smaller than this are removed (0 = off)
@@ -116,11 +116,12 @@ struct MatchParams {
                       "both views, when that is clear (their score is min-score)"},
       fillRegions);
     v(core::ParamInfo{"step-min-score", "Score beside depth steps", "",
-                      "After the fill, a match whose NCC peak is below this and whose 7 x 7 "
+                      "After the fill, a match whose NCC peak is below this, whose 7 x 7 "
                       "neighbourhood holds a depth step (valid disparities at least 3 px apart) "
-                      "is rejected: a window that reached the other surface carries its disparity "
-                      "over the outline with a weaker peak, and the snapping then closes the gap "
-                      "on the image contour; 0 = off (adaptive method)",
+                      "and whose disparity is on the step's far side is rejected: a window that "
+                      "reached the ground carries its disparity into a roof with a weaker peak, "
+                      "and the snapping then closes the gap on the image contour; 0 = off "
+                      "(adaptive method)",
                       0, 1},
       stepMinScore);
     v(core::ParamInfo{"snap-steps", "Snap depth steps to contours", "",
