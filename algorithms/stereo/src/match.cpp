@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "coarse_check.hpp"
+#include "coarse_intervals.hpp"
 #include "cpu_features.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/core/nan_mask.hpp"
@@ -418,112 +419,6 @@ detail::LevelOutput checkedHere(const detail::LevelOutput& map, const cv::Mat& k
   return out;
 }
 
-// Search intervals of a level from the validated disparities of the next coarser level: the
-// min..max of the valid coarse disparities in the 3x3 neighbourhood of the parent pixel, doubled,
-// ± margin. Where that neighbourhood holds no valid disparity (the parent was rejected), the
-// same from a wider (2·kWideRadius + 1)² neighbourhood: a rejected pixel lies on the surfaces
-// around it far more often than anywhere in the range, and searching the full range there made
-// the finer level both slower and more prone to wrong peaks. Only when that wider
-// neighbourhood is empty too is the level's full range searched (as in the paper).
-// Such a wider neighbourhood says less about the pixel: its interval gets kWideExtraMargin more
-// on each side. Rejected coarse pixels cluster on large weakly textured roofs, whose true value
-// then often lay just outside the interval, a border peak that was rejected (sim 1000²/128 d:
-// density 84.6 → 85.2 %, bad-1 1.55 → 1.43 %; 8+ raised the 600² roofRMS1 to 0.250–0.252 px).
-constexpr int kWideRadius = 4;
-constexpr int kWideExtraMargin = 7;  // px, at the finer level
-
-// One coarse row of intervalsFromCoarse(): from the 3x3 min/max (n0, n1) or, where the 3x3
-// neighbourhood holds no valid disparity, the wide one (w0, w1); the full range where `full`
-// (may be null) is non-zero. Also built for AVX2 (floor and ceil in one instruction each).
-__attribute__((target_clones("avx2", "default"))) void coarseIntervalRow(
-    const float* n0, const float* n1, const float* w0, const float* w1, const uchar* full, int cw,
-    int dmin, int dmax, int margin, int* l, int* h) {
-  for (int x = 0; x < cw; ++x) {
-    const bool isNear = n0[x] <= n1[x];
-    if ((full == nullptr || full[x] == 0) && (isNear || w0[x] <= w1[x])) {
-      const float mn = isNear ? n0[x] : w0[x], mx = isNear ? n1[x] : w1[x];
-      const int m = isNear ? margin : margin + kWideExtraMargin;
-      l[x] = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - m);
-      h[x] = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + m);
-    } else {
-      l[x] = dmin;
-      h[x] = dmax;
-    }
-  }
-}
-
-// With `fullNearRejected`, a pixel whose coarse 3x3 neighbourhood holds a rejected pixel is
-// given the full range (the paper gives it to the rejected pixels only): next to a rejected
-// pixel the coarse disparities are the least sure (a tree's carried into the roof beside it,
-// 2000²), and a wrong interval is never left again. Only above the finest level: there the
-// finest level's repeated seams lined up elsewhere (1000² / 128 d, docs/stereo.md, session 22).
-void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
-                         bool fullNearRejected, int threads, cv::Mat& lo, cv::Mat& hi) {
-  const int cw = coarse.cols, ch = coarse.rows;
-  // Neighbourhood minima and maxima of the valid coarse disparities as min/max filters (the
-  // morphology's separable float path), rejected pixels at +inf for the minimum and -inf for the
-  // maximum; the border does not extend the neighbourhood (+inf/-inf there too).
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  // (Both in one pass by bands of rows, not a NaN mask, two clones and two masked sets.)
-  cv::Mat forMin(coarse.size(), CV_32F), forMax(coarse.size(), CV_32F);
-  cv::Mat rejected = fullNearRejected ? cv::Mat(coarse.size(), CV_8U) : cv::Mat();
-  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      const float* __restrict c = coarse.ptr<float>(y);
-      float* __restrict mn = forMin.ptr<float>(y);
-      float* __restrict mx = forMax.ptr<float>(y);
-      for (int x = 0; x < cw; ++x) {
-        const bool isNumber = c[x] == c[x];  // false only for NaN
-        mn[x] = isNumber ? c[x] : kInf;
-        mx[x] = isNumber ? c[x] : -kInf;
-      }
-      if (fullNearRejected) {
-        uchar* r = rejected.ptr<uchar>(y);
-        for (int x = 0; x < cw; ++x) r[x] = c[x] == c[x] ? 0 : 1;
-      }
-    }
-  });
-  cv::Mat mn1, mx1, mnWide, mxWide, nearRejected;
-  const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
-  const cv::Mat wide = cv::Mat::ones(2 * kWideRadius + 1, 2 * kWideRadius + 1, CV_8U);
-  auto minFilter = [&](const cv::Mat& kernel, cv::Mat& out) {
-    cv::erode(forMin, out, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf);
-  };
-  auto maxFilter = [&](const cv::Mat& kernel, cv::Mat& out) {
-    cv::dilate(forMax, out, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf);
-  };
-  runTasks({[&] { minFilter(near, mn1); }, [&] { maxFilter(near, mx1); },
-            [&] { minFilter(wide, mnWide); }, [&] { maxFilter(wide, mxWide); },
-            [&] {
-              if (fullNearRejected) cv::dilate(rejected, nearRejected, near);
-            }},
-           threads);
-  cv::Mat clo(coarse.size(), CV_32S), chi(coarse.size(), CV_32S);
-  // By bands of rows on the level's threads (serial, ~0.3 % of the run's instructions).
-  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      coarseIntervalRow(mn1.ptr<float>(y), mx1.ptr<float>(y), mnWide.ptr<float>(y),
-                        mxWide.ptr<float>(y),
-                        fullNearRejected ? nearRejected.ptr<uchar>(y) : nullptr, cw, dmin, dmax,
-                        margin, clo.ptr<int>(y), chi.ptr<int>(y));
-    }
-  });
-  lo.create(size, CV_32S);
-  hi.create(size, CV_32S);
-  forRowBands(size.height, threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      const int cy = std::min(ch - 1, y / 2);
-      const int *cl = clo.ptr<int>(cy), *chh = chi.ptr<int>(cy);
-      int *l = lo.ptr<int>(y), *h = hi.ptr<int>(y);
-      for (int x = 0; x < size.width; ++x) {
-        const int cx = std::min(cw - 1, x / 2);
-        l[x] = cl[cx];
-        h[x] = chh[cx];
-      }
-    }
-  });
-}
-
 int threadCount(const MatchParams& p) {
   if (p.threads > 0) return p.threads;
   return std::max(1U, std::thread::hardware_concurrency());
@@ -611,10 +506,10 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       hiR = inL.hi;
     } else {
       const bool fullNearRejected = k > 0;
-      intervalsFromCoarse(coarseLeft, lv.left.size(), lv.dmin, lv.dmax, p.margin, fullNearRejected,
-                          threads, inL.lo, inL.hi);
-      intervalsFromCoarse(coarseRight, lv.left.size(), lv.dmin, lv.dmax, p.margin, fullNearRejected,
-                          threads, loR, hiR);
+      detail::intervalsFromCoarse(coarseLeft, lv.left.size(), lv.dmin, lv.dmax, p.margin,
+                                  fullNearRejected, threads, inL.lo, inL.hi);
+      detail::intervalsFromCoarse(coarseRight, lv.left.size(), lv.dmin, lv.dmax, p.margin,
+                                  fullNearRejected, threads, loR, hiR);
     }
     const double w = levelsShare * weight[static_cast<size_t>(k)] / total;
     core::Progress::Range leftRange(progress, done, done + 0.5 * w);
