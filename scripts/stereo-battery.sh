@@ -5,9 +5,12 @@
 # roof RMS <= 0.25 px, edge >= 90 %).
 #   battery: the 11 scenes the matcher was tuned on (sessions up to 22);
 #   held-out: 9 scenes never used to choose anything up to session 22 (seeds 11-16 600², 6-8
-#             1000²); judge a change on both, and keep them apart.
+#             1000²); session 23 looked at seeds 13-15 600² and 6-8 1000² to choose the
+#             weak-match rejection (step-min-score);
+#   fresh:    9 more scenes (seeds 17-22 600², 9-11 1000²), first run at the end of session 23
+#             to measure that choice; judge a change on all three, and keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
-# About a minute on 2 cores. Not a test: it prints numbers.
+# About a minute and a half on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build/default"
@@ -29,6 +32,10 @@ heldout=("s11-600|--size 600 --seed 11" "s12-600|--size 600 --seed 12"
   "s13-600|--size 600 --seed 13" "s14-600|--size 600 --seed 14" "s15-600|--size 600 --seed 15"
   "s16-600|--size 600 --seed 16" "s6-1000|--size 1000 --seed 6" "s7-1000|--size 1000 --seed 7"
   "s8-1000|--size 1000 --seed 8")
+fresh=("s17-600|--size 600 --seed 17" "s18-600|--size 600 --seed 18"
+  "s19-600|--size 600 --seed 19" "s20-600|--size 600 --seed 20" "s21-600|--size 600 --seed 21"
+  "s22-600|--size 600 --seed 22" "s9-1000|--size 1000 --seed 9" "s10-1000|--size 1000 --seed 10"
+  "s11-1000|--size 1000 --seed 11")
 
 run_group() {
   local name=$1
@@ -58,3 +65,4 @@ run_group() {
 extra=("$@")
 run_group battery "${battery[@]}"
 run_group held-out "${heldout[@]}"
+run_group fresh "${fresh[@]}"
