@@ -15,23 +15,25 @@ int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillSc
   if (!(settings.minScore > 0) || disparity.empty()) return 0;
   constexpr float kInf = std::numeric_limits<float>::infinity();
   // Neighbourhood min and max of the valid disparities (unmatched pixels at +inf for the min and
-  // -inf for the max), by the morphology's separable float filters.
+  // -inf for the max), by the morphology's separable float filters (as intervalsFromCoarse()).
   cv::Mat lowest(disparity.size(), CV_32F), highest(disparity.size(), CV_32F);
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    float* lo = lowest.ptr<float>(y);
-    float* hi = highest.ptr<float>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      const bool valid = d[x] == d[x];
-      lo[x] = valid ? d[x] : kInf;
-      hi[x] = valid ? d[x] : -kInf;
+  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* d = disparity.ptr<float>(y);
+      float* lo = lowest.ptr<float>(y);
+      float* hi = highest.ptr<float>(y);
+      for (int x = 0; x < disparity.cols; ++x) {
+        const bool valid = d[x] == d[x];
+        lo[x] = valid ? d[x] : kInf;
+        hi[x] = valid ? d[x] : -kInf;
+      }
     }
-  }
+  });
   const int side = 2 * settings.radius + 1;
   const cv::Mat square = cv::Mat::ones(side, side, CV_8U);
-  cv::erode(lowest, lowest, square, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(kInf));
-  cv::dilate(highest, highest, square, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
-             cv::Scalar(-kInf));
+  runTasks({[&] { cv::erode(lowest, lowest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf); },
+            [&] { cv::dilate(highest, highest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf); }},
+           settings.threads);
   const float minScore = static_cast<float>(settings.minScore);
   const float minStep = static_cast<float>(settings.minStep);
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
