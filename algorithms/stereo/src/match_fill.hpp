@@ -36,7 +36,7 @@ struct RegionFillSettings {
   double planeEaveShare = 0.33;  //   with this share of the other side's (a hip facet's eave)
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
   double planeTrimShare = 0.1;   // worst share of row ends dropped per trimmed refit (0 = off)
-  double planeMargin = 0.97;     // a plane replaces a constant the outline lines up at only when
+  double planeMargin = 0.95;     // a plane replaces a constant the outline lines up at only when
                                  //   its outline error is below this × the constant's
   double planeCandidateRatio = 1.1;  // where no constant is filled, a plane only when its outline
                                      //   error is below this × the best candidate's (0 = off)
