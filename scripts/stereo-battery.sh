@@ -8,9 +8,11 @@
 #             1000²); session 23 looked at seeds 13-15 600² and 6-8 1000² to choose the
 #             weak-match rejection (step-min-score);
 #   fresh:    9 more scenes (seeds 17-22 600², 9-11 1000²), first run at the end of session 23
-#             to measure that choice; judge a change on all three, and keep them apart.
+#             to measure that choice (seed 18 then chose the fill's plane margin);
+#   fresh-2:  9 more (seeds 23-28 600², 12-14 1000²), first run in session 23 to check the
+#             rejection's radius (kept at 3); judge a change on all four, and keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
-# About a minute and a half on 2 cores. Not a test: it prints numbers.
+# About two minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build/default"
@@ -36,6 +38,10 @@ fresh=("s17-600|--size 600 --seed 17" "s18-600|--size 600 --seed 18"
   "s19-600|--size 600 --seed 19" "s20-600|--size 600 --seed 20" "s21-600|--size 600 --seed 21"
   "s22-600|--size 600 --seed 22" "s9-1000|--size 1000 --seed 9" "s10-1000|--size 1000 --seed 10"
   "s11-1000|--size 1000 --seed 11")
+fresh2=("s23-600|--size 600 --seed 23" "s24-600|--size 600 --seed 24"
+  "s25-600|--size 600 --seed 25" "s26-600|--size 600 --seed 26" "s27-600|--size 600 --seed 27"
+  "s28-600|--size 600 --seed 28" "s12-1000|--size 1000 --seed 12"
+  "s13-1000|--size 1000 --seed 13" "s14-1000|--size 1000 --seed 14")
 
 run_group() {
   local name=$1
@@ -66,3 +72,4 @@ extra=("$@")
 run_group battery "${battery[@]}"
 run_group held-out "${heldout[@]}"
 run_group fresh "${fresh[@]}"
+run_group fresh-2 "${fresh2[@]}"
