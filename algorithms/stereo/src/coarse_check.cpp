@@ -7,6 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "neighbourhood_range.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -15,31 +16,11 @@ cv::Mat coarselyChecked(const cv::Mat& coarse, const LevelOutput& fine, double m
                         int threads) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   // Rejected neighbours (and the border) at −inf for the minimum and +inf for the maximum: the
-  // spread is then infinite, never smooth. (Both inputs in one pass by bands of rows, as
-  // intervalsFromCoarse() builds its own.)
+  // spread is then infinite, never smooth.
   const int cw = coarse.cols, ch = coarse.rows;
-  cv::Mat forMin(coarse.size(), CV_32F), forMax(coarse.size(), CV_32F);
-  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      const float* __restrict c = coarse.ptr<float>(y);
-      float* __restrict mn = forMin.ptr<float>(y);
-      float* __restrict mx = forMax.ptr<float>(y);
-      for (int x = 0; x < cw; ++x) {
-        const bool isNumber = c[x] == c[x];  // false only for NaN
-        mn[x] = isNumber ? c[x] : -kInf;
-        mx[x] = isNumber ? c[x] : kInf;
-      }
-    }
-  });
-  cv::Mat lowest, highest;
-  const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
-  runTasks({[&] {
-              cv::erode(forMin, lowest, near, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf);
-            },
-            [&] {
-              cv::dilate(forMax, highest, near, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf);
-            }},
-           threads);
+  cv::Mat forMin, forMax, lowest, highest;
+  rangeFilterInputs(coarse, -kInf, kInf, threads, forMin, forMax);
+  rangeFilters(forMin, forMax, cv::Mat::ones(3, 3, CV_8U), -kInf, kInf, threads, lowest, highest);
   cv::Mat kept(fine.disparity.size(), CV_8U);
   const auto floor = static_cast<float>(minScore);
   forRowBands(kept.rows, threads, [&](int rowStart, int rowEnd) {

@@ -5,6 +5,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "neighbourhood_range.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -38,29 +39,12 @@ __attribute__((target_clones("avx2", "default"))) void coarseIntervalRow(
 void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
                          bool fullNearRejected, int threads, cv::Mat& lo, cv::Mat& hi) {
   const int cw = coarse.cols, ch = coarse.rows;
-  // Neighbourhood minima and maxima of the valid coarse disparities as min/max filters (the
-  // morphology's separable float path), rejected pixels at +inf for the minimum and -inf for the
-  // maximum; the border does not extend the neighbourhood (+inf/-inf there too).
+  // Neighbourhood minima and maxima of the valid coarse disparities (rejected pixels ignored;
+  // the border does not extend the neighbourhood).
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  // (Both in one pass by bands of rows, not a NaN mask, two clones and two masked sets.)
-  cv::Mat forMin(coarse.size(), CV_32F), forMax(coarse.size(), CV_32F);
-  cv::Mat rejected = fullNearRejected ? cv::Mat(coarse.size(), CV_8U) : cv::Mat();
-  forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      const float* __restrict c = coarse.ptr<float>(y);
-      float* __restrict mn = forMin.ptr<float>(y);
-      float* __restrict mx = forMax.ptr<float>(y);
-      for (int x = 0; x < cw; ++x) {
-        const bool isNumber = c[x] == c[x];  // false only for NaN
-        mn[x] = isNumber ? c[x] : kInf;
-        mx[x] = isNumber ? c[x] : -kInf;
-      }
-      if (fullNearRejected) {
-        uchar* r = rejected.ptr<uchar>(y);
-        for (int x = 0; x < cw; ++x) r[x] = c[x] == c[x] ? 0 : 1;
-      }
-    }
-  });
+  cv::Mat forMin, forMax, rejected;
+  rangeFilterInputs(coarse, kInf, -kInf, threads, forMin, forMax);
+  if (fullNearRejected) cv::compare(forMin, kInf, rejected, cv::CMP_EQ);  // 255 where rejected
   cv::Mat mn1, mx1, mnWide, mxWide, nearRejected;
   const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
   const cv::Mat wide = cv::Mat::ones(2 * kWideRadius + 1, 2 * kWideRadius + 1, CV_8U);

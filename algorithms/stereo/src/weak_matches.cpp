@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "neighbourhood_range.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -14,26 +15,12 @@ int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillSc
             disparity.size() == score.size());
   if (!(settings.minScore > 0) || disparity.empty()) return 0;
   constexpr float kInf = std::numeric_limits<float>::infinity();
-  // Neighbourhood min and max of the valid disparities (unmatched pixels at +inf for the min and
-  // -inf for the max), by the morphology's separable float filters (as intervalsFromCoarse()).
-  cv::Mat lowest(disparity.size(), CV_32F), highest(disparity.size(), CV_32F);
-  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      const float* d = disparity.ptr<float>(y);
-      float* lo = lowest.ptr<float>(y);
-      float* hi = highest.ptr<float>(y);
-      for (int x = 0; x < disparity.cols; ++x) {
-        const bool valid = d[x] == d[x];
-        lo[x] = valid ? d[x] : kInf;
-        hi[x] = valid ? d[x] : -kInf;
-      }
-    }
-  });
+  // Neighbourhood min and max of the valid disparities (unmatched pixels ignored).
+  cv::Mat forMin, forMax, lowest, highest;
+  rangeFilterInputs(disparity, kInf, -kInf, settings.threads, forMin, forMax);
   const int side = 2 * settings.radius + 1;
-  const cv::Mat square = cv::Mat::ones(side, side, CV_8U);
-  runTasks({[&] { cv::erode(lowest, lowest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf); },
-            [&] { cv::dilate(highest, highest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf); }},
-           settings.threads);
+  rangeFilters(forMin, forMax, cv::Mat::ones(side, side, CV_8U), kInf, -kInf, settings.threads,
+               lowest, highest);
   const float minScore = static_cast<float>(settings.minScore);
   const float minStep = static_cast<float>(settings.minStep);
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
