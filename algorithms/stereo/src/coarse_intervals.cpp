@@ -48,14 +48,10 @@ void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dma
   cv::Mat mn1, mx1, mnWide, mxWide, nearRejected;
   const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
   const cv::Mat wide = cv::Mat::ones(2 * kWideRadius + 1, 2 * kWideRadius + 1, CV_8U);
-  auto minFilter = [&](const cv::Mat& kernel, cv::Mat& out) {
-    cv::erode(forMin, out, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf);
-  };
-  auto maxFilter = [&](const cv::Mat& kernel, cv::Mat& out) {
-    cv::dilate(forMax, out, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf);
-  };
-  runTasks({[&] { minFilter(near, mn1); }, [&] { maxFilter(near, mx1); },
-            [&] { minFilter(wide, mnWide); }, [&] { maxFilter(wide, mxWide); },
+  // The two pairs of filters and the rejected pixels' dilation as three tasks (each pair on one
+  // worker: the coarse level is small).
+  runTasks({[&] { rangeFilters(forMin, forMax, near, kInf, -kInf, 1, mn1, mx1); },
+            [&] { rangeFilters(forMin, forMax, wide, kInf, -kInf, 1, mnWide, mxWide); },
             [&] {
               if (fullNearRejected) cv::dilate(rejected, nearRejected, near);
             }},
