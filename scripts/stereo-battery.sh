@@ -10,9 +10,11 @@
 #   fresh:    9 more scenes (seeds 17-22 600², 9-11 1000²), first run at the end of session 23
 #             to measure that choice (seed 18 then chose the fill's plane margin);
 #   fresh-2:  9 more (seeds 23-28 600², 12-14 1000²), first run in session 23 to check the
-#             rejection's radius (kept at 3); judge a change on all four, and keep them apart.
+#             rejection's radius (kept at 3);
+#   fresh-3:  9 more (seeds 29-34 600², 15-17 1000²), first run at the start of session 24,
+#             before anything was chosen on it; judge a change on all five, and keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
-# About two minutes on 2 cores. Not a test: it prints numbers.
+# About two and a half minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build/default"
@@ -42,6 +44,10 @@ fresh2=("s23-600|--size 600 --seed 23" "s24-600|--size 600 --seed 24"
   "s25-600|--size 600 --seed 25" "s26-600|--size 600 --seed 26" "s27-600|--size 600 --seed 27"
   "s28-600|--size 600 --seed 28" "s12-1000|--size 1000 --seed 12"
   "s13-1000|--size 1000 --seed 13" "s14-1000|--size 1000 --seed 14")
+fresh3=("s29-600|--size 600 --seed 29" "s30-600|--size 600 --seed 30"
+  "s31-600|--size 600 --seed 31" "s32-600|--size 600 --seed 32" "s33-600|--size 600 --seed 33"
+  "s34-600|--size 600 --seed 34" "s15-1000|--size 1000 --seed 15"
+  "s16-1000|--size 1000 --seed 16" "s17-1000|--size 1000 --seed 17")
 
 run_group() {
   local name=$1
@@ -73,3 +79,4 @@ run_group battery "${battery[@]}"
 run_group held-out "${heldout[@]}"
 run_group fresh "${fresh[@]}"
 run_group fresh-2 "${fresh2[@]}"
+run_group fresh-3 "${fresh3[@]}"
