@@ -255,6 +255,10 @@
         <translation>Score près des sauts de profondeur</translation>
     </message>
     <message>
+        <source>Edge gap closing</source>
+        <translation>Fermeture des coupures de contour</translation>
+    </message>
+    <message>
         <source>Ordering check</source>
         <translation>Contrôle de l’ordre</translation>
     </message>

@@ -17,6 +17,7 @@
 
 #include "coarse_check.hpp"
 #include "coarse_intervals.hpp"
+#include "contour_gaps.hpp"
 #include "cpu_features.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/core/nan_mask.hpp"
@@ -152,6 +153,7 @@ cv::Mat edgeMap(const cv::Mat& values, const MatchParams& p) {
   if (p.edgeSigma > 0) cv::GaussianBlur(grey, grey, cv::Size(0, 0), p.edgeSigma);
   cv::Mat edges;
   cv::Canny(grey, edges, p.edgeLow, p.edgeHigh, 3, true);
+  detail::bridgeContourGaps(edges, p.edgeGap);
   return edges;
 }
 

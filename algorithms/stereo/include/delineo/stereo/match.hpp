@@ -29,6 +29,7 @@ struct MatchParams {
   double edgeLow = 40.0;             // Canny low threshold on the 0..255-normalised image
   double edgeHigh = 100.0;           // Canny high threshold
   double edgeSigma = 1.0;            // px, Gaussian smoothing before Canny (same at each level)
+  int edgeGap = 1;                   // px, largest contour gap closed at a chain's end (0 = off)
   int minShape = 25;                 // px, adaptive shapes smaller than this use the square window
   int margin = 2;                    // px, half-width added around the coarser level's disparity
   int lineShift = 1;                 // px, search ±lineShift lines (0 or 1) across the epipolar direction
@@ -93,6 +94,12 @@ struct MatchParams {
     v(core::ParamInfo{"edge-sigma", "Edge smoothing", "px",
                       "Gaussian sigma before edge detection, at every pyramid level", 0, 10},
       edgeSigma);
+    v(core::ParamInfo{"edge-gap", "Edge gap closing", "px",
+                      "A contour chain's end is joined to the nearest contour pixel ahead of it "
+                      "across at most this many missing pixels (a roof outline Canny broke where "
+                      "its contrast dips lets the adaptive windows leak through); 0 = off",
+                      0, 10},
+      edgeGap);
     v(core::ParamInfo{"min-shape", "Minimal shape", "px",
                       "Adaptive shapes with fewer pixels fall back to the square window", 1, 961},
       minShape);
