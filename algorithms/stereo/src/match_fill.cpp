@@ -70,6 +70,27 @@ float clusterMedian(const std::vector<float>& values, float centre, double refoc
   return refocus > 0 ? medianNear(values, median, static_cast<float>(refocus)) : median;
 }
 
+// Where the ring error `errorAt` is lowest on a 0.05 px grid within `reach` px of `centre`.
+template <class ErrorAt>
+float ringMinimumNear(const ErrorAt& errorAt, float centre, double reach) {
+  const int steps = static_cast<int>(std::floor(reach / 0.05 + 1e-9));
+  float lowestAt = centre;
+  double lowest = errorAt(centre);
+  for (int k = -steps; k <= steps; ++k) {
+    const float value = centre + 0.05f * static_cast<float>(k);
+    const double e = errorAt(value);
+    if (e < lowest) {
+      lowest = e;
+      lowestAt = value;
+    }
+  }
+  return lowestAt;
+}
+
+float medianOfThree(float a, float b, float c) {
+  return std::max(std::min(a, b), std::min(std::max(a, b), c));
+}
+
 // Centres (integer disparities) of the two largest clusters of ±1 px among `values`; the second
 // is at least 3 px from the first and holds at least `minCount` values, else absent.
 std::vector<int> twoLargestClusters(const std::vector<float>& values, int dmin, int dmax,
@@ -949,7 +970,11 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       // most of the good matches beside it; docs/stereo.md, session 22).
       const std::vector<float>& valueFrom =
           static_cast<int>(matchesBeside.size()) >= settings.minMatched ? matchesBeside : matches;
-      const float value = clusterMedian(valueFrom, best, settings.refocusReach);
+      float value = clusterMedian(valueFrom, best, settings.refocusReach);
+      if (settings.ringArbiterReach > 0) {
+        value =
+            medianOfThree(value, best, ringMinimumNear(ringError, best, settings.ringArbiterReach));
+      }
       constantError = ringError(value);
       return value;
     }();

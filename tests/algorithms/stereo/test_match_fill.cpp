@@ -608,7 +608,8 @@ TEST(FillFlatRegions, RefocusesTheMedianOnTheBulkOfTheOutlinesMatches) {
   // The top strip's 92 matches at the roof's disparity; the bottom strip's first row 0.6 px too
   // far and its second 1.7 px (a tail of windows along an outline that runs with the rows). All
   // lie within 1.5 px of the cluster's mean and the median falls on 20.6; within 1 px of it, the
-  // median of the matches is the roof's.
+  // median of the matches is the roof's. (The ring error's arbitration then moves it by the
+  // grid's 0.025 px: measured 20.025 and, without the refocus, the mean 20.575.)
   const auto skewed = [] {
     Scene s = scene();
     s.disparity(cv::Rect(s.roof.x + 2, s.roof.br().y - 2, s.roof.width - 4, 1)).setTo(kRoof + 0.6f);
@@ -621,8 +622,33 @@ TEST(FillFlatRegions, RefocusesTheMedianOnTheBulkOfTheOutlinesMatches) {
   const cv::Rect inner(refocused.roof.x + 5, refocused.roof.y + 5, refocused.roof.width - 10,
                        refocused.roof.height - 10);
   const auto at = [](float value) { return [value](int, int) { return value; }; };
-  EXPECT_EQ(pixelsWithin(refocused.disparity, inner, at(kRoof), 0.01), inner.area());
-  EXPECT_EQ(pixelsWithin(median.disparity, inner, at(kRoof + 0.6f), 0.01), inner.area());
+  EXPECT_EQ(pixelsWithin(refocused.disparity, inner, at(kRoof), 0.05), inner.area());
+  EXPECT_EQ(pixelsWithin(median.disparity, inner, at(kRoof + 0.6f), 0.05), inner.area());
+}
+
+TEST(FillFlatRegions, TheRingErrorArbitratesBetweenTheMatchesMedianAndTheirMean) {
+  // The matches beside the roof on its rows (136, its side columns) all 0.8 px too far, as
+  // beside a rooftop box; the strips along its top and bottom (184) 0.4 px short. The refocused
+  // median of the matches beside is 20.8, the cluster's mean about 20.1, and the outline lines
+  // up best at the roof's 20: the median of the three is the mean.
+  const auto biased = [] {
+    Scene s = scene();
+    s.disparity(cv::Rect(s.roof.x + 2, s.roof.y, s.roof.width - 4, 2)).setTo(kRoof - 0.4f);
+    s.disparity(cv::Rect(s.roof.x + 2, s.roof.br().y - 2, s.roof.width - 4, 2)).setTo(kRoof - 0.4f);
+    const int sideRows = s.roof.height - 6;
+    s.disparity(cv::Rect(s.roof.x, s.roof.y + 3, 2, sideRows)).setTo(kRoof + 0.8f);
+    s.disparity(cv::Rect(s.roof.br().x - 2, s.roof.y + 3, 2, sideRows)).setTo(kRoof + 0.8f);
+    return s;
+  };
+  RegionFillSettings medianOnly;
+  medianOnly.ringArbiterReach = 0;
+  const auto [arbitrated, median] = filledWithAndWithout(biased, {}, medianOnly);
+  const cv::Rect inner(arbitrated.roof.x + 5, arbitrated.roof.y + 5, arbitrated.roof.width - 10,
+                       arbitrated.roof.height - 10);
+  const auto at = [](float value) { return [value](int, int) { return value; }; };
+  // (Measured: every inner pixel at 20.110; 20.800 with the median alone.)
+  EXPECT_EQ(pixelsWithin(arbitrated.disparity, inner, at(kRoof), 0.2), inner.area());
+  EXPECT_EQ(pixelsWithin(median.disparity, inner, at(kRoof + 0.8f), 0.05), inner.area());
 }
 
 TEST(FillFlatRegions, TakesItsValueFromTheMatchesBesideTheRoofNotAboveOrBelowIt) {
