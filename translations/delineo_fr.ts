@@ -255,6 +255,10 @@
         <translation>Score près des sauts de profondeur</translation>
     </message>
     <message>
+        <source>Score of plain pixels near depth steps</source>
+        <translation>Score des pixels unis près des sauts de profondeur</translation>
+    </message>
+    <message>
         <source>Edge gap closing</source>
         <translation>Fermeture des coupures de contour</translation>
     </message>

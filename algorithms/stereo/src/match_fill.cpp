@@ -1125,6 +1125,12 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
 
 }  // namespace
 
+cv::Mat plainPixels(const cv::Mat& image, double sigmas) {
+  RegionFillSettings settings;
+  settings.flatSigmas = sigmas;
+  return flatMask(image, settings);
+}
+
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads, const std::function<void()>& alongside) {

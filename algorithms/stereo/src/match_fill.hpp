@@ -151,6 +151,10 @@ struct RegionFillSettings {
 // `threads` > 1: the right view's flat regions are made on a second worker, which then runs
 // `alongside` (the caller's own work, independent of the fill) while the fill goes on; else
 // `alongside` runs after the fill. Same result on any number of threads.
+// Pixels of `image` (CV_32F, NaN = nodata) whose 5x5 standard deviation is below `sigmas` times
+// the image's noise sigma (CV_8U 0/255): the fill's flat test, at another threshold.
+cv::Mat plainPixels(const cv::Mat& image, double sigmas);
+
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads = 1, const std::function<void()>& alongside = {});

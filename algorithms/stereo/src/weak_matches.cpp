@@ -10,9 +10,11 @@
 namespace delineo::stereo::detail {
 
 int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillScore,
-                                 cv::Mat& disparity, cv::Mat& score) {
+                                 cv::Mat& disparity, cv::Mat& score, const cv::Mat& candidates) {
   CV_Assert(disparity.type() == CV_32F && score.type() == CV_32F &&
             disparity.size() == score.size());
+  CV_Assert(candidates.empty() ||
+            (candidates.type() == CV_8U && candidates.size() == disparity.size()));
   if (!(settings.minScore > 0) || disparity.empty()) return 0;
   constexpr float kInf = std::numeric_limits<float>::infinity();
   // Neighbourhood min and max of the valid disparities (unmatched pixels ignored).
@@ -31,9 +33,11 @@ int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillSc
       float* s = score.ptr<float>(y);
       const float* lo = lowest.ptr<float>(y);
       const float* hi = highest.ptr<float>(y);
+      const uchar* eligible = candidates.empty() ? nullptr : candidates.ptr<uchar>(y);
       int rejected = 0;
       for (int x = 0; x < disparity.cols; ++x) {
         if (d[x] != d[x] || s[x] == fillScore || !(s[x] < minScore)) continue;
+        if (eligible != nullptr && eligible[x] == 0) continue;
         // Beside a step, and on its far side (nearer the lowest disparity than the highest).
         if (!(hi[x] - lo[x] >= minStep) || !(d[x] - lo[x] < hi[x] - d[x])) continue;
         d[x] = kNaN;

@@ -22,8 +22,11 @@ struct WeakMatchSettings {
 // are kept: a roof carried onto the ground is what the snapping cuts back, and rejecting them too
 // left roof corners unmatched (sim seed 14 600² edge 90.6 -> 89.0 %, against 90.3 % with the far
 // side only). Pixels scoring exactly `fillScore` (set by the fill, not matched) are kept.
+// `candidates` (CV_8U, non-zero = may be rejected; empty = every pixel) restricts the test, as
+// for the second, wider pass over plain pixels (see MatchParams::plainStepMinScore).
 // Returns the number of pixels rejected.
 int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillScore,
-                                 cv::Mat& disparity, cv::Mat& score);
+                                 cv::Mat& disparity, cv::Mat& score,
+                                 const cv::Mat& candidates = cv::Mat());
 
 }  // namespace delineo::stereo::detail

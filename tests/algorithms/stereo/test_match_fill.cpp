@@ -99,6 +99,18 @@ int roofPixelsWithTheRoofsDisparity(const Scene& s) {
   return roofPixelsIn(s, s.roof);
 }
 
+TEST(PlainPixels, AreThePlainRoofNotTheTexturedGround) {
+  const Scene s = scene();
+  const cv::Mat plain = plainPixels(s.left, 3.0);
+  const cv::Rect inner(s.roof.x + 3, s.roof.y + 3, s.roof.width - 6, s.roof.height - 6);
+  EXPECT_EQ(cv::countNonZero(plain(inner)), inner.area());
+  const cv::Rect ground(0, 0, s.roof.x - 3, s.left.rows);
+  // (The ground's texture: a few of its 5x5 windows may be about as plain as noise.)
+  EXPECT_LT(cv::countNonZero(plain(ground)), ground.area() / 20);
+  // A lower threshold keeps fewer of the roof's pixels, never more.
+  EXPECT_LE(cv::countNonZero(plainPixels(s.left, 1.0)(inner)), cv::countNonZero(plain(inner)));
+}
+
 TEST(FillFlatRegions, ReachesTheImageContourAndStopsThere) {
   Scene grown = scene();
   fill(grown, RegionFillSettings{}, 32);

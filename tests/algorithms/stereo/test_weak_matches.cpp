@@ -91,6 +91,36 @@ TEST(RejectWeakMatchesBesideSteps, TheSameOnAnyNumberOfThreads) {
   }
 }
 
+TEST(RejectWeakMatchesBesideSteps, OnlyCandidatesAreRejectedWhenAMaskIsGiven) {
+  // The wider pass over plain pixels: radius 7, only the pixels of the mask.
+  StepScene s;
+  s.score.at<float>(10, 14) = 0.5F;  // weak, 6 px from the step, plain: rejected
+  s.score.at<float>(12, 14) = 0.5F;  // weak, 6 px from the step, textured: kept
+  s.score.at<float>(14, 11) = 0.5F;  // weak, plain, 9 px from the step: kept
+  cv::Mat plain = cv::Mat::zeros(s.disparity.size(), CV_8U);
+  plain.at<uchar>(10, 14) = 255;
+  plain.at<uchar>(14, 11) = 255;
+  WeakMatchSettings settings;
+  settings.minScore = 0.6;
+  settings.radius = 7;
+  EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score, plain), 1);
+  EXPECT_TRUE(std::isnan(s.disparity.at<float>(10, 14)));
+  EXPECT_EQ(s.disparity.at<float>(12, 14), 10.0F);
+  EXPECT_EQ(s.disparity.at<float>(14, 11), 10.0F);
+  // Without the mask the textured one goes too.
+  EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, s.disparity, s.score), 1);
+  EXPECT_TRUE(std::isnan(s.disparity.at<float>(12, 14)));
+}
+
+TEST(RejectWeakMatchesBesideSteps, ThePlainPassIsAParameterBetweenZeroAndOne) {
+  MatchParams p;
+  EXPECT_DOUBLE_EQ(p.plainStepMinScore, 0.6);
+  p.plainStepMinScore = 1.2;
+  EXPECT_THROW(p.validate(), std::exception);
+  p.plainStepMinScore = 0;
+  EXPECT_NO_THROW(p.validate());
+}
+
 TEST(RejectWeakMatchesBesideSteps, ItsParameterIsAScoreBetweenZeroAndOne) {
   MatchParams p;
   EXPECT_DOUBLE_EQ(p.stepMinScore, 0.8);

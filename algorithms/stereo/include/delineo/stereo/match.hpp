@@ -39,6 +39,7 @@ struct MatchParams {
   bool fillRegions = true;           // flat regions take the disparity lining up their outline
   double stepMinScore = 0.8;         // NCC: far-side matches beside a depth step scoring below
                                      // this are rejected after the fill (0 = off)
+  double plainStepMinScore = 0.6;    // NCC: the same within 7 px of a step, on plain pixels only
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
   bool orderingCheck = true;         // matches a nearer one hides in the right view are rejected
   int speckleSize = 20;              // px, matched regions smaller than this are removed (0 = off)
@@ -131,6 +132,14 @@ struct MatchParams {
                       "(adaptive method)",
                       0, 1},
       stepMinScore);
+    v(core::ParamInfo{"plain-step-min-score", "Score of plain pixels near depth steps", "",
+                      "Then, a match on a plain pixel (5 x 5 standard deviation below 3 noise "
+                      "sigmas) whose NCC peak is below this, whose 15 x 15 neighbourhood holds a "
+                      "depth step and whose disparity is on the step's far side is rejected: a "
+                      "plain roof's window that reached the ground across a contour the edge "
+                      "detector missed; 0 = off (adaptive method)",
+                      0, 1},
+      plainStepMinScore);
     v(core::ParamInfo{"snap-steps", "Snap depth steps to contours", "",
                       "Along each row, the near side of a depth step between two matched pixels "
                       "(at most 16 px apart) is made to end at the strongest contour of the left "
