@@ -368,6 +368,24 @@ FacetScene facetWithARaggedEaveInTheRightView() {
   return s;
 }
 
+TEST(FillFlatRegions, APlaneThatSpansLessThanPlaneMinSpanDoesNotReplaceTheConstant) {
+  // The 0.03 px per column facet above: its plane spans about 2 px over the flat region. With
+  // planeMinSpan above that, the constant stays (as for a flat roof whose row ends took a slope
+  // of noise); at the default 1.5 px, the plane is filled.
+  FacetScene spanning = slopedFacet(0.03, 0.0, true);
+  fill(spanning, RegionFillSettings{}, 40);
+  FacetScene tooFlat = slopedFacet(0.03, 0.0, true);
+  RegionFillSettings wideSpan;
+  wideSpan.planeMinSpan = 2.5;
+  fill(tooFlat, wideSpan, 40);
+  const int area = spanning.facet.area();
+  EXPECT_GE(facetPixelsOnItsPlane(spanning, 0.5), area * 95 / 100) << " of " << area;
+  EXPECT_GE(
+      cv::countNonZero(tooFlat.disparity(tooFlat.facet) ==
+                       tooFlat.disparity.at<float>(tooFlat.facet.y + 30, tooFlat.facet.x + 35)),
+      area * 9 / 10);
+}
+
 TEST(FillFlatRegions, AFacetWhoseHipSideRowEndsAgreeTakesTheirPlaneOverARaggedEave) {
   FacetScene hip = facetWithARaggedEaveInTheRightView();
   fill(hip, RegionFillSettings{}, 40);
