@@ -646,7 +646,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   // Then a wider pass over plain pixels (5x5 standard deviation below 3 noise sigmas): a plain
   // roof's pixels up to 7 px from a step whose windows reached the ground across a contour Canny
-  // missed (seed 28 600²: an 8 px patch 62 px off, 6 px inside the roof, scoring 0.53-0.59;
+  // missed (seed 28 600²: an 8 px patch 62 px off, 4-7 px inside the roof, scoring 0.53-0.59;
   // roof RMS 0.919 -> 0.210 px). Textured pixels are left alone: on the Dublin tile the same pass
   // over every pixel removed 3.8 points of density whose bad-2 was below the rest's.
   if (p.adaptive && p.plainStepMinScore > 0) {

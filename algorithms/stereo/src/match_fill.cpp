@@ -77,6 +77,7 @@ float ringMinimumNear(const ErrorAt& errorAt, float centre, double reach) {
   float lowestAt = centre;
   double lowest = errorAt(centre);
   for (int k = -steps; k <= steps; ++k) {
+    if (k == 0) continue;
     const float value = centre + 0.05f * static_cast<float>(k);
     const double e = errorAt(value);
     if (e < lowest) {
