@@ -12,9 +12,12 @@
 #   fresh-2:  9 more (seeds 23-28 600², 12-14 1000²), first run in session 23 to check the
 #             rejection's radius (kept at 3);
 #   fresh-3:  9 more (seeds 29-34 600², 15-17 1000²), first run at the start of session 24,
-#             before anything was chosen on it; judge a change on all five, and keep them apart.
+#             before anything was chosen on it (seeds 15-16 1000² were then looked at);
+#   fresh-4:  9 more (seeds 35-40 600², 18-20 1000²), first run at the end of session 24, after
+#             its changes were chosen (seed 35 then looked at); judge a change on all six, and
+#             keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
-# About two and a half minutes on 2 cores. Not a test: it prints numbers.
+# About three minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build/default"
@@ -48,6 +51,10 @@ fresh3=("s29-600|--size 600 --seed 29" "s30-600|--size 600 --seed 30"
   "s31-600|--size 600 --seed 31" "s32-600|--size 600 --seed 32" "s33-600|--size 600 --seed 33"
   "s34-600|--size 600 --seed 34" "s15-1000|--size 1000 --seed 15"
   "s16-1000|--size 1000 --seed 16" "s17-1000|--size 1000 --seed 17")
+fresh4=("s35-600|--size 600 --seed 35" "s36-600|--size 600 --seed 36"
+  "s37-600|--size 600 --seed 37" "s38-600|--size 600 --seed 38" "s39-600|--size 600 --seed 39"
+  "s40-600|--size 600 --seed 40" "s18-1000|--size 1000 --seed 18"
+  "s19-1000|--size 1000 --seed 19" "s20-1000|--size 1000 --seed 20")
 
 run_group() {
   local name=$1
@@ -80,3 +87,4 @@ run_group held-out "${heldout[@]}"
 run_group fresh "${fresh[@]}"
 run_group fresh-2 "${fresh2[@]}"
 run_group fresh-3 "${fresh3[@]}"
+run_group fresh-4 "${fresh4[@]}"
