@@ -14,10 +14,12 @@
 #   fresh-3:  9 more (seeds 29-34 600², 15-17 1000²), first run at the start of session 24,
 #             before anything was chosen on it (seeds 15-16 1000² were then looked at);
 #   fresh-4:  9 more (seeds 35-40 600², 18-20 1000²), first run at the end of session 24, after
-#             its changes were chosen (seed 35 then looked at); judge a change on all six, and
-#             keep them apart.
+#             its changes were chosen (seed 35 then looked at);
+#   fresh-5:  9 more (seeds 41-46 600², 21-23 1000²), first run at the start of session 25,
+#             before anything was chosen on it. Judge a change on all seven groups, and keep
+#             them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
-# About three minutes on 2 cores. Not a test: it prints numbers.
+# About three and a half minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build/default"
@@ -55,6 +57,10 @@ fresh4=("s35-600|--size 600 --seed 35" "s36-600|--size 600 --seed 36"
   "s37-600|--size 600 --seed 37" "s38-600|--size 600 --seed 38" "s39-600|--size 600 --seed 39"
   "s40-600|--size 600 --seed 40" "s18-1000|--size 1000 --seed 18"
   "s19-1000|--size 1000 --seed 19" "s20-1000|--size 1000 --seed 20")
+fresh5=("s41-600|--size 600 --seed 41" "s42-600|--size 600 --seed 42"
+  "s43-600|--size 600 --seed 43" "s44-600|--size 600 --seed 44" "s45-600|--size 600 --seed 45"
+  "s46-600|--size 600 --seed 46" "s21-1000|--size 1000 --seed 21"
+  "s22-1000|--size 1000 --seed 22" "s23-1000|--size 1000 --seed 23")
 
 run_group() {
   local name=$1
@@ -88,3 +94,4 @@ run_group fresh "${fresh[@]}"
 run_group fresh-2 "${fresh2[@]}"
 run_group fresh-3 "${fresh3[@]}"
 run_group fresh-4 "${fresh4[@]}"
+run_group fresh-5 "${fresh5[@]}"
