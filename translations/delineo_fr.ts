@@ -263,6 +263,10 @@
         <translation>Fermeture des coupures de contour</translation>
     </message>
     <message>
+        <source>Steepest slanted facet</source>
+        <translation>Pente maximale des pans inclinés</translation>
+    </message>
+    <message>
         <source>Ordering check</source>
         <translation>Contrôle de l’ordre</translation>
     </message>

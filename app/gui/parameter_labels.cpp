@@ -67,6 +67,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Score beside depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Score of plain pixels near depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Edge gap closing"),
+    QT_TRANSLATE_NOOP("Parameters", "Steepest slanted facet"),
     QT_TRANSLATE_NOOP("Parameters", "Threads"),
     QT_TRANSLATE_NOOP("Parameters", "Cut windows at depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),

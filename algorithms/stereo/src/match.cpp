@@ -28,6 +28,7 @@
 #include "match_steps.hpp"
 #include "ordering.hpp"
 #include "radiometry.hpp"
+#include "slanted_facets.hpp"
 #include "smoothing.hpp"
 #include "speckles.hpp"
 #include "weak_matches.hpp"
@@ -656,6 +657,15 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     wide.threads = threads;
     detail::rejectWeakMatchesBesideSteps(wide, static_cast<float>(p.minScore), result.disparity,
                                          result.score, detail::plainPixels(left, 3.0));
+  }
+  // Then the steep facets left unmatched, matched region by region on slanted planes; before the
+  // speckles, the snapping and the ordering check, which treat their matches like any other.
+  if (p.adaptive && p.facetMaxSlope > 0) {
+    detail::SlantedFacetSettings facets;
+    facets.maxSlope = p.facetMaxSlope;
+    facets.threads = threads;
+    detail::recoverSlantedFacets(left, right, pyramid[0].leftEdges, facets, p.dmin, p.dmax,
+                                 result.disparity, result.score);
   }
   if (reachedButCanceled(0.9)) return result;
   // Speckles are removed after the fill (before it, the fill lost its seeds: 600² edge 66.1 %

@@ -40,6 +40,8 @@ struct MatchParams {
   double stepMinScore = 0.8;         // NCC: far-side matches beside a depth step scoring below
                                      // this are rejected after the fill (0 = off)
   double plainStepMinScore = 0.6;    // NCC: the same within 7 px of a step, on plain pixels only
+  double facetMaxSlope = 0.6;        // px/px: unmatched regions matched on slanted planes up to
+                                     // this slope (0 = off)
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
   bool orderingCheck = true;         // matches a nearer one hides in the right view are rejected
   int speckleSize = 20;              // px, matched regions smaller than this are removed (0 = off)
@@ -140,6 +142,15 @@ struct MatchParams {
                       "detector missed; 0 = off (adaptive method)",
                       0, 1},
       plainStepMinScore);
+    v(core::ParamInfo{"facet-max-slope", "Steepest slanted facet", "px/px",
+                      "Then, each unmatched region between contours (100 px or more) is matched "
+                      "as a whole on planes d = a + gx x + gy y with |gx|, |gy| up to this: a "
+                      "steep roof facet, stretched or squeezed in the right view, finds no peak "
+                      "with windows at one disparity. The best plane is kept when the region's "
+                      "NCC there is at least 0.8, on its pixels whose 7 x 7 window scores at "
+                      "least 0.6; 0 = off (adaptive method)",
+                      0, 2},
+      facetMaxSlope);
     v(core::ParamInfo{"snap-steps", "Snap depth steps to contours", "",
                       "Along each row, the near side of a depth step between two matched pixels "
                       "(at most 16 px apart) is made to end at the strongest contour of the left "

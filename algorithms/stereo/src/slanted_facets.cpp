@@ -1,0 +1,329 @@
+#include "slanted_facets.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/nan_mask.hpp"
+#include "workers.hpp"
+
+namespace delineo::stereo::detail {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// d(x, y) = a + gx·(x − cx) + gy·(y − cy): centred on the region, so that `a` and the slopes
+// are searched independently of where the region lies.
+struct Plane {
+  double a = 0, gx = 0, gy = 0;
+  double cx = 0, cy = 0;
+  double at(double x, double y) const { return a + gx * (x - cx) + gy * (y - cy); }
+};
+
+// Left grey levels of a set of pixels, centred on their mean (NCC then needs only Σ a·b).
+struct Samples {
+  std::vector<cv::Point> points;
+  std::vector<double> centred;
+  double sumSquares = 0;
+};
+
+Samples samplesOf(const cv::Mat& left, const std::vector<cv::Point>& points) {
+  Samples s;
+  double sum = 0;
+  for (const cv::Point& p : points) {
+    const float v = left.at<float>(p);
+    if (!std::isfinite(v)) continue;
+    s.points.push_back(p);
+    s.centred.push_back(v);
+    sum += v;
+  }
+  if (s.points.empty()) return s;
+  const double mean = sum / static_cast<double>(s.points.size());
+  for (double& v : s.centred) {
+    v -= mean;
+    s.sumSquares += v * v;
+  }
+  return s;
+}
+
+// NCC of the samples against the right view at the plane; -2 when a sample maps outside the
+// right image or onto an invalid pixel, or either side is constant.
+double planeScore(const cv::Mat& right, const Samples& s, const Plane& plane) {
+  double sb = 0, sbb = 0, sab = 0;
+  const size_t n = s.points.size();
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point p = s.points[i];
+    const double xr = p.x - plane.at(p.x, p.y);
+    const double whole = std::floor(xr);
+    const int x0 = static_cast<int>(whole);
+    if (x0 < 0 || x0 + 1 >= right.cols) return -2;
+    const float* row = right.ptr<float>(p.y);
+    const double t = xr - whole;
+    const double b = (1 - t) * row[x0] + t * row[x0 + 1];
+    if (!std::isfinite(b)) return -2;
+    sb += b;
+    sbb += b * b;
+    sab += s.centred[i] * b;
+  }
+  const double varB = sbb - sb * sb / static_cast<double>(n);
+  if (varB <= 0 || s.sumSquares <= 0) return -2;
+  return sab / std::sqrt(varB * s.sumSquares);
+}
+
+struct Scored {
+  Plane plane;
+  double score = -2;
+};
+
+constexpr double kSlopeStep = 0.15;  // px/px, the coarse grid's
+// The coarse grid's best sparse score below minRegionScore by more than this ends the search (the
+// accepted regions of sim seed 41 600² gained at most 0.04 from the later stages).
+constexpr double kHopeless = 0.15;
+
+struct Fit {
+  Scored best;
+  double elsewhere = -2;  // the best sparse score at its slopes 2 px or more from it (centre)
+};
+
+// The best plane for the region, in four stages:
+// 1. a coarse grid (slopes every kSlopeStep up to maxSlope, `a` every 0.5 px over [lo, hi]) scored
+//    on about 64 of its pixels (`sparse`), only where the plane agrees within 1 px with at least
+//    `ringShare` of the matches around the region (`ring`: x, y, d), as the accepted plane must:
+//    that skips most of the grid. When its best scores below `hopeless`, the search stops there
+//    (most regions: occluded ground, plain surfaces);
+// 2. its 12 best planes scored on about 256 pixels (`medium`);
+// 3. the best one refined on all the pixels by a pattern search over its 26 neighbours (moving
+//    while one is better, then halving the steps): coarser samples settled on another slope on
+//    the periodic texture of sim seed 41 600²'s facet;
+// 4. the range scanned again at its slopes, on the sparse pixels, for how well the region lines
+//    up 2 px or more away (`elsewhere`).
+Fit bestPlane(const cv::Mat& right, const Samples& sparse, const Samples& medium,
+              const Samples& all, const std::vector<cv::Point3d>& ring, double ringShare, double cx,
+              double cy, double lo, double hi, double maxSlope, double hopeless) {
+  constexpr size_t kKept = 12;
+  std::vector<Scored> grid;
+  const int slopeSteps = static_cast<int>(std::floor(maxSlope / kSlopeStep + 1e-9));
+  const size_t needed = std::max<size_t>(
+      1, static_cast<size_t>(std::ceil(ringShare * static_cast<double>(ring.size()))));
+  const int steps = static_cast<int>(std::floor((hi - lo) / 0.5 + 1e-9)) + 1;  // a = lo + 0.5 k
+  std::vector<int> agreeing(static_cast<size_t>(steps) + 1);  // ring matches per `a`, as steps
+  for (int i = -slopeSteps; i <= slopeSteps; ++i) {
+    for (int j = -slopeSteps; j <= slopeSteps; ++j) {
+      const double gx = kSlopeStep * i, gy = kSlopeStep * j;
+      // A ring match agrees within 1 px with every `a` within 1 px of its own at the slopes.
+      std::fill(agreeing.begin(), agreeing.end(), 0);
+      for (const cv::Point3d& q : ring) {
+        const double own = q.z - gx * (q.x - cx) - gy * (q.y - cy);
+        const int from = std::max(0, static_cast<int>(std::ceil((own - 1 - lo) / 0.5 - 1e-9)));
+        const int to =
+            std::min(steps - 1, static_cast<int>(std::floor((own + 1 - lo) / 0.5 + 1e-9)));
+        if (from > to) continue;
+        ++agreeing[static_cast<size_t>(from)];
+        --agreeing[static_cast<size_t>(to) + 1];
+      }
+      int running = 0;
+      for (int t = 0; t < steps; ++t) {
+        running += agreeing[static_cast<size_t>(t)];
+        if (static_cast<size_t>(running) < needed) continue;
+        const Plane plane{lo + 0.5 * t, gx, gy, cx, cy};
+        grid.push_back(Scored{plane, planeScore(right, sparse, plane)});
+      }
+    }
+  }
+  const size_t kept = std::min(kKept, grid.size());
+  std::partial_sort(grid.begin(), grid.begin() + static_cast<std::ptrdiff_t>(kept), grid.end(),
+                    [](const Scored& p, const Scored& q) { return p.score > q.score; });
+  Fit fit;
+  Scored& best = fit.best;
+  if (kept == 0 || grid.front().score < hopeless) return fit;
+  for (size_t k = 0; k < kept; ++k) {
+    const double s = planeScore(right, medium, grid[k].plane);
+    if (s > best.score) best = Scored{grid[k].plane, s};
+  }
+  // Pattern search: move to the best of the 26 neighbours while one is better, then halve.
+  double step = 0.25, slopeStep = kSlopeStep / 2;
+  for (int round = 0; round < 4; ++round, step /= 2, slopeStep /= 2) {
+    for (int move = 0; move < 6; ++move) {
+      const Scored from = best;
+      for (int i = -1; i <= 1; ++i) {
+        for (int j = -1; j <= 1; ++j) {
+          for (int k = -1; k <= 1; ++k) {
+            if (i == 0 && j == 0 && k == 0) continue;
+            const Plane plane{from.plane.a + step * i, from.plane.gx + slopeStep * j,
+                              from.plane.gy + slopeStep * k, cx, cy};
+            if (std::abs(plane.gx) > maxSlope || std::abs(plane.gy) > maxSlope) continue;
+            const double s = planeScore(right, all, plane);
+            if (s > best.score) best = Scored{plane, s};
+          }
+        }
+      }
+      if (best.score <= from.score) break;
+    }
+  }
+  best.score = planeScore(right, all, best.plane);
+  for (double a = lo; a <= hi + 1e-9; a += 0.5) {
+    if (std::abs(a - best.plane.a) < 2) continue;
+    const Plane plane{a, best.plane.gx, best.plane.gy, cx, cy};
+    fit.elsewhere = std::max(fit.elsewhere, planeScore(right, sparse, plane));
+  }
+  return fit;
+}
+
+// NCC of the 7 x 7 window around (x, y), region pixels only, at the plane; -2 with fewer than
+// 12 of them or a constant side.
+double pixelScore(const cv::Mat& left, const cv::Mat& right, const cv::Mat& labels, int label,
+                  const Plane& plane, int x, int y) {
+  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  int n = 0;
+  for (int v = std::max(0, y - 3); v <= std::min(left.rows - 1, y + 3); ++v) {
+    const int* l = labels.ptr<int>(v);
+    const float* a = left.ptr<float>(v);
+    const float* r = right.ptr<float>(v);
+    for (int u = std::max(0, x - 3); u <= std::min(left.cols - 1, x + 3); ++u) {
+      if (l[u] != label) continue;
+      const double xr = u - plane.at(u, v);
+      const double whole = std::floor(xr);
+      const int x0 = static_cast<int>(whole);
+      if (x0 < 0 || x0 + 1 >= right.cols) continue;
+      const double t = xr - whole;
+      const double b = (1 - t) * r[x0] + t * r[x0 + 1];
+      if (!std::isfinite(b) || !std::isfinite(a[u])) continue;
+      sa += a[u];
+      sb += b;
+      saa += static_cast<double>(a[u]) * a[u];
+      sbb += b * b;
+      sab += a[u] * b;
+      ++n;
+    }
+  }
+  if (n < 12) return -2;
+  const double va = saa - sa * sa / n, vb = sbb - sb * sb / n;
+  if (va <= 0 || vb <= 0) return -2;
+  return (sab - sa * sb / n) / std::sqrt(va * vb);
+}
+
+}  // namespace
+
+int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Mat& edges,
+                         const SlantedFacetSettings& settings, int dmin, int dmax,
+                         cv::Mat& disparity, cv::Mat& score) {
+  CV_Assert(left.type() == CV_32F && right.type() == CV_32F && left.size() == right.size());
+  CV_Assert(disparity.type() == CV_32F && disparity.size() == left.size());
+  CV_Assert(score.type() == CV_32F && score.size() == left.size());
+  CV_Assert(edges.type() == CV_8U && edges.size() == left.size());
+  if (settings.maxSlope <= 0) return 0;
+  const cv::Mat unmatched = core::nanMask(disparity) & core::numberMask(left) & (edges == 0);
+  cv::Mat labels, stats, centroids;
+  const int count =
+      cv::connectedComponentsWithStats(unmatched, labels, stats, centroids, 4, CV_32S);
+  // The pixels of each region large enough, in one pass.
+  std::vector<std::vector<cv::Point>> pixels(static_cast<size_t>(count));
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (l[x] > 0 && stats.at<int>(l[x], cv::CC_STAT_AREA) >= settings.minArea) {
+        pixels[static_cast<size_t>(l[x])].push_back({x, y});
+      }
+    }
+  }
+  // Each region's result is written by its own task into its own pixels: no two tasks touch the
+  // same pixel, and the matches read around a region are ones no task writes.
+  const cv::Mat matchedBefore = disparity.clone();
+  std::vector<int> matchedPerRegion(static_cast<size_t>(count), 0);
+  std::vector<std::function<void()>> tasks;
+  for (int r = 1; r < count; ++r) {
+    if (pixels[static_cast<size_t>(r)].empty()) continue;
+    tasks.emplace_back([&, r] {
+      const std::vector<cv::Point>& points = pixels[static_cast<size_t>(r)];
+      // The disparities of the matches within 2 px of the region bound its plane's value at
+      // its centre: a facet lies between its ridge and the ground beside its eave.
+      const cv::Rect box(stats.at<int>(r, cv::CC_STAT_LEFT), stats.at<int>(r, cv::CC_STAT_TOP),
+                         stats.at<int>(r, cv::CC_STAT_WIDTH), stats.at<int>(r, cv::CC_STAT_HEIGHT));
+      const cv::Rect around =
+          (box + cv::Size(4, 4) - cv::Point(2, 2)) & cv::Rect(0, 0, left.cols, left.rows);
+      const cv::Mat inRegion = labels(around) == r;
+      cv::Mat near;
+      cv::dilate(inRegion, near, cv::Mat::ones(5, 5, CV_8U));
+      near &= ~inRegion;
+      std::vector<cv::Point3d> ringAll;  // the matches within 2 px of the region: x, y, d
+      double lo = 1e30, hi = -1e30;
+      for (int y = 0; y < around.height; ++y) {
+        for (int x = 0; x < around.width; ++x) {
+          if (!near.at<uchar>(y, x)) continue;
+          const float d = matchedBefore.at<float>(around.y + y, around.x + x);
+          if (!std::isfinite(d)) continue;
+          ringAll.emplace_back(around.x + x, around.y + y, d);
+          lo = std::min(lo, static_cast<double>(d));
+          hi = std::max(hi, static_cast<double>(d));
+        }
+      }
+      if (ringAll.empty()) return;
+      // At most about 96 of them guide the search.
+      const size_t ringStride = (ringAll.size() + 95) / 96;
+      std::vector<cv::Point3d> ring;
+      for (size_t k = 0; k < ringAll.size(); k += ringStride) ring.push_back(ringAll[k]);
+      lo = std::max(lo - 1, static_cast<double>(dmin));
+      hi = std::min(hi + 1, static_cast<double>(dmax));
+      // The region's pixels on a regular grid of step `stride`.
+      const auto onGrid = [&](int stride) {
+        std::vector<cv::Point> kept;
+        for (const cv::Point& p : points) {
+          if (p.x % stride == 0 && p.y % stride == 0) kept.push_back(p);
+        }
+        return kept;
+      };
+      const double area = static_cast<double>(points.size());
+      const Samples all = samplesOf(left, points);
+      // About 64 pixels (at most every other one) score the coarse planes, about 256 choose
+      // among the best of them.
+      const Samples sparse =
+          samplesOf(left, onGrid(std::max(2, static_cast<int>(std::sqrt(area / 64.0)))));
+      const Samples medium =
+          samplesOf(left, onGrid(std::max(1, static_cast<int>(std::sqrt(area / 256.0)))));
+      if (sparse.points.size() < 8) return;
+      const double cx = centroids.at<double>(r, 0), cy = centroids.at<double>(r, 1);
+      const Fit fit = bestPlane(right, sparse, medium, all, ring, settings.minRingShare, cx, cy, lo,
+                                hi, settings.maxSlope, settings.minRegionScore - kHopeless);
+      const Plane& plane = fit.best.plane;
+      // Lines up well, and clearly better than anywhere 2 px away (periodic texture, plain
+      // or occluded regions line up about as well at several places).
+      bool accepted = fit.best.score >= settings.minRegionScore &&
+                      fit.elsewhere <= fit.best.score - settings.uniqueness;
+      // Continues the surface beside it somewhere: a facet meets its roof's other facets at the
+      // ridge and hips (its eave is a step down to the ground).
+      int agree = 0;
+      for (const cv::Point3d& q : ringAll) agree += std::abs(q.z - plane.at(q.x, q.y)) <= 1 ? 1 : 0;
+      accepted = accepted && agree >= settings.minRingShare * static_cast<double>(ringAll.size());
+      std::vector<float> pixelScores(points.size(), -2.0F);
+      int passing = 0;
+      if (accepted) {
+        for (size_t i = 0; i < points.size(); ++i) {
+          pixelScores[i] = static_cast<float>(
+              pixelScore(left, right, labels, r, plane, points[i].x, points[i].y));
+          passing += pixelScores[i] >= settings.minPixelScore ? 1 : 0;
+        }
+        // Most of its pixels line up there on their own too.
+        accepted = passing >= settings.minPixelShare * static_cast<double>(points.size());
+      }
+      if (!accepted) return;
+      int matched = 0;
+      for (size_t i = 0; i < points.size(); ++i) {
+        if (pixelScores[i] < settings.minPixelScore) continue;
+        disparity.at<float>(points[i]) = static_cast<float>(plane.at(points[i].x, points[i].y));
+        score.at<float>(points[i]) = pixelScores[i];
+        ++matched;
+      }
+      matchedPerRegion[static_cast<size_t>(r)] = matched;
+    });
+  }
+  runTasks(tasks, settings.threads);
+  int total = 0;
+  for (const int m : matchedPerRegion) total += m;
+  return total;
+}
+
+}  // namespace delineo::stereo::detail
