@@ -80,6 +80,30 @@ TEST(RecoverSlantedFacets, MatchesAnUnmatchedSteepFacetOnItsPlane) {
   EXPECT_EQ(s.disparity.at<float>(5, 40), s.truth.at<float>(5, 40));
 }
 
+TEST(RecoverSlantedFacets, AStripOfAnotherSurfaceInTheRegionDoesNotHideTheFacet) {
+  GableScene s;
+  // Over 10 rows the contour at the ridge is missing and the region runs on into 6 unmatched
+  // columns of the other side, whose left view there is unrelated, high-contrast texture.
+  const cv::Rect strip(60, 55, 7, 10);
+  s.edges(cv::Rect(60, 55, 1, 10)).setTo(0);
+  s.disparity(strip).setTo(kNaN);
+  cv::Mat other(strip.size(), CV_32F);
+  cv::RNG rng(5);
+  rng.fill(other, cv::RNG::UNIFORM, -400.0, 600.0);
+  other.copyTo(s.left(strip));
+  const int matched = recoverSlantedFacets(s.left, s.right, s.edges, SlantedFacetSettings{}, 0,
+                                           40, s.disparity, s.score);
+  EXPECT_GE(matched, 0.9 * s.facet.area());
+  int close = 0;
+  for (int y = s.facet.y; y < s.facet.y + s.facet.height; ++y) {
+    for (int x = s.facet.x; x < s.facet.x + s.facet.width; ++x) {
+      const float d = s.disparity.at<float>(y, x);
+      close += !std::isnan(d) && std::abs(d - s.truth.at<float>(y, x)) <= 0.25F ? 1 : 0;
+    }
+  }
+  EXPECT_GE(close, 0.9 * s.facet.area());
+}
+
 TEST(RecoverSlantedFacets, LeavesARegionNoPlaneLinesUpUnmatched) {
   GableScene s;
   // The facet's left view replaced by texture found nowhere in the right view.
