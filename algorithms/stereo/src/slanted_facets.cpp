@@ -61,6 +61,17 @@ Samples samplesOf(const cv::Mat& left, const std::vector<cv::Point>& points) {
   return s;
 }
 
+// The right view at (x − d, y), linearly interpolated along the row; NaN outside it.
+double rightAt(const cv::Mat& right, int x, int y, double d) {
+  const double xr = x - d;
+  const double whole = std::floor(xr);
+  const int x0 = static_cast<int>(whole);
+  if (x0 < 0 || x0 + 1 >= right.cols) return std::numeric_limits<double>::quiet_NaN();
+  const float* row = right.ptr<float>(y);
+  const double t = xr - whole;
+  return (1 - t) * row[x0] + t * row[x0 + 1];
+}
+
 // NCC of the samples against the right view at the plane; -2 when a sample maps outside the
 // right image or onto an invalid pixel, or either side is constant.
 double nccOverAll(const cv::Mat& right, const Samples& s, const Plane& plane);
@@ -70,20 +81,14 @@ double nccOverAll(const cv::Mat& right, const Samples& s, const Plane& plane);
 // as nccOverAll). A region often holds some unmatched pixels of another surface beside its facet
 // (the ground beyond an eave Canny does not see over a few rows: seeds 33 and 38 600²), whose
 // contrast can rule one NCC over all of it: seed 33's region scored 0.48 at its facet's true
-// plane, against 0.90 on the facet alone; its best trimmed score is 0.85.
+// plane, against 0.90 on the facet alone; its best banded score is 0.81.
 double planeScore(const cv::Mat& right, const Samples& s, const Plane& plane) {
   if (s.bands < 3) return nccOverAll(right, s, plane);
   thread_local std::vector<double> sums;  // per band: Σa, Σa², Σb, Σb², Σab, n
   sums.assign(static_cast<size_t>(s.bands) * 6, 0.0);
   for (size_t i = 0; i < s.points.size(); ++i) {
     const cv::Point p = s.points[i];
-    const double xr = p.x - plane.at(p.x, p.y);
-    const double whole = std::floor(xr);
-    const int x0 = static_cast<int>(whole);
-    if (x0 < 0 || x0 + 1 >= right.cols) return -2;
-    const float* row = right.ptr<float>(p.y);
-    const double t = xr - whole;
-    const double b = (1 - t) * row[x0] + t * row[x0 + 1];
+    const double b = rightAt(right, p.x, p.y, plane.at(p.x, p.y));
     if (!std::isfinite(b)) return -2;
     const double a = s.centred[i];
     double* q = &sums[static_cast<size_t>((p.y - s.top) / kBandRows) * 6];
@@ -117,13 +122,7 @@ double nccOverAll(const cv::Mat& right, const Samples& s, const Plane& plane) {
   const size_t n = s.points.size();
   for (size_t i = 0; i < n; ++i) {
     const cv::Point p = s.points[i];
-    const double xr = p.x - plane.at(p.x, p.y);
-    const double whole = std::floor(xr);
-    const int x0 = static_cast<int>(whole);
-    if (x0 < 0 || x0 + 1 >= right.cols) return -2;
-    const float* row = right.ptr<float>(p.y);
-    const double t = xr - whole;
-    const double b = (1 - t) * row[x0] + t * row[x0 + 1];
+    const double b = rightAt(right, p.x, p.y, plane.at(p.x, p.y));
     if (!std::isfinite(b)) return -2;
     sb += b;
     sbb += b * b;
@@ -243,15 +242,9 @@ double pixelScore(const cv::Mat& left, const cv::Mat& right, const cv::Mat& labe
   for (int v = std::max(0, y - 3); v <= std::min(left.rows - 1, y + 3); ++v) {
     const int* l = labels.ptr<int>(v);
     const float* a = left.ptr<float>(v);
-    const float* r = right.ptr<float>(v);
     for (int u = std::max(0, x - 3); u <= std::min(left.cols - 1, x + 3); ++u) {
       if (l[u] != label) continue;
-      const double xr = u - plane.at(u, v);
-      const double whole = std::floor(xr);
-      const int x0 = static_cast<int>(whole);
-      if (x0 < 0 || x0 + 1 >= right.cols) continue;
-      const double t = xr - whole;
-      const double b = (1 - t) * r[x0] + t * r[x0 + 1];
+      const double b = rightAt(right, u, v, plane.at(u, v));
       if (!std::isfinite(b) || !std::isfinite(a[u])) continue;
       sa += a[u];
       sb += b;
