@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <opencv2/core.hpp>
@@ -102,6 +103,29 @@ TEST(RecoverSlantedFacets, AStripOfAnotherSurfaceInTheRegionDoesNotHideTheFacet)
     }
   }
   EXPECT_GE(close, 0.9 * s.facet.area());
+}
+
+TEST(RecoverSlantedFacets, TheSameOnAnyNumberOfThreads) {
+  GableScene one;
+  // Both sides of the roof unmatched: two regions, one task each.
+  const cv::Rect otherSide(61, 10, 28, 60);
+  one.disparity(otherSide).setTo(kNaN);
+  one.score(otherSide).setTo(kNaN);
+  GableScene two;
+  two.disparity = one.disparity.clone();
+  two.score = one.score.clone();
+  SlantedFacetSettings settings;
+  settings.threads = 1;
+  const int matchedOne = recoverSlantedFacets(one.left, one.right, one.edges, settings, 0, 40,
+                                              one.disparity, one.score);
+  settings.threads = 2;
+  const int matchedTwo = recoverSlantedFacets(two.left, two.right, two.edges, settings, 0, 40,
+                                              two.disparity, two.score);
+  EXPECT_GE(matchedOne, 0.9 * (one.facet.area() + otherSide.area()));
+  EXPECT_EQ(matchedOne, matchedTwo);
+  const size_t bytes = one.disparity.total() * one.disparity.elemSize();
+  EXPECT_EQ(std::memcmp(one.disparity.data, two.disparity.data, bytes), 0);
+  EXPECT_EQ(std::memcmp(one.score.data, two.score.data, bytes), 0);
 }
 
 TEST(RecoverSlantedFacets, LeavesARegionNoPlaneLinesUpUnmatched) {
