@@ -370,8 +370,10 @@ int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Ma
       if (!accepted) return;
       int matched = 0;
       for (size_t i = 0; i < points.size(); ++i) {
-        if (pixelScores[i] < settings.minPixelScore) continue;
-        disparity.at<float>(points[i]) = static_cast<float>(plane.at(points[i].x, points[i].y));
+        const double d = plane.at(points[i].x, points[i].y);
+        // A plane may run out of the searched range at a region's far end: left unmatched there.
+        if (pixelScores[i] < settings.minPixelScore || d < dmin || d > dmax) continue;
+        disparity.at<float>(points[i]) = static_cast<float>(d);
         score.at<float>(points[i]) = pixelScores[i];
         ++matched;
       }
