@@ -16,8 +16,8 @@
 #   fresh-4:  9 more (seeds 35-40 600², 18-20 1000²), first run at the end of session 24, after
 #             its changes were chosen (seed 35 then looked at);
 #   fresh-5:  9 more (seeds 41-46 600², 21-23 1000²), first run at the start of session 25,
-#             before anything was chosen on it. Judge a change on all seven groups, and keep
-#             them apart.
+#             before anything was chosen on it (seed 41 then looked at). Judge a change on all
+#             seven groups, and keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
 # About three and a half minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail

@@ -147,8 +147,9 @@ struct MatchParams {
                       "as a whole on planes d = a + gx x + gy y with |gx|, |gy| up to this: a "
                       "steep roof facet, stretched or squeezed in the right view, finds no peak "
                       "with windows at one disparity. The best plane is kept when the region's "
-                      "NCC there is at least 0.75 and 0.05 above its best 2 px or more away, when "
-                      "it continues at least 30 % of the matches around the region, and when at "
+                      "score there (the mean NCC of its bands of 12 rows, the worst quarter left "
+                      "out) is at least 0.75 and 0.05 above its best 2 px or more away, when it "
+                      "continues at least 30 % of the matches around the region, and when at "
                       "least 80 % of the region's pixels score 0.6 or more on their own 7 x 7 "
                       "windows (those pixels take it); 0 = off (adaptive method)",
                       0, 2},
