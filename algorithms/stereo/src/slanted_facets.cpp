@@ -66,7 +66,7 @@ double rightAt(const cv::Mat& right, int x, int y, double d) {
   const double xr = x - d;
   const double whole = std::floor(xr);
   const int x0 = static_cast<int>(whole);
-  if (x0 < 0 || x0 + 1 >= right.cols) return std::numeric_limits<double>::quiet_NaN();
+  if (x0 < 0 || x0 + 1 >= right.cols) return kNaN;
   const float* row = right.ptr<float>(y);
   const double t = xr - whole;
   return (1 - t) * row[x0] + t * row[x0 + 1];
