@@ -128,11 +128,10 @@ std::vector<int> twoLargestClusters(const std::vector<float>& values, int dmin, 
 // the lowest error found 3 px or more away: the outline lines up there and nowhere else.
 // (`best` is a sub-pixel cluster mean and a large roof's ring error is flat within a pixel of
 // its minimum: the integer minimum can lie 1.4 px away.)
-// `errors`: out, the ring error of every integer disparity dmin..dmax (the veto reads it again).
 template <typename ErrorAt>
 bool scanConfirms(const ErrorAt& errorAt, int dmin, int dmax, float best, double agreement,
-                  double reach, std::vector<double>& errors) {
-  errors.resize(static_cast<size_t>(dmax - dmin + 1));
+                  double reach) {
+  std::vector<double> errors(static_cast<size_t>(dmax - dmin + 1));
   for (int d = dmin; d <= dmax; ++d)
     errors[static_cast<size_t>(d - dmin)] = errorAt(static_cast<float>(d));
   const auto lowest = std::min_element(errors.begin(), errors.end());
@@ -818,10 +817,13 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
   const auto [gain, offset] = radiometricMap(left, right, dmin, dmax);
   // A sloped facet's counterpart is chosen by its grey level, so the map must hold at that level:
   // the one of the matched pairs does (seed 5's dark hip facet: the images' moments put its
-  // counterpart 5.9 levels off, the matches 0.8). The other tests keep the images' map, which
-  // their tolerances were measured with (all of them on the matches' map: 600² edge 92.0 -> 89.9).
+  // counterpart 5.9 levels off, the matches 0.8). So does the scan that confirms an unclear
+  // candidate (see scanConfirms below). The other tests keep the images' map, which their
+  // tolerances were measured with (all of them on the matches' map: 600² edge 92.0 -> 89.9 in
+  // session 15; in session 26, hip facets filled with a constant on seeds 6 and 38 600²).
   const auto [matchedGain, matchedOffset] =
       radiometricMapOfMatches(left, right, disparity, {gain, offset});
+  const std::pair<double, double> imagesMap{gain, offset}, matchesMap{matchedGain, matchedOffset};
   const double maxArea = settings.maxShare * static_cast<double>(left.total());
   const cv::Rect image(0, 0, left.cols, left.rows);
   // The flat regions the fill decides on itself (the extension does not enter them).
@@ -867,10 +869,13 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       }
     }
     // Mean |left − mapped right| over the ring at the plane's disparity, the right view read
-    // with linear interpolation (the candidates are sub-pixel). 1e30 as soon as the sum exceeds
-    // `stopAboveSum` (a bound on the mean times the ring's size: the mean is sure to exceed the
-    // bound; the scans of the whole range mostly meet such errors).
-    auto planeRingError = [&](const FillPlane& plane, double stopAboveSum = 1e300) {
+    // with linear interpolation (the candidates are sub-pixel) and mapped by `map` (gain,
+    // offset). 1e30 as soon as the sum exceeds `stopAboveSum` (a bound on the mean times the
+    // ring's size: the mean is sure to exceed the bound; the scans of the whole range mostly meet
+    // such errors).
+    auto ringErrorUnder = [&](const std::pair<double, double>& map, const FillPlane& plane,
+                              double stopAboveSum) {
+      const auto [mapGain, mapOffset] = map;
       double sum = 0, n = 0;
       for (int y = 0; y < box.height; ++y) {
         if (sum > stopAboveSum) return 1e30;
@@ -886,11 +891,14 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
           if (xr - 1 < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
           const float bv = (1 - t) * b[xr] + t * b[xr - 1];
           if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
-          sum += std::abs(a[x] - (gain * bv + offset));
+          sum += std::abs(a[x] - (mapGain * bv + mapOffset));
           n += 1;
         }
       }
       return n > 0 ? sum / n : 1e30;
+    };
+    auto planeRingError = [&](const FillPlane& plane, double stopAboveSum = 1e300) {
+      return ringErrorUnder(imagesMap, plane, stopAboveSum);
     };
     // The constant disparity of the outline's matches, when the outline lines up there.
     double constantError = 0;      // the constant's error on the (final) ring
@@ -944,16 +952,23 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       const auto [best, bestError, otherError] = ranked;
       candidateError = bestError;
       if (bestError > settings.photometric * sigma) return std::nullopt;
-      std::vector<double> scanned;  // the scan of the range, when the contrast test needed it
+      // The scan compares errors within a few tenths of each other across the range, so it reads
+      // the right view through the matches' grey map: the images' moments can be off by several
+      // grey levels on a dark roof, the same at every disparity, which flattens the scan (seed
+      // 14 1000²: gain 1.040 and offset 1.17 against the matches' 1.086 and -6.44, the
+      // simulator's 1.087 and -6.5; a 7 077 px dark roof's minimum was 0.936 × the lowest 3 px
+      // or more away, 0.860 through the matches' map, with 0.93 needed).
+      const auto scanError = [&](float value) {
+        return ringErrorUnder(matchesMap, FillPlane{value, 0, 0}, 1e300);
+      };
       if (bestError > settings.contrast * otherError &&
           !(settings.scanAgreement > 0 &&
-            scanConfirms(ringError, dmin, dmax, best, settings.scanAgreement, settings.scanReach,
-                         scanned))) {
+            scanConfirms(scanError, dmin, dmax, best, settings.scanAgreement,
+                         settings.scanReach))) {
         return std::nullopt;
       }
       const double ringPixels = cv::countNonZero(ring);
       const auto vetoError = [&](float value, double stopAbove) {
-        if (!scanned.empty()) return scanned[static_cast<size_t>(static_cast<int>(value) - dmin)];
         return planeRingError(FillPlane{value, 0, 0}, stopAbove * ringPixels);
       };
       if (settings.scanVeto > 0 &&

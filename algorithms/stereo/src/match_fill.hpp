@@ -75,10 +75,11 @@ struct RegionFillSettings {
 // the mean |left − (gain · right + offset)| over the region's outline ring (2 px on both sides),
 // where only the right disparity lines the outlines up: inside a flat region every disparity
 // that stays in it matches. The best is kept when below `photometric` noise sigmas and clearly
-// better than the other, or, failing the latter, when a scan of the whole range finds its
-// minimum there too (scanAgreement), and vetoed when a scan of the range finds a disparity more
-// than 2 px away that lines the outline up clearly better (scanVeto: 2000² roof RMS 1.334 ->
-// 1.193 px, Cones bad-2 1.91 -> 1.84 %). The region is then grown back to its image contour (it
+// better than the other, or, failing the latter, when a scan of the whole range (the right
+// view mapped by the grey map of the matched pairs) finds its minimum there too
+// (scanAgreement), and vetoed when a scan of the range finds a disparity more than 2 px away
+// that lines the outline up clearly better (scanVeto: 2000² roof RMS 1.334 -> 1.193 px, Cones
+// bad-2 1.91 -> 1.84 %). The region is then grown back to its image contour (it
 // stops 2 px short: its 5x5 windows straddle it) over pixels that look like it and match at its
 // disparity on their own; its unmatched pixels and the grown ones whose own disparity explains
 // them worse take it, with `fillScore` as score.

@@ -176,6 +176,32 @@ TEST(FillFlatRegions, AScanOfTheRangeConfirmsAnUnclearCandidate) {
   EXPECT_LT(spilledOntoTheGround(scanned), perimeter / 2);
 }
 
+TEST(FillFlatRegions, TheScanReadsTheRightViewThroughTheMatchesGreyMap) {
+  // The scan's scene (grey 140 roof, noise 6), the right view seen with gain 0.9 and offset 8,
+  // and a bright band (grey 210) along its last 24 columns that the left view does not show (a
+  // surface only one view sees; the left pixels that would pair with it are unmatched). The band
+  // skews the images' grey moments: their map is gain 0.74 and offset 24 against the matches'
+  // 1.09 and -6.5, several grey levels off at the roof's grey, the same at every disparity.
+  Scene s = scene(140.0f, 6.0);
+  cv::RNG rng(11);
+  const int bandStart = s.right.cols - 24;
+  for (int y = 0; y < s.right.rows; ++y) {
+    for (int x = 0; x < s.right.cols; ++x) {
+      float& v = s.right.at<float>(y, x);
+      v = x >= bandStart ? 210.0f + static_cast<float>(rng.gaussian(6.0)) : 0.9f * v + 8.0f;
+    }
+  }
+  const int firstUnmatched = bandStart + static_cast<int>(kGround);
+  s.disparity(cv::Rect(firstUnmatched, 0, s.disparity.cols - firstUnmatched, s.disparity.rows))
+      .setTo(kNaN);
+  fill(s, RegionFillSettings{}, 32);
+  // (Measured: all 1 200 inner pixels, and 0 with the scan through the images' map.)
+  const cv::Rect inner = innerRoof(s);
+  EXPECT_EQ(roofPixelsIn(s, inner), inner.area());
+  const int perimeter = 2 * (s.roof.width + s.roof.height);
+  EXPECT_LT(spilledOntoTheGround(s), perimeter / 2);
+}
+
 TEST(FillFlatRegions, ThinFlatPartsJoinedToARoofDoNotDecideItsFill) {
   // Three plain 6-row bands of the roof's grey at the ground's disparity (a facade's bands
   // between its window rows) touch the roof's left side: their flat middles join the roof's flat
