@@ -16,8 +16,9 @@ std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& rig
                                          int dmax);
 
 // The same map from the pixel pairs a disparity map matches (left x, right x - d rounded; NaN =
-// unmatched): the moments of the grey levels both views give the same surface points. `fallback`
-// when fewer than `minPairs` pairs or either side is flat.
+// unmatched): the moments of the grey levels both views give the same surface points, over the
+// pairs that agree with a first, median-based map (wrong matches left out). `fallback` when fewer
+// than `minPairs` pairs agree or either side is flat.
 std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv::Mat& right,
                                                   const cv::Mat& disparity,
                                                   std::pair<double, double> fallback,

@@ -54,5 +54,37 @@ TEST(Radiometry, MatchedPairsGiveTheExposureMapWhereTheViewsSeeDifferentThings) 
   EXPECT_EQ(fallback.second, 2.5);
 }
 
+TEST(Radiometry, WrongMatchesAtTheEndOfTheGreyRangeDoNotPullTheMatchesMap) {
+  // The same exposures in both views, noise sigma 1.5: a weakly textured ground (grey 100 ± 8)
+  // and a plain roof (140) matched right, and 10 % of the pairs wrong, a dark band (grey ~65)
+  // matched to a plain wall only the right view shows (grey 40): a roof's value carried onto the
+  // ground beside it. Those few pairs lie far from the others in the right view's grey, so the
+  // moments of all pairs, and refits within 2.5 RMS of them, lean towards them (gain 0.887 and
+  // offset 12.6 here).
+  const int rows = 100, cols = 300;
+  cv::RNG rng(5);
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      const double ground = 100.0 + rng.gaussian(8.0);
+      double l = ground, r = ground;
+      if (x >= 200 && x < 245) l = r = 140.0;  // the roof
+      if (x >= 245 && x < 275) {               // the wrong pairs
+        l = 65.0 + rng.gaussian(3.0);
+        r = 40.0;
+      }
+      left.at<float>(y, x) = static_cast<float>(l + rng.gaussian(1.5));
+      right.at<float>(y, x) = static_cast<float>(r + rng.gaussian(1.5));
+    }
+  }
+  const cv::Mat disparity(rows, cols, CV_32F, cv::Scalar(0.0f));
+  const auto [gain, offset] = radiometricMapOfMatches(left, right, disparity, {1.0, 0.0});
+  EXPECT_NEAR(gain, 1.0, 0.02);
+  EXPECT_NEAR(offset, 0.0, 2.0);
+  // Where a grey level of 140 (the roof) and of 60 land in the left view's levels.
+  EXPECT_NEAR(gain * 140.0 + offset, 140.0, 0.5);
+  EXPECT_NEAR(gain * 60.0 + offset, 60.0, 1.0);
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail
