@@ -104,8 +104,10 @@ struct StepSnapSettings {
 // mean signed residual at its own disparities at least that bound, the nearer run's last pixels
 // (as many, at most; its mixed last pixel left out) within half of it. The gap left is then snapped
 // like the others.
-// The far side is always left alone. `left`, `right`: the original images (CV_32F, NaN =
-// nodata). Returns the pixels changed.
+// The far side is always left alone. "Mapped right": the right view's grey levels through the
+// grey map of the matched pixel pairs (radiometricMapOfMatches; the images' moments when too few
+// are matched). `left`, `right`: the original images (CV_32F, NaN = nodata). Returns the pixels
+// changed.
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSnapSettings& settings,
                         float fillScore, cv::Mat& disparity, cv::Mat& score);
 

@@ -362,8 +362,9 @@ int rowsWhoseRoofRunEndsAt(const cv::Mat& disparity, float value, int outline) {
 // whose roof run ends within 1 px of x 69.
 // With `ownRunGap` > 0 the carried value is a run of its own, 18 px, starting that many pixels
 // past the roof's run (ended at the outline); returns then the rows (of 28) whose courtyard
-// ([70, 80)) keeps none of it.
-int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings, int ownRunGap = 0) {
+// ([70, 80)) keeps none of it. `skewedImages`: see below.
+int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings, int ownRunGap = 0,
+                                 bool skewedImages = false) {
   const int rows = 30, cols = 300;
   cv::RNG rng(23);
   const cv::Mat texture = texturedGround(rows, cols, 0, rng);
@@ -396,6 +397,14 @@ int roofRowsEndingAtTheCourtyard(bool hidden, const StepSnapSettings& settings, 
     setRun(disparity, 40, 80, 20.0f);
   }
   setRun(disparity, 85, cols, 20.0f);
+  if (skewedImages) {
+    // The right view exposed with gain 0.8 and offset 30, and its last 20 columns a bright band
+    // (grey 230) of a surface only it shows (no left pixel pairs with them at these
+    // disparities): the images' moments then give gain 0.785 and offset 24.1 for the map
+    // whose gain is 1.25 and offset -37.5; the matched pairs give 1.247 and -37.2.
+    right = 0.8 * right + 30.0;
+    right.colRange(cols - 20, cols).setTo(230.0);
+  }
   snapStepsToContours(left, right, settings, 0.3f, disparity, score);
   if (ownRunGap == 0) return rowsWhoseRoofRunEndsAt(disparity, 20.0f, 69);
   int clear = 0;
@@ -414,6 +423,12 @@ TEST(SnapSteps, ARoofRunCarriedOverGroundTheRightViewDoesNotSeeStopsAtTheContour
   EXPECT_GE(roofRowsEndingAtTheCourtyard(true, StepSnapSettings{}), 28 * 9 / 10);
   // A dark band of the roof itself, which both views show alike, keeps the roof's value.
   EXPECT_EQ(roofRowsEndingAtTheCourtyard(false, StepSnapSettings{}), 0);
+}
+
+TEST(SnapSteps, ItsChecksReadTheRightViewThroughTheMatchedPairsGreyMap) {
+  // The courtyard scene above with the right view exposed differently and skewed images'
+  // moments. (Measured: 28 of 28 rows, 0 through the images' map.)
+  EXPECT_GE(roofRowsEndingAtTheCourtyard(true, StepSnapSettings{}, 0, true), 28 * 9 / 10);
 }
 
 TEST(SnapSteps, ARoofValueCarriedOntoHiddenGroundAsARunOfItsOwnIsSplitOff) {
