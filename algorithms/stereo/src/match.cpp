@@ -27,7 +27,6 @@
 #include "match_snap_rows.hpp"
 #include "match_steps.hpp"
 #include "ordering.hpp"
-#include "radiometry.hpp"
 #include "slanted_facets.hpp"
 #include "smoothing.hpp"
 #include "speckles.hpp"
@@ -686,9 +685,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                 result.disparity, result.score);
     detail::RowStepSnapSettings rows;
     rows.threads = threads;
-    const auto [gain, offset] = detail::radiometricMap(left, right, p.dmin, p.dmax);
-    detail::snapStepsAcrossRows(left, right, contrast.sigma, gain, offset, rows,
-                                static_cast<float>(p.minScore), result.disparity, result.score);
+    detail::snapStepsAcrossRows(left, right, contrast.sigma, rows, static_cast<float>(p.minScore),
+                                result.disparity, result.score);
     if (reachedButCanceled(0.98)) return result;
   }
   if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {

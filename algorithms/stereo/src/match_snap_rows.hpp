@@ -34,10 +34,11 @@ struct RowStepSnapSettings {
 // pixels: a run carried farther than `reach` past its outline moves up to a nearer contrast
 // first, and the next pass sees the outline from the new step (seed 9 600²: 7 carried rows, a
 // dark line on the roof 5 rows below its outline).
-// `sigma` is the left image's noise sigma; `gain`, `offset` map the right view's grey levels to
-// the left's. Returns the number of pixels changed.
-int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma, double gain,
-                        double offset, const RowStepSnapSettings& settings, float fillScore,
-                        cv::Mat& disparity, cv::Mat& score);
+// `sigma` is the left image's noise sigma. The right view's grey levels are mapped to the left's
+// by the grey map of the matched pixel pairs (radiometricMapOfMatches; the images' moments when
+// too few are matched). Returns the number of pixels changed.
+int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma,
+                        const RowStepSnapSettings& settings, float fillScore, cv::Mat& disparity,
+                        cv::Mat& score);
 
 }  // namespace delineo::stereo::detail
