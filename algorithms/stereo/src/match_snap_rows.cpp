@@ -54,6 +54,26 @@ int snapPass(const cv::Mat& left, const cv::Mat& right, double sigma, double gai
     }
     return n >= kMinStripPixels ? sum / n / sigma : std::numeric_limits<double>::infinity();
   };
+  // Mean |left − mapped right| of (y, x) and its two row neighbours at disparity d, in noise
+  // sigmas (right view read with linear interpolation): a gap's pixel next to the outline, whose
+  // row strip would cross a slanted outline. +inf when fewer than 2 pixels are read.
+  const auto tripletError = [&](int y, int x, float d) {
+    const float* a = left.ptr<float>(y);
+    const float* r = right.ptr<float>(y);
+    double sum = 0;
+    int n = 0;
+    for (int u = std::max(0, x - 1); u <= std::min(w - 1, x + 1); ++u) {
+      const float xr = static_cast<float>(u) - d;
+      const int x0 = static_cast<int>(std::floor(xr));
+      if (x0 < 0 || x0 + 1 >= w) continue;
+      const float t = xr - static_cast<float>(x0);
+      const float b = (1 - t) * r[x0] + t * r[x0 + 1];
+      if (!std::isfinite(a[u]) || !std::isfinite(b)) continue;
+      sum += std::abs(a[u] - (gain * b + offset));
+      ++n;
+    }
+    return n >= 2 ? sum / n / sigma : std::numeric_limits<double>::infinity();
+  };
   // |mean I(c .. c + kStepSide − 1) − mean I(c − kStepSide .. c − 1)| in column x: the contrast
   // of the cut above row c; -1 where a side leaves the image or meets nodata.
   const auto contrastAbove = [&](int x, int c) -> float {
@@ -110,6 +130,20 @@ int snapPass(const cv::Mat& left, const cv::Mat& right, double sigma, double gai
               // The upper side carried below the outline: rows cut .. b − 1 take the lower
               // side's disparity, from the gap upwards.
               for (int v = b - 1; v >= cut && moveIfExplained(v, db); --v) {
+              }
+            } else if (cut > a && cut <= b && settings.gapErrorSigmas > 0) {
+              // The outline lies in the gap: each side's unmatched pixels up to it take the side's
+              // disparity, from the side towards the outline, while each is explained there.
+              const auto fillIfExplained = [&](int v, float to) {
+                if (!(tripletError(v, x, to) <= settings.gapErrorSigmas)) return false;
+                disparity.at<float>(v, x) = to;
+                score.at<float>(v, x) = fillScore;
+                ++changed;
+                return true;
+              };
+              for (int v = a + 1; v < cut && fillIfExplained(v, da); ++v) {
+              }
+              for (int v = b - 1; v >= cut && fillIfExplained(v, db); --v) {
               }
             } else if (cut > b) {
               // The lower side carried above it: rows a + 1 .. cut − 1, from the gap downwards.

@@ -13,6 +13,8 @@ struct RowStepSnapSettings {
   int stripHalf = 7;            // px: half-width of the row strip a moved pixel is checked on
   double winRatio = 0.7;        // most error at the new disparity, × the one at the pixel's own
   double maxErrorSigmas = 4.0;  // noise sigmas: most error the new disparity may leave
+  double gapErrorSigmas = 3.0;  // noise sigmas: most 1 × 3 error of a gap pixel given its side's
+                                //   disparity up to the outline (0: the gap stays unmatched)
   int maxPasses = 3;            // passes over the map, until one moves nothing
   int threads = 1;              // workers over bands of columns (same result on any number)
 };
@@ -29,14 +31,19 @@ struct RowStepSnapSettings {
 // mapped right| over its 1 × (2 stripHalf + 1) strip (one surface only, the outline running with
 // the rows; the strip's pixels that held the new disparity are left out) at most winRatio × the
 // one at its own disparity and at most maxErrorSigmas. The gap's unmatched pixels stay unmatched
-// (passed over when the new disparity explains them within maxErrorSigmas). The first pixel that
-// fails stops the column's move. Moved pixels get `fillScore`. The passes repeat while they move
-// pixels: a run carried farther than `reach` past its outline moves up to a nearer contrast
-// first, and the next pass sees the outline from the new step (seed 9 600²: 7 carried rows, a
-// dark line on the roof 5 rows below its outline).
-// `sigma` is the left image's noise sigma. The right view's grey levels are mapped to the left's
-// by the grey map of the matched pixel pairs (radiometricMapOfMatches; the images' moments when
-// too few are matched). Returns the number of pixels changed.
+// (passed over when the new disparity explains them within maxErrorSigmas). When the outline lies
+// in the gap, each side's unmatched pixels up to it take that side's disparity, from the side
+// towards the outline, while the mean |left − mapped right| of the pixel and its two row
+// neighbours is at most gapErrorSigmas there (its row strip would cross a slanted outline): the
+// views are displaced along the rows only, so nothing is hidden across them, and those pixels,
+// often a roof's first rows, were left unmatched by windows that straddled the outline. The first
+// pixel that fails stops the column's move. Moved pixels get `fillScore`. The passes repeat while
+// they move pixels: a run carried farther than `reach` past its outline moves up to a nearer
+// contrast first, and the next pass sees the outline from the new step (seed 9 600²: 7 carried
+// rows, a dark line on the roof 5 rows below its outline). `sigma` is the left image's noise sigma.
+// The right view's grey levels are mapped to the left's by the grey map of the matched pixel pairs
+// (radiometricMapOfMatches; the images' moments when too few are matched). Returns the number of
+// pixels changed.
 int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma,
                         const RowStepSnapSettings& settings, float fillScore, cv::Mat& disparity,
                         cv::Mat& score);
