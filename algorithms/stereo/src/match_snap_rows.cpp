@@ -28,20 +28,17 @@ int snapPass(const cv::Mat& left, const cv::Mat& right, double sigma, double gai
   // The map as it was: the strips leave out the pixels that held the new disparity before any
   // move (and the columns are moved on several workers).
   const cv::Mat before = disparity.clone();
-  // Mean |left − mapped right| over the row strip of (y, x) at disparity d, in noise sigmas
-  // (right view read with linear interpolation), without the strip's other pixels whose
-  // disparity was within kSameSurface of `other`: where the outline crosses the row (a slanted
-  // one, a narrow part of a roof, a carried run's end) those pixels would vote for `other` on
-  // their own surface's behalf (a 6 px roof wing moved onto the ground without this; on the
-  // battery, edge % 0.3–0.4 point lower on 4 runs). +inf when fewer than kMinStripPixels are
-  // read.
-  const auto stripError = [&](int y, int x, float d, float other) {
+  // Mean |left − mapped right| over the pixels x − halfWidth .. x + halfWidth of row y at
+  // disparity d, in noise sigmas (right view read with linear interpolation), without the other
+  // pixels whose disparity was within kSameSurface of `other` (NaN: none left out). +inf when
+  // fewer than `fewest` are read.
+  const auto rowError = [&](int y, int x, float d, int halfWidth, float other, int fewest) {
     const float* a = left.ptr<float>(y);
     const float* r = right.ptr<float>(y);
     const float* was = before.ptr<float>(y);
     double sum = 0;
     int n = 0;
-    for (int u = std::max(0, x - half); u <= std::min(w - 1, x + half); ++u) {
+    for (int u = std::max(0, x - halfWidth); u <= std::min(w - 1, x + halfWidth); ++u) {
       if (u != x && std::abs(was[u] - other) < kSameSurface) continue;
       const float xr = static_cast<float>(u) - d;
       const int x0 = static_cast<int>(std::floor(xr));
@@ -52,27 +49,20 @@ int snapPass(const cv::Mat& left, const cv::Mat& right, double sigma, double gai
       sum += std::abs(a[u] - (gain * b + offset));
       ++n;
     }
-    return n >= kMinStripPixels ? sum / n / sigma : std::numeric_limits<double>::infinity();
+    return n >= fewest ? sum / n / sigma : std::numeric_limits<double>::infinity();
   };
-  // Mean |left − mapped right| of (y, x) and its two row neighbours at disparity d, in noise
-  // sigmas (right view read with linear interpolation): a gap's pixel next to the outline, whose
-  // row strip would cross a slanted outline. +inf when fewer than 2 pixels are read.
+  // The error over the row strip of (y, x) (stripHalf each side), without the strip's other pixels
+  // whose disparity was within kSameSurface of `other`: where the outline crosses the row (a
+  // slanted one, a narrow part of a roof, a carried run's end) those pixels would vote for `other`
+  // on their own surface's behalf (a 6 px roof wing moved onto the ground without this; on the
+  // battery, edge % 0.3–0.4 point lower on 4 runs). At least kMinStripPixels read.
+  const auto stripError = [&](int y, int x, float d, float other) {
+    return rowError(y, x, d, half, other, kMinStripPixels);
+  };
+  // The error of (y, x) and its two row neighbours: a gap's pixel next to the outline, whose row
+  // strip would cross a slanted outline. At least 2 read.
   const auto tripletError = [&](int y, int x, float d) {
-    const float* a = left.ptr<float>(y);
-    const float* r = right.ptr<float>(y);
-    double sum = 0;
-    int n = 0;
-    for (int u = std::max(0, x - 1); u <= std::min(w - 1, x + 1); ++u) {
-      const float xr = static_cast<float>(u) - d;
-      const int x0 = static_cast<int>(std::floor(xr));
-      if (x0 < 0 || x0 + 1 >= w) continue;
-      const float t = xr - static_cast<float>(x0);
-      const float b = (1 - t) * r[x0] + t * r[x0 + 1];
-      if (!std::isfinite(a[u]) || !std::isfinite(b)) continue;
-      sum += std::abs(a[u] - (gain * b + offset));
-      ++n;
-    }
-    return n >= 2 ? sum / n / sigma : std::numeric_limits<double>::infinity();
+    return rowError(y, x, d, 1, std::numeric_limits<float>::quiet_NaN(), 2);
   };
   // |mean I(c .. c + kStepSide − 1) − mean I(c − kStepSide .. c − 1)| in column x: the contrast
   // of the cut above row c; -1 where a side leaves the image or meets nodata.
