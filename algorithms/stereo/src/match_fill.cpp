@@ -7,7 +7,9 @@
 #include <functional>
 #include <latch>
 #include <limits>
+#include <map>
 #include <optional>
+#include <tuple>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -790,6 +792,129 @@ long matchesHiddenBy(const FillPlane& plane, const cv::Mat& region, const cv::Re
   return hidden;
 }
 
+// Sub-pixel position of a flat region's edge on a row of `row` (`cols` px), from the region's end
+// pixel `start` walking outwards (`step` −1 or +1) over at most 5 pixels of the roof's grey
+// (within 3 `sigma` of `roof`): the first other pixel q is the mixed one, the next lies beyond.
+// The edge is where the roof's share of q, (grey − beyond) / (roof − beyond), ends. Pixel x
+// covers [x − 0.5, x + 0.5]. Nothing when the walk leaves the row or the edge's contrast is below
+// 6 sigma (its share is then mostly noise).
+std::optional<double> subpixelEdge(const float* row, int cols, int start, int step, double roof,
+                                   double sigma) {
+  int p = start;
+  for (int k = 0; k < 5; ++k) {
+    const int next = p + step;
+    if (next - step < 0 || next - step >= cols || next + 2 * step < 0 || next + 2 * step >= cols) {
+      return std::nullopt;
+    }
+    if (std::abs(row[next] - roof) > 3 * sigma) break;
+    p = next;
+  }
+  const int q = p + step;
+  if (q + step < 0 || q + step >= cols) return std::nullopt;
+  const double beyond = row[q + step];
+  if (!std::isfinite(beyond) || !std::isfinite(row[q]) || std::abs(roof - beyond) < 6 * sigma) {
+    return std::nullopt;
+  }
+  const double share = std::clamp((row[q] - beyond) / (roof - beyond), 0.0, 1.0);
+  return step < 0 ? q + 0.5 - share : q - 0.5 + share;
+}
+
+// The constant disparity of a plain region read from its edges in both views (see
+// RegionFillSettings::edgeMinSamples): the row ends within 1.5 px of `candidate`, the right
+// view's counterpart being the flat region of the region's grey (within 3 sigma, through the
+// matches' grey map) whose row ends agree with `candidate` on most rows. Returns the mean of the
+// row-end disparities within 0.75 px of their median and their count (0: none).
+std::pair<double, int> edgeDisparity(const cv::Mat& left, const cv::Mat& right,
+                                     const cv::Mat& region, const cv::Rect& box,
+                                     const RightFlatRegions& rightFlat, double gain, double offset,
+                                     double sigma, int dmin, int dmax, float candidate) {
+  constexpr double kAgree = 1.5;
+  const double leftMean = cv::mean(left(box), region)[0];
+  const int cols = rightFlat.labels.cols;
+  struct RowEnds {
+    int y, l0, l1;
+  };
+  std::vector<RowEnds> rows;
+  for (int y = 0; y < box.height; ++y) {
+    const uchar* m = region.ptr<uchar>(y);
+    int first = -1, last = -1;
+    for (int x = 0; x < box.width; ++x) {
+      if (!m[x]) continue;
+      if (first < 0) first = x;
+      last = x;
+    }
+    if (first >= 0 && last - first >= 2) rows.push_back({box.y + y, box.x + first, box.x + last});
+  }
+  // The first and last pixel of `label` in the row's search band (-1 when absent).
+  const auto rightEnds = [&](const RowEnds& r, int label) {
+    const int* l = rightFlat.labels.ptr<int>(r.y);
+    const int x0 = std::max(0, r.l0 - dmax), x1 = std::min(cols - 1, r.l1 - dmin);
+    int r0 = -1, r1 = -1;
+    for (int x = x0; x <= x1; ++x) {
+      if (l[x] != label) continue;
+      if (r0 < 0) r0 = x;
+      r1 = x;
+    }
+    return std::pair<int, int>{r0, r1};
+  };
+  std::map<int, int> agreeing;  // right label -> rows with an end that agrees with `candidate`
+  for (const RowEnds& r : rows) {
+    const int* l = rightFlat.labels.ptr<int>(r.y);
+    const int x0 = std::max(0, r.l0 - dmax), x1 = std::min(cols - 1, r.l1 - dmin);
+    std::map<int, std::pair<int, int>> ends;
+    for (int x = x0; x <= x1; ++x) {
+      if (l[x] == 0) continue;
+      const auto [it, inserted] = ends.try_emplace(l[x], x, x);
+      if (!inserted) it->second.second = x;
+    }
+    for (const auto& [label, e] : ends) {
+      const double mapped = gain * rightFlat.meanGrey[static_cast<size_t>(label)] + offset;
+      if (std::abs(mapped - leftMean) > 3 * sigma) continue;
+      if (std::abs(r.l0 - e.first - candidate) <= kAgree ||
+          std::abs(r.l1 - e.second - candidate) <= kAgree) {
+        ++agreeing[label];
+      }
+    }
+  }
+  int label = 0, most = 0;
+  for (const auto& [k, n] : agreeing) {
+    if (n > most) {
+      most = n;
+      label = k;
+    }
+  }
+  if (label == 0) return {0.0, 0};
+  const double rightMean = rightFlat.meanGrey[static_cast<size_t>(label)];
+  const double rightSigma = sigma / gain;
+  std::vector<double> values;
+  for (const RowEnds& r : rows) {
+    const auto [r0, r1] = rightEnds(r, label);
+    if (r0 < 0) continue;
+    const float* a = left.ptr<float>(r.y);
+    const float* b = right.ptr<float>(r.y);
+    for (const auto& [l, rr, step] : {std::tuple{r.l0, r0, -1}, std::tuple{r.l1, r1, +1}}) {
+      if (std::abs(l - rr - candidate) > kAgree) continue;
+      const auto inLeft = subpixelEdge(a, left.cols, l, step, leftMean, sigma);
+      const auto inRight = subpixelEdge(b, right.cols, rr, step, rightMean, rightSigma);
+      if (inLeft && inRight) values.push_back(*inLeft - *inRight);
+    }
+  }
+  if (values.empty()) return {0.0, 0};
+  std::vector<double> sorted = values;
+  const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+  std::nth_element(sorted.begin(), middle, sorted.end());
+  const double median = *middle;
+  double sum = 0;
+  int n = 0;
+  for (const double v : values) {
+    if (std::abs(v - median) <= 0.75) {
+      sum += v;
+      ++n;
+    }
+  }
+  return {sum / n, n};
+}
+
 // The fill itself; `rightFlatRegionsOf()` gives the right view's flat regions.
 template <class RightFlat>
 int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
@@ -990,6 +1115,17 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       if (settings.ringArbiterReach > 0) {
         value =
             medianOfThree(value, best, ringMinimumNear(ringError, best, settings.ringArbiterReach));
+      }
+      // The region's edges in both views, when enough of them are sharp, over the three
+      // estimates of the matches and the ring (see RegionFillSettings::edgeMinSamples).
+      if (settings.edgeMinSamples > 0) {
+        const auto [edgeValue, samples] =
+            edgeDisparity(left, right, region, box, rightFlatRegionsOf(), matchedGain,
+                          matchedOffset, sigma, dmin, dmax, best);
+        if (samples >= settings.edgeMinSamples &&
+            std::abs(edgeValue - best) <= settings.ringArbiterReach) {
+          value = static_cast<float>(edgeValue);
+        }
       }
       constantError = ringError(value);
       return value;

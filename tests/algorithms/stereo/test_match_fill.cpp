@@ -2,6 +2,7 @@
 // contour.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -557,13 +558,18 @@ TEST(FillFlatRegions, AWiderWindowDecidesWhereTheSmallOneIsNotClearlyBest) {
 TEST(FillFlatRegions, GoesOnOverMatchesThatAgreeWithIt) {
   // The band's first 5 columns matched at the roof's disparity (a weakly textured roof's matched
   // patch): between the filled region and the unmatched rest of the band.
-  RegionFillSettings noPassing;
+  // The band's value is the constant of the matches around it, as the rule was measured with:
+  // read from the band's edges (edgeMinSamples), the extension reaches 155 of the rest's 238
+  // pixels even without passing over the matches.
+  RegionFillSettings passing;
+  passing.edgeMinSamples = 0;
+  RegionFillSettings noPassing = passing;
   noPassing.extendAgree = -1;
   // (With the wider windows, the extension reaches 159 of the rest's pixels without passing over
   // the matches.)
   noPassing.extendWideWindow = 0;
   const auto [passed, stopped] =
-      filledWithAndWithout([] { return stripedBandWithMatchedColumns(5); }, {}, noPassing);
+      filledWithAndWithout([] { return stripedBandWithMatchedColumns(5); }, passing, noPassing);
   const cv::Rect rest(passed.roof.br().x - 7, passed.roof.y + 3, 7, passed.roof.height - 6);
   expectTheRuleFills(passed, stopped, rest, 1.0 / 3, 0.6);
 }
@@ -675,6 +681,7 @@ TEST(FillFlatRegions, RefocusesTheMedianOnTheBulkOfTheOutlinesMatches) {
   };
   RegionFillSettings plainMedian;
   plainMedian.refocusReach = 0;
+  plainMedian.edgeMinSamples = 0;  // the roof's edges would give its 20 whatever the matches
   const auto [refocused, median] = filledWithAndWithout(skewed, {}, plainMedian);
   const cv::Rect inner = innerRoof(refocused);
   EXPECT_EQ(pixelsAt(refocused.disparity, inner, kRoof, 0.05), inner.area());
@@ -702,6 +709,56 @@ TEST(FillFlatRegions, TheRingErrorArbitratesBetweenTheMatchesMedianAndTheirMean)
   // (Measured: every inner pixel at 20.110; 20.800 with the median alone.)
   EXPECT_EQ(pixelsAt(arbitrated.disparity, inner, kRoof, 0.2), inner.area());
   EXPECT_EQ(pixelsAt(median.disparity, inner, kRoof + 0.8f, 0.05), inner.area());
+}
+
+// The flat roof at a sub-pixel disparity, each pixel of both views the roof's grey and the
+// ground's blended by the share of it the roof covers (as a camera integrates it): the roof
+// spans [59.5, 109.5) in the left view (pixel x covers [x - 0.5, x + 0.5)) and
+// [59.5 - d, 109.5 - d) in the right view. Ground at 4 px, noise sigma 2.
+Scene subpixelRoofScene(double d) {
+  Scene s = scene();
+  const cv::Mat ground = testing::texture(cv::Size(s.left.cols + 64, s.left.rows), 31) * 0.6 + 20.0;
+  cv::RNG rng(7);
+  const auto share = [](double x, double from, double to) {
+    return std::clamp(std::min(x + 0.5, to) - std::max(x - 0.5, from), 0.0, 1.0);
+  };
+  const double x0 = s.roof.x - 0.5, x1 = s.roof.br().x - 0.5;
+  for (int y = 0; y < s.left.rows; ++y) {
+    const bool roofRow = y >= s.roof.y && y < s.roof.br().y;
+    for (int x = 0; x < s.left.cols; ++x) {
+      const double inLeft = roofRow ? share(x, x0, x1) : 0.0;
+      const double inRight = roofRow ? share(x, x0 - d, x1 - d) : 0.0;
+      s.left.at<float>(y, x) = static_cast<float>(
+          inLeft * 200.0 + (1 - inLeft) * ground.at<float>(y, x + 32) + rng.gaussian(2.0));
+      s.right.at<float>(y, x) = static_cast<float>(
+          inRight * 200.0 + (1 - inRight) * ground.at<float>(y, x + 4 + 32) + rng.gaussian(2.0));
+    }
+  }
+  return s;
+}
+
+TEST(FillFlatRegions, APlainRoofsEdgesInBothViewsSetItsSubpixelValueOverBiasedMatches) {
+  // The roof at 20.4; every match around it 0.7 px too far (21.1), as a ground of the roof's
+  // grey beside its outline draws the windows across it. The three estimates of the matches
+  // and the ring follow them; the roof's edges in the two views do not.
+  constexpr double kTrue = 20.4;
+  const auto biased = [] {
+    Scene s = subpixelRoofScene(kTrue);
+    cv::Mat matched = s.disparity == s.disparity;
+    cv::Mat onRoof = cv::Mat::zeros(s.disparity.size(), CV_8U);
+    onRoof(s.roof).setTo(255);
+    s.disparity.setTo(kTrue + 0.7, matched & onRoof);
+    const int sideRows = s.roof.height - 6;
+    s.disparity(cv::Rect(s.roof.x, s.roof.y + 3, 2, sideRows)).setTo(kTrue + 0.7);
+    s.disparity(cv::Rect(s.roof.br().x - 2, s.roof.y + 3, 2, sideRows)).setTo(kTrue + 0.7);
+    return s;
+  };
+  RegionFillSettings noEdges;
+  noEdges.edgeMinSamples = 0;
+  const auto [edges, matches] = filledWithAndWithout(biased, {}, noEdges);
+  const cv::Rect inner = innerRoof(edges);
+  EXPECT_EQ(pixelsAt(edges.disparity, inner, static_cast<float>(kTrue), 0.15), inner.area());
+  EXPECT_EQ(pixelsAt(matches.disparity, inner, static_cast<float>(kTrue), 0.4), 0);
 }
 
 TEST(FillFlatRegions, TakesItsValueFromTheMatchesBesideTheRoofNotAboveOrBelowIt) {
