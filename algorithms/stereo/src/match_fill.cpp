@@ -1196,6 +1196,24 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
            !(planeRingError(plane) < settings.planeCandidateRatio * candidateError))) {
         if (!constant) continue;
         plane = FillPlane{*constant, 0, 0};
+      } else if (!constant && span < settings.planeMinSpan) {
+        // Taken where no constant passed, a plane that changes by less than planeMinSpan over the
+        // region is a flat roof's row ends fitted with a slope of noise, as above (sim seed 39
+        // 600²: a C-shaped plain roof at 26.74 whose matches around are mostly the ground's,
+        // given a plane of 0.8 px span, 27.22 at its centroid): the region takes the constant
+        // its edges give around the plane's value at its centroid (26.83 there; see
+        // edgeMinSamples), else that value.
+        const double centreValue = plane.at(centroids.at<double>(r, 0), centroids.at<double>(r, 1));
+        plane = FillPlane{static_cast<float>(centreValue), 0, 0};
+        if (settings.edgeMinSamples > 0) {
+          const auto [edgeValue, samples] =
+              edgeDisparity(left, right, region, box, rightFlat, matchedGain, matchedOffset, sigma,
+                            dmin, dmax, static_cast<float>(centreValue));
+          if (samples >= settings.edgeMinSamples &&
+              std::abs(edgeValue - centreValue) <= settings.ringArbiterReach) {
+            plane = FillPlane{static_cast<float>(edgeValue), 0, 0};
+          }
+        }
       }
     } else {
       if (!constant) continue;
