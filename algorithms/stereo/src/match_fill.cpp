@@ -360,14 +360,12 @@ bool trimmedPlane(const std::vector<cv::Point3d>& points, const RegionFillSettin
   return false;
 }
 
-bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
-                      double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
-                      const RegionFillSettings& settings, const std::optional<float>& constant,
-                      FillPlane& plane, bool* oneSided = nullptr,
-                      std::vector<cv::Vec2i>* rowSpans = nullptr) {
-  struct RowEnds {
-    int y, l0, l1;
-  };
+// A region's first and last pixel on each of its rows (image coordinates), for the rows it
+// spans 3 px or more (`region` is the mask of `box`).
+struct RowEnds {
+  int y, l0, l1;
+};
+std::vector<RowEnds> regionRowEnds(const cv::Mat& region, const cv::Rect& box) {
   std::vector<RowEnds> rows;
   for (int y = 0; y < box.height; ++y) {
     const uchar* m = region.ptr<uchar>(y);
@@ -379,6 +377,15 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     }
     if (first >= 0 && last - first >= 2) rows.push_back({box.y + y, box.x + first, box.x + last});
   }
+  return rows;
+}
+
+bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
+                      double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
+                      const RegionFillSettings& settings, const std::optional<float>& constant,
+                      FillPlane& plane, bool* oneSided = nullptr,
+                      std::vector<cv::Vec2i>* rowSpans = nullptr) {
+  const std::vector<RowEnds> rows = regionRowEnds(region, box);
   if (static_cast<int>(rows.size()) < settings.planeMinRows) return false;
   const int cols = right.labels.cols;
   // Search band of a row: the right columns its ends can map to.
@@ -831,20 +838,7 @@ std::pair<double, int> edgeDisparity(const cv::Mat& left, const cv::Mat& right,
   constexpr double kAgree = 1.5;
   const double leftMean = cv::mean(left(box), region)[0];
   const int cols = rightFlat.labels.cols;
-  struct RowEnds {
-    int y, l0, l1;
-  };
-  std::vector<RowEnds> rows;
-  for (int y = 0; y < box.height; ++y) {
-    const uchar* m = region.ptr<uchar>(y);
-    int first = -1, last = -1;
-    for (int x = 0; x < box.width; ++x) {
-      if (!m[x]) continue;
-      if (first < 0) first = x;
-      last = x;
-    }
-    if (first >= 0 && last - first >= 2) rows.push_back({box.y + y, box.x + first, box.x + last});
-  }
+  const std::vector<RowEnds> rows = regionRowEnds(region, box);
   // The first and last pixel of `label` in the row's search band (-1 when absent).
   const auto rightEnds = [&](const RowEnds& r, int label) {
     const int* l = rightFlat.labels.ptr<int>(r.y);
