@@ -360,6 +360,33 @@ bool trimmedPlane(const std::vector<cv::Point3d>& points, const RegionFillSettin
   return false;
 }
 
+// Sub-pixel position of a flat region's edge on a row of `row` (`cols` px), from the region's end
+// pixel `start` walking outwards (`step` −1 or +1) over at most 5 pixels of the roof's grey
+// (within 3 `sigma` of `roof`): the first other pixel q is the mixed one, the next lies beyond.
+// The edge is where the roof's share of q, (grey − beyond) / (roof − beyond), ends. Pixel x
+// covers [x − 0.5, x + 0.5]. Nothing when the walk leaves the row or the edge's contrast is below
+// 6 sigma (its share is then mostly noise).
+std::optional<double> subpixelEdge(const float* row, int cols, int start, int step, double roof,
+                                   double sigma) {
+  int p = start;
+  for (int k = 0; k < 5; ++k) {
+    const int next = p + step;
+    if (next - step < 0 || next - step >= cols || next + 2 * step < 0 || next + 2 * step >= cols) {
+      return std::nullopt;
+    }
+    if (std::abs(row[next] - roof) > 3 * sigma) break;
+    p = next;
+  }
+  const int q = p + step;
+  if (q + step < 0 || q + step >= cols) return std::nullopt;
+  const double beyond = row[q + step];
+  if (!std::isfinite(beyond) || !std::isfinite(row[q]) || std::abs(roof - beyond) < 6 * sigma) {
+    return std::nullopt;
+  }
+  const double share = std::clamp((row[q] - beyond) / (roof - beyond), 0.0, 1.0);
+  return step < 0 ? q + 0.5 - share : q - 0.5 + share;
+}
+
 // A region's first and last pixel on each of its rows (image coordinates), for the rows it
 // spans 3 px or more (`region` is the mask of `box`).
 struct RowEnds {
@@ -380,11 +407,18 @@ std::vector<RowEnds> regionRowEnds(const cv::Mat& region, const cv::Rect& box) {
   return rows;
 }
 
+// The two views, when a plane's row ends are read to a fraction of a pixel from their edges.
+struct EdgeViews {
+  const cv::Mat& left;
+  const cv::Mat& right;
+};
+
 bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
                       double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
                       const RegionFillSettings& settings, const std::optional<float>& constant,
                       FillPlane& plane, bool* oneSided = nullptr,
-                      std::vector<cv::Vec2i>* rowSpans = nullptr) {
+                      std::vector<cv::Vec2i>* rowSpans = nullptr,
+                      const EdgeViews* edgeViews = nullptr) {
   const std::vector<RowEnds> rows = regionRowEnds(region, box);
   if (static_cast<int>(rows.size()) < settings.planeMinRows) return false;
   const int cols = right.labels.cols;
@@ -436,8 +470,25 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
       // The ends' difference is the disparity at the facet's first and last pixels (both masks
       // stop kFlatReach px inside them; on a slanted facet those inner pixels are not the same
       // surface points in the two views).
-      points.emplace_back(r.l0 - kFlatReach, r.y, r.l0 - r0);
-      points.emplace_back(r.l1 + kFlatReach, r.y, r.l1 - r1);
+      // With `edgeViews`, an end whose edges are sharp in both views (see subpixelEdge) is the
+      // edges' difference at the left view's edge, when within 1.5 px of the whole-pixel one.
+      const auto subpixelEnd = [&](int leftEnd, int rightEnd,
+                                   int step) -> std::optional<cv::Point3d> {
+        if (edgeViews == nullptr) return std::nullopt;
+        const auto inLeft = subpixelEdge(edgeViews->left.ptr<float>(r.y), edgeViews->left.cols,
+                                         leftEnd, step, leftMean, sigma);
+        const auto inRight =
+            subpixelEdge(edgeViews->right.ptr<float>(r.y), edgeViews->right.cols, rightEnd, step,
+                         right.meanGrey[static_cast<size_t>(label)], sigma / gain);
+        if (!inLeft || !inRight || std::abs(*inLeft - *inRight - (leftEnd - rightEnd)) > 1.5) {
+          return std::nullopt;
+        }
+        return cv::Point3d(*inLeft, r.y, *inLeft - *inRight);
+      };
+      points.push_back(
+          subpixelEnd(r.l0, r0, -1).value_or(cv::Point3d(r.l0 - kFlatReach, r.y, r.l0 - r0)));
+      points.push_back(
+          subpixelEnd(r.l1, r1, +1).value_or(cv::Point3d(r.l1 + kFlatReach, r.y, r.l1 - r1)));
       rightEnds.emplace_back(r0, r1);
     }
     // Fit, keep the points within planeInlier px, fit again (twice).
@@ -482,7 +533,9 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
       // the facet's grey joined to it), and a row whose left region runs past the counterpart's
       // end (that end beyond the plane by more than planeInlier) only where the counterpart
       // maps: x − d(x) within [r0, r1] widened by kFlatReach, x = (xr + c + b·y) / (1 − a).
-      const bool limited = trimmed || !bothSides;
+      // The sub-pixel ends agree within planeInlier more often, on a facet and on a surface of
+      // its grey joined to it alike: their plane is limited row by row too.
+      const bool limited = trimmed || !bothSides || edgeViews != nullptr;
       rowSpans->assign(static_cast<size_t>(box.height),
                        limited ? cv::Vec2i(1, 0) : cv::Vec2i(0, box.width - 1));
       for (size_t k = 0; limited && k + 1 < points.size(); k += 2) {
@@ -799,33 +852,6 @@ long matchesHiddenBy(const FillPlane& plane, const cv::Mat& region, const cv::Re
   return hidden;
 }
 
-// Sub-pixel position of a flat region's edge on a row of `row` (`cols` px), from the region's end
-// pixel `start` walking outwards (`step` −1 or +1) over at most 5 pixels of the roof's grey
-// (within 3 `sigma` of `roof`): the first other pixel q is the mixed one, the next lies beyond.
-// The edge is where the roof's share of q, (grey − beyond) / (roof − beyond), ends. Pixel x
-// covers [x − 0.5, x + 0.5]. Nothing when the walk leaves the row or the edge's contrast is below
-// 6 sigma (its share is then mostly noise).
-std::optional<double> subpixelEdge(const float* row, int cols, int start, int step, double roof,
-                                   double sigma) {
-  int p = start;
-  for (int k = 0; k < 5; ++k) {
-    const int next = p + step;
-    if (next - step < 0 || next - step >= cols || next + 2 * step < 0 || next + 2 * step >= cols) {
-      return std::nullopt;
-    }
-    if (std::abs(row[next] - roof) > 3 * sigma) break;
-    p = next;
-  }
-  const int q = p + step;
-  if (q + step < 0 || q + step >= cols) return std::nullopt;
-  const double beyond = row[q + step];
-  if (!std::isfinite(beyond) || !std::isfinite(row[q]) || std::abs(roof - beyond) < 6 * sigma) {
-    return std::nullopt;
-  }
-  const double share = std::clamp((row[q] - beyond) / (roof - beyond), 0.0, 1.0);
-  return step < 0 ? q + 0.5 - share : q - 0.5 + share;
-}
-
 // The constant disparity of a plain region read from its edges in both views (see
 // RegionFillSettings::edgeMinSamples): the row ends within 1.5 px of `candidate`, the right
 // view's counterpart being the flat region of the region's grey (within 3 sigma, through the
@@ -1130,18 +1156,42 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       const double leftMean = cv::mean(left(box), region)[0];
       bool oneSided = false;
       std::vector<cv::Vec2i> rowSpans;
-      bool sloped =
-          slopedFacetPlane(region, box, rightFlat, leftMean, matchedGain, matchedOffset, sigma,
-                           dmin, dmax, settings, constant, plane, &oneSided, &rowSpans);
       // A plane's counterpart is found by grey level anywhere in the range: a plain rooftop box
       // (23 px on a roof at 20, 2000²) took a copy of itself 126 px away, whose outline lines up
       // as well. Filled there, it would hide in the right view the roof's matches left of it on
       // its rows, 14 times its area; a real facet hides at most about its own area (the
       // ground it hides beside a roof is mostly unmatched already).
-      if (sloped && settings.planeHiddenRatio > 0 &&
-          matchesHiddenBy(plane, region, box, disparity, dmax - dmin) >
-              settings.planeHiddenRatio * cv::countNonZero(region)) {
-        sloped = false;
+      const auto hidesTooMuch = [&](const FillPlane& p) {
+        return settings.planeHiddenRatio > 0 &&
+               matchesHiddenBy(p, region, box, disparity, dmax - dmin) >
+                   settings.planeHiddenRatio * cv::countNonZero(region);
+      };
+      // Where no constant passed, the plane through the row ends' sub-pixel edges first (see
+      // RegionFillSettings::planeEdgeEnds), kept when it passes the tests below that do not
+      // involve a constant; else the plane through the whole-pixel ends.
+      bool sloped = false;
+      if (settings.planeEdgeEnds && !constant) {
+        const EdgeViews views{left, right};
+        FillPlane edgePlane;
+        bool edgeOneSided = false;
+        std::vector<cv::Vec2i> edgeRowSpans;
+        sloped = slopedFacetPlane(region, box, rightFlat, leftMean, matchedGain, matchedOffset,
+                                  sigma, dmin, dmax, settings, constant, edgePlane, &edgeOneSided,
+                                  &edgeRowSpans, &views) &&
+                 !hidesTooMuch(edgePlane) &&
+                 (settings.planeCandidateRatio <= 0 ||
+                  planeRingError(edgePlane) < settings.planeCandidateRatio * candidateError);
+        if (sloped) {
+          plane = edgePlane;
+          oneSided = edgeOneSided;
+          rowSpans = std::move(edgeRowSpans);
+        }
+      }
+      if (!sloped) {
+        sloped =
+            slopedFacetPlane(region, box, rightFlat, leftMean, matchedGain, matchedOffset, sigma,
+                             dmin, dmax, settings, constant, plane, &oneSided, &rowSpans) &&
+            !hidesTooMuch(plane);
       }
       if (sloped) {
         for (int y = 0; y < box.height; ++y) {

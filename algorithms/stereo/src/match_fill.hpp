@@ -41,6 +41,9 @@ struct RegionFillSettings {
   double planeSideShare = 0.9;   // or: share of one side's row ends that agree (> 1 = off)
   double planeEaveShare = 0.33;  //   with this share of the other side's (a hip facet's eave)
   double planeMaxSlope = 0.5;    // px of disparity per px, in x and in y
+  bool planeEdgeEnds = true;     // where no constant passed, the plane through the row ends'
+                                 //   sub-pixel edges (as for edgeMinSamples) is tried first and
+                                 //   limited row by row; the whole-pixel ends' plane if it fails
   double planeTrimShare = 0.1;   // worst share of row ends dropped per trimmed refit (0 = off)
   double planeMargin = 0.95;     // a plane replaces a constant the outline lines up at only when
                                  //   its outline error is below this × the constant's
