@@ -407,6 +407,26 @@ std::vector<RowEnds> regionRowEnds(const cv::Mat& region, const cv::Rect& box) {
   return rows;
 }
 
+// A row's search band in the right view (`cols` px wide): the columns its ends can map to.
+std::pair<int, int> searchBand(const RowEnds& r, int dmin, int dmax, int cols) {
+  return {std::max(0, r.l0 - dmax), std::min(cols - 1, r.l1 - dmin)};
+}
+
+// The first and last pixel of `label` (in `labels`, CV_32S) on the row's search band; -1 when
+// absent.
+std::pair<int, int> labelEndsInBand(const cv::Mat& labels, const RowEnds& r, int label, int dmin,
+                                    int dmax) {
+  const int* l = labels.ptr<int>(r.y);
+  const auto [x0, x1] = searchBand(r, dmin, dmax, labels.cols);
+  int first = -1, last = -1;
+  for (int x = x0; x <= x1; ++x) {
+    if (l[x] != label) continue;
+    if (first < 0) first = x;
+    last = x;
+  }
+  return {first, last};
+}
+
 // The two views, when a plane's row ends are read to a fraction of a pixel from their edges.
 struct EdgeViews {
   const cv::Mat& left;
@@ -421,11 +441,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
                       const EdgeViews* edgeViews = nullptr) {
   const std::vector<RowEnds> rows = regionRowEnds(region, box);
   if (static_cast<int>(rows.size()) < settings.planeMinRows) return false;
-  const int cols = right.labels.cols;
-  // Search band of a row: the right columns its ends can map to.
-  auto band = [&](const RowEnds& r) {
-    return std::pair<int, int>{std::max(0, r.l0 - dmax), std::min(cols - 1, r.l1 - dmin)};
-  };
+  const auto band = [&](const RowEnds& r) { return searchBand(r, dmin, dmax, right.labels.cols); };
   // Right regions of the region's grey level met in the band, by pixel count.
   std::vector<std::pair<int, int>> candidates;  // (count, label)
   {
@@ -457,14 +473,8 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
     std::vector<cv::Point3d> points;
     std::vector<cv::Vec2i> rightEnds;  // each row's (r0, r1), as its two points
     for (const RowEnds& r : rows) {
-      const int* l = right.labels.ptr<int>(r.y);
       const auto [x0, x1] = band(r);
-      int r0 = -1, r1 = -1;
-      for (int x = x0; x <= x1; ++x) {
-        if (l[x] != label) continue;
-        if (r0 < 0) r0 = x;
-        r1 = x;
-      }
+      const auto [r0, r1] = labelEndsInBand(right.labels, r, label, dmin, dmax);
       // Ends cut by the band are not the region's ends.
       if (r0 <= x0 || r1 >= x1) continue;
       // The ends' difference is the disparity at the facet's first and last pixels (both masks
@@ -863,24 +873,11 @@ std::pair<double, int> edgeDisparity(const cv::Mat& left, const cv::Mat& right,
                                      double sigma, int dmin, int dmax, float candidate) {
   constexpr double kAgree = 1.5;
   const double leftMean = cv::mean(left(box), region)[0];
-  const int cols = rightFlat.labels.cols;
   const std::vector<RowEnds> rows = regionRowEnds(region, box);
-  // The first and last pixel of `label` in the row's search band (-1 when absent).
-  const auto rightEnds = [&](const RowEnds& r, int label) {
-    const int* l = rightFlat.labels.ptr<int>(r.y);
-    const int x0 = std::max(0, r.l0 - dmax), x1 = std::min(cols - 1, r.l1 - dmin);
-    int r0 = -1, r1 = -1;
-    for (int x = x0; x <= x1; ++x) {
-      if (l[x] != label) continue;
-      if (r0 < 0) r0 = x;
-      r1 = x;
-    }
-    return std::pair<int, int>{r0, r1};
-  };
   std::map<int, int> agreeing;  // right label -> rows with an end that agrees with `candidate`
   for (const RowEnds& r : rows) {
     const int* l = rightFlat.labels.ptr<int>(r.y);
-    const int x0 = std::max(0, r.l0 - dmax), x1 = std::min(cols - 1, r.l1 - dmin);
+    const auto [x0, x1] = searchBand(r, dmin, dmax, rightFlat.labels.cols);
     std::map<int, std::pair<int, int>> ends;
     for (int x = x0; x <= x1; ++x) {
       if (l[x] == 0) continue;
@@ -908,7 +905,7 @@ std::pair<double, int> edgeDisparity(const cv::Mat& left, const cv::Mat& right,
   const double rightSigma = sigma / gain;
   std::vector<double> values;
   for (const RowEnds& r : rows) {
-    const auto [r0, r1] = rightEnds(r, label);
+    const auto [r0, r1] = labelEndsInBand(rightFlat.labels, r, label, dmin, dmax);
     if (r0 < 0) continue;
     const float* a = left.ptr<float>(r.y);
     const float* b = right.ptr<float>(r.y);
