@@ -242,6 +242,11 @@ TEST(FillFlatRegions, ThinFlatPartsJoinedToARoofDoNotDecideItsFill) {
 // column and row, on textured ground at disparity 4; the facet's pixels unmatched, the ground
 // matched up to 3 px from it (as a window matcher leaves them). `edgeRowsMatched`: the facet's
 // top and bottom 2 rows carry their true disparity (their windows reach the outline).
+// The share of pixel x (covering [x - 0.5, x + 0.5)) that the interval [from, to) covers.
+double coveredShare(int x, double from, double to) {
+  return std::clamp(std::min(x + 0.5, to) - std::max(x - 0.5, from), 0.0, 1.0);
+}
+
 struct FacetScene {
   cv::Mat left, right, disparity, score;
   cv::Rect facet{60, 30, 70, 60};
@@ -279,8 +284,7 @@ FacetScene slopedFacet(double perColumn = 0.15, double perRow = -0.05, bool edge
         // The facet's ends in the right view: x = xf (1 − perColumn) − c − perRow y.
         const double from = (s.facet.x - 0.5) * (1.0 - perColumn) - c - perRow * y;
         const double to = (s.facet.br().x - 0.5) * (1.0 - perColumn) - c - perRow * y;
-        share =
-            facetRow ? std::clamp(std::min(x + 0.5, to) - std::max(x - 0.5, from), 0.0, 1.0) : 0.0;
+        share = facetRow ? coveredShare(x, from, to) : 0.0;
       }
       s.right.at<float>(y, x) = static_cast<float>(
           share * 180.0 + (1.0 - share) * ground.at<float>(y, x + 4 + 32) + rng.gaussian(2.0));
@@ -752,15 +756,12 @@ Scene subpixelRoofScene(double d) {
   Scene s = scene();
   const cv::Mat ground = testing::texture(cv::Size(s.left.cols + 64, s.left.rows), 31) * 0.6 + 20.0;
   cv::RNG rng(7);
-  const auto share = [](double x, double from, double to) {
-    return std::clamp(std::min(x + 0.5, to) - std::max(x - 0.5, from), 0.0, 1.0);
-  };
   const double x0 = s.roof.x - 0.5, x1 = s.roof.br().x - 0.5;
   for (int y = 0; y < s.left.rows; ++y) {
     const bool roofRow = y >= s.roof.y && y < s.roof.br().y;
     for (int x = 0; x < s.left.cols; ++x) {
-      const double inLeft = roofRow ? share(x, x0, x1) : 0.0;
-      const double inRight = roofRow ? share(x, x0 - d, x1 - d) : 0.0;
+      const double inLeft = roofRow ? coveredShare(x, x0, x1) : 0.0;
+      const double inRight = roofRow ? coveredShare(x, x0 - d, x1 - d) : 0.0;
       s.left.at<float>(y, x) = static_cast<float>(
           inLeft * 200.0 + (1 - inLeft) * ground.at<float>(y, x + 32) + rng.gaussian(2.0));
       s.right.at<float>(y, x) = static_cast<float>(
