@@ -323,6 +323,14 @@
         <translation>Tolérance du lissage</translation>
     </message>
     <message>
+        <source>Roof planes</source>
+        <translation>Plans des toits</translation>
+    </message>
+    <message>
+        <source>Roof plane area</source>
+        <translation>Surface minimale d’un plan de toit</translation>
+    </message>
+    <message>
         <source>Coarse-check score</source>
         <translation>Score du contrôle au niveau grossier</translation>
     </message>

@@ -75,5 +75,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Speckle range"),
     QT_TRANSLATE_NOOP("Parameters", "Surface smoothing"),
     QT_TRANSLATE_NOOP("Parameters", "Smoothing tolerance"),
+    QT_TRANSLATE_NOOP("Parameters", "Roof planes"),
+    QT_TRANSLATE_NOOP("Parameters", "Roof plane area"),
 };
 }  // namespace

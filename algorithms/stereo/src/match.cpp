@@ -27,6 +27,7 @@
 #include "match_snap_rows.hpp"
 #include "match_steps.hpp"
 #include "ordering.hpp"
+#include "roof_planes.hpp"
 #include "slanted_facets.hpp"
 #include "smoothing.hpp"
 #include "speckles.hpp"
@@ -704,6 +705,15 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // 1 px: sim seed 6 600² 0.255 -> 0.220, 600² 0.233 -> 0.205; see docs/stereo.md.)
   if (p.smoothWindow > 0) {
     detail::smoothSurfaces(result.disparity, p.smoothWindow, p.smoothTolerance, threads);
+  }
+  // After the smoothing: a roof's matches are noisy at the scale of the correlation window, which
+  // a 5x5 mean cannot average out; a plane over the whole roof does (see docs/stereo.md, session
+  // 28).
+  if (p.planeResidual > 0) {
+    detail::RoofPlaneSettings planes;
+    planes.maxResidual = p.planeResidual;
+    planes.minPixels = p.planeMinArea;
+    detail::fitRoofPlanes(result.disparity, planes);
   }
   core::report(progress, 1.0);
   return result;

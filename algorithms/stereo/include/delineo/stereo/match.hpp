@@ -48,6 +48,9 @@ struct MatchParams {
   int speckleRange = 2;              // px, largest disparity difference within one such region
   int smoothWindow = 5;              // px, odd side of the surface-smoothing window (0 = off)
   double smoothTolerance = 1.0;      // px, largest difference to the centre within that window
+  double planeResidual = 0.4;        // px, a raised surface planar within this RMS takes its
+                                     // fitted plane (0 = off)
+  int planeMinArea = 300;            // px, smallest surface fitted with a plane
   int threads = 0;                   // worker threads, 0 = all cores
 
   template <class V>
@@ -187,6 +190,17 @@ struct MatchParams {
                       "Largest disparity difference to the centre within a smoothed window", 0,
                       100},
       smoothTolerance);
+    v(core::ParamInfo{"plane-residual", "Roof planes", "px",
+                      "Last, a surface raised above what surrounds it (matched 4-neighbours "
+                      "within 0.5 px of each other, most pixels around it 1.5 px or more lower) "
+                      "whose trimmed least-squares plane fits it within this RMS takes the "
+                      "plane's value on its inliers (removes the correlation noise of planar "
+                      "roofs); 0 = off (adaptive method)",
+                      0, 10},
+      planeResidual);
+    v(core::ParamInfo{"plane-min-area", "Roof plane area", "px",
+                      "Smallest surface fitted with a plane", 10, 100000000},
+      planeMinArea);
     v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
       threads);
   }

@@ -1,0 +1,246 @@
+#include "roof_planes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace delineo::stereo::detail {
+
+namespace {
+
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[static_cast<size_t>(i)] != i) {
+    const int up = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+    parent[static_cast<size_t>(i)] = up;  // path halving
+    i = up;
+  }
+  return i;
+}
+
+// One surface and its plane d = a (x − cx) + b (y − cy) + c, in coordinates centred on the
+// surface (the normal equations stay well conditioned far from the image's origin).
+struct Surface {
+  long count = 0;
+  double cx = 0, cy = 0;
+  double a = 0, b = 0, c = 0;
+  double rms = 0;    // px, residuals of the pixels the last fit used
+  long inliers = 0;  // pixels within the inlier band of the last plane
+  bool fitted = true;
+  long ring = 0, lower = 0;  // matched pixels around it, and those well below its plane
+  [[nodiscard]] double at(int x, int y) const { return a * (x - cx) + b * (y - cy) + c; }
+};
+
+// The 4-connected surfaces of `disparity` (neighbours within `link`), as labels 0.. of the
+// surfaces of minPixels or more (−1 elsewhere), with their pixel counts and centroids.
+cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels,
+                      std::vector<Surface>& surfaces) {
+  const int W = disparity.cols, H = disparity.rows;
+  std::vector<int> parent(static_cast<size_t>(W) * H);
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  auto join = [&](int p, int q) {
+    const int rp = findRoot(parent, p), rq = findRoot(parent, q);
+    if (rp != rq) parent[static_cast<size_t>(std::max(rp, rq))] = std::min(rp, rq);
+  };
+  for (int y = 0; y < H; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    const float* below = y + 1 < H ? disparity.ptr<float>(y + 1) : nullptr;
+    for (int x = 0; x < W; ++x) {
+      if (!std::isfinite(d[x])) continue;  // NaN differences fail the tests below too
+      const int i = y * W + x;
+      if (x + 1 < W && std::abs(d[x + 1] - d[x]) <= link) join(i, i + 1);
+      if (below != nullptr && std::abs(below[x] - d[x]) <= link) join(i, i + W);
+    }
+  }
+  std::vector<int> size(parent.size(), 0);
+  for (int y = 0; y < H; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    for (int x = 0; x < W; ++x) {
+      if (std::isfinite(d[x])) ++size[static_cast<size_t>(findRoot(parent, y * W + x))];
+    }
+  }
+  std::vector<int> index(parent.size(), -1);
+  cv::Mat labels(disparity.size(), CV_32S, cv::Scalar(-1));
+  for (int y = 0; y < H; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    int* l = labels.ptr<int>(y);
+    for (int x = 0; x < W; ++x) {
+      if (!std::isfinite(d[x])) continue;
+      const auto root = static_cast<size_t>(findRoot(parent, y * W + x));
+      if (size[root] < minPixels) continue;
+      if (index[root] < 0) {
+        index[root] = static_cast<int>(surfaces.size());
+        surfaces.emplace_back();
+      }
+      Surface& s = surfaces[static_cast<size_t>(index[root])];
+      l[x] = index[root];
+      ++s.count;
+      s.cx += x;
+      s.cy += y;
+    }
+  }
+  for (Surface& s : surfaces) {
+    s.cx /= static_cast<double>(s.count);
+    s.cy /= static_cast<double>(s.count);
+  }
+  return labels;
+}
+
+// One round of the trimmed fit: the least-squares plane of each surface's pixels marked in
+// `keep`, the RMS of their residuals to it, then `keep` set anew to the pixels within the band.
+void fitRound(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
+              std::vector<Surface>& surfaces, const RoofPlaneSettings& s) {
+  struct Sums {
+    double n = 0, u = 0, v = 0, uu = 0, uv = 0, vv = 0, z = 0, uz = 0, vz = 0;
+  };
+  std::vector<Sums> sums(surfaces.size());
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    const int* l = labels.ptr<int>(y);
+    const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (l[x] < 0 || k[x] == 0) continue;
+      const Surface& f = surfaces[static_cast<size_t>(l[x])];
+      Sums& t = sums[static_cast<size_t>(l[x])];
+      const double u = x - f.cx, v = y - f.cy, z = d[x];
+      t.n += 1;
+      t.u += u;
+      t.v += v;
+      t.uu += u * u;
+      t.uv += u * v;
+      t.vv += v * v;
+      t.z += z;
+      t.uz += u * z;
+      t.vz += v * z;
+    }
+  }
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    const Sums& t = sums[i];
+    Surface& f = surfaces[i];
+    const cv::Matx33d m(t.uu, t.uv, t.u, t.uv, t.vv, t.v, t.u, t.v, t.n);
+    cv::Vec3d plane;
+    if (t.n < 3 || !cv::solve(m, cv::Vec3d(t.uz, t.vz, t.z), plane, cv::DECOMP_LU)) {
+      f.fitted = false;  // a line of pixels, or nothing left in the band
+      continue;
+    }
+    f.a = plane[0];
+    f.b = plane[1];
+    f.c = plane[2];
+  }
+  std::vector<double> sq(surfaces.size(), 0.0);
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    const int* l = labels.ptr<int>(y);
+    const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (l[x] < 0 || k[x] == 0) continue;
+      const double r = d[x] - surfaces[static_cast<size_t>(l[x])].at(x, y);
+      sq[static_cast<size_t>(l[x])] += r * r;
+    }
+  }
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    Surface& f = surfaces[i];
+    f.rms = sums[i].n > 0 ? std::sqrt(sq[i] / sums[i].n) : 0.0;
+    f.inliers = 0;
+  }
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    const int* l = labels.ptr<int>(y);
+    std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (l[x] < 0) continue;
+      Surface& f = surfaces[static_cast<size_t>(l[x])];
+      const double band = std::max(s.trimFactor * f.rms, s.trimFloor);
+      const bool in = f.fitted && std::abs(d[x] - f.at(x, y)) <= band;
+      k[x] = in ? 1 : 0;
+      f.inliers += in ? 1 : 0;
+    }
+  }
+}
+
+}  // namespace
+
+RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& settings) {
+  CV_Assert(disparity.type() == CV_32F);
+  const RoofPlaneSettings& s = settings;
+  RoofPlaneCounts counts;
+  std::vector<Surface> surfaces;
+  const cv::Mat labels = labelSurfaces(disparity, s.link, s.minPixels, surfaces);
+  if (surfaces.empty()) return counts;
+  cv::Mat keep(disparity.size(), CV_8U);
+  keep.setTo(1);
+  constexpr int kRounds = 3;  // the band settles after two; the third confirms it
+  for (int round = 0; round < kRounds; ++round) fitRound(disparity, labels, keep, surfaces, s);
+  std::vector<std::uint8_t> planar(surfaces.size(), 0);
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    const Surface& f = surfaces[i];
+    planar[i] = f.fitted && f.rms <= s.maxResidual &&
+                        static_cast<double>(f.inliers) >= s.minInlierShare * f.count
+                    ? 1
+                    : 0;
+  }
+  // The ring around each planar surface: the matched pixels within ringRadius outside its outer
+  // outline (its holes filled: the ground around a sunken courtyard would be raised above it).
+  const int r = s.ringRadius;
+  const cv::Mat square = cv::Mat::ones(2 * r + 1, 2 * r + 1, CV_8U);
+  std::vector<cv::Rect> boxes(surfaces.size());
+  std::vector<std::uint8_t> boxed(surfaces.size(), 0);
+  for (int y = 0; y < disparity.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (l[x] < 0) continue;
+      const auto i = static_cast<size_t>(l[x]);
+      boxes[i] = boxed[i] != 0 ? (boxes[i] | cv::Rect(x, y, 1, 1)) : cv::Rect(x, y, 1, 1);
+      boxed[i] = 1;
+    }
+  }
+  const cv::Rect image(0, 0, disparity.cols, disparity.rows);
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    if (planar[i] == 0) continue;
+    Surface& f = surfaces[i];
+    // The box with a margin of r + 1: the complement's part reached from the margin is outside.
+    const cv::Rect& b = boxes[i];
+    const cv::Rect area(b.x - r - 1, b.y - r - 1, b.width + 2 * r + 2, b.height + 2 * r + 2);
+    cv::Mat filled(area.size(), CV_8U, cv::Scalar(0));
+    const cv::Rect inImage = area & image;
+    filled(inImage - area.tl()).setTo(255, labels(inImage) == static_cast<int>(i));
+    // From a corner of the margin, which is never the surface; 8-connected, as the complement of
+    // a 4-connected surface is.
+    cv::floodFill(filled, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(), 8);
+    filled = filled != 128;  // the surface and its holes
+    cv::Mat grown;
+    cv::dilate(filled, grown, square);
+    for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
+      const float* d = disparity.ptr<float>(y);
+      const std::uint8_t* in = filled.ptr<std::uint8_t>(y - area.y);
+      const std::uint8_t* near = grown.ptr<std::uint8_t>(y - area.y);
+      for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
+        const int u = x - area.x;
+        if (in[u] != 0 || near[u] == 0 || !std::isfinite(d[x])) continue;
+        ++f.ring;
+        if (d[x] <= f.at(x, y) - s.lowerBy) ++f.lower;
+      }
+    }
+  }
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    const Surface& f = surfaces[i];
+    const bool raised = f.ring > 0 && static_cast<double>(f.lower) >= s.minLowerShare * f.ring;
+    planar[i] = planar[i] != 0 && raised ? 1 : 0;
+    if (planar[i] != 0) ++counts.planes;
+  }
+  for (int y = 0; y < disparity.rows; ++y) {
+    float* d = disparity.ptr<float>(y);
+    const int* l = labels.ptr<int>(y);
+    const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (l[x] < 0 || k[x] == 0 || planar[static_cast<size_t>(l[x])] == 0) continue;
+      d[x] = static_cast<float>(surfaces[static_cast<size_t>(l[x])].at(x, y));
+      ++counts.pixels;
+    }
+  }
+  return counts;
+}
+
+}  // namespace delineo::stereo::detail

@@ -1,0 +1,37 @@
+#pragma once
+// Raised planar surfaces of a disparity map replaced by their fitted plane (internal to
+// delineo_stereo).
+#include <opencv2/core.hpp>
+
+namespace delineo::stereo::detail {
+
+struct RoofPlaneSettings {
+  float link = 0.5F;            // px, 4-neighbours of one surface differ by at most this
+  int minPixels = 300;          // px, smaller surfaces are left as they are
+  double maxResidual = 0.4;     // px, RMS of the plane's inliers (the matches' own noise ~0.2-0.3)
+  double minInlierShare = 0.9;  // share of the surface within the inlier band of its plane
+  double trimFactor = 2.5;      // inlier band: |residual| <= max(trimFactor RMS, trimFloor)
+  double trimFloor = 0.3;       // px
+  double minLowerShare = 0.5;   // share of the matched pixels around the surface that lie ...
+  float lowerBy = 1.5F;         // ... this many px or more below its plane (a raised surface)
+  int ringRadius = 2;           // px, "around": within this Chebyshev distance, outside it
+};
+
+struct RoofPlaneCounts {
+  int planes = 0;   // surfaces replaced by their plane
+  long pixels = 0;  // pixels set to their surface's plane
+};
+
+// Surfaces are the 4-connected components of matched pixels whose neighbours differ by at most
+// `link` px. A surface of `minPixels` or more is fitted with a plane by least squares, trimmed
+// three times to the pixels within the inlier band; when its inliers' RMS is <= `maxResidual`,
+// they are `minInlierShare` of it or more, and it is raised above what surrounds it (most matched
+// pixels within `ringRadius` px outside it lie `lowerBy` px or more below the plane: a roof, not
+// the ground, a courtyard or a slope of terrain), its inliers take the plane's value. A roof's
+// matches are noisy at the scale of the correlation window (blotches of ±0.5 px on weakly
+// textured roofs); averaging over the window (the surface smoothing) cannot remove that, a plane
+// over the whole roof does. A hip roof's facets join without a step and form one surface that
+// no plane fits: it is left as it is, as is anything not planar within the matches' noise.
+RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& settings);
+
+}  // namespace delineo::stereo::detail

@@ -1,0 +1,174 @@
+// Raised planar surfaces replaced by their plane (internal fitRoofPlanes).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+#include "delineo/stereo/match.hpp"
+#include "roof_planes.hpp"
+
+namespace delineo::stereo::detail {
+namespace {
+
+constexpr int kSide = 160;
+const cv::Rect kRoof(40, 50, 80, 60);
+
+// Noise correlated over about a correlation window (blotches, as the matches of a weakly
+// textured roof show), of standard deviation `sigma` px.
+cv::Mat blotchyNoise(double sigma, int seed) {
+  cv::Mat white(kSide, kSide, CV_32F);
+  cv::RNG rng(static_cast<std::uint64_t>(seed));
+  rng.fill(white, cv::RNG::NORMAL, 0.0, 1.0);
+  cv::Mat blotches;
+  cv::GaussianBlur(white, blotches, {0, 0}, 4.0);
+  cv::Scalar mean, deviation;
+  cv::meanStdDev(blotches, mean, deviation);
+  return (blotches - mean[0]) * (sigma / deviation[0]);
+}
+
+// Sloped ground at 10 px (0.01 px/px), and inside kRoof the surface `roof` (none when empty),
+// plus blotchy noise of 0.25 px everywhere.
+cv::Mat scene(const std::function<float(int, int)>& roof) {
+  cv::Mat disparity = blotchyNoise(0.25, 3);
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      const bool onRoof = roof && kRoof.contains({x, y});
+      disparity.at<float>(y, x) += onRoof ? roof(x, y) : 10.0F + 0.01F * static_cast<float>(x);
+    }
+  }
+  return disparity;
+}
+
+float roofPlane(int x, int y) {
+  return 30.0F + 0.02F * static_cast<float>(x) - 0.01F * static_cast<float>(y);
+}
+
+double rmsOnRoof(const cv::Mat& disparity, const std::function<float(int, int)>& truth) {
+  double sq = 0;
+  int n = 0;
+  for (int y = kRoof.y; y < kRoof.y + kRoof.height; ++y) {
+    for (int x = kRoof.x; x < kRoof.x + kRoof.width; ++x) {
+      const double e = disparity.at<float>(y, x) - truth(x, y);
+      sq += e * e;
+      ++n;
+    }
+  }
+  return std::sqrt(sq / n);
+}
+
+bool identical(const cv::Mat& a, const cv::Mat& b) {
+  return cv::countNonZero(a != b) == 0;  // (no NaN in these maps)
+}
+
+TEST(FitRoofPlanes, ARaisedPlanarRoofTakesItsPlaneAndTheRestIsLeft) {
+  cv::Mat disparity = scene(roofPlane);
+  // Outliers on the roof (a wrong peak every 97th pixel, 3 px high) are not the plane's.
+  for (int i = 0; i < kRoof.area(); i += 97) {
+    disparity.at<float>(kRoof.y + i / kRoof.width, kRoof.x + i % kRoof.width) += 3.0F;
+  }
+  const cv::Mat before = disparity.clone();
+  const double rmsBefore = rmsOnRoof(before, roofPlane);
+  const RoofPlaneCounts counts = fitRoofPlanes(disparity, RoofPlaneSettings{});
+  EXPECT_EQ(counts.planes, 1);
+  // Every roof pixel but the outliers (those 3 px off, not within the inlier band).
+  const int outliers = (kRoof.area() + 96) / 97;
+  // Every roof pixel but the outliers and the noise's tail beyond the inlier band (2.5 RMS).
+  EXPECT_LE(counts.pixels, kRoof.area() - outliers);
+  EXPECT_GE(counts.pixels, (kRoof.area() - outliers) * 98 / 100);
+  int outliersKept = 0, within = 0;
+  for (int i = 0; i < kRoof.area(); ++i) {
+    const int x = kRoof.x + i % kRoof.width, y = kRoof.y + i / kRoof.width;
+    if (i % 97 == 0) {
+      outliersKept += disparity.at<float>(y, x) == before.at<float>(y, x) ? 1 : 0;
+    } else {
+      within += std::abs(disparity.at<float>(y, x) - roofPlane(x, y)) <= 0.15F ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(outliersKept, outliers);
+  EXPECT_GE(within, counts.pixels * 9 / 10);
+  EXPECT_GT(rmsBefore, 0.3);  // the blotches and the outliers
+  // The plane's error over the roof's non-outliers, against their noise of 0.25 px.
+  cv::Mat plane = disparity.clone();
+  for (int i = 0; i < kRoof.area(); i += 97) {
+    plane.at<float>(kRoof.y + i / kRoof.width, kRoof.x + i % kRoof.width) =
+        roofPlane(kRoof.x + i % kRoof.width, kRoof.y + i / kRoof.width);
+  }
+  EXPECT_LT(rmsOnRoof(plane, roofPlane), 0.1) << rmsOnRoof(plane, roofPlane);
+  // The ground (planar too, but nothing around it is lower) is left as it was.
+  cv::Mat groundBefore = before.clone(), groundAfter = disparity.clone();
+  groundBefore(kRoof).setTo(0);
+  groundAfter(kRoof).setTo(0);
+  EXPECT_TRUE(identical(groundBefore, groundAfter));
+}
+
+TEST(FitRoofPlanes, TheGroundAndASunkenCourtyardAreNotRaised) {
+  cv::Mat disparity = scene([](int, int) { return 4.0F; });  // a courtyard 6 px below the ground
+  const cv::Mat before = disparity.clone();
+  EXPECT_EQ(fitRoofPlanes(disparity, RoofPlaneSettings{}).planes, 0);
+  EXPECT_TRUE(identical(disparity, before));
+}
+
+TEST(FitRoofPlanes, RaisedSurfacesNoPlaneFitsAreLeft) {
+  // A crown (dome 4 px high) and a hip roof (two facets of ±0.08 px/px meeting at a ridge, with
+  // no step between them).
+  const std::function<float(int, int)> crown = [](int x, int y) {
+    const double u = (x - 80.0) / 40.0, v = (y - 80.0) / 30.0;
+    return static_cast<float>(30.0 + 4.0 * (1.0 - u * u - v * v));
+  };
+  const std::function<float(int, int)> hip = [](int x, int) {
+    return 30.0F - 0.08F * static_cast<float>(std::abs(x - 80));
+  };
+  for (const auto& surface : {crown, hip}) {
+    cv::Mat disparity = scene(surface);
+    const cv::Mat before = disparity.clone();
+    EXPECT_EQ(fitRoofPlanes(disparity, RoofPlaneSettings{}).planes, 0);
+    EXPECT_TRUE(identical(disparity, before));
+  }
+  // Each facet alone, raised, is a plane (the test above fails for the right reason).
+  cv::Mat oneFacet = scene([](int x, int) { return 30.0F - 0.08F * static_cast<float>(x - 80); });
+  EXPECT_EQ(fitRoofPlanes(oneFacet, RoofPlaneSettings{}).planes, 1);
+}
+
+TEST(FitRoofPlanes, UnmatchedPixelsAreNeitherFittedNorAround) {
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat disparity = scene(roofPlane);
+  // The roof's outermost pixels unmatched, and the ground left of x = 30: the ring is what
+  // remains matched within 2 px around the roof.
+  const cv::Rect inner(kRoof.x + 1, kRoof.y + 1, kRoof.width - 2, kRoof.height - 2);
+  cv::Mat unmatched(disparity.size(), CV_8U, cv::Scalar(0));
+  unmatched(kRoof).setTo(1);
+  unmatched(inner).setTo(0);
+  unmatched(cv::Rect(0, 0, 30, kSide)).setTo(1);
+  disparity.setTo(kNaN, unmatched);
+  const int matched = cv::countNonZero(disparity == disparity);
+  const RoofPlaneCounts counts = fitRoofPlanes(disparity, RoofPlaneSettings{});
+  EXPECT_EQ(counts.planes, 1);
+  EXPECT_LE(counts.pixels, inner.area());
+  EXPECT_GE(counts.pixels, inner.area() * 98 / 100);
+  EXPECT_EQ(cv::countNonZero(disparity == disparity), matched);
+  // With the whole ring unmatched (2 px around the roof), nothing shows that the roof is raised.
+  cv::Mat isolated = scene(roofPlane);
+  cv::Mat band(isolated.size(), CV_8U, cv::Scalar(0));
+  band(cv::Rect(kRoof.x - 2, kRoof.y - 2, kRoof.width + 4, kRoof.height + 4)).setTo(1);
+  band(inner).setTo(0);
+  isolated.setTo(kNaN, band);
+  EXPECT_EQ(fitRoofPlanes(isolated, RoofPlaneSettings{}).planes, 0);
+}
+
+TEST(FitRoofPlanes, ItsParametersAreChecked) {
+  MatchParams p;
+  p.planeResidual = -0.1;
+  EXPECT_THROW(p.validate(), core::Error);
+  p.planeResidual = 0.0;  // off
+  EXPECT_NO_THROW(p.validate());
+  p.planeMinArea = 5;
+  EXPECT_THROW(p.validate(), core::Error);
+}
+
+}  // namespace
+}  // namespace delineo::stereo::detail
