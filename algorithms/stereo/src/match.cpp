@@ -713,6 +713,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     detail::RoofPlaneSettings planes;
     planes.maxResidual = p.planeResidual;
     planes.minPixels = p.planeMinArea;
+    planes.threads = threads;
     detail::fitRoofPlanes(result.disparity, planes);
   }
   core::report(progress, 1.0);

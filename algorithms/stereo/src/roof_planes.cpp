@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "workers.hpp"
+
 namespace delineo::stereo::detail {
 
 namespace {
@@ -26,10 +28,12 @@ struct Surface {
   long count = 0;
   double cx = 0, cy = 0;
   double a = 0, b = 0, c = 0;
+  double z0 = 0;     // px, the disparity of its first pixel (a reference for the sums)
   double rms = 0;    // px, residuals of the pixels the last fit used
   long inliers = 0;  // pixels within the inlier band of the last plane
   bool fitted = true;
   long ring = 0, lower = 0;  // matched pixels around it, and those well below its plane
+  cv::Rect box;              // its bounding box
   [[nodiscard]] double at(int x, int y) const { return a * (x - cx) + b * (y - cy) + c; }
 };
 
@@ -73,12 +77,15 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels,
       if (index[root] < 0) {
         index[root] = static_cast<int>(surfaces.size());
         surfaces.emplace_back();
+        surfaces.back().z0 = d[x];
+        surfaces.back().box = cv::Rect(x, y, 1, 1);
       }
       Surface& s = surfaces[static_cast<size_t>(index[root])];
       l[x] = index[root];
       ++s.count;
       s.cx += x;
       s.cy += y;
+      s.box |= cv::Rect(x, y, 1, 1);
     }
   }
   for (Surface& s : surfaces) {
@@ -90,34 +97,61 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels,
 
 // One round of the trimmed fit: the least-squares plane of each surface's pixels marked in
 // `keep`, the RMS of their residuals to it, then `keep` set anew to the pixels within the band.
+// Bands of rows on `threads` workers, each with its own sums, added up in band order: the same
+// result for any number of threads.
 void fitRound(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
               std::vector<Surface>& surfaces, const RoofPlaneSettings& s) {
+  // Moments of u = x − cx, v = y − cy and z = d − z0 (z0: the surface's first pixel, so that
+  // Σz² stays small and the residual sum below keeps its precision).
   struct Sums {
-    double n = 0, u = 0, v = 0, uu = 0, uv = 0, vv = 0, z = 0, uz = 0, vz = 0;
+    double n = 0, u = 0, v = 0, uu = 0, uv = 0, vv = 0, z = 0, uz = 0, vz = 0, zz = 0;
   };
-  std::vector<Sums> sums(surfaces.size());
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    const int* l = labels.ptr<int>(y);
-    const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (l[x] < 0 || k[x] == 0) continue;
-      const Surface& f = surfaces[static_cast<size_t>(l[x])];
-      Sums& t = sums[static_cast<size_t>(l[x])];
-      const double u = x - f.cx, v = y - f.cy, z = d[x];
-      t.n += 1;
-      t.u += u;
-      t.v += v;
-      t.uu += u * u;
-      t.uv += u * v;
-      t.vv += v * v;
-      t.z += z;
-      t.uz += u * z;
-      t.vz += v * z;
-    }
-  }
+  constexpr int kBandRows = 32;
+  const int bands = (disparity.rows + kBandRows - 1) / kBandRows;
+  std::vector<std::vector<Sums>> bandSums(static_cast<size_t>(bands));
+  forRowBands(
+      disparity.rows, s.threads,
+      [&](int rowStart, int rowEnd) {
+        std::vector<Sums>& sums = bandSums[static_cast<size_t>(rowStart / kBandRows)];
+        sums.assign(surfaces.size(), Sums{});
+        for (int y = rowStart; y < rowEnd; ++y) {
+          const float* d = disparity.ptr<float>(y);
+          const int* l = labels.ptr<int>(y);
+          const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+          for (int x = 0; x < disparity.cols; ++x) {
+            if (l[x] < 0 || k[x] == 0) continue;
+            const Surface& f = surfaces[static_cast<size_t>(l[x])];
+            Sums& t = sums[static_cast<size_t>(l[x])];
+            const double u = x - f.cx, v = y - f.cy, z = d[x] - f.z0;
+            t.n += 1;
+            t.u += u;
+            t.v += v;
+            t.uu += u * u;
+            t.uv += u * v;
+            t.vv += v * v;
+            t.z += z;
+            t.uz += u * z;
+            t.vz += v * z;
+            t.zz += z * z;
+          }
+        }
+      },
+      kBandRows);
   for (size_t i = 0; i < surfaces.size(); ++i) {
-    const Sums& t = sums[i];
+    Sums t;
+    for (const std::vector<Sums>& band : bandSums) {
+      const Sums& b = band[i];
+      t.n += b.n;
+      t.u += b.u;
+      t.v += b.v;
+      t.uu += b.uu;
+      t.uv += b.uv;
+      t.vv += b.vv;
+      t.z += b.z;
+      t.uz += b.uz;
+      t.vz += b.vz;
+      t.zz += b.zz;
+    }
     Surface& f = surfaces[i];
     const cv::Matx33d m(t.uu, t.uv, t.u, t.uv, t.vv, t.v, t.u, t.v, t.n);
     cv::Vec3d plane;
@@ -127,36 +161,35 @@ void fitRound(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
     }
     f.a = plane[0];
     f.b = plane[1];
-    f.c = plane[2];
+    f.c = plane[2] + f.z0;
+    // The least-squares residual is orthogonal to the regressors: Σr² = Σz² − θ·(Σuz, Σvz, Σz).
+    const double sq = t.zz - (plane[0] * t.uz + plane[1] * t.vz + plane[2] * t.z);
+    f.rms = std::sqrt(std::max(0.0, sq) / t.n);
   }
-  std::vector<double> sq(surfaces.size(), 0.0);
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    const int* l = labels.ptr<int>(y);
-    const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (l[x] < 0 || k[x] == 0) continue;
-      const double r = d[x] - surfaces[static_cast<size_t>(l[x])].at(x, y);
-      sq[static_cast<size_t>(l[x])] += r * r;
-    }
-  }
+  std::vector<std::vector<long>> bandInliers(static_cast<size_t>(bands));
+  forRowBands(
+      disparity.rows, s.threads,
+      [&](int rowStart, int rowEnd) {
+        std::vector<long>& inliers = bandInliers[static_cast<size_t>(rowStart / kBandRows)];
+        inliers.assign(surfaces.size(), 0);
+        for (int y = rowStart; y < rowEnd; ++y) {
+          const float* d = disparity.ptr<float>(y);
+          const int* l = labels.ptr<int>(y);
+          std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+          for (int x = 0; x < disparity.cols; ++x) {
+            if (l[x] < 0) continue;
+            const Surface& f = surfaces[static_cast<size_t>(l[x])];
+            const double band = std::max(s.trimFactor * f.rms, s.trimFloor);
+            const bool in = f.fitted && std::abs(d[x] - f.at(x, y)) <= band;
+            k[x] = in ? 1 : 0;
+            inliers[static_cast<size_t>(l[x])] += in ? 1 : 0;
+          }
+        }
+      },
+      kBandRows);
   for (size_t i = 0; i < surfaces.size(); ++i) {
-    Surface& f = surfaces[i];
-    f.rms = sums[i].n > 0 ? std::sqrt(sq[i] / sums[i].n) : 0.0;
-    f.inliers = 0;
-  }
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    const int* l = labels.ptr<int>(y);
-    std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (l[x] < 0) continue;
-      Surface& f = surfaces[static_cast<size_t>(l[x])];
-      const double band = std::max(s.trimFactor * f.rms, s.trimFloor);
-      const bool in = f.fitted && std::abs(d[x] - f.at(x, y)) <= band;
-      k[x] = in ? 1 : 0;
-      f.inliers += in ? 1 : 0;
-    }
+    surfaces[i].inliers = 0;
+    for (const std::vector<long>& band : bandInliers) surfaces[i].inliers += band[i];
   }
 }
 
@@ -185,23 +218,14 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
   // outline (its holes filled: the ground around a sunken courtyard would be raised above it).
   const int r = s.ringRadius;
   const cv::Mat square = cv::Mat::ones(2 * r + 1, 2 * r + 1, CV_8U);
-  std::vector<cv::Rect> boxes(surfaces.size());
-  std::vector<std::uint8_t> boxed(surfaces.size(), 0);
-  for (int y = 0; y < disparity.rows; ++y) {
-    const int* l = labels.ptr<int>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (l[x] < 0) continue;
-      const auto i = static_cast<size_t>(l[x]);
-      boxes[i] = boxed[i] != 0 ? (boxes[i] | cv::Rect(x, y, 1, 1)) : cv::Rect(x, y, 1, 1);
-      boxed[i] = 1;
-    }
-  }
   const cv::Rect image(0, 0, disparity.cols, disparity.rows);
+  std::vector<cv::Mat> grownOf(surfaces.size());
+  std::vector<cv::Rect> areaOf(surfaces.size());
   for (size_t i = 0; i < surfaces.size(); ++i) {
     if (planar[i] == 0) continue;
     Surface& f = surfaces[i];
     // The box with a margin of r + 1: the complement's part reached from the margin is outside.
-    const cv::Rect& b = boxes[i];
+    const cv::Rect& b = f.box;
     const cv::Rect area(b.x - r - 1, b.y - r - 1, b.width + 2 * r + 2, b.height + 2 * r + 2);
     cv::Mat filled(area.size(), CV_8U, cv::Scalar(0));
     const cv::Rect inImage = area & image;
@@ -212,6 +236,8 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
     filled = filled != 128;  // the surface and its holes
     cv::Mat grown;
     cv::dilate(filled, grown, square);
+    grownOf[i] = grown;  // (kept for the roofs' other pixels, below)
+    areaOf[i] = area;
     for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
       const float* d = disparity.ptr<float>(y);
       const std::uint8_t* in = filled.ptr<std::uint8_t>(y - area.y);
@@ -238,6 +264,36 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
       if (l[x] < 0 || k[x] == 0 || planar[static_cast<size_t>(l[x])] == 0) continue;
       d[x] = static_cast<float>(surfaces[static_cast<size_t>(l[x])].at(x, y));
       ++counts.pixels;
+    }
+  }
+  // Then the other matched pixels on the roof or around it (within ringRadius of its outer
+  // outline) that lie within absorbWithin of its plane: a roof's pixels beyond the inlier band
+  // (or cut from the surface by a jump of more than `link`) are its matches' outliers, at the
+  // roof's level all the same. In surface order; a pixel takes the first roof that claims it.
+  if (s.absorbWithin > 0) {
+    cv::Mat taken(disparity.size(), CV_8U, cv::Scalar(0));
+    for (size_t i = 0; i < surfaces.size(); ++i) {
+      if (planar[i] == 0) continue;
+      const Surface& f = surfaces[i];
+      const cv::Rect area = areaOf[i];
+      const cv::Rect inImage = area & image;
+      for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
+        float* d = disparity.ptr<float>(y);
+        const int* l = labels.ptr<int>(y);
+        const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+        const std::uint8_t* near = grownOf[i].ptr<std::uint8_t>(y - area.y);
+        std::uint8_t* t = taken.ptr<std::uint8_t>(y);
+        for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
+          if (near[x - area.x] == 0 || !std::isfinite(d[x]) || t[x] != 0) continue;
+          if (l[x] >= 0 && k[x] != 0 && planar[static_cast<size_t>(l[x])] != 0) continue;
+          const double p = f.at(x, y);
+          if (std::abs(d[x] - p) <= s.absorbWithin) {
+            d[x] = static_cast<float>(p);
+            t[x] = 1;
+            ++counts.absorbed;
+          }
+        }
+      }
     }
   }
   return counts;

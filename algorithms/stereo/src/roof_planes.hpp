@@ -15,11 +15,14 @@ struct RoofPlaneSettings {
   double minLowerShare = 0.5;   // share of the matched pixels around the surface that lie ...
   float lowerBy = 1.5F;         // ... this many px or more below its plane (a raised surface)
   int ringRadius = 2;           // px, "around": within this Chebyshev distance, outside it
+  float absorbWithin = 1.5F;    // px: a roof's other pixels this near its plane take it too
+  int threads = 1;              // workers over bands of rows (same result for any number)
 };
 
 struct RoofPlaneCounts {
-  int planes = 0;   // surfaces replaced by their plane
-  long pixels = 0;  // pixels set to their surface's plane
+  int planes = 0;     // surfaces replaced by their plane
+  long pixels = 0;    // pixels set to their surface's plane (its inliers)
+  long absorbed = 0;  // other pixels on or around a roof set to its plane
 };
 
 // Surfaces are the 4-connected components of matched pixels whose neighbours differ by at most
@@ -30,7 +33,10 @@ struct RoofPlaneCounts {
 // the ground, a courtyard or a slope of terrain), its inliers take the plane's value. A roof's
 // matches are noisy at the scale of the correlation window (blotches of ±0.5 px on weakly
 // textured roofs); averaging over the window (the surface smoothing) cannot remove that, a plane
-// over the whole roof does. A hip roof's facets join without a step and form one surface that
+// over the whole roof does. Then every other matched pixel on such a roof or around it (within
+// `ringRadius` of its outer outline) whose disparity lies within `absorbWithin` of the plane takes
+// it too (the same 1.5 px that tells the roof from what lies below it): the roof's outliers and
+// the pixels a jump cut from it. A hip roof's facets join without a step and form one surface that
 // no plane fits: it is left as it is, as is anything not planar within the matches' noise.
 RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& settings);
 
