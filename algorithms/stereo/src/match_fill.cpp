@@ -863,15 +863,15 @@ long matchesHiddenBy(const FillPlane& plane, const cv::Mat& region, const cv::Re
 }
 
 // The constant disparity of a plain region read from its edges in both views (see
-// RegionFillSettings::edgeMinSamples): the row ends within 1.5 px of `candidate`, the right
+// RegionFillSettings::edgeMinSamples): the row ends within `reach` of `candidate`, the right
 // view's counterpart being the flat region of the region's grey (within 3 sigma, through the
 // matches' grey map) whose row ends agree with `candidate` on most rows. Returns the mean of the
 // row-end disparities within 0.75 px of their median and their count (0: none).
 std::pair<double, int> edgeDisparity(const cv::Mat& left, const cv::Mat& right,
                                      const cv::Mat& region, const cv::Rect& box,
                                      const RightFlatRegions& rightFlat, double gain, double offset,
-                                     double sigma, int dmin, int dmax, float candidate) {
-  constexpr double kAgree = 1.5;
+                                     double sigma, int dmin, int dmax, float candidate,
+                                     double reach) {
   const double leftMean = cv::mean(left(box), region)[0];
   const std::vector<RowEnds> rows = regionRowEnds(region, box);
   std::map<int, int> agreeing;  // right label -> rows with an end that agrees with `candidate`
@@ -887,8 +887,8 @@ std::pair<double, int> edgeDisparity(const cv::Mat& left, const cv::Mat& right,
     for (const auto& [label, e] : ends) {
       const double mapped = gain * rightFlat.meanGrey[static_cast<size_t>(label)] + offset;
       if (std::abs(mapped - leftMean) > 3 * sigma) continue;
-      if (std::abs(r.l0 - e.first - candidate) <= kAgree ||
-          std::abs(r.l1 - e.second - candidate) <= kAgree) {
+      if (std::abs(r.l0 - e.first - candidate) <= reach ||
+          std::abs(r.l1 - e.second - candidate) <= reach) {
         ++agreeing[label];
       }
     }
@@ -910,7 +910,7 @@ std::pair<double, int> edgeDisparity(const cv::Mat& left, const cv::Mat& right,
     const float* a = left.ptr<float>(r.y);
     const float* b = right.ptr<float>(r.y);
     for (const auto& [l, rr, step] : {std::tuple{r.l0, r0, -1}, std::tuple{r.l1, r1, +1}}) {
-      if (std::abs(l - rr - candidate) > kAgree) continue;
+      if (std::abs(l - rr - candidate) > reach) continue;
       const auto inLeft = subpixelEdge(a, left.cols, l, step, leftMean, sigma);
       const auto inRight = subpixelEdge(b, right.cols, rr, step, rightMean, rightSigma);
       if (inLeft && inRight) values.push_back(*inLeft - *inRight);
@@ -1138,9 +1138,9 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       if (settings.edgeMinSamples > 0) {
         const auto [edgeValue, samples] =
             edgeDisparity(left, right, region, box, rightFlatRegionsOf(), matchedGain,
-                          matchedOffset, sigma, dmin, dmax, best);
+                          matchedOffset, sigma, dmin, dmax, best, settings.edgeReach);
         if (samples >= settings.edgeMinSamples &&
-            std::abs(edgeValue - best) <= settings.ringArbiterReach) {
+            std::abs(edgeValue - best) <= settings.edgeReach) {
           value = static_cast<float>(edgeValue);
         }
       }
@@ -1249,9 +1249,9 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         if (settings.edgeMinSamples > 0) {
           const auto [edgeValue, samples] =
               edgeDisparity(left, right, region, box, rightFlat, matchedGain, matchedOffset, sigma,
-                            dmin, dmax, static_cast<float>(centreValue));
+                            dmin, dmax, static_cast<float>(centreValue), settings.edgeReach);
           if (samples >= settings.edgeMinSamples &&
-              std::abs(edgeValue - centreValue) <= settings.ringArbiterReach) {
+              std::abs(edgeValue - centreValue) <= settings.edgeReach) {
             plane = FillPlane{static_cast<float>(edgeValue), 0, 0};
           }
         }

@@ -14,24 +14,26 @@ struct RegionFillSettings {
   int minMatched = 20;       // px: matches around a region needed to propose a disparity
   double photometric = 6.0;  // × noise sigma: mean |left − mapped right| allowed on the outline
   double contrast = 0.5;     // the best candidate's outline error must be below this × the other's
-  double scanAgreement = 0.93;   // a full-range scan confirming the best candidate (0 = off)
-  double scanReach = 1.5;        // px: the scan's minimum this close to the candidate confirms it
-  double scanVeto = 0.8;         // a disparity > 2 px from the chosen candidate whose outline
-                                 //   error is below this × the candidate's vetoes it (0 = off)
-  double refocusReach = 1.0;     // px: the value filled is the median of the matches this close
-                                 //   to the cluster's median (0: the cluster's median)
+  double scanAgreement = 0.93;    // a full-range scan confirming the best candidate (0 = off)
+  double scanReach = 1.5;         // px: the scan's minimum this close to the candidate confirms it
+  double scanVeto = 0.8;          // a disparity > 2 px from the chosen candidate whose outline
+                                  //   error is below this × the candidate's vetoes it (0 = off)
+  double refocusReach = 1.0;      // px: the value filled is the median of the matches this close
+                                  //   to the cluster's median (0: the cluster's median)
   double ringArbiterReach = 1.5;  // px: the value filled is the median of that median, the
                                   //   cluster's mean and the ring error's minimum within this of
                                   //   the mean (0 = the median alone)
   int edgeMinSamples = 20;        // row ends whose sub-pixel edges, measured in both views, set a
                                   //   plain region's constant instead (fewer: the estimates above
                                   //   are kept; 0 = off)
-  int growReach = 3;             // px: the filled region grows back to its contour by at most this
-  double growSigmas = 3.0;       // × noise sigma: grown pixel vs the region's local mean grey
-  double growPhotometric = 4.0;  // × noise sigma: a grown pixel's |left − mapped right|
-  int coreOpening = 5;           // px: square opening that gives a region's core (0 = off)
-  double coreMinShare = 0.5;     // the core replaces the region only when this share of it
-  double coreErrorRatio = 0.85;  //   and when its ring's error is below this × the region's
+  double edgeReach = 2.0;         // px: the row ends read are those within this of the candidate,
+                                  //   and their value is filled when it lies within it too
+  int growReach = 3;              // px: the filled region grows back to its contour by at most this
+  double growSigmas = 3.0;        // × noise sigma: grown pixel vs the region's local mean grey
+  double growPhotometric = 4.0;   // × noise sigma: a grown pixel's |left − mapped right|
+  int coreOpening = 5;            // px: square opening that gives a region's core (0 = off)
+  double coreMinShare = 0.5;      // the core replaces the region only when this share of it
+  double coreErrorRatio = 0.85;   //   and when its ring's error is below this × the region's
   // Sloped facets (regions whose outline lines up at no constant disparity): a plane through
   // the row ends of the region and of its counterpart in the right view.
   int planeMinRows = 10;         // rows (and right pixels) needed; 0 = no sloped facets
@@ -160,14 +162,17 @@ struct RegionFillSettings {
 // biases the same way: a textured ground of the roof's grey beside an edge draws the windows and
 // the ring's outer half across it (sim seed 13 1000²: a roof at 70.42 filled at 71.20, its
 // matches, mean and ring minimum all 0.3-1.1 px high). Its edges, measured in the images, are not:
-// on each row whose ends lie within 1.5 px of the best candidate in both views, each end's
-// position is read to a fraction of a pixel from the grey of its mixed pixel (the share of the
-// roof between the roof's grey and the grey beyond), in the left view and at the counterpart's
+// on each row whose ends lie within edgeReach (2 px) of the best candidate in both views, each
+// end's position is read to a fraction of a pixel from the grey of its mixed pixel (the share of
+// the roof between the roof's grey and the grey beyond), in the left view and at the counterpart's
 // row end in the right view (the right view's flat region of the region's grey whose row ends
 // agree with the candidate on most rows); their difference is that row end's disparity. With
 // edgeMinSamples or more of them (edges with a contrast of 6 noise sigmas or more), the mean of
-// those within 0.75 px of their median is filled when it lies within ringArbiterReach of the
-// candidate (that roof: 70.82; four others of that scene within 0.1 px of the truth).
+// those within 0.75 px of their median is filled when it lies within edgeReach of the candidate
+// (that roof: 70.82; four others of that scene within 0.1 px of the truth). The reach is 2 px
+// rather than the arbiter's 1.5: beside a rooftop box the matches' candidate can be 1.9 px off
+// (sim seed 18 1000²: a roof at 43.29 filled at 45.2, 43.3 from its edges; docs/stereo.md,
+// session 28).
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
 // `threads` > 1: the right view's flat regions are made on a second worker, which then runs
 // `alongside` (the caller's own work, independent of the fill) while the fill goes on; else
