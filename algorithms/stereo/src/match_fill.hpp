@@ -48,7 +48,8 @@ struct RegionFillSettings {
                                  //   limited row by row; the whole-pixel ends' plane if it fails
   double planeTrimShare = 0.1;   // worst share of row ends dropped per trimmed refit (0 = off)
   double planeMargin = 0.95;     // a plane replaces a constant the outline lines up at only when
-                                 //   its outline error is below this × the constant's
+                                 //   its outline error is below this × the constant's (where no
+                                 //   constant passed: the constant of the region's edges)
   double planeMinSpan = 1.5;     // px: and when it changes by at least this over the region's
                                  //   bounding box (|a| · width + |b| · height; 0 = off)
   double planeCandidateRatio = 1.1;  // where no constant is filled, a plane only when its outline
