@@ -4,11 +4,13 @@
 // recovery and the French translation.
 #include <QAction>
 #include <QCheckBox>
+#include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QScrollArea>
 #include <QSettings>
 #include <QSignalSpy>
+#include <QSpinBox>
 #include <QStandardPaths>
 #include <QTabWidget>
 #include <QTableView>
@@ -603,6 +605,37 @@ class MainWindowTest : public QObject {
     if (!dir.isEmpty()) window_->grab().save(dir + QStringLiteral("/matching-tab.png"));
     box->click();
     QVERIFY(stored());
+    tabs->setCurrentIndex(0);
+  }
+
+  void roofPlanesAreMatchingParametersOfTheProject() {
+    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
+    if (!window_->document()) QVERIFY(window_->openProject(projectPath_));
+    auto* residual = window_->matchingForm()->findChild<QDoubleSpinBox*>(QStringLiteral("plane-residual"));
+    auto* area = window_->matchingForm()->findChild<QSpinBox*>(QStringLiteral("plane-min-area"));
+    QVERIFY(residual);
+    QVERIFY(area);
+    QCOMPARE(residual->value(), 0.4);
+    QCOMPARE(area->value(), 300);
+    QVERIFY(!residual->toolTip().isEmpty());
+    const auto stored = [&] {
+      return project::parameters<stereo::MatchParams>(window_->document()->project(), "matching").planeResidual;
+    };
+    // Off (0) from the form, stored in the project, and back by undo.
+    residual->setValue(0.0);
+    QCOMPARE(stored(), 0.0);
+    window_->document()->undoStack()->undo();
+    QCOMPARE(stored(), 0.4);
+    QCOMPARE(residual->value(), 0.4);
+    auto* tabs = window_->findChild<QTabWidget*>();
+    QVERIFY(tabs);
+    tabs->setCurrentIndex(1);
+    auto* scroll = qobject_cast<QScrollArea*>(tabs->currentWidget());
+    QVERIFY(scroll);
+    scroll->ensureWidgetVisible(area);
+    QVERIFY(area->isVisible());
+    const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
+    if (!dir.isEmpty()) window_->grab().save(dir + QStringLiteral("/matching-tab-planes.png"));
     tabs->setCurrentIndex(0);
   }
 

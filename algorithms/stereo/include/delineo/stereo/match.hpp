@@ -199,7 +199,7 @@ struct MatchParams {
                       0, 10},
       planeResidual);
     v(core::ParamInfo{"plane-min-area", "Roof plane area", "px",
-                      "Smallest surface fitted with a plane", 10, 100000000},
+                      "Smallest surface fitted with a plane", 10, 100000},
       planeMinArea);
     v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
       threads);
