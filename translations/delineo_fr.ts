@@ -374,6 +374,10 @@
         <translation>suppression des îlots laissés par le calage</translation>
     </message>
     <message>
+        <source>fitting roof planes</source>
+        <translation>ajustement des plans de toit</translation>
+    </message>
+    <message>
         <source>matching (SGBM)</source>
         <translation>appariement (SGBM)</translation>
     </message>

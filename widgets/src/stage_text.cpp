@@ -20,6 +20,7 @@ constexpr const char* kStageWords[] = {
     QT_TRANSLATE_NOOP("Stages", "removing speckles"),
     QT_TRANSLATE_NOOP("Stages", "snapping depth steps to contours"),
     QT_TRANSLATE_NOOP("Stages", "removing speckles left by the snapping"),
+    QT_TRANSLATE_NOOP("Stages", "fitting roof planes"),
     QT_TRANSLATE_NOOP("Stages", "matching (SGBM)"),
     QT_TRANSLATE_NOOP("Stages", "simulating: layout"),
     QT_TRANSLATE_NOOP("Stages", "simulating: rendering"),

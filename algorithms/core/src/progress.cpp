@@ -28,6 +28,7 @@ std::string Stage::english() const {
     case StageId::RemovingSpeckles: return "removing speckles";
     case StageId::SnappingDepthSteps: return "snapping depth steps to contours";
     case StageId::RemovingSnappingSpeckles: return "removing speckles left by the snapping";
+    case StageId::FittingRoofPlanes: return "fitting roof planes";
     case StageId::MatchingSgbm: return "matching (SGBM)";
     case StageId::SimulatingLayout: return "simulate: layout";
     case StageId::SimulatingRendering: return "simulate: rendering";

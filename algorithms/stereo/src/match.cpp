@@ -710,6 +710,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // a 5x5 mean cannot average out; a plane over the whole roof does (see docs/stereo.md, session
   // 28).
   if (p.planeResidual > 0) {
+    if (reachedButCanceled(0.99)) return result;
+    core::setStage(progress, core::StageId::FittingRoofPlanes);
     detail::RoofPlaneSettings planes;
     planes.maxResidual = p.planeResidual;
     planes.minPixels = p.planeMinArea;

@@ -470,7 +470,8 @@ TEST(Match, TheStepsAfterTheLevelsReportProgressAndHonourACancel) {
   for (const double f : fractions) afterLevels += f > 0.8 && f < 1.0 ? 1 : 0;
   EXPECT_GE(afterLevels, 3);
   EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
-  // Canceled on the report that follows the snapping (the last but one): no result.
+  // Canceled on the last report but one (after the snapping and the smoothing, before the roof
+  // planes): no result.
   core::Progress late;
   late.cancelAfterReports(full.reportCount() - 1);
   const MatchResult r = matchStereo(left, right, p, &late);

@@ -28,6 +28,7 @@ enum class StageId {
   RemovingSpeckles,
   SnappingDepthSteps,
   RemovingSnappingSpeckles,
+  FittingRoofPlanes,
   MatchingSgbm,
   // Scene simulation.
   SimulatingLayout,
