@@ -13,6 +13,8 @@ namespace delineo::stereo::detail {
 
 namespace {
 
+constexpr int kPiece = -2;  // label of a matched pixel whose surface is a small piece
+
 int findRoot(std::vector<int>& parent, int i) {
   while (parent[static_cast<size_t>(i)] != i) {
     const int up = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
@@ -38,8 +40,9 @@ struct Surface {
 };
 
 // The 4-connected surfaces of `disparity` (neighbours within `link`), as labels 0.. of the
-// surfaces of minPixels or more (−1 elsewhere), with their pixel counts and centroids.
-cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels,
+// surfaces of minPixels or more (kPiece on the matched pixels of those under maxPiece, −1
+// elsewhere), with their pixel counts and centroids.
+cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int maxPiece,
                       std::vector<Surface>& surfaces) {
   const int W = disparity.cols, H = disparity.rows;
   std::vector<int> parent(static_cast<size_t>(W) * H);
@@ -73,6 +76,7 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels,
     for (int x = 0; x < W; ++x) {
       if (!std::isfinite(d[x])) continue;
       const auto root = static_cast<size_t>(findRoot(parent, y * W + x));
+      if (size[root] < maxPiece) l[x] = kPiece;
       if (size[root] < minPixels) continue;
       if (index[root] < 0) {
         index[root] = static_cast<int>(surfaces.size());
@@ -200,7 +204,10 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
   const RoofPlaneSettings& s = settings;
   RoofPlaneCounts counts;
   std::vector<Surface> surfaces;
-  const cv::Mat labels = labelSurfaces(disparity, s.link, s.minPixels, surfaces);
+  // The roofs' other pixels (below) come from small pieces only: a piece as large as a surface is
+  // a structure (a box on a roof, a parapet), not the matches' noise.
+  const int maxPiece = s.minPixels;
+  const cv::Mat labels = labelSurfaces(disparity, s.link, s.minPixels, maxPiece, surfaces);
   if (surfaces.empty()) return counts;
   cv::Mat keep(disparity.size(), CV_8U);
   keep.setTo(1);
@@ -224,9 +231,11 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
   for (size_t i = 0; i < surfaces.size(); ++i) {
     if (planar[i] == 0) continue;
     Surface& f = surfaces[i];
-    // The box with a margin of r + 1: the complement's part reached from the margin is outside.
+    // The box with a margin of r + 1 + gapReach: the complement's part reached from the margin
+    // is outside.
+    const int m = r + 1 + s.gapReach;
     const cv::Rect& b = f.box;
-    const cv::Rect area(b.x - r - 1, b.y - r - 1, b.width + 2 * r + 2, b.height + 2 * r + 2);
+    const cv::Rect area(b.x - m, b.y - m, b.width + 2 * m, b.height + 2 * m);
     cv::Mat filled(area.size(), CV_8U, cv::Scalar(0));
     const cv::Rect inImage = area & image;
     filled(inImage - area.tl()).setTo(255, labels(inImage) == static_cast<int>(i));
@@ -236,12 +245,36 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
     filled = filled != 128;  // the surface and its holes
     cv::Mat grown;
     cv::dilate(filled, grown, square);
-    grownOf[i] = grown;  // (kept for the roofs' other pixels, below)
     areaOf[i] = area;
+    // Across the unmatched pixels along its outline (a roof's occluded or unmatched border) and
+    // those at its level (its own rim, cut from the surface by jumps), up to gapReach px: the
+    // ring is what lies beyond them.
+    cv::Mat passable(area.size(), CV_8U, cv::Scalar(0));
+    for (int y = inImage.y; y < inImage.br().y; ++y) {
+      const float* d = disparity.ptr<float>(y);
+      std::uint8_t* out = passable.ptr<std::uint8_t>(y - area.y);
+      for (int x = inImage.x; x < inImage.br().x; ++x) {
+        const bool level = std::isfinite(d[x]) && std::abs(d[x] - f.at(x, y)) < s.lowerBy;
+        out[x - area.x] = !std::isfinite(d[x]) || level ? 255 : 0;
+      }
+    }
+    cv::Mat across = filled.clone(), step;
+    const cv::Mat cross = cv::getStructuringElement(cv::MORPH_RECT, {3, 3});
+    for (int k = 0; k < s.gapReach; ++k) {
+      cv::dilate(across, step, cross);
+      step &= passable;
+      if (cv::countNonZero(step & ~across) == 0) break;
+      across |= step;
+    }
+    // The roofs' other pixels (below) are looked for there too: within ringRadius of the outer
+    // outline and across its rim.
+    grownOf[i] = grown | across;
+    cv::Mat ring;
+    cv::dilate(across, ring, square);
     for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
       const float* d = disparity.ptr<float>(y);
-      const std::uint8_t* in = filled.ptr<std::uint8_t>(y - area.y);
-      const std::uint8_t* near = grown.ptr<std::uint8_t>(y - area.y);
+      const std::uint8_t* in = across.ptr<std::uint8_t>(y - area.y);
+      const std::uint8_t* near = ring.ptr<std::uint8_t>(y - area.y);
       for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
         const int u = x - area.x;
         if (in[u] != 0 || near[u] == 0 || !std::isfinite(d[x])) continue;
@@ -277,15 +310,27 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
       const Surface& f = surfaces[i];
       const cv::Rect area = areaOf[i];
       const cv::Rect inImage = area & image;
+      // The surface's own pixels beyond its inlier band, by 8-connected blob: a blob of maxPiece
+      // pixels or more is a structure on the roof (a box, a parapet), not its noise.
+      cv::Mat outside(area.size(), CV_8U, cv::Scalar(0));
+      outside(inImage - area.tl())
+          .setTo(255, (labels(inImage) == static_cast<int>(i)) & (keep(inImage) == 0));
+      cv::Mat blobs, blobStats, blobCentroids;
+      cv::connectedComponentsWithStats(outside, blobs, blobStats, blobCentroids, 8, CV_32S);
       for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
         float* d = disparity.ptr<float>(y);
         const int* l = labels.ptr<int>(y);
         const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+        const int* blob = blobs.ptr<int>(y - area.y);
         const std::uint8_t* near = grownOf[i].ptr<std::uint8_t>(y - area.y);
         std::uint8_t* t = taken.ptr<std::uint8_t>(y);
         for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
           if (near[x - area.x] == 0 || !std::isfinite(d[x]) || t[x] != 0) continue;
           if (l[x] >= 0 && k[x] != 0 && planar[static_cast<size_t>(l[x])] != 0) continue;
+          const bool piece = l[x] == kPiece;
+          const bool ownNoise = l[x] == static_cast<int>(i) &&
+                                blobStats.at<int>(blob[x - area.x], cv::CC_STAT_AREA) < maxPiece;
+          if (!piece && !ownNoise) continue;
           const double p = f.at(x, y);
           if (std::abs(d[x] - p) <= s.absorbWithin) {
             d[x] = static_cast<float>(p);

@@ -1,6 +1,7 @@
 // Raised planar surfaces replaced by their plane (internal fitRoofPlanes).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -143,6 +144,47 @@ TEST(FitRoofPlanes, ARoofsOtherPixelsNearItsPlaneTakeItButNotABoxOnIt) {
   for (const cv::Point& p : high) EXPECT_EQ(kept.at<float>(p), before.at<float>(p));
 }
 
+TEST(FitRoofPlanes, AStructureOnTheRoofKeepsItsValuesAndASmallPieceTakesThePlane) {
+  // Three things 1.2 px above the roof: a 20x20 box with sharp sides (a surface of its own), the
+  // same box with sides ramped over 3 px (part of the roof's surface, beyond its inlier band), and
+  // a 5x5 patch (a piece of 25 px).
+  cv::Mat disparity = scene(roofPlane);
+  const cv::Rect sharp(48, 58, 20, 20), ramped(84, 58, 20, 20), patch(60, 92, 5, 5);
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      float rise = 0;
+      if (sharp.contains({x, y}) || patch.contains({x, y})) rise = 1.2F;
+      // Ramped: 1.2 px on the box, down by 0.3 px per px over the 3 px around it (no jump of
+      // more than 0.5 px with the noise of the blotches, which are alike from pixel to pixel).
+      const int dx = std::max({ramped.x - x, x - (ramped.br().x - 1), 0});
+      const int dy = std::max({ramped.y - y, y - (ramped.br().y - 1), 0});
+      const int out = std::max(dx, dy);
+      if (out <= 3) rise = std::max(rise, 1.2F - 0.3F * static_cast<float>(out));
+      disparity.at<float>(y, x) += rise;
+    }
+  }
+  const RoofPlaneCounts counts = fitRoofPlanes(disparity, RoofPlaneSettings{});
+  // The roof, and the sharp box may be a plane of its own (raised above the ground beyond the
+  // roof): either way both boxes keep their height.
+  EXPECT_GE(counts.planes, 1);
+  // The ramped box's top: beyond the roof's band (> 0.6 px above the plane), one blob of 324 px.
+  const cv::Rect top(ramped.x + 1, ramped.y + 1, ramped.width - 2, ramped.height - 2);
+  for (const cv::Rect& box : {sharp, top}) {
+    int high = 0;
+    for (int y = box.y; y < box.br().y; ++y) {
+      for (int x = box.x; x < box.br().x; ++x) {
+        high += disparity.at<float>(y, x) - roofPlane(x, y) > 0.8F ? 1 : 0;
+      }
+    }
+    EXPECT_GE(high, box.area() * 95 / 100) << box;
+  }
+  for (int y = patch.y; y < patch.br().y; ++y) {
+    for (int x = patch.x; x < patch.br().x; ++x) {
+      EXPECT_LT(std::abs(disparity.at<float>(y, x) - roofPlane(x, y)), 0.3F) << x << "," << y;
+    }
+  }
+}
+
 TEST(FitRoofPlanes, TheGroundAndASunkenCourtyardAreNotRaised) {
   cv::Mat disparity = scene([](int, int) { return 4.0F; });  // a courtyard 6 px below the ground
   const cv::Mat before = disparity.clone();
@@ -188,13 +230,62 @@ TEST(FitRoofPlanes, UnmatchedPixelsAreNeitherFittedNorAround) {
   EXPECT_LE(counts.pixels, inner.area());
   EXPECT_GE(counts.pixels, inner.area() * 98 / 100);
   EXPECT_EQ(cv::countNonZero(disparity == disparity), matched);
-  // With the whole ring unmatched (2 px around the roof), nothing shows that the roof is raised.
-  cv::Mat isolated = scene(roofPlane);
-  cv::Mat band(isolated.size(), CV_8U, cv::Scalar(0));
-  band(cv::Rect(kRoof.x - 2, kRoof.y - 2, kRoof.width + 4, kRoof.height + 4)).setTo(1);
-  band(inner).setTo(0);
-  isolated.setTo(kNaN, band);
-  EXPECT_EQ(fitRoofPlanes(isolated, RoofPlaneSettings{}).planes, 0);
+  // An unmatched band all around the roof (an occluded or unmatched border): the ring is what is
+  // matched beyond it, up to 8 px (gapReach) out; a wider band leaves nothing to tell.
+  const auto bandAround = [&](int width) {
+    cv::Mat m = scene(roofPlane);
+    cv::Mat band(m.size(), CV_8U, cv::Scalar(0));
+    band(cv::Rect(kRoof.x - width, kRoof.y - width, kRoof.width + 2 * width,
+                  kRoof.height + 2 * width))
+        .setTo(1);
+    band(inner).setTo(0);
+    m.setTo(kNaN, band);
+    return m;
+  };
+  cv::Mat narrow = bandAround(6), wide = bandAround(12);
+  EXPECT_EQ(fitRoofPlanes(narrow, RoofPlaneSettings{}).planes, 1);
+  EXPECT_EQ(fitRoofPlanes(wide, RoofPlaneSettings{}).planes, 0);
+  RoofPlaneSettings adjacentOnly;
+  adjacentOnly.gapReach = 0;
+  cv::Mat narrowAgain = bandAround(6);
+  EXPECT_EQ(fitRoofPlanes(narrowAgain, adjacentOnly).planes, 0);
+}
+
+TEST(FitRoofPlanes, ARimAtTheRoofsLevelIsCrossedToWhatLiesBelow) {
+  // The roof's outer 3 px 0.7 or 1.3 px high in a checkerboard (a rough rim: no two neighbours
+  // within 0.5 px, so no surface of its own, and cut from the roof's), then the ground: past the
+  // rim the ring is the ground, and the rim takes the roof's plane.
+  cv::Mat disparity = scene(roofPlane);
+  const cv::Rect inner(kRoof.x + 3, kRoof.y + 3, kRoof.width - 6, kRoof.height - 6);
+  cv::Mat rim(disparity.size(), CV_8U, cv::Scalar(0));
+  rim(kRoof).setTo(1);
+  rim(inner).setTo(0);
+  disparity.setTo(0, rim);
+  cv::Mat raisedRim = disparity.clone();
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      if (rim.at<uchar>(y, x) != 0) {
+        raisedRim.at<float>(y, x) = roofPlane(x, y) + ((x + y) % 2 == 0 ? 0.7F : 1.3F);
+      }
+    }
+  }
+  disparity = raisedRim;
+  const cv::Mat before = disparity.clone();
+  const RoofPlaneCounts counts = fitRoofPlanes(disparity, RoofPlaneSettings{});
+  EXPECT_EQ(counts.planes, 1);
+  int rimOnPlane = 0;
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      if (rim.at<uchar>(y, x) == 0) continue;
+      rimOnPlane += std::abs(disparity.at<float>(y, x) - roofPlane(x, y)) < 0.3F ? 1 : 0;
+    }
+  }
+  EXPECT_GE(rimOnPlane, cv::countNonZero(rim) * 99 / 100);  // (measured: 800 of 804)
+  // Stopped at the rim (gapReach 0), the ring is the rim itself, at the roof's level: not raised.
+  RoofPlaneSettings adjacentOnly;
+  adjacentOnly.gapReach = 0;
+  cv::Mat again = before.clone();
+  EXPECT_EQ(fitRoofPlanes(again, adjacentOnly).planes, 0);
 }
 
 TEST(FitRoofPlanes, GivesTheSameMapOnAnyNumberOfThreads) {
