@@ -285,7 +285,11 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
   }
   for (size_t i = 0; i < surfaces.size(); ++i) {
     const Surface& f = surfaces[i];
-    const bool raised = f.ring > 0 && static_cast<double>(f.lower) >= s.minLowerShare * f.ring;
+    // A ring of a few pixels tells nothing (the ground, whose outer outline is the image's
+    // border but for a few pixels): at least √count, an eighth of the 2 px ring around a
+    // square of that area.
+    const bool raised = static_cast<double>(f.ring) >= std::sqrt(static_cast<double>(f.count)) &&
+                        static_cast<double>(f.lower) >= s.minLowerShare * f.ring;
     planar[i] = planar[i] != 0 && raised ? 1 : 0;
     if (planar[i] != 0) ++counts.planes;
   }

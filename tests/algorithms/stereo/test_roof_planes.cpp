@@ -190,6 +190,14 @@ TEST(FitRoofPlanes, TheGroundAndASunkenCourtyardAreNotRaised) {
   const cv::Mat before = disparity.clone();
   EXPECT_EQ(fitRoofPlanes(disparity, RoofPlaneSettings{}).planes, 0);
   EXPECT_TRUE(identical(disparity, before));
+  // The ground alone, but for a ditch 4 px lower at the image's border (3 x 6 px): the ground's
+  // outer outline is the border but there, and its ring those 18 pixels, all lower. Too few to
+  // tell (fewer than the square root of its 25 600 pixels).
+  cv::Mat ditch = scene({});
+  ditch(cv::Rect(0, 70, 3, 6)) -= 4.0;
+  const cv::Mat withDitch = ditch.clone();
+  EXPECT_EQ(fitRoofPlanes(ditch, RoofPlaneSettings{}).planes, 0);
+  EXPECT_TRUE(identical(ditch, withDitch));
 }
 
 TEST(FitRoofPlanes, RaisedSurfacesNoPlaneFitsAreLeft) {
