@@ -34,17 +34,17 @@ struct RoofPlaneCounts {
 // take the plane's value. Raised: of the matched pixels within `ringRadius` px outside its outer
 // outline (holes filled), once past the unmatched pixels and those at its level (within `lowerBy`
 // of the plane: its own rim, cut from the surface by jumps) for up to `gapReach` px, half or
-// more lie `lowerBy` px or more below the plane: a roof, not the ground, a courtyard or a slope
-// of terrain. (On real roofs, 5 cm aerial tiles of Toulouse, the big flat roofs had 85-87 % of
-// their pixels in the band and an unmatched or rim border all around: see docs/stereo.md.) A roof's
-// matches are noisy at the scale of the correlation window (blotches of ±0.5 px on weakly
-// textured roofs); averaging over the window (the surface smoothing) cannot remove that, a plane
-// over the whole roof does. Then the other matched pixels on such a roof or around it (within
-// `ringRadius` of its outer outline, and across its rim) whose disparity lies within
-// `absorbWithin` of the plane take it too (the same 1.5 px that tells the roof from what lies
-// below it): the roof's outliers and the pixels a jump cut from it. Only those of small pieces,
-// though: pixels of surfaces under `minPixels`, and the roof's own pixels beyond its inlier band
-// in 8-connected blobs under `minPixels`; a larger one is a structure on the roof (a box, a
+// more lie `lowerBy` px or more below the plane, that ring holding √count pixels or more: a roof,
+// not the ground, a courtyard or a slope of terrain. (On real roofs, 5 cm aerial tiles of Toulouse,
+// the big flat roofs had 85-87 % of their pixels in the band and an unmatched or rim border all
+// around: see docs/stereo.md.) A roof's matches are noisy at the scale of the correlation window
+// (blotches of ±0.5 px on weakly textured roofs); averaging over the window (the surface smoothing)
+// cannot remove that, a plane over the whole roof does. Then the other matched pixels on such a
+// roof or around it (within `ringRadius` of its outer outline, and across its rim) whose disparity
+// lies within `absorbWithin` of the plane take it too (the same 1.5 px that tells the roof from
+// what lies below it): the roof's outliers and the pixels a jump cut from it. Only those of small
+// pieces, though: pixels of surfaces under `minPixels`, and the roof's own pixels beyond its inlier
+// band in 8-connected blobs under `minPixels`; a larger one is a structure on the roof (a box, a
 // parapet) and keeps its values. A hip roof's facets join without a step and form one surface that
 // no plane fits: it is left as it is, as is anything not planar within the matches' noise.
 RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& settings);
