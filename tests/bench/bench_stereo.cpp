@@ -432,13 +432,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
 
 #ifdef DELINEO_BENCH_HAVE_SIM
 Case simulated(int size, int seed) {
-  sim::SceneParams sp;
-  sp.seed = seed;
-  sp.width = size;
-  sp.height = size;
-  sp.buildings = std::max(1, size * size / 40000);
-  sp.trees = std::max(1, size * size / 30000);
-  const sim::Scene scene = sim::simulateScene(sp);
+  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(size, seed));
   Case c;
   c.name = "simulated scene (seed " + std::to_string(seed) + ", default noise)";
   scene.left.convertTo(c.left, CV_32F);

@@ -1,5 +1,6 @@
 #include "delineo/sim/scene.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -55,6 +56,16 @@ core::Feature footprintFeature(const detail::Building& b, const SceneParams& p) 
 }
 
 }  // namespace
+
+SceneParams squareSceneParams(int size, int seed) {
+  SceneParams sp;
+  sp.seed = seed;
+  sp.width = size;
+  sp.height = size;
+  sp.buildings = std::max(1, size * size / 40000);
+  sp.trees = std::max(1, size * size / 30000);
+  return sp;
+}
 
 Scene simulateScene(const SceneParams& params, core::Progress* progress) {
   params.validate();
@@ -116,7 +127,8 @@ Scene simulateScene(const SceneParams& params, core::Progress* progress) {
   core::setStage(progress, core::StageId::SimulatingRadiometry);
   scene.left.create(h, w, CV_8U);
   scene.right.create(h, w, CV_8U);
-  const std::uint64_t noiseSeed = detail::mix64(static_cast<std::uint64_t>(params.seed) ^ 0x6e6f697365ULL);
+  const std::uint64_t noiseSeed =
+      detail::mix64(static_cast<std::uint64_t>(params.seed) ^ 0x6e6f697365ULL);
   for (int y = 0; y < h; ++y) {
     const float* rl = radianceLeft.ptr<float>(y);
     const float* rr = radianceRight.ptr<float>(y);

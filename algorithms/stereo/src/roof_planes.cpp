@@ -7,6 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "union_find.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -14,15 +15,6 @@ namespace delineo::stereo::detail {
 namespace {
 
 constexpr int kPiece = -2;  // label of a matched pixel whose surface is a small piece
-
-int findRoot(std::vector<int>& parent, int i) {
-  while (parent[static_cast<size_t>(i)] != i) {
-    const int up = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
-    parent[static_cast<size_t>(i)] = up;  // path halving
-    i = up;
-  }
-  return i;
-}
 
 // One surface and its plane d = a (x − cx) + b (y − cy) + c, in coordinates centred on the
 // surface (the normal equations stay well conditioned far from the image's origin).
@@ -47,18 +39,14 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int m
   const int W = disparity.cols, H = disparity.rows;
   std::vector<int> parent(static_cast<size_t>(W) * H);
   for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-  auto join = [&](int p, int q) {
-    const int rp = findRoot(parent, p), rq = findRoot(parent, q);
-    if (rp != rq) parent[static_cast<size_t>(std::max(rp, rq))] = std::min(rp, rq);
-  };
   for (int y = 0; y < H; ++y) {
     const float* d = disparity.ptr<float>(y);
     const float* below = y + 1 < H ? disparity.ptr<float>(y + 1) : nullptr;
     for (int x = 0; x < W; ++x) {
       if (!std::isfinite(d[x])) continue;  // NaN differences fail the tests below too
       const int i = y * W + x;
-      if (x + 1 < W && std::abs(d[x + 1] - d[x]) <= link) join(i, i + 1);
-      if (below != nullptr && std::abs(below[x] - d[x]) <= link) join(i, i + W);
+      if (x + 1 < W && std::abs(d[x + 1] - d[x]) <= link) joinRoots(parent, i, i + 1);
+      if (below != nullptr && std::abs(below[x] - d[x]) <= link) joinRoots(parent, i, i + W);
     }
   }
   std::vector<int> size(parent.size(), 0);

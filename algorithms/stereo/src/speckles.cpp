@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "union_find.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -17,26 +18,6 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 struct Run {
   int y, x0, x1;
 };
-
-// Union-find over run indices in which the smaller index always becomes the root: every run's
-// parent precedes it.
-int findRoot(std::vector<int>& parent, int i) {
-  while (parent[static_cast<size_t>(i)] != i) {
-    const int up = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
-    parent[static_cast<size_t>(i)] = up;  // path halving
-    i = up;
-  }
-  return i;
-}
-
-void joinRoots(std::vector<int>& parent, int a, int b) {
-  const int ra = findRoot(parent, a), rb = findRoot(parent, b);
-  if (ra < rb) {
-    parent[static_cast<size_t>(rb)] = ra;
-  } else if (rb < ra) {
-    parent[static_cast<size_t>(ra)] = rb;
-  }
-}
 
 // Joins each run of row y (ids in `ids`, -1 where unmatched) to the runs of row y − 1 (`upIds`)
 // that one of its pixels has an 8-neighbour within `tol` in. A run's pixels mostly meet the same

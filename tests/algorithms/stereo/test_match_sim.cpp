@@ -2,8 +2,6 @@
 // situation the small synthetic scenes do not produce.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-
 #include <opencv2/core.hpp>
 
 #include "delineo/sim/scene.hpp"
@@ -12,24 +10,13 @@
 namespace delineo::stereo {
 namespace {
 
-// The bench's simulated scene of this size and seed (bench_stereo --size N --seed S).
-sim::Scene benchScene(int size, int seed) {
-  sim::SceneParams sp;
-  sp.seed = seed;
-  sp.width = size;
-  sp.height = size;
-  sp.buildings = std::max(1, size * size / 40000);
-  sp.trees = std::max(1, size * size / 30000);
-  return sim::simulateScene(sp);
-}
-
 TEST(MatchSimulated, ANearlyLevelPlainRoofTakesItsEdgesConstantOverAPlaneThatFitsNoBetter) {
   // Seed 24 600²: its largest roof, plain, at 53.45 px. No constant passed the fill's tests (the
   // matches around it are the ground's and a neighbour's), and the plane through its row ends
   // rises 2.7 px over it (52.65 at its centroid) yet lines its outline up no better than the
   // constant its edges give (ring error 14.67 against 14.57): it takes that constant (53.33).
   // Filled with the plane, its pixels were 0.76 px low on average.
-  const sim::Scene scene = benchScene(600, 24);
+  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(600, 24));
   cv::Mat left, right;
   scene.left.convertTo(left, CV_32F);
   scene.right.convertTo(right, CV_32F);

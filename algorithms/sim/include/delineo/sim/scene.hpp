@@ -134,6 +134,11 @@ struct Scene {
 // `progress` once per band of rows; a cancel returns a Scene with status Canceled.
 Scene simulateScene(const SceneParams& params, core::Progress* progress = nullptr);
 
+// The square scene of the stereo benchmarks (bench_stereo --size N --seed S): N x N px, one
+// building per 40 000 px and one tree per 30 000 px (at least one of each), the rest at the
+// defaults above.
+SceneParams squareSceneParams(int size, int seed);
+
 // scene.json: image size, disparity search range, GSD, metres per disparity, seed, the
 // geometry convention, the output file names and the full parameters.
 nlohmann::json sceneDescription(const Scene& scene, const SceneParams& params);
