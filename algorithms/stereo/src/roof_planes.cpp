@@ -292,9 +292,10 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
     }
   }
   // Then the other matched pixels on the roof or around it (within ringRadius of its outer
-  // outline) that lie within absorbWithin of its plane: a roof's pixels beyond the inlier band
-  // (or cut from the surface by a jump of more than `link`) are its matches' outliers, at the
-  // roof's level all the same. In surface order; a pixel takes the first roof that claims it.
+  // outline, and across its rim) that lie within absorbWithin of its plane, when they are small
+  // pieces: a roof's pixels beyond the inlier band (or cut from the surface by a jump of more
+  // than `link`) are its matches' outliers, at the roof's level all the same. In surface order;
+  // a pixel takes the first roof that claims it.
   if (s.absorbWithin > 0) {
     cv::Mat taken(disparity.size(), CV_8U, cv::Scalar(0));
     for (size_t i = 0; i < surfaces.size(); ++i) {
