@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -216,61 +217,67 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
   const cv::Rect image(0, 0, disparity.cols, disparity.rows);
   std::vector<cv::Mat> grownOf(surfaces.size());
   std::vector<cv::Rect> areaOf(surfaces.size());
+  // One task per planar surface (each writes only its own ring, mask and area).
+  std::vector<std::function<void()>> ringTasks;
   for (size_t i = 0; i < surfaces.size(); ++i) {
     if (planar[i] == 0) continue;
-    Surface& f = surfaces[i];
-    // The box with a margin of r + 1 + gapReach: the complement's part reached from the margin
-    // is outside.
-    const int m = r + 1 + s.gapReach;
-    const cv::Rect& b = f.box;
-    const cv::Rect area(b.x - m, b.y - m, b.width + 2 * m, b.height + 2 * m);
-    cv::Mat filled(area.size(), CV_8U, cv::Scalar(0));
-    const cv::Rect inImage = area & image;
-    filled(inImage - area.tl()).setTo(255, labels(inImage) == static_cast<int>(i));
-    // From a corner of the margin, which is never the surface; 8-connected, as the complement of
-    // a 4-connected surface is.
-    cv::floodFill(filled, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(), 8);
-    filled = filled != 128;  // the surface and its holes
-    cv::Mat grown;
-    cv::dilate(filled, grown, square);
-    areaOf[i] = area;
-    // Across the unmatched pixels along its outline (a roof's occluded or unmatched border) and
-    // those at its level (its own rim, cut from the surface by jumps), up to gapReach px: the
-    // ring is what lies beyond them.
-    cv::Mat passable(area.size(), CV_8U, cv::Scalar(0));
-    for (int y = inImage.y; y < inImage.br().y; ++y) {
-      const float* d = disparity.ptr<float>(y);
-      std::uint8_t* out = passable.ptr<std::uint8_t>(y - area.y);
-      for (int x = inImage.x; x < inImage.br().x; ++x) {
-        const bool level = std::isfinite(d[x]) && std::abs(d[x] - f.at(x, y)) < s.lowerBy;
-        out[x - area.x] = !std::isfinite(d[x]) || level ? 255 : 0;
+    ringTasks.emplace_back([&, i] {
+      Surface& f = surfaces[i];
+      // The box with a margin of r + 1 + gapReach: the complement's part reached from the margin
+      // is outside.
+      const int m = r + 1 + s.gapReach;
+      const cv::Rect& b = f.box;
+      const cv::Rect area(b.x - m, b.y - m, b.width + 2 * m, b.height + 2 * m);
+      cv::Mat filled(area.size(), CV_8U, cv::Scalar(0));
+      const cv::Rect inImage = area & image;
+      filled(inImage - area.tl()).setTo(255, labels(inImage) == static_cast<int>(i));
+      // From a corner of the margin, which is never the surface; 8-connected, as the complement of
+      // a 4-connected surface is.
+      cv::floodFill(filled, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(),
+                    8);
+      filled = filled != 128;  // the surface and its holes
+      cv::Mat grown;
+      cv::dilate(filled, grown, square);
+      areaOf[i] = area;
+      // Across the unmatched pixels along its outline (a roof's occluded or unmatched border) and
+      // those at its level (its own rim, cut from the surface by jumps), up to gapReach px: the
+      // ring is what lies beyond them.
+      cv::Mat passable(area.size(), CV_8U, cv::Scalar(0));
+      for (int y = inImage.y; y < inImage.br().y; ++y) {
+        const float* d = disparity.ptr<float>(y);
+        std::uint8_t* out = passable.ptr<std::uint8_t>(y - area.y);
+        for (int x = inImage.x; x < inImage.br().x; ++x) {
+          const bool level = std::isfinite(d[x]) && std::abs(d[x] - f.at(x, y)) < s.lowerBy;
+          out[x - area.x] = !std::isfinite(d[x]) || level ? 255 : 0;
+        }
       }
-    }
-    cv::Mat across = filled.clone(), step;
-    const cv::Mat cross = cv::getStructuringElement(cv::MORPH_RECT, {3, 3});
-    for (int k = 0; k < s.gapReach; ++k) {
-      cv::dilate(across, step, cross);
-      step &= passable;
-      if (cv::countNonZero(step & ~across) == 0) break;
-      across |= step;
-    }
-    // The roofs' other pixels (below) are looked for there too: within ringRadius of the outer
-    // outline and across its rim.
-    grownOf[i] = grown | across;
-    cv::Mat ring;
-    cv::dilate(across, ring, square);
-    for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
-      const float* d = disparity.ptr<float>(y);
-      const std::uint8_t* in = across.ptr<std::uint8_t>(y - area.y);
-      const std::uint8_t* near = ring.ptr<std::uint8_t>(y - area.y);
-      for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
-        const int u = x - area.x;
-        if (in[u] != 0 || near[u] == 0 || !std::isfinite(d[x])) continue;
-        ++f.ring;
-        if (d[x] <= f.at(x, y) - s.lowerBy) ++f.lower;
+      cv::Mat across = filled.clone(), step;
+      const cv::Mat cross = cv::getStructuringElement(cv::MORPH_RECT, {3, 3});
+      for (int k = 0; k < s.gapReach; ++k) {
+        cv::dilate(across, step, cross);
+        step &= passable;
+        if (cv::countNonZero(step & ~across) == 0) break;
+        across |= step;
       }
-    }
+      // The roofs' other pixels (below) are looked for there too: within ringRadius of the outer
+      // outline and across its rim.
+      grownOf[i] = grown | across;
+      cv::Mat ring;
+      cv::dilate(across, ring, square);
+      for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
+        const float* d = disparity.ptr<float>(y);
+        const std::uint8_t* in = across.ptr<std::uint8_t>(y - area.y);
+        const std::uint8_t* near = ring.ptr<std::uint8_t>(y - area.y);
+        for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
+          const int u = x - area.x;
+          if (in[u] != 0 || near[u] == 0 || !std::isfinite(d[x])) continue;
+          ++f.ring;
+          if (d[x] <= f.at(x, y) - s.lowerBy) ++f.lower;
+        }
+      }
+    });
   }
+  runTasks(ringTasks, s.threads);
   for (size_t i = 0; i < surfaces.size(); ++i) {
     const Surface& f = surfaces[i];
     // A ring of a few pixels tells nothing (the ground, whose outer outline is the image's
