@@ -38,47 +38,76 @@ struct Surface {
 cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int maxPiece,
                       std::vector<Surface>& surfaces) {
   const int W = disparity.cols, H = disparity.rows;
-  std::vector<int> parent(static_cast<size_t>(W) * H);
-  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  // Runs of a row's matched pixels whose left neighbours are within `link`, joined across rows
+  // where a pixel of one and the pixel below it in the other are within `link` (the union-find
+  // then works on runs, not pixels).
+  struct Run {
+    int y, x0, x1;
+  };
+  std::vector<Run> runs;
+  std::vector<size_t> rowStart(static_cast<size_t>(H) + 1);
   for (int y = 0; y < H; ++y) {
+    rowStart[static_cast<size_t>(y)] = runs.size();
     const float* d = disparity.ptr<float>(y);
-    const float* below = y + 1 < H ? disparity.ptr<float>(y + 1) : nullptr;
-    for (int x = 0; x < W; ++x) {
-      if (!std::isfinite(d[x])) continue;  // NaN differences fail the tests below too
-      const int i = y * W + x;
-      if (x + 1 < W && std::abs(d[x + 1] - d[x]) <= link) joinRoots(parent, i, i + 1);
-      if (below != nullptr && std::abs(below[x] - d[x]) <= link) joinRoots(parent, i, i + W);
-    }
-  }
-  std::vector<int> size(parent.size(), 0);
-  for (int y = 0; y < H; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    for (int x = 0; x < W; ++x) {
-      if (std::isfinite(d[x])) ++size[static_cast<size_t>(findRoot(parent, y * W + x))];
-    }
-  }
-  std::vector<int> index(parent.size(), -1);
-  cv::Mat labels(disparity.size(), CV_32S, cv::Scalar(-1));
-  for (int y = 0; y < H; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    int* l = labels.ptr<int>(y);
     for (int x = 0; x < W; ++x) {
       if (!std::isfinite(d[x])) continue;
-      const auto root = static_cast<size_t>(findRoot(parent, y * W + x));
-      if (size[root] < maxPiece) l[x] = kPiece;
-      if (size[root] < minPixels) continue;
-      if (index[root] < 0) {
-        index[root] = static_cast<int>(surfaces.size());
-        surfaces.emplace_back();
-        surfaces.back().z0 = d[x];
-        surfaces.back().box = cv::Rect(x, y, 1, 1);
+      const int x0 = x;
+      while (x + 1 < W && std::abs(d[x + 1] - d[x]) <= link) ++x;  // (NaN fails the test)
+      runs.push_back({y, x0, x});
+    }
+  }
+  rowStart[static_cast<size_t>(H)] = runs.size();
+  std::vector<int> parent(runs.size());
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+  for (int y = 1; y < H; ++y) {
+    const float* up = disparity.ptr<float>(y - 1);
+    const float* d = disparity.ptr<float>(y);
+    size_t a = rowStart[static_cast<size_t>(y - 1)], b = rowStart[static_cast<size_t>(y)];
+    const size_t aEnd = rowStart[static_cast<size_t>(y)],
+                 bEnd = rowStart[static_cast<size_t>(y) + 1];
+    while (a < aEnd && b < bEnd) {
+      const Run& ra = runs[a];
+      const Run& rb = runs[b];
+      for (int x = std::max(ra.x0, rb.x0); x <= std::min(ra.x1, rb.x1); ++x) {
+        if (std::abs(d[x] - up[x]) <= link) {
+          joinRoots(parent, static_cast<int>(a), static_cast<int>(b));
+          break;
+        }
       }
-      Surface& s = surfaces[static_cast<size_t>(index[root])];
+      if (ra.x1 < rb.x1) {
+        ++a;
+      } else {
+        ++b;
+      }
+    }
+  }
+  std::vector<int> size(runs.size(), 0);
+  for (size_t i = 0; i < runs.size(); ++i) {
+    size[static_cast<size_t>(findRoot(parent, static_cast<int>(i)))] += runs[i].x1 - runs[i].x0 + 1;
+  }
+  std::vector<int> index(runs.size(), -1);
+  cv::Mat labels(disparity.size(), CV_32S, cv::Scalar(-1));
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const Run& run = runs[i];
+    const auto root = static_cast<size_t>(findRoot(parent, static_cast<int>(i)));
+    int* l = labels.ptr<int>(run.y);
+    if (size[root] < minPixels) {
+      if (size[root] < maxPiece) std::fill(l + run.x0, l + run.x1 + 1, kPiece);
+      continue;
+    }
+    if (index[root] < 0) {
+      index[root] = static_cast<int>(surfaces.size());
+      surfaces.emplace_back();
+      surfaces.back().z0 = disparity.at<float>(run.y, run.x0);
+      surfaces.back().box = cv::Rect(run.x0, run.y, 1, 1);
+    }
+    Surface& s = surfaces[static_cast<size_t>(index[root])];
+    s.box |= cv::Rect(run.x0, run.y, run.x1 - run.x0 + 1, 1);
+    for (int x = run.x0; x <= run.x1; ++x) {
       l[x] = index[root];
       ++s.count;
       s.cx += x;
-      s.cy += y;
-      s.box |= cv::Rect(x, y, 1, 1);
+      s.cy += run.y;
     }
   }
   for (Surface& s : surfaces) {
