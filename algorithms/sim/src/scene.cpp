@@ -127,8 +127,7 @@ Scene simulateScene(const SceneParams& params, core::Progress* progress) {
   core::setStage(progress, core::StageId::SimulatingRadiometry);
   scene.left.create(h, w, CV_8U);
   scene.right.create(h, w, CV_8U);
-  const std::uint64_t noiseSeed =
-      detail::mix64(static_cast<std::uint64_t>(params.seed) ^ 0x6e6f697365ULL);
+  const std::uint64_t noiseSeed = detail::mix64(static_cast<std::uint64_t>(params.seed) ^ 0x6e6f697365ULL);
   for (int y = 0; y < h; ++y) {
     const float* rl = radianceLeft.ptr<float>(y);
     const float* rr = radianceRight.ptr<float>(y);

@@ -1042,6 +1042,19 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     auto planeRingError = [&](const FillPlane& plane, double stopAboveSum = 1e300) {
       return ringErrorUnder(imagesMap, plane, stopAboveSum);
     };
+    // The constant its edges in both views give a plain region, when edgeMinSamples or more row
+    // ends give one within edgeReach of `reference` (see RegionFillSettings::edgeMinSamples).
+    const auto edgeConstantNear = [&](double reference) -> std::optional<float> {
+      if (settings.edgeMinSamples <= 0) return std::nullopt;
+      const auto [edgeValue, samples] =
+          edgeDisparity(left, right, region, box, rightFlatRegionsOf(), matchedGain, matchedOffset,
+                        sigma, dmin, dmax, static_cast<float>(reference), settings.edgeReach);
+      if (samples < settings.edgeMinSamples ||
+          std::abs(edgeValue - reference) > settings.edgeReach) {
+        return std::nullopt;
+      }
+      return static_cast<float>(edgeValue);
+    };
     // The constant disparity of the outline's matches, when the outline lines up there.
     double constantError = 0;      // the constant's error on the (final) ring
     double candidateError = 1e30;  // the best candidate's, filled or not
@@ -1135,15 +1148,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       }
       // The region's edges in both views, when enough of them are sharp, over the three
       // estimates of the matches and the ring (see RegionFillSettings::edgeMinSamples).
-      if (settings.edgeMinSamples > 0) {
-        const auto [edgeValue, samples] =
-            edgeDisparity(left, right, region, box, rightFlatRegionsOf(), matchedGain,
-                          matchedOffset, sigma, dmin, dmax, best, settings.edgeReach);
-        if (samples >= settings.edgeMinSamples &&
-            std::abs(edgeValue - best) <= settings.edgeReach) {
-          value = static_cast<float>(edgeValue);
-        }
-      }
+      if (const auto edges = edgeConstantNear(best)) value = *edges;
       constantError = ringError(value);
       return value;
     }();
@@ -1245,17 +1250,9 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         // its edges give around the plane's value at its centroid (26.83 there; see
         // edgeMinSamples), else that value.
         const double centreValue = plane.at(centroids.at<double>(r, 0), centroids.at<double>(r, 1));
-        plane = FillPlane{static_cast<float>(centreValue), 0, 0};
-        if (settings.edgeMinSamples > 0) {
-          const auto [edgeValue, samples] =
-              edgeDisparity(left, right, region, box, rightFlat, matchedGain, matchedOffset, sigma,
-                            dmin, dmax, static_cast<float>(centreValue), settings.edgeReach);
-          if (samples >= settings.edgeMinSamples &&
-              std::abs(edgeValue - centreValue) <= settings.edgeReach) {
-            plane = FillPlane{static_cast<float>(edgeValue), 0, 0};
-          }
-        }
-      } else if (!constant && settings.edgeMinSamples > 0) {
+        const auto edges = edgeConstantNear(centreValue);
+        plane = FillPlane{edges ? *edges : static_cast<float>(centreValue), 0, 0};
+      } else if (!constant) {
         // Any other plane taken where no constant passed must line the outline up clearly better
         // (planeMargin) than the constant the region's edges give around its centroid value, as
         // a plane must over a constant that passed: a plain roof nearly level, whose row ends
@@ -1263,12 +1260,8 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         // px over it, 52.65 at its centroid, ring error 14.67 against 14.57 for its edges'
         // 53.33; see docs/stereo.md, session 28).
         const double centreValue = plane.at(centroids.at<double>(r, 0), centroids.at<double>(r, 1));
-        const auto [edgeValue, samples] =
-            edgeDisparity(left, right, region, box, rightFlat, matchedGain, matchedOffset, sigma,
-                          dmin, dmax, static_cast<float>(centreValue), settings.edgeReach);
-        if (samples >= settings.edgeMinSamples &&
-            std::abs(edgeValue - centreValue) <= settings.edgeReach) {
-          const FillPlane level{static_cast<float>(edgeValue), 0, 0};
+        if (const auto edges = edgeConstantNear(centreValue)) {
+          const FillPlane level{*edges, 0, 0};
           if (!(planeRingError(plane) < settings.planeMargin * planeRingError(level))) {
             plane = level;
           }
