@@ -96,6 +96,21 @@ class MainWindowTest : public QObject {
     return lateness;
   }
 
+  // Shows `editor` on the Matching tab, scrolled to (DELINEO_SCREENSHOT_DIR keeps a rendering,
+  // named `shot`). Returns the tab widget, left on that tab, or nullptr when it is not shown.
+  QTabWidget* showOnMatchingTab(QWidget* editor, const QString& shot) {
+    auto* tabs = window_->findChild<QTabWidget*>();
+    if (!tabs) return nullptr;
+    tabs->setCurrentIndex(1);
+    auto* scroll = qobject_cast<QScrollArea*>(tabs->currentWidget());
+    if (!scroll) return nullptr;
+    scroll->ensureWidgetVisible(editor);
+    if (!editor->isVisible()) return nullptr;
+    const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
+    if (!dir.isEmpty()) window_->grab().save(dir + QLatin1Char('/') + shot);
+    return tabs;
+  }
+
  private slots:
   void initTestCase() {
     QStandardPaths::setTestModeEnabled(true);
@@ -593,16 +608,9 @@ class MainWindowTest : public QObject {
     undo->redo();
     QVERIFY(!stored());
     QVERIFY(!box->isChecked());
-    // Shown on the Matching tab, scrolled to (DELINEO_SCREENSHOT_DIR keeps a rendering).
-    auto* tabs = window_->findChild<QTabWidget*>();
+    // Shown on the Matching tab, scrolled to.
+    QTabWidget* tabs = showOnMatchingTab(box, QStringLiteral("matching-tab.png"));
     QVERIFY(tabs);
-    tabs->setCurrentIndex(1);
-    auto* scroll = qobject_cast<QScrollArea*>(tabs->currentWidget());
-    QVERIFY(scroll);
-    scroll->ensureWidgetVisible(box);
-    QVERIFY(box->isVisible());
-    const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
-    if (!dir.isEmpty()) window_->grab().save(dir + QStringLiteral("/matching-tab.png"));
     box->click();
     QVERIFY(stored());
     tabs->setCurrentIndex(0);
@@ -627,15 +635,8 @@ class MainWindowTest : public QObject {
     window_->document()->undoStack()->undo();
     QCOMPARE(stored(), 0.4);
     QCOMPARE(residual->value(), 0.4);
-    auto* tabs = window_->findChild<QTabWidget*>();
+    QTabWidget* tabs = showOnMatchingTab(area, QStringLiteral("matching-tab-planes.png"));
     QVERIFY(tabs);
-    tabs->setCurrentIndex(1);
-    auto* scroll = qobject_cast<QScrollArea*>(tabs->currentWidget());
-    QVERIFY(scroll);
-    scroll->ensureWidgetVisible(area);
-    QVERIFY(area->isVisible());
-    const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
-    if (!dir.isEmpty()) window_->grab().save(dir + QStringLiteral("/matching-tab-planes.png"));
     tabs->setCurrentIndex(0);
   }
 
