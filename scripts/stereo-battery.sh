@@ -16,8 +16,10 @@
 #   fresh-4:  9 more (seeds 35-40 600², 18-20 1000²), first run at the end of session 24, after
 #             its changes were chosen (seed 35 then looked at);
 #   fresh-5:  9 more (seeds 41-46 600², 21-23 1000²), first run at the start of session 25,
-#             before anything was chosen on it (seed 41 then looked at). Judge a change on all
-#             seven groups, and keep them apart.
+#             before anything was chosen on it (seed 41 then looked at);
+#   fresh-6:  9 more (seeds 47-52 600², 24-26 1000²), first run at the start of session 29,
+#             before anything was chosen on it. Judge a change on all eight groups, and keep
+#             them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
 # About three and a half minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
@@ -61,6 +63,10 @@ fresh5=("s41-600|--size 600 --seed 41" "s42-600|--size 600 --seed 42"
   "s43-600|--size 600 --seed 43" "s44-600|--size 600 --seed 44" "s45-600|--size 600 --seed 45"
   "s46-600|--size 600 --seed 46" "s21-1000|--size 1000 --seed 21"
   "s22-1000|--size 1000 --seed 22" "s23-1000|--size 1000 --seed 23")
+fresh6=("s47-600|--size 600 --seed 47" "s48-600|--size 600 --seed 48"
+  "s49-600|--size 600 --seed 49" "s50-600|--size 600 --seed 50" "s51-600|--size 600 --seed 51"
+  "s52-600|--size 600 --seed 52" "s24-1000|--size 1000 --seed 24"
+  "s25-1000|--size 1000 --seed 25" "s26-1000|--size 1000 --seed 26")
 
 run_group() {
   local name=$1
@@ -95,3 +101,4 @@ run_group fresh-2 "${fresh2[@]}"
 run_group fresh-3 "${fresh3[@]}"
 run_group fresh-4 "${fresh4[@]}"
 run_group fresh-5 "${fresh5[@]}"
+run_group fresh-6 "${fresh6[@]}"
