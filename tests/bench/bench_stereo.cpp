@@ -569,6 +569,14 @@ int main(int argc, char** argv) {
       range = std::atoi(argv[++i]);
     } else if (a == "--dump" && i + 1 < argc) {
       dump = argv[++i];
+      // Made here, so that a wrong path fails at once with its name, not as unreadable dumps.
+      std::error_code made;
+      std::filesystem::create_directories(dump, made);
+      if (made) {
+        std::fprintf(stderr, "bench_stereo: cannot create dump directory %s: %s\n", dump.c_str(),
+                     made.message().c_str());
+        return 2;
+      }
     } else if (a == "--params" && i + 1 < argc) {
       overrides = nlohmann::json::parse(argv[++i]);
     } else if (a == "--repeat" && i + 1 < argc) {

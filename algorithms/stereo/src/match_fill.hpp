@@ -52,6 +52,9 @@ struct RegionFillSettings {
                                  //   constant passed: the constant of the region's edges)
   double planeMinSpan = 1.5;     // px: and when it changes by at least this over the region's
                                  //   bounding box (|a| · width + |b| · height; 0 = off)
+  bool planeWithinMatches = true;    // over a constant, a plane only when its values over the
+                                     //   region stay within planeInlier of the range of the
+                                     //   matches within 3 px of the region
   double planeCandidateRatio = 1.1;  // where no constant is filled, a plane only when its outline
                                      //   error is below this × the best candidate's (0 = off)
   double planeHiddenRatio = 4.0;     // a plane is not filled when it would hide more matches in
