@@ -22,7 +22,8 @@
 //              white located, magenta roof found inside, cyan outside, orange not found;
 //              and outline_METHOD.csv, every scored outline pixel with its outcome;
 //              disparity_METHOD.tif, score_METHOD.tif, truth.tif and the views left.tif,
-//              right.tif (float32); roof.png, the flat-roof pixels the roof RMS is read on.
+//              right.tif (float32); roof.png, the flat-roof pixels the roof RMS is read on;
+//              sloped_roof.png, the sloped facets' pixels --outline-diag reports on.
 //   --range N  search at least N disparities on the simulated scene (dmax raised)
 //   --params J MatchParams overrides for adaptive and square, e.g. '{"min-score": 0.2}'.
 //   --repeat N run the methods N times round-robin, report each one's fastest run (shared
@@ -69,6 +70,7 @@ struct Case {
   cv::Mat truth;        // CV_32F, NaN where unknown
   cv::Mat evaluate;     // CV_8U, 1 where scored (known and non-occluded)
   cv::Mat roof;         // CV_8U, 1 on flat-roof pixels (may be empty)
+  cv::Mat slopedRoof;   // CV_8U, 1 on sloped roof facets' pixels (may be empty)
   int dmin = 0, dmax = 0;
   struct OutlinePixel {
     int y, xb, dir;  // building pixel xb, ground at xb - dir
@@ -307,6 +309,26 @@ void roofErrorDiagnosis(const cv::Mat& disparity, const Case& c) {
       roofN, off1, off5, sq > 0 ? 100.0 * sq5 / sq : 0.0);
 }
 
+// The matches on sloped roof facets: their RMS error and the share off by more than 1 px.
+void slopedRoofDiagnosis(const cv::Mat& disparity, const Case& c) {
+  long n = 0, off1 = 0, total = 0;
+  double sq = 0;
+  for (int y = 0; y < c.slopedRoof.rows; ++y) {
+    for (int x = 0; x < c.slopedRoof.cols; ++x) {
+      if (!c.slopedRoof.at<uchar>(y, x)) continue;
+      ++total;
+      const float d = disparity.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      const double e = d - c.truth.at<float>(y, x);
+      ++n;
+      sq += e * e;
+      off1 += std::abs(e) > 1 ? 1 : 0;
+    }
+  }
+  std::printf("    sloped-roof pixels: %ld, matched %ld, RMS %.4f px, off > 1 px %.2f %%\n", total,
+              n, n > 0 ? std::sqrt(sq / n) : 0.0, n > 0 ? 100.0 * off1 / n : 0.0);
+}
+
 // Records when the matcher enters each progress stage, to print where its wall time goes.
 class StageClock : public core::Progress {
  public:
@@ -402,6 +424,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
     if (gOutlineDiagnosis && !c.outline.empty()) {
       outlineDiagnosis(disparity[i], c);
       roofErrorDiagnosis(disparity[i], c);
+      if (!c.slopedRoof.empty()) slopedRoofDiagnosis(disparity[i], c);
     }
     if (!dump.empty() && !c.outline.empty()) {
       cv::Mat grey;
@@ -414,6 +437,7 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
       if (i == 0) {
         cv::imwrite(dump + "/truth.tif", c.truth);
         if (!c.roof.empty()) cv::imwrite(dump + "/roof.png", c.roof * 255);
+        if (!c.slopedRoof.empty()) cv::imwrite(dump + "/sloped_roof.png", c.slopedRoof * 255);
         cv::imwrite(dump + "/left.tif", c.left);
         cv::imwrite(dump + "/right.tif", c.right);
       }
@@ -454,6 +478,16 @@ Case simulated(int size, int seed) {
   cv::erode(flat, flat, cv::Mat::ones(5, 5, CV_8U));
   c.roof = building & flat & scored;
   c.roof /= 255;
+  // Sloped facets (gable and hip roofs) away from their outlines, ridges and hips: building
+  // pixels whose true disparity is planar (second derivatives zero) but not level.
+  cv::Mat gxx, gyy, gxy;
+  cv::Sobel(truthFilled, gxx, CV_32F, 2, 0);
+  cv::Sobel(truthFilled, gyy, CV_32F, 0, 2);
+  cv::Sobel(truthFilled, gxy, CV_32F, 1, 1);
+  cv::Mat planar = (cv::abs(gxx) < 1e-3) & (cv::abs(gyy) < 1e-3) & (cv::abs(gxy) < 1e-3) & ~flat;
+  cv::erode(planar, planar, cv::Mat::ones(5, 5, CV_8U));
+  c.slopedRoof = building & planar & scored;
+  c.slopedRoof /= 255;
   c.evaluate = scored / 255;
   c.dmin = scene.disparityMin;
   c.dmax = scene.disparityMax;
