@@ -1244,7 +1244,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       // its shadow on the roof, of the same grey, form one region whose counterpart in the right
       // view a dark wall splits; the row ends gave a plane rising 0.47 px per column, up to 12 px
       // above the roof and 7.6 px above the highest match around (51.4-59.0), over the constant
-      // 57.95 (sim seed 24 1000²: roof RMS 0.330 -> 0.215 px without it). Where no constant
+      // 57.95 (sim seed 24 1000²: roof RMS 0.330 -> 0.215 px once refused). Where no constant
       // passed, the matches around may all be the ground, and a roof's facets rise above them
       // (test_match_fill.cpp's plain facets on textured ground: this rule left them unfilled).
       const auto outsideMatches = [&] {
