@@ -19,10 +19,12 @@
 #   fresh-5:  9 more (seeds 41-46 600², 21-23 1000²), first run at the start of session 25,
 #             before anything was chosen on it (seed 41 then looked at);
 #   fresh-6:  9 more (seeds 47-52 600², 24-26 1000²), first run at the start of session 29,
-#             before anything was chosen on it. Judge a change on all eight groups, and keep
-#             them apart.
+#             before anything was chosen on it;
+#   fresh-7:  9 more (seeds 53-58 600², 27-29 1000²), first run in session 29 to check the
+#             speckle size chosen on the eight groups above (20 -> 40 px). Judge a change on all
+#             nine groups, and keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
-# About three and a half minutes on 2 cores. Not a test: it prints numbers.
+# A few minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 build="$root/build/default"
@@ -68,6 +70,10 @@ fresh6=("s47-600|--size 600 --seed 47" "s48-600|--size 600 --seed 48"
   "s49-600|--size 600 --seed 49" "s50-600|--size 600 --seed 50" "s51-600|--size 600 --seed 51"
   "s52-600|--size 600 --seed 52" "s24-1000|--size 1000 --seed 24"
   "s25-1000|--size 1000 --seed 25" "s26-1000|--size 1000 --seed 26")
+fresh7=("s53-600|--size 600 --seed 53" "s54-600|--size 600 --seed 54"
+  "s55-600|--size 600 --seed 55" "s56-600|--size 600 --seed 56" "s57-600|--size 600 --seed 57"
+  "s58-600|--size 600 --seed 58" "s27-1000|--size 1000 --seed 27"
+  "s28-1000|--size 1000 --seed 28" "s29-1000|--size 1000 --seed 29")
 
 run_group() {
   local name=$1
@@ -107,3 +113,4 @@ run_group fresh-3 "${fresh3[@]}"
 run_group fresh-4 "${fresh4[@]}"
 run_group fresh-5 "${fresh5[@]}"
 run_group fresh-6 "${fresh6[@]}"
+run_group fresh-7 "${fresh7[@]}"

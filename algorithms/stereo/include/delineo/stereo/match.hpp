@@ -44,7 +44,7 @@ struct MatchParams {
                                      // this slope (0 = off)
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
   bool orderingCheck = true;         // matches a nearer one hides in the right view are rejected
-  int speckleSize = 20;              // px, matched regions smaller than this are removed (0 = off)
+  int speckleSize = 40;              // px, matched regions smaller than this are removed (0 = off)
   int speckleRange = 2;              // px, largest disparity difference within one such region
   int smoothWindow = 5;              // px, odd side of the surface-smoothing window (0 = off)
   double smoothTolerance = 1.0;      // px, largest difference to the centre within that window
