@@ -21,8 +21,10 @@
 #   fresh-6:  9 more (seeds 47-52 600², 24-26 1000²), first run at the start of session 29,
 #             before anything was chosen on it;
 #   fresh-7:  9 more (seeds 53-58 600², 27-29 1000²), first run in session 29 to check the
-#             speckle size chosen on the eight groups above (20 -> 40 px). Judge a change on all
-#             nine groups, and keep them apart.
+#             speckle size chosen on the eight groups above (20 -> 40 px);
+#   fresh-8:  9 more (seeds 59-64 600², 30-32 1000²), first run in session 29 to check the
+#             edges' decision of the fill (it never decides there). Judge a change on all ten
+#             groups, and keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
 # A few minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
@@ -74,6 +76,10 @@ fresh7=("s53-600|--size 600 --seed 53" "s54-600|--size 600 --seed 54"
   "s55-600|--size 600 --seed 55" "s56-600|--size 600 --seed 56" "s57-600|--size 600 --seed 57"
   "s58-600|--size 600 --seed 58" "s27-1000|--size 1000 --seed 27"
   "s28-1000|--size 1000 --seed 28" "s29-1000|--size 1000 --seed 29")
+fresh8=("s59-600|--size 600 --seed 59" "s60-600|--size 600 --seed 60"
+  "s61-600|--size 600 --seed 61" "s62-600|--size 600 --seed 62" "s63-600|--size 600 --seed 63"
+  "s64-600|--size 600 --seed 64" "s30-1000|--size 1000 --seed 30"
+  "s31-1000|--size 1000 --seed 31" "s32-1000|--size 1000 --seed 32")
 
 run_group() {
   local name=$1
@@ -114,3 +120,4 @@ run_group fresh-4 "${fresh4[@]}"
 run_group fresh-5 "${fresh5[@]}"
 run_group fresh-6 "${fresh6[@]}"
 run_group fresh-7 "${fresh7[@]}"
+run_group fresh-8 "${fresh8[@]}"

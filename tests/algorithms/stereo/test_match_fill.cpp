@@ -167,6 +167,7 @@ TEST(FillFlatRegions, AScanOfTheRangeConfirmsAnUnclearCandidate) {
   RegionFillSettings noScan;
   noScan.scanAgreement = 0;
   noScan.coreOpening = 0;  // the core (without the thin parts along the ground) lines up better
+  noScan.edgeDecideShare = 0;  // where the scan does not confirm, the roof's edges would decide
   fill(unscanned, noScan, 32);
   const int rows = scanned.roof.height - 6;
   EXPECT_EQ(rowsFilledToTheOutline(unscanned), 0);
