@@ -1138,7 +1138,24 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       }
       const auto [best, bestError, otherError] = ranked;
       candidateError = bestError;
-      if (bestError > settings.photometric * sigma) return std::nullopt;
+      // Where the ring alone cannot establish the candidate, the region's own edges in both
+      // views may still tell its disparity (see RegionFillSettings::edgeDecideShare), when the
+      // outline lines up there within the photometric limit. Sim seed 35 600²: a plain
+      // diamond-shaped roof at 31.47 px, 3 711 px, unmatched but 257 of them, whose ring lines
+      // up about as well elsewhere (plain surroundings: the scan below does not confirm the
+      // candidate); 65 of its 76 row ends read agree (16 at left ends), at 31.40: 3 578 of its
+      // pixels within 0.3 px, edge 84.4 → 94.4 %. Sim seed 29 1000²: a plain roof at 21.91 whose
+      // candidate, the matches' cluster mean 21.46, misses the limit (ring error 11.27 against
+      // 10.88; its edges give 21.82, 10.15): edge 86.8 → 89.7 %. A facet sloping along the rows
+      // agrees on one side only (sim seeds 10 1000², 12 and 34 600²: all of 31-78 agreeing ends on
+      // one side; filled level, bad-1 +0.2-0.5 point).
+      const auto decidedByEdges = [&]() -> std::optional<float> {
+        const auto edges = edgesDecide(best);
+        if (!edges || !(ringError(*edges) <= settings.photometric * sigma)) return std::nullopt;
+        constantError = ringError(*edges);
+        return edges;
+      };
+      if (bestError > settings.photometric * sigma) return decidedByEdges();
       // The scan compares errors within a few tenths of each other across the range, so it reads
       // the right view through the matches' grey map: the images' moments can be off by several
       // grey levels on a dark roof, the same at every disparity, which flattens the scan (seed
@@ -1152,17 +1169,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
           !(settings.scanAgreement > 0 &&
             scanConfirms(scanError, dmin, dmax, best, settings.scanAgreement,
                          settings.scanReach))) {
-        // The ring lines up about as well elsewhere (plain surroundings): the region's own edges
-        // in both views may still tell its disparity. Sim seed 35 600²: a plain diamond-shaped
-        // roof at 31.47 px, 3 711 px, unmatched but 257 of them; 65 of its 76 row ends read
-        // agree (16 at left ends), at 31.40: 3 578 of its pixels within 0.3 px, edge 84.4 →
-        // 94.4 %. A facet sloping along the rows agrees on one side only (sim seeds 10 1000²,
-        // 12 and 34 600²: all of 31-78 agreeing ends on one side; filled, bad-1 +0.2-0.5 point).
-        if (const auto edges = edgesDecide(best)) {
-          constantError = ringError(*edges);
-          return *edges;
-        }
-        return std::nullopt;
+        return decidedByEdges();
       }
       const double ringPixels = cv::countNonZero(ring);
       const auto vetoError = [&](float value, double stopAbove) {
