@@ -2,6 +2,8 @@
 // situation the small synthetic scenes do not produce.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <opencv2/core.hpp>
 
 #include "delineo/sim/scene.hpp"
@@ -10,34 +12,56 @@
 namespace delineo::stereo {
 namespace {
 
+// A simulated scene (the bench's square scene of `size`² and `seed`) and the adaptive matcher's
+// result on its views, or on the part `crop` of them (the truth stays the whole scene's).
+struct MatchedScene {
+  sim::Scene scene;
+  cv::Rect crop;
+  MatchResult result;
+};
+
+MatchedScene matchScene(int size, int seed, cv::Rect crop = {}) {
+  MatchedScene m{sim::simulateScene(sim::squareSceneParams(size, seed)), crop, {}};
+  if (m.crop.empty()) m.crop = cv::Rect(0, 0, m.scene.left.cols, m.scene.left.rows);
+  cv::Mat left, right;
+  m.scene.left(m.crop).convertTo(left, CV_32F);
+  m.scene.right(m.crop).convertTo(right, CV_32F);
+  MatchParams p;
+  p.dmin = m.scene.disparityMin;
+  p.dmax = m.scene.disparityMax;
+  m.result = matchStereo(left, right, p);
+  return m;
+}
+
+// Of the building pixels in `box` (scene coordinates) whose true disparity lies within
+// `levelTolerance` of `level`, how many there are and how many were matched within 0.3 px.
+std::pair<int, int> roofPixelsMatchedClosely(const MatchedScene& m, const cv::Rect& box,
+                                             float level, float levelTolerance) {
+  int roof = 0, within = 0;
+  for (int y = box.y; y < box.br().y; ++y) {
+    for (int x = box.x; x < box.br().x; ++x) {
+      const float truth = m.scene.disparity.at<float>(y, x);
+      if (!(std::abs(truth - level) < levelTolerance) ||
+          m.scene.labels.at<uchar>(y, x) != sim::kLabelBuilding) {
+        continue;
+      }
+      ++roof;
+      const float d = m.result.disparity.at<float>(y - m.crop.y, x - m.crop.x);
+      within += std::abs(d - truth) <= 0.3F ? 1 : 0;  // (NaN: not within)
+    }
+  }
+  return {roof, within};
+}
+
 TEST(MatchSimulated, ANearlyLevelPlainRoofTakesItsEdgesConstantOverAPlaneThatFitsNoBetter) {
   // Seed 24 600²: its largest roof, plain, at 53.45 px. No constant passed the fill's tests (the
   // matches around it are the ground's and a neighbour's), and the plane through its row ends
   // rises 2.7 px over it (52.65 at its centroid) yet lines its outline up no better than the
   // constant its edges give (ring error 14.67 against 14.57): it takes that constant (53.33).
   // Filled with the plane, its pixels were 0.76 px low on average.
-  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(600, 24));
-  cv::Mat left, right;
-  scene.left.convertTo(left, CV_32F);
-  scene.right.convertTo(right, CV_32F);
-  MatchParams p;
-  p.dmin = scene.disparityMin;
-  p.dmax = scene.disparityMax;
-  const MatchResult r = matchStereo(left, right, p);
-  const cv::Rect box(257, 115, 154, 153);
-  int roof = 0, within = 0;
-  for (int y = box.y; y < box.br().y; ++y) {
-    for (int x = box.x; x < box.br().x; ++x) {
-      const float truth = scene.disparity.at<float>(y, x);
-      if (!(std::abs(truth - 53.45F) < 0.01F) ||
-          scene.labels.at<uchar>(y, x) != sim::kLabelBuilding) {
-        continue;
-      }
-      ++roof;
-      const float d = r.disparity.at<float>(y, x);
-      within += std::abs(d - truth) <= 0.3F ? 1 : 0;  // (NaN: not within)
-    }
-  }
+  const MatchedScene m = matchScene(600, 24);
+  const auto [roof, within] =
+      roofPixelsMatchedClosely(m, cv::Rect(257, 115, 154, 153), 53.45F, 0.01F);
   ASSERT_GT(roof, 5000);  // the roof is where it was measured
   EXPECT_GT(within, roof * 85 / 100) << within << " of " << roof;
 }
@@ -51,20 +75,12 @@ TEST(MatchSimulated, APlainBoxAndItsShadowOfOneGreyDoNotTakeAPlaneRisingAboveThe
   // Matched on a 400² crop around the box, where the same constant and plane compete (on a
   // 240² crop no constant passes). Measured: with the rule off, 167 of the area's 521 matches
   // above 60 px (that plane filled); with it, none of 434.
-  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(1000, 24));
-  const cv::Rect crop(600, 100, 400, 400);
-  cv::Mat left, right;
-  scene.left(crop).convertTo(left, CV_32F);
-  scene.right(crop).convertTo(right, CV_32F);
-  MatchParams p;
-  p.dmin = scene.disparityMin;
-  p.dmax = scene.disparityMax;
-  const MatchResult r = matchStereo(left, right, p);
-  const cv::Rect area(870 - crop.x, 290 - crop.y, 30, 22);
+  const MatchedScene m = matchScene(1000, 24, cv::Rect(600, 100, 400, 400));
+  const cv::Rect area(870 - m.crop.x, 290 - m.crop.y, 30, 22);
   int matched = 0, high = 0;
   for (int y = area.y; y < area.br().y; ++y) {
     for (int x = area.x; x < area.br().x; ++x) {
-      const float d = r.disparity.at<float>(y, x);
+      const float d = m.result.disparity.at<float>(y, x);
       if (!std::isfinite(d)) continue;
       ++matched;
       high += d > 60.0F ? 1 : 0;  // above the box (57.8) by more than 2 px
@@ -80,24 +96,8 @@ TEST(MatchSimulated, APlainRoofWhoseRingIsAmbiguousTakesTheConstantItsEdgesAgree
   // both views agree on 65 of the 76 row ends read, on both sides (16 at left ends), at 31.40.
   // Measured: 137 of its 3 711 pixels within 0.3 px when the edges may not decide, 3 578 when
   // they may.
-  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(600, 35));
-  cv::Mat left, right;
-  scene.left.convertTo(left, CV_32F);
-  scene.right.convertTo(right, CV_32F);
-  MatchParams p;
-  p.dmin = scene.disparityMin;
-  p.dmax = scene.disparityMax;
-  const MatchResult r = matchStereo(left, right, p);
-  const cv::Rect box(102, 204, 97, 96);
-  int roof = 0, within = 0;
-  for (int y = box.y; y < box.br().y; ++y) {
-    for (int x = box.x; x < box.br().x; ++x) {
-      const float truth = scene.disparity.at<float>(y, x);
-      if (!(std::abs(truth - 31.47F) < 0.1F)) continue;
-      ++roof;
-      within += std::abs(r.disparity.at<float>(y, x) - truth) <= 0.3F ? 1 : 0;  // (NaN: not)
-    }
-  }
+  const MatchedScene m = matchScene(600, 35);
+  const auto [roof, within] = roofPixelsMatchedClosely(m, cv::Rect(102, 204, 97, 96), 31.47F, 0.1F);
   ASSERT_GT(roof, 3000);  // the roof is where it was measured
   EXPECT_GT(within, roof * 9 / 10) << within << " of " << roof;
 }
