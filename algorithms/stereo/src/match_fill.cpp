@@ -393,7 +393,9 @@ std::optional<double> subpixelEdge(const float* row, int cols, int start, int st
 struct RowEnds {
   int y, l0, l1;
 };
-std::vector<RowEnds> regionRowEnds(const cv::Mat& region, const cv::Rect& box) {
+// The rows of `region` (over `box`) whose ends lie at least `minSpan` px apart (a sloped facet's
+// row ends need 2: a tip's rows tell nothing of its slope).
+std::vector<RowEnds> regionRowEnds(const cv::Mat& region, const cv::Rect& box, int minSpan = 2) {
   std::vector<RowEnds> rows;
   for (int y = 0; y < box.height; ++y) {
     const uchar* m = region.ptr<uchar>(y);
@@ -403,9 +405,24 @@ std::vector<RowEnds> regionRowEnds(const cv::Mat& region, const cv::Rect& box) {
       if (first < 0) first = x;
       last = x;
     }
-    if (first >= 0 && last - first >= 2) rows.push_back({box.y + y, box.x + first, box.x + last});
+    if (first >= 0 && last - first >= minSpan) {
+      rows.push_back({box.y + y, box.x + first, box.x + last});
+    }
   }
   return rows;
+}
+
+// The lowest and highest value of `plane` over the rows `rows` (a plane's extremes on a row are
+// at its ends).
+std::pair<double, double> planeRange(const FillPlane& plane, const std::vector<RowEnds>& rows) {
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  for (const RowEnds& r : rows) {
+    for (const int x : {r.l0, r.l1}) {
+      lowest = std::min(lowest, plane.at(x, r.y));
+      highest = std::max(highest, plane.at(x, r.y));
+    }
+  }
+  return {lowest, highest};
 }
 
 // A row's search band in the right view (`cols` px wide): the columns its ends can map to.
@@ -581,13 +598,7 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
   // slope of noise); one outside the plane's range over the region says the counterpart is
   // another surface of the same grey.
   if (constant) {
-    double lowest = 1e30, highest = -1e30;
-    for (const RowEnds& r : rows) {
-      for (const int x : {r.l0, r.l1}) {
-        lowest = std::min(lowest, plane.at(x, r.y));
-        highest = std::max(highest, plane.at(x, r.y));
-      }
-    }
+    const auto [lowest, highest] = planeRange(plane, rows);
     if (*constant < lowest - settings.planeInlier || *constant > highest + settings.planeInlier) {
       return false;
     }
@@ -1060,8 +1071,13 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     };
     // The constant its edges in both views give a plain region, when edgeMinSamples or more row
     // ends give one within edgeReach of `reference` (see RegionFillSettings::edgeMinSamples).
-    const auto edgeConstantNear = [&](double reference) -> std::optional<float> {
-      if (settings.edgeMinSamples <= 0) return std::nullopt;
+    // `decide`: only when the edges alone can decide (see RegionFillSettings::edgeDecideShare):
+    // most row ends read agree, on both sides of the region.
+    const auto edgeConstantNear = [&](double reference,
+                                      bool decide = false) -> std::optional<float> {
+      if (settings.edgeMinSamples <= 0 || (decide && settings.edgeDecideShare <= 0)) {
+        return std::nullopt;
+      }
       const EdgeReading edges =
           edgeDisparity(left, right, region, box, rightFlatRegionsOf(), matchedGain, matchedOffset,
                         sigma, dmin, dmax, static_cast<float>(reference), settings.edgeReach);
@@ -1069,20 +1085,9 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
           std::abs(edges.value - reference) > settings.edgeReach) {
         return std::nullopt;
       }
-      return static_cast<float>(edges.value);
-    };
-    // The same constant when the edges alone can decide (see RegionFillSettings::
-    // edgeDecideShare): most row ends read agree, on both sides of the region.
-    const auto edgesDecide = [&](double reference) -> std::optional<float> {
-      if (settings.edgeMinSamples <= 0 || settings.edgeDecideShare <= 0) return std::nullopt;
-      const EdgeReading edges =
-          edgeDisparity(left, right, region, box, rightFlatRegionsOf(), matchedGain, matchedOffset,
-                        sigma, dmin, dmax, static_cast<float>(reference), settings.edgeReach);
-      if (edges.samples < settings.edgeMinSamples ||
-          edges.samples < settings.edgeDecideShare * edges.read ||
-          edges.fromLeftEnds < settings.edgeDecidePerSide ||
-          edges.samples - edges.fromLeftEnds < settings.edgeDecidePerSide ||
-          std::abs(edges.value - reference) > settings.edgeReach) {
+      if (decide && (edges.samples < settings.edgeDecideShare * edges.read ||
+                     edges.fromLeftEnds < settings.edgeDecidePerSide ||
+                     edges.samples - edges.fromLeftEnds < settings.edgeDecidePerSide)) {
         return std::nullopt;
       }
       return static_cast<float>(edges.value);
@@ -1150,9 +1155,11 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       // agrees on one side only (sim seeds 10 1000², 12 and 34 600²: all of 31-78 agreeing ends on
       // one side; filled level, bad-1 +0.2-0.5 point).
       const auto decidedByEdges = [&]() -> std::optional<float> {
-        const auto edges = edgesDecide(best);
-        if (!edges || !(ringError(*edges) <= settings.photometric * sigma)) return std::nullopt;
-        constantError = ringError(*edges);
+        const auto edges = edgeConstantNear(best, true);
+        if (!edges) return std::nullopt;
+        const double error = ringError(*edges);
+        if (!(error <= settings.photometric * sigma)) return std::nullopt;
+        constantError = error;
         return edges;
       };
       if (bestError > settings.photometric * sigma) return decidedByEdges();
@@ -1294,16 +1301,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       // passed, the matches around may all be the ground, and a roof's facets rise above them
       // (test_match_fill.cpp's plain facets on textured ground: this rule left them unfilled).
       const auto outsideMatches = [&] {
-        double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
-        for (int y = 0; y < box.height; ++y) {
-          const uchar* m = region.ptr<uchar>(y);
-          for (int x = 0; x < box.width; ++x) {
-            if (!m[x]) continue;
-            const double value = plane.at(box.x + x, box.y + y);
-            lowest = std::min(lowest, value);
-            highest = std::max(highest, value);
-          }
-        }
+        const auto [lowest, highest] = planeRange(plane, regionRowEnds(region, box, 0));
         return highest > highestMatch + settings.planeInlier ||
                lowest < lowestMatch - settings.planeInlier;
       };
