@@ -277,17 +277,16 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
         h, settings.threads,
         [&](int rowStart, int rowEnd) {
           auto& [lo, hi] = bandRange[static_cast<size_t>(rowStart / bandRows)];
-          bool seen = false;
           for (int y = rowStart; y < rowEnd; ++y) {
             const float* d = disparity.ptr<float>(y);
+            // Without branches, so that it vectorises (with them: 6 ms at 1 Mpx); a comparison
+            // with NaN is false, so an unmatched pixel never wins.
             for (int x = 0; x < w; ++x) {
-              if (d[x] != d[x]) continue;
-              lo = std::min(lo, d[x]);
-              hi = std::max(hi, d[x]);
-              seen = true;
+              lo = d[x] < lo ? d[x] : lo;
+              hi = d[x] > hi ? d[x] : hi;
             }
           }
-          if (seen) found = true;
+          if (lo <= hi) found = true;
         },
         bandRows);
     double mn = 0, mx = 0;

@@ -1,6 +1,7 @@
 #pragma once
 // Image noise and the grey-level map between the two views (internal to delineo_stereo).
 #include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -23,5 +24,9 @@ std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv:
                                                   const cv::Mat& disparity,
                                                   std::pair<double, double> fallback,
                                                   int minPairs = 1000);
+
+// The middle value of `values`, the upper one of an even count: the element std::nth_element
+// puts at size / 2, without reordering a copy of a large set.
+double middleValue(const std::vector<double>& values);
 
 }  // namespace delineo::stereo::detail

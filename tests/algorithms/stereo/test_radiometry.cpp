@@ -3,8 +3,10 @@
 // not.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -84,6 +86,30 @@ TEST(Radiometry, WrongMatchesAtTheEndOfTheGreyRangeDoNotPullTheMatchesMap) {
   // Where a grey level of 140 (the roof) and of 60 land in the left view's levels.
   EXPECT_NEAR(gain * 140.0 + offset, 140.0, 0.5);
   EXPECT_NEAR(gain * 60.0 + offset, 60.0, 1.0);
+}
+
+// The bucket selection gives the element nth_element puts in the middle, on sets with heavy
+// ties, a long tail, negative values, one value only, and both parities.
+TEST(Radiometry, MiddleValueIsTheMiddleElement) {
+  cv::RNG rng(7);
+  const auto nthMiddle = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  for (const int n : {1, 2, 101, 4095, 4096, 20001, 250000}) {
+    std::vector<double> uniform(static_cast<size_t>(n)), tied(static_cast<size_t>(n)),
+        tailed(static_cast<size_t>(n)), constant(static_cast<size_t>(n), -3.25);
+    for (int i = 0; i < n; ++i) {
+      uniform[static_cast<size_t>(i)] = rng.uniform(-50.0, 200.0);
+      tied[static_cast<size_t>(i)] = std::round(rng.uniform(0.0, 4.0));  // five values
+      // Most within a grey level, a few thousand levels out: one bin would hold nearly all.
+      tailed[static_cast<size_t>(i)] =
+          i % 97 == 0 ? rng.uniform(1000.0, 5000.0) : std::abs(rng.gaussian(0.7));
+    }
+    for (const auto* values : {&uniform, &tied, &tailed, &constant}) {
+      EXPECT_EQ(middleValue(*values), nthMiddle(*values)) << n;
+    }
+  }
 }
 
 }  // namespace
