@@ -14,55 +14,67 @@ namespace {
 // The wider neighbourhood's radius, and the extra margin its intervals get (see the header).
 constexpr int kWideRadius = 4;
 constexpr int kWideExtraMargin = 7;  // px, at the finer level
+// The widest neighbourhood's radius, above the finest level and at it (see the header).
+constexpr int kWidestRadiusAbove = 12;
+constexpr int kWidestRadiusFinest = 16;
 
 // One coarse row of intervalsFromCoarse(): from the 3x3 min/max (n0, n1) or, where the 3x3
-// neighbourhood holds no valid disparity, the wide one (w0, w1); the full range where `full`
-// (may be null) is non-zero. Also built for AVX2 (floor and ceil in one instruction each).
+// neighbourhood holds no valid disparity, the wide one (w0, w1); from the widest one (f0, f1)
+// where `beside` (may be null) is non-zero or both are empty; the full range where that is
+// empty too. Also built for AVX2 (floor and ceil in one instruction each).
 __attribute__((target_clones("avx2", "default"))) void coarseIntervalRow(
-    const float* n0, const float* n1, const float* w0, const float* w1, const uchar* full, int cw,
-    int dmin, int dmax, int margin, int* l, int* h) {
+    const float* n0, const float* n1, const float* w0, const float* w1, const float* f0,
+    const float* f1, const uchar* beside, int cw, int dmin, int dmax, int margin, int* l, int* h) {
   for (int x = 0; x < cw; ++x) {
     const bool isNear = n0[x] <= n1[x];
-    if ((full == nullptr || full[x] == 0) && (isNear || w0[x] <= w1[x])) {
-      const float mn = isNear ? n0[x] : w0[x], mx = isNear ? n1[x] : w1[x];
-      const int m = isNear ? margin : margin + kWideExtraMargin;
-      l[x] = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - m);
-      h[x] = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + m);
-    } else {
+    const bool widest = (beside != nullptr && beside[x] != 0) || !(isNear || w0[x] <= w1[x]);
+    if (widest && !(f0[x] <= f1[x])) {
       l[x] = dmin;
       h[x] = dmax;
+      continue;
     }
+    const float mn = widest ? f0[x] : isNear ? n0[x] : w0[x];
+    const float mx = widest ? f1[x] : isNear ? n1[x] : w1[x];
+    const int m = isNear && !widest ? margin : margin + kWideExtraMargin;
+    l[x] = std::max(dmin, static_cast<int>(std::floor(2.0F * mn)) - m);
+    h[x] = std::min(dmax, static_cast<int>(std::ceil(2.0F * mx)) + m);
   }
 }
 }  // namespace
 
 void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
-                         bool fullNearRejected, int threads, cv::Mat& lo, cv::Mat& hi) {
+                         bool widenNearRejected, int threads, cv::Mat& lo, cv::Mat& hi) {
   const int cw = coarse.cols, ch = coarse.rows;
   // Neighbourhood minima and maxima of the valid coarse disparities (rejected pixels ignored;
   // the border does not extend the neighbourhood).
   constexpr float kInf = std::numeric_limits<float>::infinity();
   cv::Mat forMin, forMax, rejected;
   rangeFilterInputs(coarse, kInf, -kInf, threads, forMin, forMax);
-  if (fullNearRejected) cv::compare(forMin, kInf, rejected, cv::CMP_EQ);  // 255 where rejected
-  cv::Mat mn1, mx1, mnWide, mxWide, nearRejected;
-  const cv::Mat near = cv::Mat::ones(3, 3, CV_8U);
-  const cv::Mat wide = cv::Mat::ones(2 * kWideRadius + 1, 2 * kWideRadius + 1, CV_8U);
-  // The two pairs of filters and the rejected pixels' dilation as three tasks (each pair on one
+  if (widenNearRejected) cv::compare(forMin, kInf, rejected, cv::CMP_EQ);  // 255 where rejected
+  cv::Mat mn1, mx1, mnWide, mxWide, mnWidest, mxWidest, nearRejected;
+  const auto square = [](int radius) {
+    return cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_8U);
+  };
+  const int widestRadius = widenNearRejected ? kWidestRadiusAbove : kWidestRadiusFinest;
+  // The three pairs of filters and the rejected pixels' dilation as four tasks (each pair on one
   // worker: the coarse level is small).
-  runTasks({[&] { rangeFilters(forMin, forMax, near, kInf, -kInf, 1, mn1, mx1); },
-            [&] { rangeFilters(forMin, forMax, wide, kInf, -kInf, 1, mnWide, mxWide); },
-            [&] {
-              if (fullNearRejected) cv::dilate(rejected, nearRejected, near);
-            }},
-           threads);
+  runTasks(
+      {[&] { rangeFilters(forMin, forMax, square(1), kInf, -kInf, 1, mn1, mx1); },
+       [&] { rangeFilters(forMin, forMax, square(kWideRadius), kInf, -kInf, 1, mnWide, mxWide); },
+       [&] {
+         rangeFilters(forMin, forMax, square(widestRadius), kInf, -kInf, 1, mnWidest, mxWidest);
+       },
+       [&] {
+         if (widenNearRejected) cv::dilate(rejected, nearRejected, square(1));
+       }},
+      threads);
   cv::Mat clo(coarse.size(), CV_32S), chi(coarse.size(), CV_32S);
   // By bands of rows on the level's threads (serial, ~0.3 % of the run's instructions).
   forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
     for (int y = rowStart; y < rowEnd; ++y) {
       coarseIntervalRow(mn1.ptr<float>(y), mx1.ptr<float>(y), mnWide.ptr<float>(y),
-                        mxWide.ptr<float>(y),
-                        fullNearRejected ? nearRejected.ptr<uchar>(y) : nullptr, cw, dmin, dmax,
+                        mxWide.ptr<float>(y), mnWidest.ptr<float>(y), mxWidest.ptr<float>(y),
+                        widenNearRejected ? nearRejected.ptr<uchar>(y) : nullptr, cw, dmin, dmax,
                         margin, clo.ptr<int>(y), chi.ptr<int>(y));
     }
   });

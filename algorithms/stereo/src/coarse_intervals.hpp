@@ -10,22 +10,26 @@ namespace delineo::stereo::detail {
 // ± margin. Where that neighbourhood holds no valid disparity (the parent was rejected), the
 // same from a wider 9x9 neighbourhood: a rejected pixel lies on the surfaces
 // around it far more often than anywhere in the range, and searching the full range there made
-// the finer level both slower and more prone to wrong peaks. Only when that wider
-// neighbourhood is empty too is the level's full range searched (as in the paper).
-// Such a wider neighbourhood says less about the pixel: its interval gets 7 px more on each
+// the finer level both slower and more prone to wrong peaks. Where that one is empty too, the
+// same from the widest neighbourhood (25x25 coarse pixels above the finest level, 33x33 for the
+// finest); only when that is empty as well is the level's full range searched (as in the paper).
+// Such wider neighbourhoods say less about the pixel: their intervals get 7 px more on each
 // side. Rejected coarse pixels cluster on large weakly textured roofs, whose true value
 // then often lay just outside the interval, a border peak that was rejected (sim 1000²/128 d:
 // density 84.6 → 85.2 %, bad-1 1.55 → 1.43 %; 8+ raised the 600² roofRMS1 to 0.250–0.252 px).
 //
-// With `fullNearRejected`, a pixel whose coarse 3x3 neighbourhood holds a rejected pixel is
-// given the full range (the paper gives it to the rejected pixels only): next to a rejected
-// pixel the coarse disparities are the least sure (a tree's carried into the roof beside it,
-// 2000²), and a wrong interval is never left again. Only above the finest level: there the
-// finest level's repeated seams lined up elsewhere (1000² / 128 d, docs/stereo.md, session 22).
+// With `widenNearRejected`, a pixel whose coarse 3x3 neighbourhood holds a rejected pixel gets the
+// widest neighbourhood's interval (the paper gives the full range to the rejected pixels only):
+// next to a rejected pixel the coarse disparities are the least sure (a tree's carried into the
+// roof beside it, 2000²), and a wrong interval is never left again. Only above the finest level:
+// there the finest level's repeated seams lined up elsewhere (1000² / 128 d, docs/stereo.md,
+// session 22). Until session 30 such pixels searched the full range: 41 % of the pixels of the
+// level below the finest at 1000² / 128 d, a fifth of the matching's time; the widest
+// neighbourhood (50 px at the finer level) holds the surfaces on both sides of such a boundary.
 //
 // `coarse`: CV_32F, NaN where rejected; `size`: the level's size (twice the coarse one, ±1);
 // `lo`, `hi`: out, CV_32S, the inclusive interval of each pixel within dmin..dmax.
 void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
-                         bool fullNearRejected, int threads, cv::Mat& lo, cv::Mat& hi);
+                         bool widenNearRejected, int threads, cv::Mat& lo, cv::Mat& hi);
 
 }  // namespace delineo::stereo::detail

@@ -508,11 +508,11 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       loR = inL.lo;
       hiR = inL.hi;
     } else {
-      const bool fullNearRejected = k > 0;
+      const bool widenNearRejected = k > 0;
       detail::intervalsFromCoarse(coarseLeft, lv.left.size(), lv.dmin, lv.dmax, p.margin,
-                                  fullNearRejected, threads, inL.lo, inL.hi);
+                                  widenNearRejected, threads, inL.lo, inL.hi);
       detail::intervalsFromCoarse(coarseRight, lv.left.size(), lv.dmin, lv.dmax, p.margin,
-                                  fullNearRejected, threads, loR, hiR);
+                                  widenNearRejected, threads, loR, hiR);
     }
     const double w = levelsShare * weight[static_cast<size_t>(k)] / total;
     core::Progress::Range leftRange(progress, done, done + 0.5 * w);

@@ -43,30 +43,44 @@ TEST(IntervalsFromCoarse, TheParentsNeighbourhoodDoubledWithTheMargin) {
   EXPECT_EQ(iv.at(1, 8), std::make_pair(18, kDmax));
 }
 
-TEST(IntervalsFromCoarse, ARejectedNeighbourhoodTakesTheWideOneAndAnEmptyOneTheFullRange) {
-  cv::Mat coarse(20, 20, CV_32F, cv::Scalar(10.0));
-  coarse(cv::Rect(2, 2, 5, 5)).setTo(kNaN);    // (4, 4)'s 3x3 all rejected, its 9x9 not
-  coarse(cv::Rect(11, 0, 9, 20)).setTo(kNaN);  // (16, 10)'s 9x9 all rejected
+TEST(IntervalsFromCoarse, ARejectedNeighbourhoodTakesTheWideOneThenTheWidestThenTheFullRange) {
+  cv::Mat coarse(50, 50, CV_32F, cv::Scalar(10.0));
+  coarse(cv::Rect(2, 2, 5, 5)).setTo(kNaN);     // (4, 4)'s 3x3 all rejected, its 9x9 not
+  coarse(cv::Rect(40, 0, 10, 12)).setTo(kNaN);  // (45, 5)'s 9x9 all rejected, its 33x33 not
+  coarse.at<float>(0, 30) = 12.0F;              // ... which holds 12 too (15 px left of it)
+  coarse(cv::Rect(0, 16, 50, 34)).setTo(kNaN);  // (25, 33)'s 33x33 all rejected
   const Intervals iv = intervals(coarse, false);
   EXPECT_EQ(iv.at(4, 4), std::make_pair(20 - kMargin - 7, 20 + kMargin + 7));
-  EXPECT_EQ(iv.at(16, 10), std::make_pair(kDmin, kDmax));
+  EXPECT_EQ(iv.at(45, 5), std::make_pair(20 - kMargin - 7, 24 + kMargin + 7));
+  EXPECT_EQ(iv.at(25, 33), std::make_pair(kDmin, kDmax));
 }
 
-TEST(IntervalsFromCoarse, TheFullRangeBesideARejectedPixelOnlyWhenAsked) {
-  cv::Mat coarse(10, 10, CV_32F, cv::Scalar(10.0));
+TEST(IntervalsFromCoarse, TheWidestRangeBesideARejectedPixelOnlyWhenAsked) {
+  cv::Mat coarse(30, 30, CV_32F, cv::Scalar(10.0));
   coarse.at<float>(3, 3) = kNaN;
+  coarse.at<float>(3, 14) = 13.0F;  // 9 to 12 coarse px right of the rejected pixel's 3x3
   const Intervals narrow = intervals(coarse, false);
-  const Intervals full = intervals(coarse, true, 3);
-  // The rejected pixel and its 8 neighbours: from their valid neighbours, or the full range.
+  const Intervals widened = intervals(coarse, true, 3);
+  // The rejected pixel and its 8 neighbours: from their valid neighbours, or from the 25x25
+  // neighbourhood (which reaches the 13) with the wider margin.
   for (int cy = 2; cy <= 4; ++cy) {
     for (int cx = 2; cx <= 4; ++cx) {
       EXPECT_EQ(narrow.at(cx, cy), std::make_pair(18, 22)) << cx << "," << cy;
-      EXPECT_EQ(full.at(cx, cy), std::make_pair(kDmin, kDmax)) << cx << "," << cy;
+      EXPECT_EQ(widened.at(cx, cy), std::make_pair(20 - kMargin - 7, 26 + kMargin + 7))
+          << cx << "," << cy;
     }
   }
   // One pixel farther, the same either way.
-  EXPECT_EQ(full.at(5, 3), std::make_pair(18, 22));
-  EXPECT_EQ(full.at(3, 1), std::make_pair(18, 22));
+  EXPECT_EQ(widened.at(5, 3), std::make_pair(18, 22));
+  EXPECT_EQ(widened.at(3, 1), std::make_pair(18, 22));
+  // One valid pixel in a rejected level: its widened interval up to 12 coarse px from it, the
+  // full range farther.
+  cv::Mat oneValid(30, 30, CV_32F, cv::Scalar(kNaN));
+  oneValid.at<float>(0, 29) = 10.0F;
+  const Intervals sparse = intervals(oneValid, true);
+  EXPECT_EQ(sparse.at(17, 12), std::make_pair(20 - kMargin - 7, 20 + kMargin + 7));
+  EXPECT_EQ(sparse.at(16, 1), std::make_pair(kDmin, kDmax));
+  EXPECT_EQ(sparse.at(3, 28), std::make_pair(kDmin, kDmax));
 }
 
 TEST(IntervalsFromCoarse, AnOddLevelSizeTakesTheLastCoarsePixel) {
