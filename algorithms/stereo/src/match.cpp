@@ -620,20 +620,23 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       for (int x = 0; x < result.score.cols; ++x) out[x] = d[x] == d[x] ? sc[x] : kNaN;
     }
   });
-  // The fill runs on one worker; the snapping's contrast map (images only) is prepared on the
-  // other meanwhile, after the fill's right-view flat regions.
+  // The fill runs on one worker; the snapping's contrast map and the plain pixels of the weak
+  // matches' wider pass (images only) are prepared on the other meanwhile, after the fill's own
+  // preparations there.
   core::setStage(progress, core::StageId::FillingFlatRegions);
   detail::StepContrast contrast;
-  std::function<void()> prepareContrast;
-  if (p.snapSteps && p.adaptive) {
-    prepareContrast = [&] { contrast = detail::stepContrast(left, right); };
-  }
+  cv::Mat plain;
+  const bool plainPass = p.adaptive && p.plainStepMinScore > 0;
+  const auto prepareImages = [&] {
+    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right);
+    if (plainPass) plain = detail::plainPixels(left, 3.0);
+  };
   if (p.fillRegions && p.adaptive) {
     detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
                             static_cast<float>(p.minScore), result.disparity, result.score, threads,
-                            prepareContrast);
-  } else if (prepareContrast) {
-    prepareContrast();
+                            prepareImages);
+  } else {
+    prepareImages();
   }
   // After the fill, whose candidates are the matches around a region (before it, a roof's weak
   // edge matches went and the fill took a box on it for the whole roof: sim seed 15 600², roof
@@ -650,13 +653,13 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // missed (seed 28 600²: an 8 px patch 62 px off, 4-7 px inside the roof, scoring 0.53-0.59;
   // roof RMS 0.919 -> 0.210 px). Textured pixels are left alone: on the Dublin tile the same pass
   // over every pixel removed 3.8 points of density whose bad-2 was below the rest's.
-  if (p.adaptive && p.plainStepMinScore > 0) {
+  if (plainPass) {
     detail::WeakMatchSettings wide;
     wide.minScore = p.plainStepMinScore;
     wide.radius = 7;
     wide.threads = threads;
     detail::rejectWeakMatchesBesideSteps(wide, static_cast<float>(p.minScore), result.disparity,
-                                         result.score, detail::plainPixels(left, 3.0));
+                                         result.score, plain);
   }
   // Then the steep facets left unmatched, matched region by region on slanted planes; before the
   // speckles, the snapping and the ordering check, which treat their matches like any other.

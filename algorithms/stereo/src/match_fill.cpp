@@ -956,11 +956,26 @@ EdgeReading edgeDisparity(const cv::Mat& left, const cv::Mat& right, const cv::M
   return reading;
 }
 
-// The fill itself; `rightFlatRegionsOf()` gives the right view's flat regions.
-template <class RightFlat>
+// The grey-level maps of the right view to the left: from the images' moments over the range,
+// and from the pairs the disparity map matches (that one as the fallback).
+struct GreyMaps {
+  std::pair<double, double> images, matches;
+};
+
+GreyMaps greyMaps(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity, int dmin,
+                  int dmax) {
+  GreyMaps maps;
+  maps.images = radiometricMap(left, right, dmin, dmax);
+  maps.matches = radiometricMapOfMatches(left, right, disparity, maps.images);
+  return maps;
+}
+
+// The fill itself; `greyMapsOf()` gives greyMaps() of the disparities as they come in (read
+// before the fill writes any), `rightFlatRegionsOf()` the right view's flat regions.
+template <class GreyMapsOf, class RightFlat>
 int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                 int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
-                const RightFlat& rightFlatRegionsOf) {
+                const GreyMapsOf& greyMapsOf, const RightFlat& rightFlatRegionsOf) {
   double sigma = 0;
   const cv::Mat flat = flatMask(left, settings, &sigma);
   // The regions without their thin parts (see RegionFillSettings::coreOpening).
@@ -980,15 +995,15 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       if (l[x] != 0 && !std::isfinite(d[x])) ++unmatched[static_cast<size_t>(l[x])];
     }
   }
-  const auto [gain, offset] = radiometricMap(left, right, dmin, dmax);
+  const GreyMaps& greyMaps = greyMapsOf();
+  const auto [gain, offset] = greyMaps.images;
   // A sloped facet's counterpart is chosen by its grey level, so the map must hold at that level:
   // the one of the matched pairs does (seed 5's dark hip facet: the images' moments put its
   // counterpart 5.9 levels off, the matches 0.8). So does the scan that confirms an unclear
   // candidate (see scanConfirms below). The other tests keep the images' map, which their
   // tolerances were measured with (all of them on the matches' map: 600² edge 92.0 -> 89.9 in
   // session 15; in session 26, hip facets filled with a constant on seeds 6 and 38 600²).
-  const auto [matchedGain, matchedOffset] =
-      radiometricMapOfMatches(left, right, disparity, {gain, offset});
+  const auto [matchedGain, matchedOffset] = greyMaps.matches;
   const std::pair<double, double> imagesMap{gain, offset}, matchesMap{matchedGain, matchedOffset};
   const double maxArea = settings.maxShare * static_cast<double>(left.total());
   const cv::Rect image(0, 0, left.cols, left.rows);
@@ -1436,21 +1451,31 @@ cv::Mat plainPixels(const cv::Mat& image, double sigmas) {
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads, const std::function<void()>& alongside) {
-  // With a second worker, it makes the right view's flat regions and then runs `alongside`,
-  // while this one makes the left ones and fills the regions, waiting for the right ones only
-  // when a region first needs them (about as long to make as the left ones).
+  // With a second worker, it makes the grey maps, the right view's flat regions and then runs
+  // `alongside`, while this one makes the left flat regions and fills them, waiting for each of
+  // the other's results only when it first needs it (the grey maps come first: the fill needs
+  // them before its first region, the right flat regions only at a region's edges or facets).
   if (threads > 1 && settings.planeMinRows > 0) {
+    GreyMaps maps;
     RightFlatRegions rightFlat;
-    std::latch rightReady(1);
+    std::latch mapsReady(1), rightReady(1);
     int filled = 0;
     runTasks({[&] {
-                filled = fillRegions(left, right, settings, dmin, dmax, fillScore, disparity, score,
-                                     [&]() -> const RightFlatRegions& {
-                                       rightReady.wait();
-                                       return rightFlat;
-                                     });
+                filled = fillRegions(
+                    left, right, settings, dmin, dmax, fillScore, disparity, score,
+                    [&]() -> const GreyMaps& {
+                      mapsReady.wait();
+                      return maps;
+                    },
+                    [&]() -> const RightFlatRegions& {
+                      rightReady.wait();
+                      return rightFlat;
+                    });
               },
               [&] {
+                // Reads the disparities before the fill writes any: the fill waits for it first.
+                maps = greyMaps(left, right, disparity, dmin, dmax);
+                mapsReady.count_down();
                 rightFlat = rightFlatRegions(flatMask(right, settings), right);
                 rightReady.count_down();
                 if (alongside) alongside();
@@ -1460,13 +1485,15 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
   }
   // Else the right view's flat regions only when a region first needs them.
   RightFlatRegions rightFlat;
-  const int filled = fillRegions(left, right, settings, dmin, dmax, fillScore, disparity, score,
-                                 [&]() -> const RightFlatRegions& {
-                                   if (rightFlat.labels.empty()) {
-                                     rightFlat = rightFlatRegions(flatMask(right, settings), right);
-                                   }
-                                   return rightFlat;
-                                 });
+  const GreyMaps maps = greyMaps(left, right, disparity, dmin, dmax);
+  const int filled = fillRegions(
+      left, right, settings, dmin, dmax, fillScore, disparity, score,
+      [&]() -> const GreyMaps& { return maps; },
+      [&]() -> const RightFlatRegions& {
+        if (rightFlat.labels.empty())
+          rightFlat = rightFlatRegions(flatMask(right, settings), right);
+        return rightFlat;
+      });
   if (alongside) alongside();
   return filled;
 }

@@ -183,15 +183,16 @@ struct RegionFillSettings {
 // (sim seed 18 1000²: a roof at 43.29 filled at 45.2, 43.3 from its edges; docs/stereo.md,
 // session 28).
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
-// `threads` > 1: the right view's flat regions are made on a second worker, which then runs
-// `alongside` (the caller's own work, independent of the fill) while the fill goes on; else
-// `alongside` runs after the fill. Same result on any number of threads.
-// Pixels of `image` (CV_32F, NaN = nodata) whose 5x5 standard deviation is below `sigmas` times
-// the image's noise sigma (CV_8U 0/255): the fill's flat test, at another threshold.
-cv::Mat plainPixels(const cv::Mat& image, double sigmas);
-
+// `threads` > 1: the grey maps and the right view's flat regions are made on a second worker,
+// which then runs `alongside` (the caller's own work on the images: it must not touch the
+// disparities the fill writes) while the fill goes on; else `alongside` runs after the fill.
+// Same result on any number of threads.
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads = 1, const std::function<void()>& alongside = {});
+
+// Pixels of `image` (CV_32F, NaN = nodata) whose 5x5 standard deviation is below `sigmas` times
+// the image's noise sigma (CV_8U 0/255): the fill's flat test, at another threshold.
+cv::Mat plainPixels(const cv::Mat& image, double sigmas);
 
 }  // namespace delineo::stereo::detail
