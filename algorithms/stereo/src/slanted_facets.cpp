@@ -25,17 +25,23 @@ struct Plane {
   double at(double x, double y) const { return a + gx * (x - cx) + gy * (y - cy); }
 };
 
-// Left grey levels of a set of pixels, centred on their mean (NCC then needs only Σ a·b).
+// Left grey levels of a set of pixels, centred on their mean (NCC then needs only Σ a·b), with
+// what every plane's score reads of them alone, computed once: the pixels' offsets from the
+// planes' centre and, per band of kBandRows rows, Σa, Σa² and the count (summed in the order the
+// scores summed them).
 struct Samples {
   std::vector<cv::Point> points;
   std::vector<double> centred;
+  std::vector<double> fromCx, fromCy;  // x − cx, y − cy
+  std::vector<int> band;               // (y − top) / kBandRows
+  std::vector<double> bandSumA, bandSumAA, bandCount;
   double sumSquares = 0;
   int top = 0, bands = 1;  // the points' bands of kBandRows rows, from row `top`
 };
 
 constexpr int kBandRows = 12;
 
-Samples samplesOf(const cv::Mat& left, const std::vector<cv::Point>& points) {
+Samples samplesOf(const cv::Mat& left, const std::vector<cv::Point>& points, double cx, double cy) {
   Samples s;
   double sum = 0;
   for (const cv::Point& p : points) {
@@ -58,15 +64,32 @@ Samples samplesOf(const cv::Mat& left, const std::vector<cv::Point>& points) {
     v -= mean;
     s.sumSquares += v * v;
   }
+  const auto bands = static_cast<size_t>(s.bands);
+  s.bandSumA.assign(bands, 0.0);
+  s.bandSumAA.assign(bands, 0.0);
+  s.bandCount.assign(bands, 0.0);
+  for (size_t i = 0; i < s.points.size(); ++i) {
+    const cv::Point p = s.points[i];
+    s.fromCx.push_back(p.x - cx);
+    s.fromCy.push_back(p.y - cy);
+    const int k = (p.y - s.top) / kBandRows;
+    s.band.push_back(k);
+    const double a = s.centred[i];
+    s.bandSumA[static_cast<size_t>(k)] += a;
+    s.bandSumAA[static_cast<size_t>(k)] += a * a;
+    s.bandCount[static_cast<size_t>(k)] += 1;
+  }
   return s;
 }
 
 // The right view at (x − d, y), linearly interpolated along the row; NaN outside it.
 double rightAt(const cv::Mat& right, int x, int y, double d) {
   const double xr = x - d;
-  const double whole = std::floor(xr);
-  const int x0 = static_cast<int>(whole);
-  if (x0 < 0 || x0 + 1 >= right.cols) return kNaN;
+  // std::floor is a library call in the baseline build (no SSE4.1): this is the same value for
+  // any xr that lands in the image, and rejects the others as it did (NaN compares false).
+  if (!(xr >= 0.0 && xr < static_cast<double>(right.cols - 1))) return kNaN;
+  const int x0 = static_cast<int>(xr);  // truncation is the floor of a non-negative value
+  const double whole = x0;
   const float* row = right.ptr<float>(y);
   const double t = xr - whole;
   return (1 - t) * row[x0] + t * row[x0 + 1];
@@ -84,30 +107,28 @@ double nccOverAll(const cv::Mat& right, const Samples& s, const Plane& plane);
 // plane, against 0.90 on the facet alone; its best banded score is 0.81.
 double planeScore(const cv::Mat& right, const Samples& s, const Plane& plane) {
   if (s.bands < 3) return nccOverAll(right, s, plane);
-  thread_local std::vector<double> sums;  // per band: Σa, Σa², Σb, Σb², Σab, n
-  sums.assign(static_cast<size_t>(s.bands) * 6, 0.0);
+  thread_local std::vector<double> sums;  // per band: Σb, Σb², Σab
+  sums.assign(static_cast<size_t>(s.bands) * 3, 0.0);
   for (size_t i = 0; i < s.points.size(); ++i) {
-    const cv::Point p = s.points[i];
-    const double b = rightAt(right, p.x, p.y, plane.at(p.x, p.y));
+    // plane.at(x, y), from the offsets computed once.
+    const double d = plane.a + plane.gx * s.fromCx[i] + plane.gy * s.fromCy[i];
+    const double b = rightAt(right, s.points[i].x, s.points[i].y, d);
     if (!std::isfinite(b)) return -2;
     const double a = s.centred[i];
-    double* q = &sums[static_cast<size_t>((p.y - s.top) / kBandRows) * 6];
-    q[0] += a;
-    q[1] += a * a;
-    q[2] += b;
-    q[3] += b * b;
-    q[4] += a * b;
-    q[5] += 1;
+    double* q = &sums[static_cast<size_t>(s.band[i]) * 3];
+    q[0] += b;
+    q[1] += b * b;
+    q[2] += a * b;
   }
   thread_local std::vector<double> scores;
   scores.clear();
-  for (int k = 0; k < s.bands; ++k) {
-    const double* q = &sums[static_cast<size_t>(k) * 6];
-    const double n = q[5];
+  for (size_t k = 0; k < static_cast<size_t>(s.bands); ++k) {
+    const double* q = &sums[k * 3];
+    const double n = s.bandCount[k], sa = s.bandSumA[k];
     if (n < 8) continue;
-    const double va = q[1] - q[0] * q[0] / n, vb = q[3] - q[2] * q[2] / n;
+    const double va = s.bandSumAA[k] - sa * sa / n, vb = q[1] - q[0] * q[0] / n;
     if (va <= 0 || vb <= 0) continue;
-    scores.push_back((q[4] - q[0] * q[2] / n) / std::sqrt(va * vb));
+    scores.push_back((q[2] - sa * q[0] / n) / std::sqrt(va * vb));
   }
   if (scores.size() < 3) return nccOverAll(right, s, plane);
   std::sort(scores.begin(), scores.end());
@@ -121,8 +142,8 @@ double nccOverAll(const cv::Mat& right, const Samples& s, const Plane& plane) {
   double sb = 0, sbb = 0, sab = 0;
   const size_t n = s.points.size();
   for (size_t i = 0; i < n; ++i) {
-    const cv::Point p = s.points[i];
-    const double b = rightAt(right, p.x, p.y, plane.at(p.x, p.y));
+    const double d = plane.a + plane.gx * s.fromCx[i] + plane.gy * s.fromCy[i];
+    const double b = rightAt(right, s.points[i].x, s.points[i].y, d);
     if (!std::isfinite(b)) return -2;
     sb += b;
     sbb += b * b;
@@ -336,14 +357,14 @@ int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Ma
         }
         return kept;
       };
-      const Samples all = samplesOf(left, points);
+      const double cx = centroids.at<double>(r, 0), cy = centroids.at<double>(r, 1);
+      const Samples all = samplesOf(left, points, cx, cy);
       // About 64 pixels (12 a band, for tall regions) score the coarse planes, about 256 choose
       // among the best of them.
       const double bands = static_cast<double>(box.height / kBandRows + 1);
-      const Samples sparse = samplesOf(left, scattered(std::max(64.0, 12 * bands)));
-      const Samples medium = samplesOf(left, scattered(256));
+      const Samples sparse = samplesOf(left, scattered(std::max(64.0, 12 * bands)), cx, cy);
+      const Samples medium = samplesOf(left, scattered(256), cx, cy);
       if (sparse.points.size() < 8) return;
-      const double cx = centroids.at<double>(r, 0), cy = centroids.at<double>(r, 1);
       const Fit fit = bestPlane(right, sparse, medium, all, ring, settings.minRingShare, cx, cy, lo,
                                 hi, settings.maxSlope, settings.minRegionScore - kHopeless);
       const Plane& plane = fit.best.plane;
