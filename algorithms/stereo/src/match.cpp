@@ -721,7 +721,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     planes.threads = threads;
     detail::fitRoofPlanes(result.disparity, planes);
   }
-
+  core::report(progress, 1.0);
   return result;
 }
 
