@@ -140,27 +140,49 @@ void chooseCuts(std::vector<std::vector<NearSideCut>>& rows, const StepSnapSetti
         // Fewer than lineRows linked rows above and below together: too short to be a line,
         // the row decides.
         if (linked < settings.lineRows) continue;
-        // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost.
-        double bestSum = std::numeric_limits<double>::infinity();
-        int bestE = c.chosen, bestSlope = 0;
-        for (size_t i = 0; i < c.cost.size(); ++i) {
-          const int e0 = c.eFirst + static_cast<int>(i);
+        // The line e(k) = e0 + slope * k through the row's candidate e0 of least summed cost:
+        // the first in the order (e0, then slope) of the lines of least sum. Its rows' costs
+        // summed in row order, given up once the sum passes `bound` (the costs are ≥ 0: a sum
+        // never falls below a partial sum, nor below the row's own cost at e0).
+        const auto lineSum = [&](int e0, int si, double bound, bool orEqual) {
+          const int* offsets = &lineOffset[static_cast<size_t>(si * span)];
+          double sum = 0;
+          for (int k = -settings.lineRows;
+               k <= settings.lineRows && (sum < bound || (orEqual && sum == bound)); ++k) {
+            const NearSideCut* q = chain[static_cast<size_t>(k + settings.lineRows)];
+            if (q == nullptr) continue;
+            const int e = e0 + offsets[k + settings.lineRows];
+            const int j = e - q->eFirst;
+            sum += j >= 0 && j < static_cast<int>(q->cost.size()) ? q->cost[static_cast<size_t>(j)]
+                                                                  : cap;
+          }
+          return sum;
+        };
+        // The least sum first, from the row's own best outwards (a tight bound early prunes
+        // most lines); then the first line in order that reaches it exactly (the same sums,
+        // summed the same way).
+        const int count = static_cast<int>(c.cost.size());
+        const int own = c.rowBest - c.eFirst;
+        double least = std::numeric_limits<double>::infinity();
+        for (int step = 0; step < 2 * count; ++step) {
+          const int i = own + (step % 2 == 0 ? step / 2 : -(step + 1) / 2);
+          if (i < 0 || i >= count || static_cast<double>(c.cost[static_cast<size_t>(i)]) >= least) {
+            continue;
+          }
           for (int si = 0; si < slopes; ++si) {
-            const int* offsets = &lineOffset[static_cast<size_t>(si * span)];
-            double sum = 0;
-            for (int k = -settings.lineRows; k <= settings.lineRows && sum < bestSum; ++k) {
-              const NearSideCut* q = chain[static_cast<size_t>(k + settings.lineRows)];
-              if (q == nullptr) continue;
-              const int e = e0 + offsets[k + settings.lineRows];
-              const int j = e - q->eFirst;
-              sum += j >= 0 && j < static_cast<int>(q->cost.size())
-                         ? q->cost[static_cast<size_t>(j)]
-                         : cap;
-            }
-            if (sum < bestSum) {
-              bestSum = sum;
-              bestE = e0;
+            least = std::min(least, lineSum(c.eFirst + i, si, least, false));
+          }
+        }
+        int bestE = c.chosen, bestSlope = 0;
+        bool found = false;
+        for (int i = 0; i < count && !found; ++i) {
+          if (static_cast<double>(c.cost[static_cast<size_t>(i)]) > least) continue;
+          for (int si = 0; si < slopes; ++si) {
+            if (lineSum(c.eFirst + i, si, least, true) == least) {
+              bestE = c.eFirst + i;
               bestSlope = si - settings.slopeSteps;
+              found = true;
+              break;
             }
           }
         }
