@@ -288,38 +288,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   double gain = 1, offset = 0;
   int dlo = 0;  // the smallest disparity of the map (checked only): carried runs search from it
   if (checked) {
-    // The extremes of the non-NaN disparities, by bands of rows on the workers (0 and 0 when
-    // there are none, as cv::minMaxIdx under a mask gives).
-    const int bandRows = 16;
-    std::vector<std::pair<float, float>> bandRange(
-        static_cast<size_t>((h + bandRows - 1) / bandRows),
-        {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity()});
-    std::atomic<bool> found{false};
-    forRowBands(
-        h, settings.threads,
-        [&](int rowStart, int rowEnd) {
-          auto& [lo, hi] = bandRange[static_cast<size_t>(rowStart / bandRows)];
-          for (int y = rowStart; y < rowEnd; ++y) {
-            const float* d = disparity.ptr<float>(y);
-            // Without branches, so that it vectorises (with them: 6 ms at 1 Mpx); a comparison
-            // with NaN is false, so an unmatched pixel never wins.
-            for (int x = 0; x < w; ++x) {
-              lo = d[x] < lo ? d[x] : lo;
-              hi = d[x] > hi ? d[x] : hi;
-            }
-          }
-          if (lo <= hi) found = true;
-        },
-        bandRows);
-    double mn = 0, mx = 0;
-    if (found) {
-      mn = std::numeric_limits<double>::infinity();
-      mx = -mn;
-      for (const auto& [lo, hi] : bandRange) {
-        mn = std::min(mn, static_cast<double>(lo));
-        mx = std::max(mx, static_cast<double>(hi));
-      }
-    }
+    const auto [mn, mx] = matchedRange(disparity);
     dlo = static_cast<int>(std::floor(mn));
     const int dhi = static_cast<int>(std::ceil(mx));
     // The grey map of the matched pixel pairs, the images' moments as the fallback: every check

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "delineo/core/nan_mask.hpp"
 #include "radiometry.hpp"
 #include "workers.hpp"
 
@@ -167,10 +166,7 @@ int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma,
   // The grey map of the matched pairs; the images' moments at the map's disparities when too few
   // are matched (the moments can be several grey levels off at a roof's grey: simulated seed 9
   // 1000², a roof's top rows that carried the ground's value stayed so).
-  const cv::Mat finite = core::numberMask(disparity);
-  double lowest = 0, highest = 0;
-  if (cv::countNonZero(finite) > 0)
-    cv::minMaxIdx(disparity, &lowest, &highest, nullptr, nullptr, finite);
+  const auto [lowest, highest] = matchedRange(disparity);
   const auto [gain, offset] =
       radiometricMapOfMatches(left, right, disparity,
                               radiometricMap(left, right, static_cast<int>(std::floor(lowest)),

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -110,6 +111,22 @@ std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& rig
   }
   if (moments.count < 2) return {1.0, 0.0};
   return moments.map().value_or(std::pair{1.0, 0.0});
+}
+
+std::pair<double, double> matchedRange(const cv::Mat& disparity) {
+  CV_Assert(disparity.type() == CV_32F);
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    // Without branches, so that it vectorises (with a branch per pixel: 6 ms at 1 Mpx); a
+    // comparison with NaN is false, so an unmatched pixel never wins.
+    for (int x = 0; x < disparity.cols; ++x) {
+      lo = d[x] < lo ? d[x] : lo;
+      hi = d[x] > hi ? d[x] : hi;
+    }
+  }
+  if (!(lo <= hi)) return {0.0, 0.0};
+  return {lo, hi};
 }
 
 // Large sets by bucket selection: a histogram of 4096 equal bins between the

@@ -25,6 +25,10 @@ std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv:
                                                   std::pair<double, double> fallback,
                                                   int minPairs = 1000);
 
+// The smallest and largest disparity of a map (CV_32F, NaN = unmatched); (0, 0) when none is
+// matched, as cv::minMaxIdx under the matched mask gives.
+std::pair<double, double> matchedRange(const cv::Mat& disparity);
+
 // The middle value of `values`, the upper one of an even count: the element std::nth_element
 // puts at size / 2, without reordering a copy of a large set.
 double middleValue(const std::vector<double>& values);
