@@ -28,9 +28,11 @@ struct RegionFillSettings {
                                   //   are kept; 0 = off)
   double edgeReach = 2.0;         // px: the row ends read are those within this of the candidate,
                                   //   and their value is filled when it lies within it too
-  double edgeDecideShare = 0.8;   // where the ring cannot tell the candidate from other
+  double edgeDecideShare = 0.7;   // where the ring cannot tell the candidate from other
                                   //   disparities (the scan does not confirm it), the edges decide
-                                  //   when this share of the row ends read agree (0 = off) ...
+                                  //   when this share of the row ends read agree (0 = off;
+                                  //   0.8 until session 30: seed 49 600²'s plain roof agreed
+                                  //   on 26 of 36 and stayed unmatched) ...
   int edgeDecidePerSide = 5;      //   and this many of those on each side of the region (a facet
                                   //   sloping along the rows agrees on one side only)
   int growReach = 3;              // px: the filled region grows back to its contour by at most this
