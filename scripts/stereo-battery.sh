@@ -23,8 +23,10 @@
 #   fresh-7:  9 more (seeds 53-58 600², 27-29 1000²), first run in session 29 to check the
 #             speckle size chosen on the eight groups above (20 -> 40 px);
 #   fresh-8:  9 more (seeds 59-64 600², 30-32 1000²), first run in session 29 to check the
-#             edges' decision of the fill (it never decides there). Judge a change on all ten
-#             groups, and keep them apart.
+#             edges' decision of the fill (it never decides there);
+#   fresh-9:  9 more (seeds 65-70 600², 33-35 1000²), first run in session 30 to check the edges'
+#             share (0.8 -> 0.7, chosen on seed 49 600²: no scene of it moves). Judge a change on
+#             all eleven groups, and keep them apart.
 # Usage: scripts/stereo-battery.sh [BUILD_DIR] [extra bench_stereo arguments, e.g. --params '{}']
 # A few minutes on 2 cores. Not a test: it prints numbers.
 set -euo pipefail
@@ -80,6 +82,10 @@ fresh8=("s59-600|--size 600 --seed 59" "s60-600|--size 600 --seed 60"
   "s61-600|--size 600 --seed 61" "s62-600|--size 600 --seed 62" "s63-600|--size 600 --seed 63"
   "s64-600|--size 600 --seed 64" "s30-1000|--size 1000 --seed 30"
   "s31-1000|--size 1000 --seed 31" "s32-1000|--size 1000 --seed 32")
+fresh9=("s65-600|--size 600 --seed 65" "s66-600|--size 600 --seed 66"
+  "s67-600|--size 600 --seed 67" "s68-600|--size 600 --seed 68" "s69-600|--size 600 --seed 69"
+  "s70-600|--size 600 --seed 70" "s33-1000|--size 1000 --seed 33"
+  "s34-1000|--size 1000 --seed 34" "s35-1000|--size 1000 --seed 35")
 
 run_group() {
   local name=$1
@@ -121,3 +127,4 @@ run_group fresh-5 "${fresh5[@]}"
 run_group fresh-6 "${fresh6[@]}"
 run_group fresh-7 "${fresh7[@]}"
 run_group fresh-8 "${fresh8[@]}"
+run_group fresh-9 "${fresh9[@]}"
