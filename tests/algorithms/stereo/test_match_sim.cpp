@@ -54,17 +54,23 @@ std::pair<int, int> roofPixelsMatchedClosely(const MatchedScene& m, const cv::Re
   return {roof, within};
 }
 
+// The roof of `box` (building pixels at `level` ± levelTolerance, more than `minRoof` of them:
+// the roof is where it was measured) matched within 0.3 px on more than `share` of its pixels.
+void expectRoofMatchedClosely(int size, int seed, const cv::Rect& box, float level,
+                              float levelTolerance, int minRoof, double share) {
+  const MatchedScene m = matchScene(size, seed);
+  const auto [roof, within] = roofPixelsMatchedClosely(m, box, level, levelTolerance);
+  ASSERT_GT(roof, minRoof);
+  EXPECT_GT(within, share * roof) << within << " of " << roof;
+}
+
 TEST(MatchSimulated, ANearlyLevelPlainRoofTakesItsEdgesConstantOverAPlaneThatFitsNoBetter) {
   // Seed 24 600²: its largest roof, plain, at 53.45 px. No constant passed the fill's tests (the
   // matches around it are the ground's and a neighbour's), and the plane through its row ends
   // rises 2.7 px over it (52.65 at its centroid) yet lines its outline up no better than the
   // constant its edges give (ring error 14.67 against 14.57): it takes that constant (53.33).
   // Filled with the plane, its pixels were 0.76 px low on average.
-  const MatchedScene m = matchScene(600, 24);
-  const auto [roof, within] =
-      roofPixelsMatchedClosely(m, cv::Rect(257, 115, 154, 153), 53.45F, 0.01F);
-  ASSERT_GT(roof, 5000);  // the roof is where it was measured
-  EXPECT_GT(within, roof * 85 / 100) << within << " of " << roof;
+  expectRoofMatchedClosely(600, 24, cv::Rect(257, 115, 154, 153), 53.45F, 0.01F, 5000, 0.85);
 }
 
 TEST(MatchSimulated, APlainBoxAndItsShadowOfOneGreyDoNotTakeAPlaneRisingAboveTheMatchesAround) {
@@ -97,10 +103,7 @@ TEST(MatchSimulated, APlainRoofWhoseRingIsAmbiguousTakesTheConstantItsEdgesAgree
   // both views agree on 65 of the 76 row ends read, on both sides (16 at left ends), at 31.40.
   // Measured: 137 of its 3 711 pixels within 0.3 px when the edges may not decide, 3 578 when
   // they may.
-  const MatchedScene m = matchScene(600, 35);
-  const auto [roof, within] = roofPixelsMatchedClosely(m, cv::Rect(102, 204, 97, 96), 31.47F, 0.1F);
-  ASSERT_GT(roof, 3000);  // the roof is where it was measured
-  EXPECT_GT(within, roof * 9 / 10) << within << " of " << roof;
+  expectRoofMatchedClosely(600, 35, cv::Rect(102, 204, 97, 96), 31.47F, 0.1F, 3000, 0.9);
 }
 
 TEST(MatchSimulated, APlainRoofWhoseEdgesMostlyAgreeTakesTheirConstant) {
@@ -108,11 +111,7 @@ TEST(MatchSimulated, APlainRoofWhoseEdgesMostlyAgreeTakesTheirConstant) {
   // establish a candidate and whose edges in both views agree on 26 of the 36 row ends read (6
   // at left ends), at 49.33. Measured: none of its 2 371 pixels within 0.3 px when the edges had
   // to agree on 80 % of the row ends, 2 279 with 70 %.
-  const MatchedScene m = matchScene(600, 49);
-  const auto [roof, within] =
-      roofPixelsMatchedClosely(m, cv::Rect(451, 130, 71, 75), 49.18F, 0.05F);
-  ASSERT_GT(roof, 2000);  // the roof is where it was measured
-  EXPECT_GT(within, roof * 9 / 10) << within << " of " << roof;
+  expectRoofMatchedClosely(600, 49, cv::Rect(451, 130, 71, 75), 49.18F, 0.05F, 2000, 0.9);
 }
 
 }  // namespace
