@@ -259,6 +259,10 @@
         <translation>Score des pixels unis près des sauts de profondeur</translation>
     </message>
     <message>
+        <source>Score beside unmatched plain regions</source>
+        <translation>Score près des régions unies non appariées</translation>
+    </message>
+    <message>
         <source>Edge gap closing</source>
         <translation>Fermeture des coupures de contour</translation>
     </message>

@@ -66,6 +66,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Snap depth steps to contours"),
     QT_TRANSLATE_NOOP("Parameters", "Score beside depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Score of plain pixels near depth steps"),
+    QT_TRANSLATE_NOOP("Parameters", "Score beside unmatched plain regions"),
     QT_TRANSLATE_NOOP("Parameters", "Edge gap closing"),
     QT_TRANSLATE_NOOP("Parameters", "Steepest slanted facet"),
     QT_TRANSLATE_NOOP("Parameters", "Threads"),

@@ -626,7 +626,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   core::setStage(progress, core::StageId::FillingFlatRegions);
   detail::StepContrast contrast;
   cv::Mat plain;
-  const bool plainPass = p.adaptive && p.plainStepMinScore > 0;
+  const bool plainPass = p.adaptive && (p.plainStepMinScore > 0 || p.unmatchedPlainMinScore > 0);
   const auto prepareImages = [&] {
     if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right);
     if (plainPass) plain = detail::plainPixels(left, 3.0);
@@ -653,13 +653,23 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // missed (seed 28 600²: an 8 px patch 62 px off, 4-7 px inside the roof, scoring 0.53-0.59;
   // roof RMS 0.919 -> 0.210 px). Textured pixels are left alone: on the Dublin tile the same pass
   // over every pixel removed 3.8 points of density whose bad-2 was below the rest's.
-  if (plainPass) {
+  if (plainPass && p.plainStepMinScore > 0) {
     detail::WeakMatchSettings wide;
     wide.minScore = p.plainStepMinScore;
     wide.radius = 7;
     wide.threads = threads;
     detail::rejectWeakMatchesBesideSteps(wide, static_cast<float>(p.minScore), result.disparity,
                                          result.score, plain);
+  }
+  // Then the weak matches on plain pixels beside a plain region the fill could not decide (a roof
+  // and the ground of one grey): the windows of the surface beside it that reached into it (sim
+  // seed 15 1000²: roof RMS 0.260 -> 0.134 px; see docs/stereo.md, session 30).
+  if (plainPass && p.unmatchedPlainMinScore > 0) {
+    detail::UnmatchedPlainSettings beside;
+    beside.minScore = p.unmatchedPlainMinScore;
+    beside.threads = threads;
+    detail::rejectWeakMatchesBesideUnmatchedPlain(beside, static_cast<float>(p.minScore), plain,
+                                                  result.disparity, result.score);
   }
   // Then the steep facets left unmatched, matched region by region on slanted planes; before the
   // speckles, the snapping and the ordering check, which treat their matches like any other.

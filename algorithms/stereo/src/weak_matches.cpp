@@ -52,4 +52,62 @@ int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillSc
   return total;
 }
 
+int rejectWeakMatchesBesideUnmatchedPlain(const UnmatchedPlainSettings& settings, float fillScore,
+                                          const cv::Mat& plain, cv::Mat& disparity,
+                                          cv::Mat& score) {
+  CV_Assert(disparity.type() == CV_32F && score.type() == CV_32F &&
+            disparity.size() == score.size());
+  CV_Assert(plain.type() == CV_8U && plain.size() == disparity.size());
+  if (!(settings.minScore > 0) || disparity.empty()) return 0;
+  // The unmatched plain pixels, their 4-connected regions, and the large ones grown by the radius.
+  cv::Mat unmatched(disparity.size(), CV_8U);
+  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* d = disparity.ptr<float>(y);
+      const uchar* p = plain.ptr<uchar>(y);
+      uchar* u = unmatched.ptr<uchar>(y);
+      for (int x = 0; x < disparity.cols; ++x) u[x] = d[x] != d[x] && p[x] != 0 ? 255 : 0;
+    }
+  });
+  cv::Mat labels, stats, centroids;
+  cv::connectedComponentsWithStats(unmatched, labels, stats, centroids, 4, CV_32S);
+  cv::Mat large(disparity.size(), CV_8U);
+  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const int* l = labels.ptr<int>(y);
+      uchar* out = large.ptr<uchar>(y);
+      for (int x = 0; x < disparity.cols; ++x) {
+        out[x] = l[x] > 0 && stats.at<int>(l[x], cv::CC_STAT_AREA) >= settings.minArea ? 255 : 0;
+      }
+    }
+  });
+  cv::Mat beside;
+  const int side = 2 * settings.radius + 1;
+  cv::dilate(large, beside, cv::Mat::ones(side, side, CV_8U));
+  const float minScore = static_cast<float>(settings.minScore);
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  std::vector<int> rejectedPerRow(static_cast<size_t>(disparity.rows), 0);
+  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      float* d = disparity.ptr<float>(y);
+      float* s = score.ptr<float>(y);
+      const uchar* p = plain.ptr<uchar>(y);
+      const uchar* b = beside.ptr<uchar>(y);
+      int rejected = 0;
+      for (int x = 0; x < disparity.cols; ++x) {
+        if (d[x] != d[x] || s[x] == fillScore || !(s[x] < minScore) || p[x] == 0 || b[x] == 0) {
+          continue;
+        }
+        d[x] = kNaN;
+        s[x] = kNaN;
+        ++rejected;
+      }
+      rejectedPerRow[static_cast<size_t>(y)] = rejected;
+    }
+  });
+  int total = 0;
+  for (const int r : rejectedPerRow) total += r;
+  return total;
+}
+
 }  // namespace delineo::stereo::detail

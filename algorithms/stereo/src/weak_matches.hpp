@@ -29,4 +29,23 @@ int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillSc
                                  cv::Mat& disparity, cv::Mat& score,
                                  const cv::Mat& candidates = cv::Mat());
 
+struct UnmatchedPlainSettings {
+  double minScore = 0.5;  // NCC: a match beside such a region scoring below this is rejected
+                          //   (0 = off)
+  int radius = 5;         // px: beside = within this Chebyshev distance of the region
+  int minArea = 500;      // px: smaller unmatched plain regions are left alone
+  int threads = 1;        // workers over bands of rows (same result on any number)
+};
+
+// A plain region the fill left unmatched (at least minArea 4-connected pixels that are plain in
+// `plain`, CV_8U non-zero, and unmatched) is a surface no disparity could be told for: a roof and
+// the ground beside it of one grey. The windows of the surface beside it that reached into it
+// carried that surface's disparity across its outline with a weak peak (sim seed 15 1000²: the
+// ground's matches 4 px into a plain roof at NCC 0.3-0.4, 42 px off, three of them 74 % of the
+// roof's squared error). Matches on plain pixels within `radius` of such a region that score below
+// minScore are made unmatched (NaN in `disparity` and `score`); pixels scoring exactly
+// `fillScore` (set by the fill) are kept. Returns the number of pixels rejected.
+int rejectWeakMatchesBesideUnmatchedPlain(const UnmatchedPlainSettings& settings, float fillScore,
+                                          const cv::Mat& plain, cv::Mat& disparity, cv::Mat& score);
+
 }  // namespace delineo::stereo::detail

@@ -114,5 +114,28 @@ TEST(MatchSimulated, APlainRoofWhoseEdgesMostlyAgreeTakesTheirConstant) {
   expectRoofMatchedClosely(600, 49, cv::Rect(451, 130, 71, 75), 49.18F, 0.05F, 2000, 0.9);
 }
 
+TEST(MatchSimulated, WeakGroundMatchesBesideAnUndecidedPlainRoofAreRejected) {
+  // Seed 15 1000²: a plain roof at 51.1 px (grey 61) beside ground of grey 60; the fill cannot
+  // tell the two apart and leaves it unmatched, and the ground's windows reach into it at NCC
+  // 0.3-0.4. Measured: 100 of its pixels carry the ground's value (off by more than 5 px) with
+  // unmatched-plain-min-score 0, 63 with 0.5 (those left score higher or lie farther in).
+  const MatchedScene m = matchScene(1000, 15);
+  const cv::Rect box(248, 657, 77, 84);
+  int roof = 0, carried = 0;
+  for (int y = box.y; y < box.br().y; ++y) {
+    for (int x = box.x; x < box.br().x; ++x) {
+      const float truth = m.scene.disparity.at<float>(y, x);
+      if (!(std::abs(truth - 51.1F) < 0.05F) ||
+          m.scene.labels.at<uchar>(y, x) != sim::kLabelBuilding) {
+        continue;
+      }
+      ++roof;
+      carried += std::abs(m.result.disparity.at<float>(y, x) - truth) > 5.0F ? 1 : 0;
+    }
+  }
+  ASSERT_GT(roof, 3000);  // the roof is where it was measured
+  EXPECT_LT(carried, 80) << carried << " of " << roof;
+}
+
 }  // namespace
 }  // namespace delineo::stereo

@@ -1,4 +1,5 @@
-// Weak matches beside depth steps rejected (internal rejectWeakMatchesBesideSteps).
+// Weak matches beside depth steps and beside plain regions left unmatched rejected (internal
+// rejectWeakMatchesBesideSteps, rejectWeakMatchesBesideUnmatchedPlain).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -129,6 +130,94 @@ TEST(RejectWeakMatchesBesideSteps, ItsParameterIsAScoreBetweenZeroAndOne) {
   p.stepMinScore = -0.1;
   EXPECT_THROW(p.validate(), std::exception);
   p.stepMinScore = 0;
+  EXPECT_NO_THROW(p.validate());
+}
+
+// A plain scene (every pixel plain) of ground at 10 scoring 0.9, with a plain roof left unmatched
+// in (20..49, 10..29): 600 px.
+struct UnmatchedRoofScene {
+  cv::Mat disparity{40, 70, CV_32F, cv::Scalar(10.0)};
+  cv::Mat score{40, 70, CV_32F, cv::Scalar(0.9)};
+  cv::Mat plain{40, 70, CV_8U, cv::Scalar(255)};
+  UnmatchedRoofScene() {
+    disparity(cv::Rect(20, 10, 30, 20)).setTo(kNaN);
+    score(cv::Rect(20, 10, 30, 20)).setTo(kNaN);
+  }
+};
+
+TEST(RejectWeakMatchesBesideUnmatchedPlain, RejectsWeakPlainMatchesWithinTheRadiusOfALargeRegion) {
+  UnmatchedRoofScene s;
+  s.score.at<float>(12, 50) = 0.4F;        // weak, plain, 1 px beside the region: rejected
+  s.score.at<float>(20, 54) = 0.4F;        // 5 px beside it: rejected
+  s.score.at<float>(20, 55) = 0.4F;        // 6 px: kept
+  s.score.at<float>(5, 30) = 0.6F;         // 5 px above it, but not weak: kept
+  s.score.at<float>(31, 30) = kFillScore;  // filled, not matched: kept
+  s.score.at<float>(32, 25) = 0.4F;        // weak beside it, but textured: kept
+  s.plain.at<uchar>(32, 25) = 0;
+  UnmatchedPlainSettings settings;
+  EXPECT_EQ(
+      rejectWeakMatchesBesideUnmatchedPlain(settings, kFillScore, s.plain, s.disparity, s.score),
+      2);
+  EXPECT_TRUE(std::isnan(s.disparity.at<float>(12, 50)));
+  EXPECT_TRUE(std::isnan(s.score.at<float>(20, 54)));
+  EXPECT_EQ(s.disparity.at<float>(20, 55), 10.0F);
+  EXPECT_EQ(s.disparity.at<float>(5, 30), 10.0F);
+  EXPECT_EQ(s.disparity.at<float>(31, 30), 10.0F);
+  EXPECT_EQ(s.disparity.at<float>(32, 25), 10.0F);
+}
+
+TEST(RejectWeakMatchesBesideUnmatchedPlain, SmallOrTexturedUnmatchedRegionsAndZeroLeaveAll) {
+  UnmatchedRoofScene s;
+  s.score.at<float>(12, 50) = 0.4F;
+  UnmatchedPlainSettings settings;
+  settings.minArea = 601;  // the region has 600 px
+  EXPECT_EQ(
+      rejectWeakMatchesBesideUnmatchedPlain(settings, kFillScore, s.plain, s.disparity, s.score),
+      0);
+  settings.minArea = 500;
+  cv::Mat textured = s.plain.clone();
+  textured(cv::Rect(20, 10, 30, 20)).setTo(0);  // unmatched but not plain: not such a region
+  EXPECT_EQ(
+      rejectWeakMatchesBesideUnmatchedPlain(settings, kFillScore, textured, s.disparity, s.score),
+      0);
+  settings.minScore = 0;
+  EXPECT_EQ(
+      rejectWeakMatchesBesideUnmatchedPlain(settings, kFillScore, s.plain, s.disparity, s.score),
+      0);
+  EXPECT_EQ(s.disparity.at<float>(12, 50), 10.0F);
+}
+
+TEST(RejectWeakMatchesBesideUnmatchedPlain, TheSameOnAnyNumberOfThreads) {
+  cv::Mat disparity(97, 61, CV_32F), score(97, 61, CV_32F), plain(97, 61, CV_8U);
+  cv::RNG rng(11);
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) {
+      const bool hole = (x / 25 + y / 30) % 2 == 1;
+      disparity.at<float>(y, x) = hole ? kNaN : 12.0F;
+      score.at<float>(y, x) = static_cast<float>(rng.uniform(0.3, 1.0));
+      plain.at<uchar>(y, x) = rng.uniform(0, 4) > 0 ? 255 : 0;
+    }
+  }
+  cv::Mat d1 = disparity.clone(), s1 = score.clone(), d2 = disparity.clone(), s2 = score.clone();
+  UnmatchedPlainSettings settings;
+  settings.minArea = 100;
+  const int one = rejectWeakMatchesBesideUnmatchedPlain(settings, kFillScore, plain, d1, s1);
+  settings.threads = 3;
+  EXPECT_EQ(rejectWeakMatchesBesideUnmatchedPlain(settings, kFillScore, plain, d2, s2), one);
+  EXPECT_GT(one, 0);
+  for (int y = 0; y < d1.rows; ++y) {
+    EXPECT_EQ(std::memcmp(d1.ptr(y), d2.ptr(y), d1.cols * sizeof(float)), 0) << "row " << y;
+  }
+}
+
+TEST(RejectWeakMatchesBesideUnmatchedPlain, ItsParameterIsAScoreBetweenZeroAndOne) {
+  MatchParams p;
+  EXPECT_DOUBLE_EQ(p.unmatchedPlainMinScore, 0.5);
+  p.unmatchedPlainMinScore = 1.1;
+  EXPECT_THROW(p.validate(), std::exception);
+  p.unmatchedPlainMinScore = -0.2;
+  EXPECT_THROW(p.validate(), std::exception);
+  p.unmatchedPlainMinScore = 0;
   EXPECT_NO_THROW(p.validate());
 }
 

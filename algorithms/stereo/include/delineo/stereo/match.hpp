@@ -40,6 +40,9 @@ struct MatchParams {
   double stepMinScore = 0.8;         // NCC: far-side matches beside a depth step scoring below
                                      // this are rejected after the fill (0 = off)
   double plainStepMinScore = 0.6;    // NCC: the same within 7 px of a step, on plain pixels only
+  double unmatchedPlainMinScore = 0.5;  // NCC: matches on plain pixels within 5 px of a plain
+                                        // region left unmatched (500 px or more) scoring below
+                                        // this are rejected (0 = off)
   double facetMaxSlope = 0.6;        // px/px: unmatched regions matched on slanted planes up to
                                      // this slope (0 = off)
   bool snapSteps = true;             // the near side of a depth step ends at the image contour
@@ -145,6 +148,14 @@ struct MatchParams {
                       "detector missed; 0 = off (adaptive method)",
                       0, 1},
       plainStepMinScore);
+    v(core::ParamInfo{"unmatched-plain-min-score", "Score beside unmatched plain regions", "",
+                      "Then, a match on a plain pixel within 5 px of a plain region the fill left "
+                      "unmatched (500 px or more: a roof and the ground beside it of one grey, "
+                      "whose disparity nothing tells) whose NCC peak is below this is rejected: "
+                      "the window of the surface beside it reached into it; 0 = off (adaptive "
+                      "method)",
+                      0, 1},
+      unmatchedPlainMinScore);
     v(core::ParamInfo{"facet-max-slope", "Steepest slanted facet", "px/px",
                       "Then, each unmatched region between contours (100 px or more) is matched "
                       "as a whole on planes d = a + gx x + gy y with |gx|, |gy| up to this: a "
