@@ -9,6 +9,35 @@
 
 namespace delineo::stereo::detail {
 
+namespace {
+// Makes unmatched (NaN disparity and score) every matched pixel that does not score exactly
+// `fillScore` (the fill's), scores below `minScore` and passes `rejects(y, x)`; by bands of rows
+// on `threads` workers. Returns how many.
+template <class Rejects>
+int rejectWeakWhere(cv::Mat& disparity, cv::Mat& score, float fillScore, float minScore,
+                    int threads, const Rejects& rejects) {
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  std::vector<int> rejectedPerRow(static_cast<size_t>(disparity.rows), 0);
+  forRowBands(disparity.rows, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      float* d = disparity.ptr<float>(y);
+      float* s = score.ptr<float>(y);
+      int rejected = 0;
+      for (int x = 0; x < disparity.cols; ++x) {
+        if (d[x] != d[x] || s[x] == fillScore || !(s[x] < minScore) || !rejects(y, x)) continue;
+        d[x] = kNaN;
+        s[x] = kNaN;
+        ++rejected;
+      }
+      rejectedPerRow[static_cast<size_t>(y)] = rejected;
+    }
+  });
+  int total = 0;
+  for (const int r : rejectedPerRow) total += r;
+  return total;
+}
+}  // namespace
+
 int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillScore,
                                  cv::Mat& disparity, cv::Mat& score, const cv::Mat& candidates) {
   CV_Assert(disparity.type() == CV_32F && score.type() == CV_32F &&
@@ -23,33 +52,17 @@ int rejectWeakMatchesBesideSteps(const WeakMatchSettings& settings, float fillSc
   const int side = 2 * settings.radius + 1;
   rangeFilters(forMin, forMax, cv::Mat::ones(side, side, CV_8U), kInf, -kInf, settings.threads,
                lowest, highest);
-  const float minScore = static_cast<float>(settings.minScore);
   const float minStep = static_cast<float>(settings.minStep);
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  std::vector<int> rejectedPerRow(static_cast<size_t>(disparity.rows), 0);
-  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      float* d = disparity.ptr<float>(y);
-      float* s = score.ptr<float>(y);
-      const float* lo = lowest.ptr<float>(y);
-      const float* hi = highest.ptr<float>(y);
-      const uchar* eligible = candidates.empty() ? nullptr : candidates.ptr<uchar>(y);
-      int rejected = 0;
-      for (int x = 0; x < disparity.cols; ++x) {
-        if (d[x] != d[x] || s[x] == fillScore || !(s[x] < minScore)) continue;
-        if (eligible != nullptr && eligible[x] == 0) continue;
-        // Beside a step, and on its far side (nearer the lowest disparity than the highest).
-        if (!(hi[x] - lo[x] >= minStep) || !(d[x] - lo[x] < hi[x] - d[x])) continue;
-        d[x] = kNaN;
-        s[x] = kNaN;
-        ++rejected;
-      }
-      rejectedPerRow[static_cast<size_t>(y)] = rejected;
-    }
-  });
-  int total = 0;
-  for (const int r : rejectedPerRow) total += r;
-  return total;
+  return rejectWeakWhere(disparity, score, fillScore, static_cast<float>(settings.minScore),
+                         settings.threads, [&](int y, int x) {
+                           if (!candidates.empty() && candidates.ptr<uchar>(y)[x] == 0)
+                             return false;
+                           // Beside a step, and on its far side (nearer the lowest disparity than
+                           // the highest).
+                           const float lo = lowest.ptr<float>(y)[x], hi = highest.ptr<float>(y)[x];
+                           const float d = disparity.ptr<float>(y)[x];
+                           return hi - lo >= minStep && d - lo < hi - d;
+                         });
 }
 
 int rejectWeakMatchesBesideUnmatchedPlain(const UnmatchedPlainSettings& settings, float fillScore,
@@ -84,30 +97,9 @@ int rejectWeakMatchesBesideUnmatchedPlain(const UnmatchedPlainSettings& settings
   cv::Mat beside;
   const int side = 2 * settings.radius + 1;
   cv::dilate(large, beside, cv::Mat::ones(side, side, CV_8U));
-  const float minScore = static_cast<float>(settings.minScore);
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-  std::vector<int> rejectedPerRow(static_cast<size_t>(disparity.rows), 0);
-  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
-    for (int y = rowStart; y < rowEnd; ++y) {
-      float* d = disparity.ptr<float>(y);
-      float* s = score.ptr<float>(y);
-      const uchar* p = plain.ptr<uchar>(y);
-      const uchar* b = beside.ptr<uchar>(y);
-      int rejected = 0;
-      for (int x = 0; x < disparity.cols; ++x) {
-        if (d[x] != d[x] || s[x] == fillScore || !(s[x] < minScore) || p[x] == 0 || b[x] == 0) {
-          continue;
-        }
-        d[x] = kNaN;
-        s[x] = kNaN;
-        ++rejected;
-      }
-      rejectedPerRow[static_cast<size_t>(y)] = rejected;
-    }
-  });
-  int total = 0;
-  for (const int r : rejectedPerRow) total += r;
-  return total;
+  return rejectWeakWhere(
+      disparity, score, fillScore, static_cast<float>(settings.minScore), settings.threads,
+      [&](int y, int x) { return plain.ptr<uchar>(y)[x] != 0 && beside.ptr<uchar>(y)[x] != 0; });
 }
 
 }  // namespace delineo::stereo::detail

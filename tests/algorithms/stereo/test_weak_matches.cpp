@@ -17,6 +17,14 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kFillScore = 0.3F;
 
+// Two float maps equal bit for bit, NaNs included.
+void expectSameBits(const cv::Mat& a, const cv::Mat& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (int y = 0; y < a.rows; ++y) {
+    EXPECT_EQ(std::memcmp(a.ptr(y), b.ptr(y), a.cols * sizeof(float)), 0) << "row " << y;
+  }
+}
+
 // A roof (disparity 30, x >= 20) beside the ground (10), every match scoring 0.9.
 struct StepScene {
   cv::Mat disparity{24, 40, CV_32F, cv::Scalar(10.0)};
@@ -86,10 +94,7 @@ TEST(RejectWeakMatchesBesideSteps, TheSameOnAnyNumberOfThreads) {
   settings.threads = 3;
   EXPECT_EQ(rejectWeakMatchesBesideSteps(settings, kFillScore, d2, s2), one);
   EXPECT_GT(one, 0);
-  // Bit for bit, NaNs included.
-  for (int y = 0; y < d1.rows; ++y) {
-    EXPECT_EQ(std::memcmp(d1.ptr(y), d2.ptr(y), d1.cols * sizeof(float)), 0) << "row " << y;
-  }
+  expectSameBits(d1, d2);
 }
 
 TEST(RejectWeakMatchesBesideSteps, OnlyCandidatesAreRejectedWhenAMaskIsGiven) {
@@ -205,9 +210,7 @@ TEST(RejectWeakMatchesBesideUnmatchedPlain, TheSameOnAnyNumberOfThreads) {
   settings.threads = 3;
   EXPECT_EQ(rejectWeakMatchesBesideUnmatchedPlain(settings, kFillScore, plain, d2, s2), one);
   EXPECT_GT(one, 0);
-  for (int y = 0; y < d1.rows; ++y) {
-    EXPECT_EQ(std::memcmp(d1.ptr(y), d2.ptr(y), d1.cols * sizeof(float)), 0) << "row " << y;
-  }
+  expectSameBits(d1, d2);
 }
 
 TEST(RejectWeakMatchesBesideUnmatchedPlain, ItsParameterIsAScoreBetweenZeroAndOne) {
