@@ -938,10 +938,7 @@ EdgeReading edgeDisparity(const cv::Mat& left, const cv::Mat& right, const cv::M
     }
   }
   if (values.empty()) return {};
-  std::vector<double> sorted = values;
-  const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
-  std::nth_element(sorted.begin(), middle, sorted.end());
-  const double median = *middle;
+  const double median = middleValue(values);
   EdgeReading reading;
   reading.read = static_cast<int>(values.size());
   double sum = 0;
