@@ -67,23 +67,18 @@ constexpr float kLineShiftGain = 0.05F;
 constexpr double kFlatVariance = 0.01;
 
 // Mean and standard deviation of every square window that lies inside the image and holds only
-// valid pixels; ok = 0 elsewhere.
-struct WindowStats {
-  cv::Mat mean, sd;  // CV_32F
-  cv::Mat ok;        // CV_8U
-};
-
+// valid pixels and is not flat; usable = 0 elsewhere.
 // Also built for AVX2 (the column sums 4 doubles a vector; no FMA, so the same arithmetic).
 DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
-WindowStats windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
+WindowMoments windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
   // Running sums (double): per column over the window's rows, slid down one row at a time,
   // then along the row. Two passes over the image instead of three integral images.
   const int r = window / 2;
   const double n = static_cast<double>(window) * window;
   const int W = img.cols, H = img.rows;
-  WindowStats s{cv::Mat(img.size(), CV_32F, cv::Scalar(0)),
-                cv::Mat(img.size(), CV_32F, cv::Scalar(0)),
-                cv::Mat(img.size(), CV_8U, cv::Scalar(0))};
+  WindowMoments s{cv::Mat(img.size(), CV_32F, cv::Scalar(0)),
+                  cv::Mat(img.size(), CV_32F, cv::Scalar(0)),
+                  cv::Mat(img.size(), CV_8U, cv::Scalar(0))};
   if (W < window || H < window) return s;
   std::vector<double> colSum(static_cast<size_t>(W), 0.0), colSq(static_cast<size_t>(W), 0.0);
   std::vector<int> colCount(static_cast<size_t>(W), 0);
@@ -104,7 +99,7 @@ WindowStats windowStats(const cv::Mat& img, const cv::Mat& valid, int window) {
     addRow(y + r, 1.0);
     float* mean = s.mean.ptr<float>(y);
     float* sd = s.sd.ptr<float>(y);
-    uchar* ok = s.ok.ptr<uchar>(y);
+    uchar* ok = s.usable.ptr<uchar>(y);
     double sum = 0, sq = 0;
     int count = 0;
     for (int x = 0; x < window - 1; ++x) {
@@ -501,6 +496,31 @@ struct ShapeTemplate {
   int count = 0;
 };
 
+// A padded buffer of one view turned, in place, into the other view's: `inner` (the image)
+// mirrored left to right, the padding left as it is (the moments and quantised copies are 0
+// there in both views: a window reaching into the padding holds nodata). In place: fresh
+// buffers cost as much as computing them again (their pages are new to the process).
+template <class T>
+void mirrorRows(cv::Mat& m, const cv::Rect& inner) {
+  for (int y = inner.y; y < inner.br().y; ++y) {
+    T* row = m.ptr<T>(y) + inner.x;
+    std::reverse(row, row + inner.width);
+  }
+}
+void mirrorInner(cv::Mat& m, const cv::Rect& inner) {
+  switch (m.elemSize()) {
+    case 1:
+      mirrorRows<uint8_t>(m, inner);
+      break;
+    case 2:
+      mirrorRows<uint16_t>(m, inner);
+      break;
+    default:
+      CV_Assert(m.elemSize() == 4);
+      mirrorRows<uint32_t>(m, inner);
+  }
+}
+
 // Per-worker buffers, reused from tile to tile.
 struct Scratch {
   ShapeTemplate shape;
@@ -514,7 +534,8 @@ class LevelMatcher {
  public:
   // `in` is padded; the outputs cover `inner`, the unpadded image, and are written at
   // (x, y) − inner.tl() (only inner pixels are searched: the padding's intervals are empty).
-  LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out, cv::Rect inner)
+  LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out, cv::Rect inner,
+               LevelPreparations* shared)
       : in_(in),
         s_(s),
         out_(out),
@@ -529,19 +550,45 @@ class LevelMatcher {
     // Independent preparations, run on the level's threads (serial, they took ~12 % of the
     // matcher's time).
     std::vector<std::function<void()>> tasks;
-    tasks.emplace_back([&] { refStats_ = windowStats(in.ref, in.refValid, s.window); });
-    tasks.emplace_back([&] { otherStats_ = windowStats(in.other, in.otherValid, s.window); });
+    // The other view's preparations, mirrored, when it left them (see LevelPreparations).
+    const bool mirrored = shared != nullptr && !shared->empty();
+    if (mirrored) {
+      // Taken over (the other view is done with them) and mirrored in place.
+      refStats_ = shared->other;
+      otherStats_ = shared->ref;
+      refQ_ = shared->otherQ;
+      otherQ_ = shared->refQ;
+      const double scale = shared->scale;
+      *shared = LevelPreparations{};
+      shared->scale = scale;
+      for (cv::Mat* m : {&refStats_.mean, &refStats_.sd, &refStats_.usable, &otherStats_.mean,
+                         &otherStats_.sd, &otherStats_.usable}) {
+        tasks.emplace_back([m, inner] { mirrorInner(*m, inner); });
+      }
+    } else {
+      tasks.emplace_back([&] { refStats_ = windowStats(in.ref, in.refValid, s.window); });
+      tasks.emplace_back([&] { otherStats_ = windowStats(in.other, in.otherValid, s.window); });
+    }
     tasks.emplace_back([&] {
-      // Quantised copies for the integer shape kernels: one scale for both images, the largest
-      // that keeps |q| ≤ kShapeQuantMax (the images are mapped to ~±128: a step of < 0.1 grey).
-      double refMin = 0, refMax = 0, otherMin = 0, otherMax = 0;
-      cv::minMaxLoc(in.ref, &refMin, &refMax);
-      cv::minMaxLoc(in.other, &otherMin, &otherMax);
-      const double maxAbs = std::max(
-          {std::abs(refMin), std::abs(refMax), std::abs(otherMin), std::abs(otherMax), 1e-6});
-      const double scale = std::floor(kShapeQuantMax / maxAbs * 1e6) / 1e6;  // round(scale·v) ≤ max
-      in.ref.convertTo(refQ_, CV_16S, scale);
-      in.other.convertTo(otherQ_, CV_16S, scale);
+      double scale = 0;
+      if (mirrored) {
+        // (Here, before the prefix sums read otherQ_.)
+        scale = shared->scale;
+        mirrorInner(refQ_, inner);
+        mirrorInner(otherQ_, inner);
+      } else {
+        // Quantised copies for the integer shape kernels: one scale for both images, the largest
+        // that keeps |q| ≤ kShapeQuantMax (the images are mapped to ~±128: a step of < 0.1 grey).
+        double refMin = 0, refMax = 0, otherMin = 0, otherMax = 0;
+        cv::minMaxLoc(in.ref, &refMin, &refMax);
+        cv::minMaxLoc(in.other, &otherMin, &otherMax);
+        const double maxAbs = std::max(
+            {std::abs(refMin), std::abs(refMax), std::abs(otherMin), std::abs(otherMax), 1e-6});
+        scale = std::floor(kShapeQuantMax / maxAbs * 1e6) / 1e6;  // round(scale·v) ≤ max
+        in.ref.convertTo(refQ_, CV_16S, scale);
+        in.other.convertTo(otherQ_, CV_16S, scale);
+      }
+      scale_ = scale;
       if (useSpans_) {
         // Row prefix sums of B and B² for the main-line span kernel.
         otherPrefixB_.create(H_, W_ + 1 + kPrefixPad, CV_32S);
@@ -593,6 +640,9 @@ class LevelMatcher {
     tasks.emplace_back([&] { out.lineShift = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
     tasks.emplace_back([&] { out.score = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
     runTasks(tasks, s.threads);
+    if (shared != nullptr && !mirrored) {
+      *shared = LevelPreparations{scale_, refStats_, otherStats_, refQ_, otherQ_};
+    }
     otherQStride_ = static_cast<ptrdiff_t>(otherQ_.step1());
     refQStride_ = static_cast<ptrdiff_t>(refQ_.step1());
     refStride_ = in.ref.step1();
@@ -603,8 +653,8 @@ class LevelMatcher {
       prefixBData_ = otherPrefixB_.ptr<int32_t>(0);
       prefixBBData_ = otherPrefixBB_.ptr<int32_t>(0);
     }
-    otherOk_ = otherStats_.ok.ptr<uchar>(0);
-    okStride_ = static_cast<ptrdiff_t>(otherStats_.ok.step1());
+    otherOk_ = otherStats_.usable.ptr<uchar>(0);
+    okStride_ = static_cast<ptrdiff_t>(otherStats_.usable.step1());
     otherQData_ = otherQ_.ptr<int16_t>(0);
     for (int v = 0; v < 16; ++v) prefixRowOffsets_[v] = static_cast<int32_t>(v * prefixStride_);
     for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
@@ -684,7 +734,7 @@ class LevelMatcher {
     for (int y = tile.y; y < tile.br().y; ++y) {
       const int* lo = in_.lo.ptr<int>(y);
       const int* hi = in_.hi.ptr<int>(y);
-      const uchar* ok = refStats_.ok.ptr<uchar>(y);
+      const uchar* ok = refStats_.usable.ptr<uchar>(y);
       const uchar* near = nearEdge_.ptr<uchar>(y);
       const uchar* refValid = in_.refValid.ptr<uchar>(y);
       for (int x = tile.x; x < tile.br().x; ++x) {
@@ -1417,14 +1467,14 @@ class LevelMatcher {
   const bool fillAvx2_ = cpuHasAvx2() && !cpuHasAvx512Vl();
   const int batchWindows_ = shapeBatchWindows();  // main-line windows per pass without spans
   cv::Mat otherPrefixB_, otherPrefixBB_;  // CV_32S, row prefix sums of otherQ_ and its squares
-  WindowStats refStats_, otherStats_;
+  WindowMoments refStats_, otherStats_;
   cv::Mat otherSq_;
   cv::Mat refQ_, otherQ_;  // CV_16S, grey levels quantised for the integer shape kernels
   ptrdiff_t otherQStride_ = 0, prefixStride_ = 0;  // their row strides, in elements
   int32_t prefixRowOffsets_[16] = {};     // v · prefixStride_: the span terms' row offsets
   const int32_t* prefixBData_ = nullptr;  // row 0 of otherPrefixB_, otherPrefixBB_
   const int32_t* prefixBBData_ = nullptr;
-  const uchar* otherOk_ = nullptr;  // row 0 of otherStats_.ok
+  const uchar* otherOk_ = nullptr;  // row 0 of otherStats_.usable
   ptrdiff_t okStride_ = 0;
   const int16_t* otherQData_ = nullptr;  // row 0 of otherQ_
   // cv::Mat::step1 is a library call, not inlined: the strides the per-pixel paths use.
@@ -1432,6 +1482,7 @@ class LevelMatcher {
   size_t refStride_ = 0, otherStride_ = 0;
   ptrdiff_t invalidStride_ = 0;  // of otherInvalidBits_
   double flatQ_ = 0;             // kFlatVariance in quantised units
+  double scale_ = 0;             // quantisation scale of refQ_ and otherQ_
   float squareLanes_[16] = {};   // 1 for the columns of a square window, 0 past it
   cv::Mat nearEdge_;
   cv::Mat blocked_;      // CV_8U, non-zero on contour and nodata pixels of ref
@@ -1445,7 +1496,7 @@ class LevelMatcher {
 }  // namespace
 
 bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
-                     core::Progress* progress) {
+                     core::Progress* progress, LevelPreparations* shared) {
   // Padding every input by the window radius with nodata lets adaptive shapes serve the pixels
   // whose window leaves the image (their shape stops at the border), and keeps every window
   // access inside the buffers.
@@ -1468,7 +1519,7 @@ bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelO
             [&] { padded.hi = pad(in.hi, 0); }},
            settings.threads);
   // The matcher writes the unpadded outputs directly (no copy out).
-  LevelMatcher matcher(padded, settings, out, cv::Rect(r, r, in.ref.cols, in.ref.rows));
+  LevelMatcher matcher(padded, settings, out, cv::Rect(r, r, in.ref.cols, in.ref.rows), shared);
   return matcher.run(progress);
 }
 
@@ -1492,11 +1543,11 @@ cv::Point2f subpixelPeak(const float s[3][3]) {
 }
 
 bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
-                core::Progress* progress) {
+                core::Progress* progress, LevelPreparations* shared) {
 #ifdef DELINEO_LEVEL_MATCHER_HAS_AVX2_BUILD
-  if (cpuHasAvx2()) return avx2build::matchLevelBuild(in, settings, out, progress);
+  if (cpuHasAvx2()) return avx2build::matchLevelBuild(in, settings, out, progress, shared);
 #endif
-  return base::matchLevelBuild(in, settings, out, progress);
+  return base::matchLevelBuild(in, settings, out, progress, shared);
 }
 
 }  // namespace delineo::stereo::detail

@@ -42,9 +42,29 @@ struct LevelOutput {
   cv::Mat score;      // CV_32F, NCC of the peak
 };
 
+// Window moments of one image as the matcher pads it: mean and standard deviation of each square
+// window that holds only valid pixels and is not flat (`usable` 1), 0 elsewhere.
+struct WindowMoments {
+  cv::Mat mean, sd;  // CV_32F
+  cv::Mat usable;    // CV_8U
+};
+
+// What the matcher prepares from the two images of a level, kept for the other view: the right
+// view's inputs are the left view's mirrored (ref = flip(right), other = flip(left), the masks
+// likewise), so its moments and quantised copies are the left view's, mirrored in place.
+struct LevelPreparations {
+  double scale = 0;          // quantisation scale, the same for both images
+  WindowMoments ref, other;  // of the view's ref and other images, padded
+  cv::Mat refQ, otherQ;      // CV_16S, quantised copies, padded
+  bool empty() const { return ref.mean.empty(); }
+};
+
 // Returns false when `progress` was canceled (outputs are then incomplete).
+// `shared` (optional): empty, it receives this view's preparations; filled by the other view of
+// the same level (`in` being that view's inputs mirrored), they are taken over from it (and
+// modified: it keeps only the scale).
 bool matchLevel(const LevelInput& in, const LevelSettings& settings, LevelOutput& out,
-                core::Progress* progress);
+                core::Progress* progress, LevelPreparations* shared = nullptr);
 
 // Sub-pixel offset of a peak from its 3x3 neighbourhood s[i][j], i = d-1..d+1, j = dy-1..dy+1
 // (NaN where not evaluated): separable parabolas through the peak's row and column. A

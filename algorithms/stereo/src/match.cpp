@@ -515,8 +515,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
                                   widenNearRejected, threads, loR, hiR);
     }
     const double w = levelsShare * weight[static_cast<size_t>(k)] / total;
+    detail::LevelPreparations shared;  // the left view's, for the right view
     core::Progress::Range leftRange(progress, done, done + 0.5 * w);
-    if (!detail::matchLevel(inL, s, leftOut, progress ? &leftRange : nullptr) ||
+    if (!detail::matchLevel(inL, s, leftOut, progress ? &leftRange : nullptr, &shared) ||
         core::isCanceled(progress)) {
       result.status = core::RunStatus::Canceled;
       return result;
@@ -544,7 +545,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
 
     core::Progress::Range rightRange(progress, done + 0.5 * w, done + w);
     detail::LevelOutput mirrored;
-    if (!detail::matchLevel(inR, s, mirrored, progress ? &rightRange : nullptr) ||
+    if (!detail::matchLevel(inR, s, mirrored, progress ? &rightRange : nullptr, &shared) ||
         core::isCanceled(progress)) {
       result.status = core::RunStatus::Canceled;
       return result;

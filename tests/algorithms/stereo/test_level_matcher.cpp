@@ -1,8 +1,9 @@
 // One level of the adaptive-window matcher (detail::matchLevel): the uniqueness test of wide
-// search intervals.
+// search intervals, and the right view taking the left view's preparations.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include <opencv2/core.hpp>
 
@@ -109,6 +110,56 @@ TEST(LevelMatcherUniqueness, AUniquePeakOrANarrowIntervalIsKept) {
     // A guided interval of 11 disparities holds one of the repeated peaks: not tested.
     const Counts narrow = count(run(levelPair(true, 5, 15, edgeColumn), 24), x0, x1);
     EXPECT_GT(narrow.atTruth, narrow.pixels * 95 / 100);
+  }
+}
+
+// The inputs of the other view: every image mirrored left to right, the interval kept (the test
+// compares two runs on the same mirrored input, not their disparities with the left view's).
+detail::LevelInput mirroredView(const detail::LevelInput& in) {
+  detail::LevelInput m;  // fresh buffers (a copy of `in` would share its images)
+  m.lo = in.lo.clone();
+  m.hi = in.hi.clone();
+  m.dmin = in.dmin;
+  m.dmax = in.dmax;
+  cv::flip(in.other, m.ref, 1);
+  cv::flip(in.ref, m.other, 1);
+  cv::flip(in.otherValid, m.refValid, 1);
+  cv::flip(in.refValid, m.otherValid, 1);
+  // The right view has contours of its own.
+  m.refEdges = cv::Mat::zeros(in.refEdges.size(), CV_8U);
+  m.refEdges.col(60).setTo(255);
+  return m;
+}
+
+bool sameBytes(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() && a.isContinuous() && b.isContinuous() &&
+         std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+
+TEST(LevelMatcherPreparations, TheOtherViewMatchesAsWithItsOwn) {
+  for (const int window : {15, 17}) {  // the integer shape kernels, the float ones
+    SCOPED_TRACE(window);
+    detail::LevelInput left = levelPair(false, 0, 59, 100);
+    // Nodata in both views: the moments' usable flags must follow it when mirrored.
+    left.other(cv::Rect(30, 20, 12, 9)).setTo(0);
+    left.otherValid(cv::Rect(30, 20, 12, 9)).setTo(0);
+    left.refValid(cv::Rect(150, 5, 6, 30)).setTo(0);
+    detail::LevelSettings s;
+    s.window = window;
+    detail::LevelPreparations shared;
+    detail::LevelOutput leftOut;
+    ASSERT_TRUE(detail::matchLevel(left, s, leftOut, nullptr, &shared));
+    EXPECT_FALSE(shared.empty());
+    const detail::LevelInput right = mirroredView(left);
+    detail::LevelOutput taken, own;
+    ASSERT_TRUE(detail::matchLevel(right, s, taken, nullptr, &shared));
+    EXPECT_TRUE(shared.empty());  // taken over
+    ASSERT_TRUE(detail::matchLevel(right, s, own, nullptr));
+    EXPECT_TRUE(sameBytes(taken.disparity, own.disparity));
+    EXPECT_TRUE(sameBytes(taken.lineShift, own.lineShift));
+    EXPECT_TRUE(sameBytes(taken.score, own.score));
+    // Not a vacuous comparison: the right view matches most of its pixels.
+    EXPECT_GT(cv::countNonZero(own.disparity == own.disparity), own.disparity.total() / 2);
   }
 }
 
