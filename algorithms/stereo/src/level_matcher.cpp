@@ -535,7 +535,7 @@ class LevelMatcher {
   // `in` is padded; the outputs cover `inner`, the unpadded image, and are written at
   // (x, y) − inner.tl() (only inner pixels are searched: the padding's intervals are empty).
   LevelMatcher(const LevelInput& in, const LevelSettings& s, LevelOutput& out, cv::Rect inner,
-               LevelPreparations* shared)
+               LevelPreparations* shared, LevelScratch& scratch)
       : in_(in),
         s_(s),
         out_(out),
@@ -550,6 +550,15 @@ class LevelMatcher {
     // Independent preparations, run on the level's threads (serial, they took ~12 % of the
     // matcher's time).
     std::vector<std::function<void()>> tasks;
+    // The buffers the other view left (empty for the first view), overwritten below.
+    blocked_ = std::move(scratch.blocked);
+    blockedBits_ = std::move(scratch.blockedBits);
+    nearEdge_ = std::move(scratch.nearEdge);
+    otherInvalidBits_ = std::move(scratch.otherInvalidBits);
+    otherPrefixB_ = std::move(scratch.prefixB);
+    otherPrefixBB_ = std::move(scratch.prefixBB);
+    otherSq_ = std::move(scratch.otherSq);
+    freeColumns_ = std::move(scratch.freeColumns);
     // The other view's preparations, mirrored, when it left them (see LevelPreparations).
     const bool mirrored = shared != nullptr && !shared->empty();
     if (mirrored) {
@@ -603,13 +612,19 @@ class LevelMatcher {
       if (s.window > 15) cv::multiply(in.other, in.other, otherSq_);
       // Nodata of the other image as row words (see blockedBits_): a shape window touches
       // nodata when one of its rows shares a bit with these (one AND per row).
-      otherInvalidBits_ = rowWindowBits(in.otherValid == 0);
+      rowWindowBits(in.otherValid, /*markedWhenZero=*/true, otherInvalidBits_);
     });
     tasks.emplace_back([&] {
       // Pixels a shape never enters: contours and nodata. blockedBits_(y, x): bit u set when
       // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
-      blocked_ = (in.refEdges != 0) | (in.refValid == 0);
-      blockedBits_ = rowWindowBits(blocked_);
+      blocked_.create(in.ref.size(), CV_8U);
+      for (int y = 0; y < H_; ++y) {
+        const uchar* edge = in.refEdges.ptr<uchar>(y);
+        const uchar* valid = in.refValid.ptr<uchar>(y);
+        uchar* b = blocked_.ptr<uchar>(y);
+        for (int x = 0; x < W_; ++x) b[x] = (edge[x] != 0) | (valid[x] == 0) ? 255 : 0;
+      }
+      rowWindowBits(blocked_, /*markedWhenZero=*/false, blockedBits_);
       if (s.window <= 15) {
         // Column-major copy of the free (not blocked) row words: the 16 rows of a window are
         // contiguous, one load for the fill. 16 spare rows keep every window's read inside.
@@ -633,7 +648,8 @@ class LevelMatcher {
         cv::dilate(blocked_, nearEdge_,
                    cv::getStructuringElement(cv::MORPH_RECT, cv::Size(s.window, s.window)));
       } else {
-        nearEdge_ = cv::Mat::zeros(in.ref.size(), CV_8U);
+        nearEdge_.create(in.ref.size(), CV_8U);
+        nearEdge_.setTo(0);
       }
     });
     tasks.emplace_back([&] { out.disparity = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
@@ -641,7 +657,11 @@ class LevelMatcher {
     tasks.emplace_back([&] { out.score = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
     runTasks(tasks, s.threads);
     if (shared != nullptr && !mirrored) {
-      *shared = LevelPreparations{scale_, refStats_, otherStats_, refQ_, otherQ_};
+      shared->scale = scale_;
+      shared->ref = refStats_;
+      shared->other = otherStats_;
+      shared->refQ = refQ_;
+      shared->otherQ = otherQ_;
     }
     otherQStride_ = static_cast<ptrdiff_t>(otherQ_.step1());
     refQStride_ = static_cast<ptrdiff_t>(refQ_.step1());
@@ -674,13 +694,27 @@ class LevelMatcher {
     return prefixBBData_ + static_cast<ptrdiff_t>(y) * prefixStride_;
   }
 
-  // Per pixel, the row of its window as one word: bit u set when (x - r + u, y) is marked in
-  // `marked` (CV_8U) or lies outside the image.
-  cv::Mat rowWindowBits(const cv::Mat& marked) const {
-    cv::Mat out(marked.size(), CV_32S);  // every element is written below
+  // The buffers this view leaves to the other view of the level (see LevelScratch).
+  void leaveBuffers(LevelScratch& scratch) {
+    scratch.blocked = std::move(blocked_);
+    scratch.blockedBits = std::move(blockedBits_);
+    scratch.nearEdge = std::move(nearEdge_);
+    scratch.otherInvalidBits = std::move(otherInvalidBits_);
+    scratch.prefixB = std::move(otherPrefixB_);
+    scratch.prefixBB = std::move(otherPrefixBB_);
+    scratch.otherSq = std::move(otherSq_);
+    scratch.freeColumns = std::move(freeColumns_);
+  }
+
+  // Per pixel, the row of its window as one word (into `out`, CV_32S): bit u set when
+  // (x - r + u, y) is marked in `mask` (CV_8U: non-zero, or zero with `markedWhenZero`) or lies
+  // outside the image.
+  void rowWindowBits(const cv::Mat& mask, bool markedWhenZero, cv::Mat& out) const {
+    out.create(mask.size(), CV_32S);  // every element is written below
+    const uint32_t whenZero = markedWhenZero ? 1U : 0U;
     const int w = s_.window;
     for (int y = 0; y < H_; ++y) {
-      const uchar* b = marked.ptr<uchar>(y);
+      const uchar* b = mask.ptr<uchar>(y);
       int* bits = out.ptr<int>(y);
       uint32_t word = w == 32 ? ~0U : (1U << w) - 1U;  // columns left of the image: marked
       // After the step at x, word covers columns x - r .. x + r. Three loops: the column
@@ -688,9 +722,11 @@ class LevelMatcher {
       // loop with both tests cost ~20 instructions a pixel).
       const int inside = W_ - r_;
       int x = -r_;
-      for (; x < std::min(0, inside); ++x) word = (word >> 1) | ((b[x + r_] ? 1U : 0U) << (w - 1));
+      for (; x < std::min(0, inside); ++x) {
+        word = (word >> 1) | (((b[x + r_] ? 1U : 0U) ^ whenZero) << (w - 1));
+      }
       for (; x < inside; ++x) {
-        word = (word >> 1) | ((b[x + r_] ? 1U : 0U) << (w - 1));
+        word = (word >> 1) | (((b[x + r_] ? 1U : 0U) ^ whenZero) << (w - 1));
         bits[x] = static_cast<int>(word);
       }
       for (; x < W_; ++x) {
@@ -698,7 +734,6 @@ class LevelMatcher {
         if (x >= 0) bits[x] = static_cast<int>(word);
       }
     }
-    return out;
   }
 
   bool run(core::Progress* progress) {
@@ -1503,24 +1538,34 @@ bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelO
   // The right side gets 32 more columns: dense shape rows read up to 32 floats from a window's
   // left column.
   const int r = settings.window / 2;
-  auto pad = [r](const cv::Mat& m, double value) {
-    cv::Mat padded;
-    cv::copyMakeBorder(m, padded, r, r, r, r + 32, cv::BORDER_CONSTANT, cv::Scalar(value));
-    return padded;
+  // The first view of a level leaves its buffers to the second, which overwrites them.
+  const bool leaving = shared != nullptr && shared->empty();
+  LevelScratch scratch;
+  if (shared != nullptr && !shared->empty()) scratch = std::move(shared->scratch);
+  LevelInput& padded = scratch.padded;
+  auto pad = [r](const cv::Mat& m, double value, cv::Mat& to) {
+    cv::copyMakeBorder(m, to, r, r, r, r + 32, cv::BORDER_CONSTANT, cv::Scalar(value));
   };
   // The padded copies run on the level's threads too (serial, the copies in and out were ~4 %
   // of the level's wall time with two threads).
-  LevelInput padded = in;
-  runTasks({[&] { padded.ref = pad(in.ref, 0); }, [&] { padded.other = pad(in.other, 0); },
-            [&] { padded.refValid = pad(in.refValid, 0); },
-            [&] { padded.otherValid = pad(in.otherValid, 0); },
-            [&] { padded.refEdges = pad(in.refEdges, 0); },
-            [&] { padded.lo = pad(in.lo, 1); },  // lo > hi: not searched
-            [&] { padded.hi = pad(in.hi, 0); }},
+  runTasks({[&] { pad(in.ref, 0, padded.ref); }, [&] { pad(in.other, 0, padded.other); },
+            [&] { pad(in.refValid, 0, padded.refValid); },
+            [&] { pad(in.otherValid, 0, padded.otherValid); },
+            [&] { pad(in.refEdges, 0, padded.refEdges); },
+            [&] { pad(in.lo, 1, padded.lo); },  // lo > hi: not searched
+            [&] { pad(in.hi, 0, padded.hi); }},
            settings.threads);
+  padded.dmin = in.dmin;
+  padded.dmax = in.dmax;
   // The matcher writes the unpadded outputs directly (no copy out).
-  LevelMatcher matcher(padded, settings, out, cv::Rect(r, r, in.ref.cols, in.ref.rows), shared);
-  return matcher.run(progress);
+  LevelMatcher matcher(padded, settings, out, cv::Rect(r, r, in.ref.cols, in.ref.rows), shared,
+                       scratch);
+  const bool finished = matcher.run(progress);
+  if (leaving) {
+    matcher.leaveBuffers(shared->scratch);
+    shared->scratch.padded = std::move(scratch.padded);
+  }
+  return finished;
 }
 
 }  // namespace delineo::stereo::detail::DELINEO_LEVEL_MATCHER_BUILD
