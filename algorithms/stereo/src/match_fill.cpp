@@ -969,10 +969,13 @@ GreyMaps greyMaps(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disp
 
 // The fill itself; `greyMapsOf()` gives greyMaps() of the disparities as they come in (read
 // before the fill writes any), `rightFlatRegionsOf()` the right view's flat regions.
-template <class GreyMapsOf, class RightFlat>
+// `offerRegions(tasks)` hands the regions' tasks to `helpers` other threads, which each call
+// tasks.help() once.
+template <class GreyMapsOf, class RightFlat, class OfferRegions>
 int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                 int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
-                const GreyMapsOf& greyMapsOf, const RightFlat& rightFlatRegionsOf) {
+                const GreyMapsOf& greyMapsOf, const RightFlat& rightFlatRegionsOf, int helpers,
+                const OfferRegions& offerRegions) {
   double sigma = 0;
   const cv::Mat flat = flatMask(left, settings, &sigma);
   // The regions without their thin parts (see RegionFillSettings::coreOpening).
@@ -1010,24 +1013,35 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     ownFill[static_cast<size_t>(r)] = unmatched[static_cast<size_t>(r)] >= settings.minUnmatched &&
                                       stats.at<int>(r, cv::CC_STAT_AREA) <= maxArea;
   }
-  int filled = 0;
   struct FilledRegion {
     cv::Rect box;
     cv::Mat grown;
     FillPlane plane;
   };
-  std::vector<FilledRegion> filledRegions;
+  // The regions decided here, in label order, each in its bounding box grown by 4 px. A region
+  // reads and writes the disparities (and scores) of its box's rows only: the matches around it,
+  // those its plane would hide left of it on its rows, its own pixels. Regions on disjoint rows
+  // are decided side by side (with a helper), the others in label order: the same result.
+  std::vector<int> decided;
+  std::vector<cv::Rect> boxes;
+  std::vector<std::pair<int, int>> rows;
   for (int r = 1; r < count; ++r) {
-    if (unmatched[static_cast<size_t>(r)] < settings.minUnmatched ||
-        stats.at<int>(r, cv::CC_STAT_AREA) > maxArea) {
-      continue;
-    }
-    // Work in the region's bounding box grown by 4 px.
+    if (!ownFill[static_cast<size_t>(r)]) continue;
     const cv::Rect box =
         cv::Rect(stats.at<int>(r, cv::CC_STAT_LEFT) - 4, stats.at<int>(r, cv::CC_STAT_TOP) - 4,
                  stats.at<int>(r, cv::CC_STAT_WIDTH) + 8,
                  stats.at<int>(r, cv::CC_STAT_HEIGHT) + 8) &
         image;
+    decided.push_back(r);
+    boxes.push_back(box);
+    rows.emplace_back(box.y, box.br().y);
+  }
+  std::vector<int> filledIn(decided.size(), 0);
+  std::vector<std::optional<FilledRegion>> filledRegion(decided.size());
+  const auto decideRegion = [&](size_t task) {
+    const int r = decided[task];
+    const cv::Rect box = boxes[task];
+    int& filled = filledIn[task];
     cv::Mat region = labels(box) == r;
     cv::Mat near, beside;
     cv::dilate(region, near, cv::getStructuringElement(cv::MORPH_RECT, {7, 7}));
@@ -1322,7 +1336,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
           (constant && !(planeRingError(plane) < settings.planeMargin * constantError)) ||
           (!constant && settings.planeCandidateRatio > 0 &&
            !(planeRingError(plane) < settings.planeCandidateRatio * candidateError))) {
-        if (!constant) continue;
+        if (!constant) return;
         plane = FillPlane{*constant, 0, 0};
       } else if (!constant && span < settings.planeMinSpan) {
         // Taken where no constant passed, a plane that changes by less than planeMinSpan over the
@@ -1350,7 +1364,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         }
       }
     } else {
-      if (!constant) continue;
+      if (!constant) return;
       plane.c = *constant;
     }
     // Whether the fill's value explains the inRegionWindow² window at (x, y) (image
@@ -1426,7 +1440,16 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         ++filled;
       }
     }
-    if (settings.extendReach > 0) filledRegions.push_back({box, grown, plane});
+    if (settings.extendReach > 0) filledRegion[task] = FilledRegion{box, grown, plane};
+  };
+  RowOrderedTasks regionTasks(rows, decideRegion, helpers);
+  offerRegions(regionTasks);
+  regionTasks.run();
+  int filled = 0;
+  std::vector<FilledRegion> filledRegions;
+  for (size_t k = 0; k < decided.size(); ++k) {
+    filled += filledIn[k];
+    if (filledRegion[k]) filledRegions.push_back(std::move(*filledRegion[k]));
   }
   // Once every region is filled (the extension's pixels do not become another region's
   // candidates).
@@ -1455,7 +1478,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
   if (threads > 1 && settings.planeMinRows > 0) {
     GreyMaps maps;
     RightFlatRegions rightFlat;
-    std::latch mapsReady(1), rightReady(1);
+    std::latch mapsReady(1), rightReady(1), regionsOffered(1);
+    RowOrderedTasks* regionTasks = nullptr;
     int filled = 0;
     runTasks({[&] {
                 filled = fillRegions(
@@ -1467,6 +1491,11 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                     [&]() -> const RightFlatRegions& {
                       rightReady.wait();
                       return rightFlat;
+                    },
+                    1,
+                    [&](RowOrderedTasks& tasks) {
+                      regionTasks = &tasks;
+                      regionsOffered.count_down();
                     });
               },
               [&] {
@@ -1476,6 +1505,9 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                 rightFlat = rightFlatRegions(flatMask(right, settings), right);
                 rightReady.count_down();
                 if (alongside) alongside();
+                // Then it helps with the regions (the rest of the fill's time is theirs).
+                regionsOffered.wait();
+                regionTasks->help();
               }},
              threads);
     return filled;
@@ -1490,7 +1522,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
         if (rightFlat.labels.empty())
           rightFlat = rightFlatRegions(flatMask(right, settings), right);
         return rightFlat;
-      });
+      },
+      0, [](RowOrderedTasks&) {});
   if (alongside) alongside();
   return filled;
 }

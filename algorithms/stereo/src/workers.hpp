@@ -5,8 +5,13 @@
 // own outputs, so results never depend on the number of threads.
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <cstddef>
 #include <functional>
+#include <mutex>
+#include <set>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace delineo::stereo::detail {
@@ -40,5 +45,75 @@ void forRowBands(int rows, int threads, const BandFn& band, int bandRows = 16) {
   worker();
   for (auto& t : pool) t.join();
 }
+
+// Tasks 0 .. n−1 whose result must be that of running them in this order, where task k reads and
+// writes only the rows rows[k] = [first, end) of the outputs they share: task k starts once every
+// earlier task whose rows overlap its own has finished; tasks on disjoint rows run side by side
+// (they touch disjoint data, so their order does not matter).
+// The owner calls run(); up to `helpers` other threads may each call help() once, at any time
+// (before, during or after run()). run() returns once every task has finished and every helper
+// has called help() and left it: the owner may then destroy this object.
+class RowOrderedTasks {
+ public:
+  RowOrderedTasks(const std::vector<std::pair<int, int>>& rows, std::function<void(size_t)> task,
+                  int helpers)
+      : task_(std::move(task)),
+        waitingOn_(rows.size(), 0),
+        after_(rows.size()),
+        unfinished_(rows.size()),
+        helpersToCome_(helpers) {
+    for (size_t k = 0; k < rows.size(); ++k) {
+      for (size_t j = 0; j < k; ++j) {
+        if (rows[j].first < rows[k].second && rows[k].first < rows[j].second) {
+          ++waitingOn_[k];
+          after_[j].push_back(k);
+        }
+      }
+      if (waitingOn_[k] == 0) ready_.insert(k);
+    }
+  }
+
+  void run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    workUntilAllFinished(lock);
+    changed_.wait(lock, [&] { return helpersToCome_ == 0; });
+  }
+
+  void help() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    workUntilAllFinished(lock);
+    --helpersToCome_;
+    changed_.notify_all();  // (under the lock: run() cannot return before it is released)
+  }
+
+ private:
+  void workUntilAllFinished(std::unique_lock<std::mutex>& lock) {
+    while (unfinished_ > 0) {
+      if (ready_.empty()) {
+        changed_.wait(lock);
+        continue;
+      }
+      const size_t k = *ready_.begin();  // the earliest ready task
+      ready_.erase(ready_.begin());
+      lock.unlock();
+      task_(k);
+      lock.lock();
+      for (const size_t next : after_[k]) {
+        if (--waitingOn_[next] == 0) ready_.insert(next);
+      }
+      --unfinished_;
+      changed_.notify_all();
+    }
+  }
+
+  std::function<void(size_t)> task_;
+  std::vector<int> waitingOn_;              // unfinished earlier tasks on overlapping rows
+  std::vector<std::vector<size_t>> after_;  // the later tasks on overlapping rows
+  std::set<size_t> ready_;                  // not started, nothing left to wait for
+  size_t unfinished_;
+  int helpersToCome_;  // helpers that have not left help() yet
+  std::mutex mutex_;
+  std::condition_variable changed_;
+};
 
 }  // namespace delineo::stereo::detail

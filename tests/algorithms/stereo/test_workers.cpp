@@ -1,0 +1,101 @@
+// The worker model (workers.hpp): tasks run in an order fixed by the rows they touch.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "workers.hpp"
+
+namespace {
+
+namespace detail = delineo::stereo::detail;
+
+// Tasks over the rows of a 100-row map: each appends its index to the log of every row it
+// touches. Whatever the threads do, a row's log must list its tasks in increasing order, each
+// task once.
+struct RowLogs {
+  std::vector<std::pair<int, int>> rows;
+  std::vector<std::vector<size_t>> logs = std::vector<std::vector<size_t>>(100);
+  std::vector<std::atomic<int>> runs;
+  std::vector<std::atomic<bool>> finished;
+  std::atomic<int> startedTooEarly{0};
+  std::mutex logsMutex;  // so that a broken scheduler shows as a failure, not as a data race
+  explicit RowLogs(std::vector<std::pair<int, int>> r)
+      : rows(std::move(r)), runs(rows.size()), finished(rows.size()) {}
+  bool overlap(size_t j, size_t k) const {
+    return rows[j].first < rows[k].second && rows[k].first < rows[j].second;
+  }
+  void task(size_t k) {
+    ++runs[k];
+    for (size_t j = 0; j < k; ++j) {
+      if (overlap(j, k) && !finished[j]) ++startedTooEarly;
+    }
+    // Long enough for the other thread to start a task meanwhile.
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    {
+      std::lock_guard<std::mutex> lock(logsMutex);
+      for (int y = rows[k].first; y < rows[k].second; ++y) logs[static_cast<size_t>(y)].push_back(k);
+    }
+    finished[k] = true;
+  }
+  void expectSerialOrderPerRow() const {
+    EXPECT_EQ(startedTooEarly.load(), 0) << "tasks started before an earlier overlapping one ended";
+    for (size_t k = 0; k < rows.size(); ++k) EXPECT_EQ(runs[k].load(), 1) << "task " << k;
+    for (int y = 0; y < 100; ++y) {
+      std::vector<size_t> expected;
+      for (size_t k = 0; k < rows.size(); ++k) {
+        if (rows[k].first <= y && y < rows[k].second) expected.push_back(k);
+      }
+      EXPECT_EQ(logs[static_cast<size_t>(y)], expected) << "row " << y;
+    }
+  }
+};
+
+std::vector<std::pair<int, int>> someRows() {
+  // Overlapping chains and disjoint bands, in no particular row order.
+  return {{0, 10}, {50, 60}, {5, 15}, {55, 70}, {90, 100}, {12, 30}, {80, 85}, {0, 100},
+          {20, 25}, {60, 95}, {30, 31}, {1, 2}, {40, 45}, {44, 50}, {99, 100}, {10, 90}};
+}
+
+TEST(RowOrderedTasks, OverlappingTasksRunInOrderOnOneThread) {
+  RowLogs logs(someRows());
+  detail::RowOrderedTasks tasks(logs.rows, [&](size_t k) { logs.task(k); }, 0);
+  tasks.run();
+  logs.expectSerialOrderPerRow();
+}
+
+TEST(RowOrderedTasks, AHelperRunsDisjointTasksAlongsideAndOverlappingOnesInOrder) {
+  // The helper arrives before, at about the same time as, and after the owner starts.
+  for (const int helperDelayMs : {0, 1, 50}) {
+    SCOPED_TRACE(helperDelayMs);
+    RowLogs logs(someRows());
+    std::atomic<int> concurrent{0}, mostConcurrent{0};
+    detail::RowOrderedTasks tasks(
+        logs.rows,
+        [&](size_t k) {
+          const int now = ++concurrent;
+          int seen = mostConcurrent.load();
+          while (now > seen && !mostConcurrent.compare_exchange_weak(seen, now)) {
+          }
+          logs.task(k);
+          --concurrent;
+        },
+        1);
+    std::thread helper([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(helperDelayMs));
+      tasks.help();
+    });
+    tasks.run();
+    helper.join();
+    logs.expectSerialOrderPerRow();
+    if (helperDelayMs == 0) {
+      EXPECT_EQ(mostConcurrent.load(), 2);  // the disjoint bands
+    }
+  }
+}
+
+}  // namespace
