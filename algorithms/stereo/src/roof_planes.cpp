@@ -117,12 +117,14 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int m
   return labels;
 }
 
-// One round of the trimmed fit: the least-squares plane of each surface's pixels marked in
+// The trimmed fit, `rounds` rounds: the least-squares plane of each surface's pixels marked in
 // `keep`, the RMS of their residuals to it, then `keep` set anew to the pixels within the band.
-// Bands of rows on `threads` workers, each with its own sums, added up in band order: the same
-// result for any number of threads.
-void fitRound(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
-              std::vector<Surface>& surfaces, const RoofPlaneSettings& s) {
+// One pass over the image per round plus one: a pass sets `keep` from the previous round's planes
+// and sums the next round's moments over the pixels it keeps. Bands of rows on `threads`
+// workers, each with its own sums, added up in band order: the same result for any number of
+// threads.
+void fitPlanes(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
+               std::vector<Surface>& surfaces, const RoofPlaneSettings& s, int rounds) {
   // Moments of u = x − cx, v = y − cy and z = d − z0 (z0: the surface's first pixel, so that
   // Σz² stays small and the residual sum below keeps its precision).
   struct Sums {
@@ -131,87 +133,84 @@ void fitRound(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
   constexpr int kBandRows = 32;
   const int bands = (disparity.rows + kBandRows - 1) / kBandRows;
   std::vector<std::vector<Sums>> bandSums(static_cast<size_t>(bands));
-  forRowBands(
-      disparity.rows, s.threads,
-      [&](int rowStart, int rowEnd) {
-        std::vector<Sums>& sums = bandSums[static_cast<size_t>(rowStart / kBandRows)];
-        sums.assign(surfaces.size(), Sums{});
-        for (int y = rowStart; y < rowEnd; ++y) {
-          const float* d = disparity.ptr<float>(y);
-          const int* l = labels.ptr<int>(y);
-          const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-          for (int x = 0; x < disparity.cols; ++x) {
-            if (l[x] < 0 || k[x] == 0) continue;
-            const Surface& f = surfaces[static_cast<size_t>(l[x])];
-            Sums& t = sums[static_cast<size_t>(l[x])];
-            const double u = x - f.cx, v = y - f.cy, z = d[x] - f.z0;
-            t.n += 1;
-            t.u += u;
-            t.v += v;
-            t.uu += u * u;
-            t.uv += u * v;
-            t.vv += v * v;
-            t.z += z;
-            t.uz += u * z;
-            t.vz += v * z;
-            t.zz += z * z;
-          }
-        }
-      },
-      kBandRows);
-  for (size_t i = 0; i < surfaces.size(); ++i) {
-    Sums t;
-    for (const std::vector<Sums>& band : bandSums) {
-      const Sums& b = band[i];
-      t.n += b.n;
-      t.u += b.u;
-      t.v += b.v;
-      t.uu += b.uu;
-      t.uv += b.uv;
-      t.vv += b.vv;
-      t.z += b.z;
-      t.uz += b.uz;
-      t.vz += b.vz;
-      t.zz += b.zz;
-    }
-    Surface& f = surfaces[i];
-    const cv::Matx33d m(t.uu, t.uv, t.u, t.uv, t.vv, t.v, t.u, t.v, t.n);
-    cv::Vec3d plane;
-    if (t.n < 3 || !cv::solve(m, cv::Vec3d(t.uz, t.vz, t.z), plane, cv::DECOMP_LU)) {
-      f.fitted = false;  // a line of pixels, or nothing left in the band
-      continue;
-    }
-    f.a = plane[0];
-    f.b = plane[1];
-    f.c = plane[2] + f.z0;
-    // The least-squares residual is orthogonal to the regressors: Σr² = Σz² − θ·(Σuz, Σvz, Σz).
-    const double sq = t.zz - (plane[0] * t.uz + plane[1] * t.vz + plane[2] * t.z);
-    f.rms = std::sqrt(std::max(0.0, sq) / t.n);
-  }
   std::vector<std::vector<long>> bandInliers(static_cast<size_t>(bands));
-  forRowBands(
-      disparity.rows, s.threads,
-      [&](int rowStart, int rowEnd) {
-        std::vector<long>& inliers = bandInliers[static_cast<size_t>(rowStart / kBandRows)];
-        inliers.assign(surfaces.size(), 0);
-        for (int y = rowStart; y < rowEnd; ++y) {
-          const float* d = disparity.ptr<float>(y);
-          const int* l = labels.ptr<int>(y);
-          std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-          for (int x = 0; x < disparity.cols; ++x) {
-            if (l[x] < 0) continue;
-            const Surface& f = surfaces[static_cast<size_t>(l[x])];
-            const double band = std::max(s.trimFactor * f.rms, s.trimFloor);
-            const bool in = f.fitted && std::abs(d[x] - f.at(x, y)) <= band;
-            k[x] = in ? 1 : 0;
-            inliers[static_cast<size_t>(l[x])] += in ? 1 : 0;
+  for (int pass = 0; pass <= rounds; ++pass) {
+    const bool trim = pass > 0;      // keep from the previous round's planes
+    const bool sum = pass < rounds;  // this round's moments
+    forRowBands(
+        disparity.rows, s.threads,
+        [&](int rowStart, int rowEnd) {
+          const auto band = static_cast<size_t>(rowStart / kBandRows);
+          std::vector<Sums>& sums = bandSums[band];
+          std::vector<long>& inliers = bandInliers[band];
+          if (sum) sums.assign(surfaces.size(), Sums{});
+          if (trim) inliers.assign(surfaces.size(), 0);
+          for (int y = rowStart; y < rowEnd; ++y) {
+            const float* d = disparity.ptr<float>(y);
+            const int* l = labels.ptr<int>(y);
+            std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+            for (int x = 0; x < disparity.cols; ++x) {
+              if (l[x] < 0) continue;
+              const Surface& f = surfaces[static_cast<size_t>(l[x])];
+              if (trim) {
+                const double within = std::max(s.trimFactor * f.rms, s.trimFloor);
+                const bool in = f.fitted && std::abs(d[x] - f.at(x, y)) <= within;
+                k[x] = in ? 1 : 0;
+                inliers[static_cast<size_t>(l[x])] += in ? 1 : 0;
+              }
+              if (!sum || k[x] == 0) continue;
+              Sums& t = sums[static_cast<size_t>(l[x])];
+              const double u = x - f.cx, v = y - f.cy, z = d[x] - f.z0;
+              t.n += 1;
+              t.u += u;
+              t.v += v;
+              t.uu += u * u;
+              t.uv += u * v;
+              t.vv += v * v;
+              t.z += z;
+              t.uz += u * z;
+              t.vz += v * z;
+              t.zz += z * z;
+            }
           }
-        }
-      },
-      kBandRows);
-  for (size_t i = 0; i < surfaces.size(); ++i) {
-    surfaces[i].inliers = 0;
-    for (const std::vector<long>& band : bandInliers) surfaces[i].inliers += band[i];
+        },
+        kBandRows);
+    if (trim) {
+      for (size_t i = 0; i < surfaces.size(); ++i) {
+        surfaces[i].inliers = 0;
+        for (const std::vector<long>& band : bandInliers) surfaces[i].inliers += band[i];
+      }
+    }
+    if (!sum) break;
+    for (size_t i = 0; i < surfaces.size(); ++i) {
+      Sums t;
+      for (const std::vector<Sums>& band : bandSums) {
+        const Sums& b = band[i];
+        t.n += b.n;
+        t.u += b.u;
+        t.v += b.v;
+        t.uu += b.uu;
+        t.uv += b.uv;
+        t.vv += b.vv;
+        t.z += b.z;
+        t.uz += b.uz;
+        t.vz += b.vz;
+        t.zz += b.zz;
+      }
+      Surface& f = surfaces[i];
+      const cv::Matx33d m(t.uu, t.uv, t.u, t.uv, t.vv, t.v, t.u, t.v, t.n);
+      cv::Vec3d plane;
+      if (t.n < 3 || !cv::solve(m, cv::Vec3d(t.uz, t.vz, t.z), plane, cv::DECOMP_LU)) {
+        f.fitted = false;  // a line of pixels, or nothing left in the band
+        continue;
+      }
+      f.a = plane[0];
+      f.b = plane[1];
+      f.c = plane[2] + f.z0;
+      // The least-squares residual is orthogonal to the regressors: Σr² = Σz² − θ·(Σuz, Σvz, Σz).
+      const double sq = t.zz - (plane[0] * t.uz + plane[1] * t.vz + plane[2] * t.z);
+      f.rms = std::sqrt(std::max(0.0, sq) / t.n);
+    }
   }
 }
 
@@ -230,7 +229,7 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
   cv::Mat keep(disparity.size(), CV_8U);
   keep.setTo(1);
   constexpr int kRounds = 3;  // the band settles after two; the third confirms it
-  for (int round = 0; round < kRounds; ++round) fitRound(disparity, labels, keep, surfaces, s);
+  fitPlanes(disparity, labels, keep, surfaces, s, kRounds);
   std::vector<std::uint8_t> planar(surfaces.size(), 0);
   for (size_t i = 0; i < surfaces.size(); ++i) {
     const Surface& f = surfaces[i];
