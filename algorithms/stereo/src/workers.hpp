@@ -62,14 +62,25 @@ class RowOrderedTasks {
         after_(rows.size()),
         unfinished_(rows.size()),
         helpersToCome_(helpers) {
+    // Task k waits for the last earlier task on each of its rows only: that one waits in turn
+    // for the earlier ones there. (Σ of the spans' heights, not n² pairs: a large image has many
+    // thousands of regions.)
+    int end = 0;
+    for (const auto& span : rows) end = std::max(end, span.second);
+    std::vector<size_t> lastOnRow(static_cast<size_t>(end), kNone);
+    std::vector<size_t> before;
     for (size_t k = 0; k < rows.size(); ++k) {
-      for (size_t j = 0; j < k; ++j) {
-        if (rows[j].first < rows[k].second && rows[k].first < rows[j].second) {
-          ++waitingOn_[k];
-          after_[j].push_back(k);
-        }
+      before.clear();
+      for (int y = std::max(0, rows[k].first); y < rows[k].second; ++y) {
+        size_t& last = lastOnRow[static_cast<size_t>(y)];
+        if (last != kNone) before.push_back(last);
+        last = k;
       }
-      if (waitingOn_[k] == 0) ready_.insert(k);
+      std::sort(before.begin(), before.end());
+      before.erase(std::unique(before.begin(), before.end()), before.end());
+      for (const size_t j : before) after_[j].push_back(k);
+      waitingOn_[k] = static_cast<int>(before.size());
+      if (before.empty()) ready_.insert(k);
     }
   }
 
@@ -106,9 +117,10 @@ class RowOrderedTasks {
     }
   }
 
+  static constexpr size_t kNone = static_cast<size_t>(-1);
   std::function<void(size_t)> task_;
-  std::vector<int> waitingOn_;              // unfinished earlier tasks on overlapping rows
-  std::vector<std::vector<size_t>> after_;  // the later tasks on overlapping rows
+  std::vector<int> waitingOn_;              // unfinished earlier tasks it waits for
+  std::vector<std::vector<size_t>> after_;  // the later tasks waiting for it
   std::set<size_t> ready_;                  // not started, nothing left to wait for
   size_t unfinished_;
   int helpersToCome_;  // helpers that have not left help() yet
