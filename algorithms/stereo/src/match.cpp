@@ -377,14 +377,15 @@ cv::Mat validate(const detail::LevelOutput& map, const detail::LevelOutput& othe
 // Bands of 64 rows: each scans 2 · (lineShift + 2) rows beyond its own.
 constexpr int kPointedBandRows = 64;
 // One source row of pointedTo(): marks the pointed pixels in output rows rowStart..rowEnd − 1
-// (`needed` is row 0 of the map). Also built for AVX2 (floor in one instruction).
+// (`needed` is row 0 of the map), except from the pixels `skip` marks (null: none). Also built
+// for AVX2 (floor in one instruction).
 __attribute__((target_clones("avx2", "default"))) void pointedRow(const float* d, const float* dy,
-                                                                  int y, int W, int rowStart,
-                                                                  int rowEnd, uchar* needed,
-                                                                  size_t step) {
+                                                                  const uchar* skip, int y, int W,
+                                                                  int rowStart, int rowEnd,
+                                                                  uchar* needed, size_t step) {
   const auto yf = static_cast<float>(y);
   for (int x = 0; x < W; ++x) {
-    if (!std::isfinite(d[x])) continue;
+    if (!std::isfinite(d[x]) || (skip && skip[x])) continue;
     const int fx = static_cast<int>(std::floor(static_cast<float>(x) - d[x]));
     const int fy = static_cast<int>(std::floor(yf + dy[x]));
     for (int m = 0; m <= 1; ++m) {
@@ -397,7 +398,9 @@ __attribute__((target_clones("avx2", "default"))) void pointedRow(const float* d
   }
 }
 
-cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
+// The matches that `kept` (CV_8U, may be empty) marks keep the coarser level's check: they point
+// to nothing.
+cv::Mat pointedTo(const detail::LevelOutput& map, const cv::Mat& kept, int lineShift, int threads) {
   cv::Mat needed = cv::Mat::zeros(map.disparity.size(), CV_8U);
   const int reach = lineShift + 2;
   forRowBands(
@@ -405,21 +408,13 @@ cv::Mat pointedTo(const detail::LevelOutput& map, int lineShift, int threads) {
       [&](int rowStart, int rowEnd) {
         for (int y = std::max(0, rowStart - reach); y < std::min(needed.rows, rowEnd + reach);
              ++y) {
-          pointedRow(map.disparity.ptr<float>(y), map.lineShift.ptr<float>(y), y, needed.cols,
-                     rowStart, rowEnd, needed.ptr<uchar>(0), needed.step1());
+          pointedRow(map.disparity.ptr<float>(y), map.lineShift.ptr<float>(y),
+                     kept.empty() ? nullptr : kept.ptr<uchar>(y), y, needed.cols, rowStart, rowEnd,
+                     needed.ptr<uchar>(0), needed.step1());
         }
       },
       kPointedBandRows);
   return needed;
-}
-
-// The matches of `map` that are checked at this level: those `kept` marks made NaN (a copy).
-detail::LevelOutput checkedHere(const detail::LevelOutput& map, const cv::Mat& kept) {
-  if (kept.empty()) return map;
-  detail::LevelOutput out = map;
-  out.disparity = map.disparity.clone();
-  out.disparity.setTo(std::numeric_limits<float>::quiet_NaN(), kept);
-  return out;
 }
 
 int threadCount(const MatchParams& p) {
@@ -537,7 +532,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     if (inheritChecks) {
       kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
     }
-    const cv::Mat needed = pointedTo(checkedHere(leftOut, kept), p.lineShift, threads);
+    const cv::Mat needed = pointedTo(leftOut, kept, p.lineShift, threads);
     // Right -> left: mirrored images turn x_left = x_right + d into x'_other = x'_ref - d.
     runTasks({[&] { inR.ref = flipped(lv.right); }, [&] { inR.other = flipped(lv.left); },
               [&] { inR.refValid = flipped(lv.rightValid); },
@@ -583,7 +578,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       if (inheritChecks) {
         kept = detail::coarselyChecked(parentLeft, leftOut, p.coarseCheckScore, threads);
       }
-      const cv::Mat pointed = pointedTo(checkedHere(leftOut, kept), p.lineShift, threads);
+      const cv::Mat pointed = pointedTo(leftOut, kept, p.lineShift, threads);
       cv::Mat rightNeeded, rightValidated;  // mirrored, both flipped at once
       runTasks(
           {[&] { rightNeeded = flipped(pointed); }, [&] { rightValidated = flipped(coarseRight); }},
