@@ -288,7 +288,7 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   double gain = 1, offset = 0;
   int dlo = 0;  // the smallest disparity of the map (checked only): carried runs search from it
   if (checked) {
-    const auto [mn, mx] = matchedRange(disparity);
+    const auto [mn, mx] = matchedRange(disparity, settings.threads);
     dlo = static_cast<int>(std::floor(mn));
     const int dhi = static_cast<int>(std::ceil(mx));
     // The grey map of the matched pixel pairs, the images' moments as the fallback: every check
@@ -296,8 +296,9 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
     // levels off at a roof's grey (simulated seed 14 1000²: gain 1.040 and offset 1.17 against
     // the matches' 1.086 and -6.44, the simulator's 1.087 and -6.5), which a plain roof's pixels
     // then carry at their own disparity.
-    std::tie(gain, offset) =
-        radiometricMapOfMatches(left, right, disparity, radiometricMap(left, right, dlo, dhi));
+    std::tie(gain, offset) = radiometricMapOfMatches(
+        left, right, disparity, [&] { return radiometricMap(left, right, dlo, dhi); }, 1000,
+        settings.threads);
   }
   // Mean of left − mapped right (its absolute value, or signed: a brightness offset) over the
   // pixel and its two vertical neighbours at disparity d, in noise sigmas; `none` where nothing

@@ -166,11 +166,14 @@ int snapStepsAcrossRows(const cv::Mat& left, const cv::Mat& right, double sigma,
   // The grey map of the matched pairs; the images' moments at the map's disparities when too few
   // are matched (the moments can be several grey levels off at a roof's grey: simulated seed 9
   // 1000², a roof's top rows that carried the ground's value stayed so).
-  const auto [lowest, highest] = matchedRange(disparity);
-  const auto [gain, offset] =
-      radiometricMapOfMatches(left, right, disparity,
-                              radiometricMap(left, right, static_cast<int>(std::floor(lowest)),
-                                             static_cast<int>(std::ceil(highest))));
+  const auto [lowest, highest] = matchedRange(disparity, settings.threads);
+  const auto [gain, offset] = radiometricMapOfMatches(
+      left, right, disparity,
+      [&, lowest = lowest, highest = highest] {
+        return radiometricMap(left, right, static_cast<int>(std::floor(lowest)),
+                              static_cast<int>(std::ceil(highest)));
+      },
+      1000, settings.threads);
   int total = 0;
   for (int pass = 0; pass < settings.maxPasses; ++pass) {
     const int moved =

@@ -10,6 +10,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "workers.hpp"
+
 namespace delineo::stereo::detail {
 
 // Noise sigma of an image from its response to the difference of two Laplacians, which cancels
@@ -113,17 +115,33 @@ std::pair<double, double> radiometricMap(const cv::Mat& left, const cv::Mat& rig
   return moments.map().value_or(std::pair{1.0, 0.0});
 }
 
-std::pair<double, double> matchedRange(const cv::Mat& disparity) {
+std::pair<double, double> matchedRange(const cv::Mat& disparity, int threads) {
   CV_Assert(disparity.type() == CV_32F);
+  constexpr int kBandRows = 64;
+  const int bands = (disparity.rows + kBandRows - 1) / kBandRows;
+  std::vector<float> bandLo(static_cast<size_t>(bands), std::numeric_limits<float>::infinity());
+  std::vector<float> bandHi(static_cast<size_t>(bands), -std::numeric_limits<float>::infinity());
+  forRowBands(
+      disparity.rows, threads,
+      [&](int rowStart, int rowEnd) {
+        float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+        for (int y = rowStart; y < rowEnd; ++y) {
+          const float* d = disparity.ptr<float>(y);
+          // Without branches, so that it vectorises (with a branch per pixel: 6 ms at 1 Mpx); a
+          // comparison with NaN is false, so an unmatched pixel never wins.
+          for (int x = 0; x < disparity.cols; ++x) {
+            lo = d[x] < lo ? d[x] : lo;
+            hi = d[x] > hi ? d[x] : hi;
+          }
+        }
+        bandLo[static_cast<size_t>(rowStart / kBandRows)] = lo;
+        bandHi[static_cast<size_t>(rowStart / kBandRows)] = hi;
+      },
+      kBandRows);
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    // Without branches, so that it vectorises (with a branch per pixel: 6 ms at 1 Mpx); a
-    // comparison with NaN is false, so an unmatched pixel never wins.
-    for (int x = 0; x < disparity.cols; ++x) {
-      lo = d[x] < lo ? d[x] : lo;
-      hi = d[x] > hi ? d[x] : hi;
-    }
+  for (int b = 0; b < bands; ++b) {
+    lo = std::min(lo, bandLo[static_cast<size_t>(b)]);
+    hi = std::max(hi, bandHi[static_cast<size_t>(b)]);
   }
   if (!(lo <= hi)) return {0.0, 0.0};
   return {lo, hi};
@@ -134,7 +152,7 @@ std::pair<double, double> matchedRange(const cv::Mat& disparity) {
 // it), then nth_element over that bin only: the same value, in three passes without branches
 // and one over a bin, instead of reordering a copy of the 250 000 values of a 1 Mpx map (three
 // medians a call, three calls a match).
-double middleValue(const std::vector<double>& values) {
+double middleValue(const std::vector<double>& values, int threads) {
   const size_t n = values.size();
   const size_t middle = n / 2;
   constexpr size_t kDirectBelow = 4096;
@@ -143,24 +161,57 @@ double middleValue(const std::vector<double>& values) {
     std::nth_element(copy.begin(), copy.begin() + static_cast<std::ptrdiff_t>(middle), copy.end());
     return copy[middle];
   }
+  // Chunks of the values for the workers; every step below gives the same result in any split
+  // (extremes, integer counts, and the bin's values, whose order nth_element does not depend on).
+  constexpr int kChunk = 32768;
+  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
+  const auto chunkRange = [&](int c) {
+    const size_t begin = static_cast<size_t>(c) * kChunk;
+    return std::pair{begin, std::min(n, begin + kChunk)};
+  };
+  const auto eachChunk = [&](const auto& work) {
+    forRowBands(
+        chunks, threads,
+        [&](int first, int last) {
+          for (int c = first; c < last; ++c) work(c);
+        },
+        1);
+  };
   // The extremes without branches (vectorised; values hold no NaN).
-  double low = values[0], high = values[0];
-  for (const double v : values) {
-    low = v < low ? v : low;
-    high = v > high ? v : high;
-  }
+  std::vector<double> chunkLow(static_cast<size_t>(chunks)), chunkHigh(static_cast<size_t>(chunks));
+  eachChunk([&](int c) {
+    const auto [begin, end] = chunkRange(c);
+    double low = values[begin], high = values[begin];
+    for (size_t i = begin; i < end; ++i) {
+      const double v = values[i];
+      low = v < low ? v : low;
+      high = v > high ? v : high;
+    }
+    chunkLow[static_cast<size_t>(c)] = low;
+    chunkHigh[static_cast<size_t>(c)] = high;
+  });
+  const double low = *std::min_element(chunkLow.begin(), chunkLow.end());
+  const double high = *std::max_element(chunkHigh.begin(), chunkHigh.end());
   if (!(high > low)) return low;
   constexpr int kBins = 4096;
   const double scale = kBins / (high - low);
   // Each value's bin once (a loop without branches), then the counts.
-  thread_local std::vector<uint16_t> bins;
-  bins.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    bins[i] =
-        static_cast<uint16_t>(std::min(kBins - 1, static_cast<int>((values[i] - low) * scale)));
-  }
+  std::vector<uint16_t> bins(n);
+  std::vector<std::vector<size_t>> chunkCounts(static_cast<size_t>(chunks));
+  eachChunk([&](int c) {
+    const auto [begin, end] = chunkRange(c);
+    for (size_t i = begin; i < end; ++i) {
+      bins[i] =
+          static_cast<uint16_t>(std::min(kBins - 1, static_cast<int>((values[i] - low) * scale)));
+    }
+    std::vector<size_t>& counts = chunkCounts[static_cast<size_t>(c)];
+    counts.assign(kBins, 0);
+    for (size_t i = begin; i < end; ++i) ++counts[bins[i]];
+  });
   std::vector<size_t> counts(kBins, 0);
-  for (size_t i = 0; i < n; ++i) ++counts[bins[i]];
+  for (const auto& chunk : chunkCounts) {
+    for (int b = 0; b < kBins; ++b) counts[static_cast<size_t>(b)] += chunk[static_cast<size_t>(b)];
+  }
   size_t before = 0;
   int bin = 0;
   while (before + counts[static_cast<size_t>(bin)] <= middle) {
@@ -178,13 +229,27 @@ double middleValue(const std::vector<double>& values) {
 
 namespace {
 
+// work(begin, end) over [0, n) in chunks shared by `threads` workers.
+template <class Work>
+void forEachPairChunk(size_t n, int threads, const Work& work) {
+  constexpr size_t kChunk = 32768;
+  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
+  forRowBands(
+      chunks, threads,
+      [&](int first, int last) {
+        work(static_cast<size_t>(first) * kChunk, std::min(n, static_cast<size_t>(last) * kChunk));
+      },
+      1);
+}
+
 // A first map of (left, right) pairs that wrong pairs cannot pull far: the median slope between
 // pairs of pairs at least kSlopeSpread grey levels apart in the right view (Theil-Sen, on up to
 // kSlopeSamples draws of a fixed sequence), then the median offset. None when too few draws are
 // that far apart or the slope is not positive.
 constexpr double kSlopeSpread = 10.0;
 constexpr int kSlopeSamples = 20000;
-std::optional<std::pair<double, double>> medianSlopeMap(const std::vector<cv::Vec2f>& pairs) {
+std::optional<std::pair<double, double>> medianSlopeMap(const std::vector<cv::Vec2f>& pairs,
+                                                        int threads) {
   std::vector<double> slopes;
   slopes.reserve(kSlopeSamples);
   std::uint64_t state = 0x9e3779b97f4a7c15ULL;  // xorshift64: the same draws on every run
@@ -204,10 +269,11 @@ std::optional<std::pair<double, double>> medianSlopeMap(const std::vector<cv::Ve
   if (slopes.size() < 100) return std::nullopt;
   const double gain = middleValue(slopes);
   if (!(gain > 0)) return std::nullopt;
-  std::vector<double> offsets;
-  offsets.reserve(pairs.size());
-  for (const cv::Vec2f& p : pairs) offsets.push_back(p[0] - gain * p[1]);
-  return std::pair{gain, middleValue(offsets)};
+  std::vector<double> offsets(pairs.size());
+  forEachPairChunk(pairs.size(), threads, [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) offsets[i] = pairs[i][0] - gain * pairs[i][1];
+  });
+  return std::pair{gain, middleValue(offsets, threads)};
 }
 
 }  // namespace
@@ -220,42 +286,69 @@ std::optional<std::pair<double, double>> medianSlopeMap(const std::vector<cv::Ve
 // end of the grey range pulled the map towards themselves and were kept by the refits (a unit
 // scene of the snapping: gain 0.768 and offset 32.5 where the views' exposures are the same).
 constexpr double kInlierMads = 2.5;
-std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv::Mat& right,
-                                                  const cv::Mat& disparity,
-                                                  std::pair<double, double> fallback,
-                                                  int minPairs) {
-  std::vector<cv::Vec2f> pairs;  // (left, right) grey levels
-  for (int y = 0; y < left.rows; y += 2) {
-    const float* pl = left.ptr<float>(y);
-    const float* pr = right.ptr<float>(y);
-    const float* d = disparity.ptr<float>(y);
-    for (int x = 0; x < left.cols; x += 2) {
-      if (!std::isfinite(d[x])) continue;
-      const int xr = x - static_cast<int>(std::lround(d[x]));
-      if (xr < 0 || xr >= right.cols || !std::isfinite(pl[x]) || !std::isfinite(pr[xr])) continue;
-      pairs.emplace_back(pl[x], pr[xr]);
-    }
-  }
-  if (static_cast<int>(pairs.size()) < minPairs) return fallback;
-  const auto start = medianSlopeMap(pairs);
-  if (!start) return fallback;
+std::pair<double, double> radiometricMapOfMatches(
+    const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity,
+    const std::function<std::pair<double, double>()>& fallback, int minPairs, int threads) {
+  // (left, right) grey levels of every 2nd row and column, by bands of rows, joined in row order.
+  constexpr int kBandRows = 32;
+  const int pairRows = (left.rows + 1) / 2;
+  std::vector<std::vector<cv::Vec2f>> bandPairs(
+      static_cast<size_t>((pairRows + kBandRows - 1) / kBandRows));
+  forRowBands(
+      pairRows, threads,
+      [&](int first, int last) {
+        std::vector<cv::Vec2f>& out = bandPairs[static_cast<size_t>(first / kBandRows)];
+        for (int y = 2 * first; y < 2 * last; y += 2) {
+          const float* pl = left.ptr<float>(y);
+          const float* pr = right.ptr<float>(y);
+          const float* d = disparity.ptr<float>(y);
+          for (int x = 0; x < left.cols; x += 2) {
+            if (!std::isfinite(d[x])) continue;
+            const int xr = x - static_cast<int>(std::lround(d[x]));
+            if (xr < 0 || xr >= right.cols || !std::isfinite(pl[x]) || !std::isfinite(pr[xr])) {
+              continue;
+            }
+            out.emplace_back(pl[x], pr[xr]);
+          }
+        }
+      },
+      kBandRows);
+  size_t total = 0;
+  for (const auto& band : bandPairs) total += band.size();
+  if (static_cast<int>(total) < minPairs) return fallback();
+  std::vector<cv::Vec2f> pairs;
+  pairs.reserve(total);
+  for (const auto& band : bandPairs) pairs.insert(pairs.end(), band.begin(), band.end());
+  const auto start = medianSlopeMap(pairs, threads);
+  if (!start) return fallback();
   std::pair<double, double> map = *start;
   std::vector<double> residuals(pairs.size());
   for (int pass = 0; pass < 2; ++pass) {
-    for (size_t i = 0; i < pairs.size(); ++i) {
-      residuals[i] = std::abs(pairs[i][0] - (map.first * pairs[i][1] + map.second));
-    }
-    const double limit = kInlierMads * 1.4826 * middleValue(residuals);
+    forEachPairChunk(pairs.size(), threads, [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        residuals[i] = std::abs(pairs[i][0] - (map.first * pairs[i][1] + map.second));
+      }
+    });
+    const double limit = kInlierMads * 1.4826 * middleValue(residuals, threads);
+    // (In the pairs' order: the sums, and so the map, do not depend on the threads.)
     GreyMoments moments;
     for (size_t i = 0; i < pairs.size(); ++i) {
       if (residuals[i] <= limit) moments.add(pairs[i][0], pairs[i][1]);
     }
-    if (moments.count < minPairs) return fallback;
+    if (moments.count < minPairs) return fallback();
     const auto fitted = moments.map();
-    if (!fitted) return fallback;
+    if (!fitted) return fallback();
     map = *fitted;
   }
   return map;
+}
+
+std::pair<double, double> radiometricMapOfMatches(const cv::Mat& left, const cv::Mat& right,
+                                                  const cv::Mat& disparity,
+                                                  std::pair<double, double> fallback, int minPairs,
+                                                  int threads) {
+  return radiometricMapOfMatches(
+      left, right, disparity, [fallback] { return fallback; }, minPairs, threads);
 }
 
 }  // namespace delineo::stereo::detail

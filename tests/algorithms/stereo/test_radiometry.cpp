@@ -88,6 +88,49 @@ TEST(Radiometry, WrongMatchesAtTheEndOfTheGreyRangeDoNotPullTheMatchesMap) {
   EXPECT_NEAR(gain * 60.0 + offset, 60.0, 1.0);
 }
 
+// Several workers give the same map as one, bit for bit (the sums are taken in one order), and
+// the fallback is only computed when it is the answer.
+TEST(Radiometry, MapOfMatchesIsTheSameOnAnyNumberOfThreads) {
+  const int rows = 301, cols = 257;
+  cv::RNG rng(11);
+  cv::Mat left(rows, cols, CV_32F), right(rows, cols, CV_32F), disparity(rows, cols, CV_32F);
+  rng.fill(left, cv::RNG::UNIFORM, 20.0, 220.0);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      const int d = x < 120 ? 4 : 9;
+      disparity.at<float>(y, x) = rng.uniform(0, 10) == 0
+                                      ? std::numeric_limits<float>::quiet_NaN()
+                                      : static_cast<float>(d) + rng.uniform(-0.4f, 0.4f);
+      const int xl = std::min(cols - 1, x + d);
+      right.at<float>(y, x) =
+          static_cast<float>(0.9 * left.at<float>(y, xl) + 5.0 + rng.gaussian(2.0));
+    }
+  }
+  int fallbacks = 0;
+  const auto fallback = [&] {
+    ++fallbacks;
+    return std::pair{1.0, 0.0};
+  };
+  const auto one = radiometricMapOfMatches(left, right, disparity, fallback, 1000, 1);
+  for (const int threads : {2, 3}) {
+    const auto many = radiometricMapOfMatches(left, right, disparity, fallback, 1000, threads);
+    EXPECT_EQ(many.first, one.first) << threads;
+    EXPECT_EQ(many.second, one.second) << threads;
+  }
+  EXPECT_EQ(fallbacks, 0);
+  EXPECT_NEAR(one.first, 1.0 / 0.9, 0.02);
+  // Too few pairs: the fallback, computed once.
+  const auto few = radiometricMapOfMatches(left, right, disparity, fallback, rows * cols, 2);
+  EXPECT_EQ(few.first, 1.0);
+  EXPECT_EQ(fallbacks, 1);
+  const auto [lo, hi] = matchedRange(disparity, 1);
+  const auto [lo2, hi2] = matchedRange(disparity, 3);
+  EXPECT_EQ(lo, lo2);
+  EXPECT_EQ(hi, hi2);
+  EXPECT_GE(lo, 3.6);
+  EXPECT_LE(hi, 9.4);
+}
+
 // The bucket selection gives the element nth_element puts in the middle, on sets with heavy
 // ties, a long tail, negative values, one value only, and both parities.
 TEST(Radiometry, MiddleValueIsTheMiddleElement) {
@@ -108,6 +151,7 @@ TEST(Radiometry, MiddleValueIsTheMiddleElement) {
     }
     for (const auto* values : {&uniform, &tied, &tailed, &constant}) {
       EXPECT_EQ(middleValue(*values), nthMiddle(*values)) << n;
+      EXPECT_EQ(middleValue(*values, 3), nthMiddle(*values)) << n << ", 3 threads";
     }
   }
 }
