@@ -56,18 +56,21 @@ void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dma
     return cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_8U);
   };
   const int widestRadius = widenNearRejected ? kWidestRadiusAbove : kWidestRadiusFinest;
-  // The three pairs of filters and the rejected pixels' dilation as four tasks (each pair on one
-  // worker: the coarse level is small).
-  runTasks(
-      {[&] { rangeFilters(forMin, forMax, square(1), kInf, -kInf, 1, mn1, mx1); },
-       [&] { rangeFilters(forMin, forMax, square(kWideRadius), kInf, -kInf, 1, mnWide, mxWide); },
-       [&] {
-         rangeFilters(forMin, forMax, square(widestRadius), kInf, -kInf, 1, mnWidest, mxWidest);
-       },
-       [&] {
-         if (widenNearRejected) cv::dilate(rejected, nearRejected, square(1));
-       }},
-      threads);
+  // The six filters and the rejected pixels' dilation as seven tasks, the widest (the longest)
+  // first, so that the workers share them evenly.
+  const auto minFilter = [&](int radius, cv::Mat& out) {
+    cv::erode(forMin, out, square(radius), {-1, -1}, 1, cv::BORDER_CONSTANT, kInf);
+  };
+  const auto maxFilter = [&](int radius, cv::Mat& out) {
+    cv::dilate(forMax, out, square(radius), {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf);
+  };
+  runTasks({[&] { minFilter(widestRadius, mnWidest); }, [&] { maxFilter(widestRadius, mxWidest); },
+            [&] { minFilter(kWideRadius, mnWide); }, [&] { maxFilter(kWideRadius, mxWide); },
+            [&] { minFilter(1, mn1); }, [&] { maxFilter(1, mx1); },
+            [&] {
+              if (widenNearRejected) cv::dilate(rejected, nearRejected, square(1));
+            }},
+           threads);
   cv::Mat clo(coarse.size(), CV_32S), chi(coarse.size(), CV_32S);
   // By bands of rows on the level's threads (serial, ~0.3 % of the run's instructions).
   forRowBands(ch, threads, [&](int rowStart, int rowEnd) {
