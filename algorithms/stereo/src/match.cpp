@@ -706,7 +706,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // and before the smoothing, which would average a hidden match into the surface hiding it.
   // (600² roof RMS over all matches 2.121 -> 0.226 px; see docs/stereo.md, session 20.)
   if (p.orderingCheck) {
-    detail::rejectOrderingViolations(result.disparity, result.score, detail::OrderingSettings{});
+    detail::OrderingSettings ordering;
+    ordering.threads = threads;
+    detail::rejectOrderingViolations(result.disparity, result.score, ordering);
   }
   // Last: on the final map, where the fill, the snapping and the speckle removal have set the
   // steps that the smoothing must not cross. (Flat-roof RMS of the matches within 1 px, 5x5 and

@@ -9,6 +9,7 @@ struct OrderingSettings {
   double tolerance = 1.0;  // px: how far a match's right-view position may lie beyond a match's
                            //   to its right (sub-pixel noise, slanted surfaces)
   double minJump = 2.0;    // px: the nearer match must be at least this much nearer
+  int threads = 1;         // workers over bands of rows (the rows are independent)
 };
 
 // Whether a match that lies at `nearMapped` in the right view with disparity `nearDisparity`

@@ -5,7 +5,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "delineo/core/nan_mask.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -14,30 +13,37 @@ int smoothSurfaces(cv::Mat& disparity, int window, double tolerance, int threads
   CV_Assert(disparity.type() == CV_32F);
   const int r = window / 2;
   if (r < 1 || disparity.rows <= 2 * r || disparity.cols <= 2 * r) return 0;
-  const cv::Mat source = disparity.clone();
   constexpr float kInf = std::numeric_limits<float>::infinity();
   // The window's lowest and highest disparity and its sum, as OpenCV's min, max and box filters
   // of the map with unmatched pixels at -inf, +inf and 0: an unmatched pixel then fails the test
-  // below like a step. (The sums, of at most 31² floats, are exact in double.)
-  const cv::Mat unmatched = core::nanMask(source);
+  // below like a step. (The sums, of at most 31² floats, are exact in double.) The three inputs
+  // and the source's copy in one pass by bands of rows.
+  cv::Mat source(disparity.size(), CV_32F), forMin(disparity.size(), CV_32F),
+      forMax(disparity.size(), CV_32F), forSum(disparity.size(), CV_32F);
+  forRowBands(disparity.rows, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* __restrict d = disparity.ptr<float>(y);
+      float* __restrict copy = source.ptr<float>(y);
+      float* __restrict mn = forMin.ptr<float>(y);
+      float* __restrict mx = forMax.ptr<float>(y);
+      float* __restrict sm = forSum.ptr<float>(y);
+      for (int x = 0; x < disparity.cols; ++x) {
+        const bool isNumber = d[x] == d[x];  // false only for NaN
+        copy[x] = d[x];
+        mn[x] = isNumber ? d[x] : -kInf;
+        mx[x] = isNumber ? d[x] : kInf;
+        sm[x] = isNumber ? d[x] : 0.0F;
+      }
+    }
+  });
   const cv::Mat square = cv::Mat::ones(window, window, CV_8U);
   cv::Mat lowest, highest, sums;
-  runTasks({[&] {
-              cv::Mat m = source.clone();
-              m.setTo(-kInf, unmatched);
-              cv::erode(m, lowest, square);
-            },
-            [&] {
-              cv::Mat m = source.clone();
-              m.setTo(kInf, unmatched);
-              cv::dilate(m, highest, square);
-            },
-            [&] {
-              cv::Mat m = source.clone();
-              m.setTo(0.0F, unmatched);
-              cv::boxFilter(m, sums, CV_64F, {window, window}, {-1, -1}, false);
-            }},
-           threads);
+  runTasks(
+      {[&] {
+         cv::boxFilter(forSum, sums, CV_64F, {window, window}, {-1, -1}, false);
+       },
+       [&] { cv::erode(forMin, lowest, square); }, [&] { cv::dilate(forMax, highest, square); }},
+      threads);
   const auto tol = static_cast<float>(tolerance);
   const double invCount = 1.0 / (static_cast<double>(window) * window);
   std::vector<int> averaged(static_cast<size_t>(disparity.rows), 0);
