@@ -316,25 +316,42 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
     planar[i] = planar[i] != 0 && raised ? 1 : 0;
     if (planar[i] != 0) ++counts.planes;
   }
-  for (int y = 0; y < disparity.rows; ++y) {
-    float* d = disparity.ptr<float>(y);
-    const int* l = labels.ptr<int>(y);
-    const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (l[x] < 0 || k[x] == 0 || planar[static_cast<size_t>(l[x])] == 0) continue;
-      d[x] = static_cast<float>(surfaces[static_cast<size_t>(l[x])].at(x, y));
-      ++counts.pixels;
+  std::vector<int> setIn(static_cast<size_t>(disparity.rows), 0);
+  forRowBands(disparity.rows, s.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      float* d = disparity.ptr<float>(y);
+      const int* l = labels.ptr<int>(y);
+      const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+      int set = 0;
+      for (int x = 0; x < disparity.cols; ++x) {
+        if (l[x] < 0 || k[x] == 0 || planar[static_cast<size_t>(l[x])] == 0) continue;
+        d[x] = static_cast<float>(surfaces[static_cast<size_t>(l[x])].at(x, y));
+        ++set;
+      }
+      setIn[static_cast<size_t>(y)] = set;
     }
-  }
+  });
+  for (const int n : setIn) counts.pixels += n;
   // Then the other matched pixels on the roof or around it (within ringRadius of its outer
   // outline, and across its rim) that lie within absorbWithin of its plane, when they are small
   // pieces: a roof's pixels beyond the inlier band (or cut from the surface by a jump of more
   // than `link`) are its matches' outliers, at the roof's level all the same. In surface order;
   // a pixel takes the first roof that claims it.
+  // A surface reads and writes only the rows of its area: surfaces on disjoint rows are absorbed
+  // side by side, in surface order where their rows overlap (the same result).
   if (s.absorbWithin > 0) {
     cv::Mat taken(disparity.size(), CV_8U, cv::Scalar(0));
+    std::vector<size_t> order;
+    std::vector<std::pair<int, int>> rows;
     for (size_t i = 0; i < surfaces.size(); ++i) {
       if (planar[i] == 0) continue;
+      const cv::Rect inImage = areaOf[i] & image;
+      order.push_back(i);
+      rows.emplace_back(inImage.y, inImage.y + inImage.height);
+    }
+    std::vector<int> absorbedBy(order.size(), 0);
+    const auto absorb = [&](size_t task) {
+      const size_t i = order[task];
       const Surface& f = surfaces[i];
       const cv::Rect area = areaOf[i];
       const cv::Rect inImage = area & image;
@@ -345,6 +362,7 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
           .setTo(255, (labels(inImage) == static_cast<int>(i)) & (keep(inImage) == 0));
       cv::Mat blobs, blobStats, blobCentroids;
       cv::connectedComponentsWithStats(outside, blobs, blobStats, blobCentroids, 8, CV_32S);
+      int absorbed = 0;
       for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
         float* d = disparity.ptr<float>(y);
         const int* l = labels.ptr<int>(y);
@@ -363,11 +381,18 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
           if (std::abs(d[x] - p) <= s.absorbWithin) {
             d[x] = static_cast<float>(p);
             t[x] = 1;
-            ++counts.absorbed;
+            ++absorbed;
           }
         }
       }
-    }
+      absorbedBy[task] = absorbed;
+    };
+    const int helpers = order.size() > 1 ? std::max(0, s.threads - 1) : 0;
+    RowOrderedTasks tasks(rows, absorb, helpers);
+    std::vector<std::function<void()>> workers{[&] { tasks.run(); }};
+    for (int h = 0; h < helpers; ++h) workers.emplace_back([&] { tasks.help(); });
+    runTasks(workers, helpers + 1);
+    for (const int n : absorbedBy) counts.absorbed += n;
   }
   return counts;
 }
