@@ -1452,11 +1452,43 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     if (filledRegion[k]) filledRegions.push_back(std::move(*filledRegion[k]));
   }
   // Once every region is filled (the extension's pixels do not become another region's
-  // candidates).
+  // candidates). In the regions' order where they may meet: an extension writes only within its
+  // box ± extendReach and reads the maps one row beyond it and, along its rows, up to the range's
+  // width beyond it (the right-view positions of a pixel's candidates, see matchesAt); extensions
+  // whose such rectangles share no tile of kExtensionTile px run side by side, with the result of
+  // running them in order.
+  constexpr int kExtensionTile = 32;
+  const int tilesX = (left.cols + kExtensionTile - 1) / kExtensionTile;
+  const int tilesY = (left.rows + kExtensionTile - 1) / kExtensionTile;
+  std::vector<std::vector<int>> extensionTiles;
+  extensionTiles.reserve(filledRegions.size());
   for (const FilledRegion& f : filledRegions) {
-    filled += extendOverUnmatched(left, right, f.box, f.grown, f.plane, gain, offset, sigma, dmin,
-                                  dmax, settings, fillScore, labels, ownFill, disparity, score);
+    const int across = settings.extendReach + (dmax - dmin) + 2, down = settings.extendReach + 1;
+    const cv::Rect reads = cv::Rect(f.box.x - across, f.box.y - down, f.box.width + 2 * across,
+                                    f.box.height + 2 * down) &
+                           image;
+    std::vector<int>& tiles = extensionTiles.emplace_back();
+    for (int ty = reads.y / kExtensionTile; ty <= (reads.br().y - 1) / kExtensionTile; ++ty) {
+      for (int tx = reads.x / kExtensionTile; tx <= (reads.br().x - 1) / kExtensionTile; ++tx) {
+        tiles.push_back(ty * tilesX + tx);
+      }
+    }
   }
+  std::vector<int> extendedIn(filledRegions.size(), 0);
+  const int extensionHelpers = filledRegions.size() > 1 ? helpers : 0;
+  RowOrderedTasks extensions(
+      extensionTiles, tilesX * tilesY,
+      [&](size_t k) {
+        const FilledRegion& f = filledRegions[k];
+        extendedIn[k] =
+            extendOverUnmatched(left, right, f.box, f.grown, f.plane, gain, offset, sigma, dmin,
+                                dmax, settings, fillScore, labels, ownFill, disparity, score);
+      },
+      extensionHelpers);
+  std::vector<std::function<void()>> workers{[&] { extensions.run(); }};
+  for (int h = 0; h < extensionHelpers; ++h) workers.emplace_back([&] { extensions.help(); });
+  runTasks(workers, extensionHelpers + 1);
+  for (const int n : extendedIn) filled += n;
   return filled;
 }
 

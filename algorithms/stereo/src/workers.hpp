@@ -57,31 +57,25 @@ class RowOrderedTasks {
  public:
   RowOrderedTasks(const std::vector<std::pair<int, int>>& rows, std::function<void(size_t)> task,
                   int helpers)
-      : task_(std::move(task)),
-        waitingOn_(rows.size(), 0),
-        after_(rows.size()),
-        unfinished_(rows.size()),
-        helpersToCome_(helpers) {
-    // Task k waits for the last earlier task on each of its rows only: that one waits in turn
-    // for the earlier ones there. (Σ of the spans' heights, not n² pairs: a large image has many
-    // thousands of regions.)
+      : RowOrderedTasks(rows.size(), std::move(task), helpers) {
     int end = 0;
     for (const auto& span : rows) end = std::max(end, span.second);
-    std::vector<size_t> lastOnRow(static_cast<size_t>(end), kNone);
-    std::vector<size_t> before;
+    std::vector<size_t> lastOn(static_cast<size_t>(end), kNone);
+    std::vector<int> cells;
     for (size_t k = 0; k < rows.size(); ++k) {
-      before.clear();
-      for (int y = std::max(0, rows[k].first); y < rows[k].second; ++y) {
-        size_t& last = lastOnRow[static_cast<size_t>(y)];
-        if (last != kNone) before.push_back(last);
-        last = k;
-      }
-      std::sort(before.begin(), before.end());
-      before.erase(std::unique(before.begin(), before.end()), before.end());
-      for (const size_t j : before) after_[j].push_back(k);
-      waitingOn_[k] = static_cast<int>(before.size());
-      if (before.empty()) ready_.insert(k);
+      cells.clear();
+      for (int y = std::max(0, rows[k].first); y < rows[k].second; ++y) cells.push_back(y);
+      link(k, cells, lastOn);
     }
+  }
+
+  // The same order where task k reads and writes only the cells cells[k] (ids 0 .. cellCount − 1,
+  // e.g. the tiles of an image a rectangle covers): it waits for every earlier task sharing one.
+  RowOrderedTasks(const std::vector<std::vector<int>>& cells, int cellCount,
+                  std::function<void(size_t)> task, int helpers)
+      : RowOrderedTasks(cells.size(), std::move(task), helpers) {
+    std::vector<size_t> lastOn(static_cast<size_t>(cellCount), kNone);
+    for (size_t k = 0; k < cells.size(); ++k) link(k, cells[k], lastOn);
   }
 
   void run() {
@@ -115,6 +109,30 @@ class RowOrderedTasks {
       --unfinished_;
       changed_.notify_all();
     }
+  }
+
+  RowOrderedTasks(size_t tasks, std::function<void(size_t)> task, int helpers)
+      : task_(std::move(task)),
+        waitingOn_(tasks, 0),
+        after_(tasks),
+        unfinished_(tasks),
+        helpersToCome_(helpers) {}
+
+  // Task k waits for the last earlier task on each of its cells only: that one waits in turn for
+  // the earlier ones there. (Σ of the tasks' cell counts, not n² pairs: a large image has many
+  // thousands of regions.)
+  void link(size_t k, const std::vector<int>& cells, std::vector<size_t>& lastOn) {
+    std::vector<size_t> before;
+    for (const int c : cells) {
+      size_t& last = lastOn[static_cast<size_t>(c)];
+      if (last != kNone && last != k) before.push_back(last);
+      last = k;
+    }
+    std::sort(before.begin(), before.end());
+    before.erase(std::unique(before.begin(), before.end()), before.end());
+    for (const size_t j : before) after_[j].push_back(k);
+    waitingOn_[k] = static_cast<int>(before.size());
+    if (before.empty()) ready_.insert(k);
   }
 
   static constexpr size_t kNone = static_cast<size_t>(-1);

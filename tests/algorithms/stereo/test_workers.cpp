@@ -98,4 +98,78 @@ TEST(RowOrderedTasks, AHelperRunsDisjointTasksAlongsideAndOverlappingOnesInOrder
   }
 }
 
+// Tasks over the 10 x 10 tiles of an image, each on a rectangle of tiles (given as its tile ids):
+// a tile's log must list its tasks in increasing order, each task once, and tasks on disjoint
+// rectangles that share rows run side by side.
+TEST(RowOrderedTasks, TasksOnTilesRunInOrderWhereTheyShareOne) {
+  struct Box {
+    int x0, y0, x1, y1;  // tiles [x0, x1) x [y0, y1)
+  };
+  // Left and right halves of the same rows (disjoint), overlapping chains, one over everything.
+  const std::vector<Box> boxes{{0, 0, 4, 5},   {6, 0, 10, 5},  {3, 2, 7, 4}, {0, 5, 5, 10},
+                               {5, 5, 10, 10}, {0, 0, 10, 10}, {1, 1, 2, 2}, {8, 8, 10, 10},
+                               {4, 0, 6, 10},  {0, 9, 10, 10}};
+  std::vector<std::vector<int>> cells;
+  for (const Box& b : boxes) {
+    auto& c = cells.emplace_back();
+    for (int y = b.y0; y < b.y1; ++y) {
+      for (int x = b.x0; x < b.x1; ++x) c.push_back(10 * y + x);
+    }
+  }
+  for (const int helpers : {0, 1}) {
+    SCOPED_TRACE(helpers);
+    std::vector<std::vector<size_t>> logs(100);
+    std::vector<std::atomic<int>> runs(boxes.size());
+    std::vector<std::atomic<bool>> finished(boxes.size());
+    std::atomic<int> startedTooEarly{0}, concurrent{0}, mostConcurrent{0};
+    std::mutex logsMutex;
+    const auto shares = [&](size_t j, size_t k) {
+      for (const int a : cells[j]) {
+        for (const int b : cells[k]) {
+          if (a == b) return true;
+        }
+      }
+      return false;
+    };
+    detail::RowOrderedTasks tasks(
+        cells, 100,
+        [&](size_t k) {
+          ++runs[k];
+          const int now = ++concurrent;
+          int seen = mostConcurrent.load();
+          while (now > seen && !mostConcurrent.compare_exchange_weak(seen, now)) {
+          }
+          for (size_t j = 0; j < k; ++j) {
+            if (shares(j, k) && !finished[j]) ++startedTooEarly;
+          }
+          std::this_thread::sleep_for(std::chrono::microseconds(500));
+          {
+            std::lock_guard<std::mutex> lock(logsMutex);
+            for (const int c : cells[k]) logs[static_cast<size_t>(c)].push_back(k);
+          }
+          finished[k] = true;
+          --concurrent;
+        },
+        helpers);
+    std::thread helper([&] {
+      if (helpers > 0) tasks.help();
+    });
+    tasks.run();
+    helper.join();
+    EXPECT_EQ(startedTooEarly.load(), 0);
+    for (size_t k = 0; k < boxes.size(); ++k) EXPECT_EQ(runs[k].load(), 1) << "task " << k;
+    for (int c = 0; c < 100; ++c) {
+      std::vector<size_t> expected;
+      for (size_t k = 0; k < boxes.size(); ++k) {
+        for (const int own : cells[k]) {
+          if (own == c) expected.push_back(k);
+        }
+      }
+      EXPECT_EQ(logs[static_cast<size_t>(c)], expected) << "tile " << c;
+    }
+    // The first two share rows but no tile.
+    EXPECT_EQ(mostConcurrent.load(), helpers + 1);
+  }
+}
+
 }  // namespace
