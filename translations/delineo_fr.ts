@@ -303,6 +303,10 @@
         <translation>Coût de bande selon l’appariement</translation>
     </message>
     <message>
+        <source>Square windows on one surface</source>
+        <translation>Fenêtres carrées sur une même surface</translation>
+    </message>
+    <message>
         <source>Cut windows at depth steps</source>
         <translation>Fenêtres coupées aux sauts de profondeur</translation>
     </message>

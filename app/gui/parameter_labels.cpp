@@ -11,9 +11,12 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Default: %1"),
     // delineation::DelineationParams
     QT_TRANSLATE_NOOP("Parameters", "Occlusion"),
-    QT_TRANSLATE_NOOP("Parameters", "Percentage p of ROI pixels taken as unmatched; NoMatchCost is the (100-p)% quantile of the best costs (paper: 10)"),
+    QT_TRANSLATE_NOOP("Parameters",
+                      "Percentage p of ROI pixels taken as unmatched; NoMatchCost is the (100-p)% "
+                      "quantile of the best costs (paper: 10)"),
     QT_TRANSLATE_NOOP("Parameters", "Edge weight"),
-    QT_TRANSLATE_NOOP("Parameters", "Weight lambda of the left and right image edge terms (paper: 5)"),
+    QT_TRANSLATE_NOOP("Parameters",
+                      "Weight lambda of the left and right image edge terms (paper: 5)"),
     QT_TRANSLATE_NOOP("Parameters", "Rigidity"),
     QT_TRANSLATE_NOOP("Parameters", "Weight beta of the vertex angle prior R (paper: 15)"),
     QT_TRANSLATE_NOOP("Parameters", "Initial spacing"),
@@ -70,6 +73,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Edge gap closing"),
     QT_TRANSLATE_NOOP("Parameters", "Steepest slanted facet"),
     QT_TRANSLATE_NOOP("Parameters", "Threads"),
+    QT_TRANSLATE_NOOP("Parameters", "Square windows on one surface"),
     QT_TRANSLATE_NOOP("Parameters", "Cut windows at depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),
     QT_TRANSLATE_NOOP("Parameters", "Speckle size"),

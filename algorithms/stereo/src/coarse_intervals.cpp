@@ -97,4 +97,37 @@ void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dma
   });
 }
 
+cv::Mat oneSurfacePixels(const cv::Mat& coarse, cv::Size size, int radius, float spread,
+                         int threads) {
+  CV_Assert(coarse.type() == CV_32F && radius >= 0);
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  // A rejected pixel makes the neighbourhood's spread infinite: -inf for the minimum, +inf for
+  // the maximum, and so does the border.
+  cv::Mat forMin, forMax, lowest, highest;
+  rangeFilterInputs(coarse, -kInf, kInf, threads, forMin, forMax);
+  const cv::Mat square = cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_8U);
+  runTasks({[&] {
+              cv::erode(forMin, lowest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf);
+            },
+            [&] {
+              cv::dilate(forMax, highest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf);
+            }},
+           threads);
+  const int cw = coarse.cols, ch = coarse.rows;
+  cv::Mat out(size, CV_8U);
+  forRowBands(size.height, threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const int cy = std::min(ch - 1, y / 2);
+      const float* lo = lowest.ptr<float>(cy);
+      const float* hi = highest.ptr<float>(cy);
+      uchar* o = out.ptr<uchar>(y);
+      for (int x = 0; x < size.width; ++x) {
+        const int cx = std::min(cw - 1, x / 2);
+        o[x] = hi[cx] - lo[cx] <= spread ? 1 : 0;  // (inf − (−inf) never is)
+      }
+    }
+  });
+  return out;
+}
+
 }  // namespace delineo::stereo::detail

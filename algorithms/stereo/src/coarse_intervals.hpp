@@ -32,4 +32,13 @@ namespace delineo::stereo::detail {
 void intervalsFromCoarse(const cv::Mat& coarse, cv::Size size, int dmin, int dmax, int margin,
                          bool widenNearRejected, int threads, cv::Mat& lo, cv::Mat& hi);
 
+// The pixels of a level whose window lies on one surface by the next coarser level's validated
+// map `coarse` (CV_32F, NaN where rejected): every coarse pixel within `radius` (a square
+// neighbourhood) of the pixel's parent validated, the image's border counting as rejected, and
+// their disparities within `spread` coarse px of each other. CV_8U at `size` (twice the coarse
+// one, ±1): 1 there, 0 elsewhere. Such a window holds no depth step the coarse level saw; a
+// rejected coarse pixel (an occlusion, a surface neither view matched) may hide one.
+cv::Mat oneSurfacePixels(const cv::Mat& coarse, cv::Size size, int radius, float spread,
+                         int threads);
+
 }  // namespace delineo::stereo::detail

@@ -772,9 +772,13 @@ class LevelMatcher {
       const uchar* ok = refStats_.usable.ptr<uchar>(y);
       const uchar* near = nearEdge_.ptr<uchar>(y);
       const uchar* refValid = in_.refValid.ptr<uchar>(y);
+      const uchar* one = in_.oneSurface.empty() ? nullptr : in_.oneSurface.ptr<uchar>(y);
       for (int x = tile.x; x < tile.br().x; ++x) {
         if (lo[x] > hi[x] || !refValid[x]) continue;
-        if (near[x] && buildShape(x, y, sc.shape, ok[x] != 0)) {
+        // On one surface the contours in the window are texture, not depth steps: the square
+        // window (when usable) matches it as well, for the price of a box filter.
+        const bool oneSurface = one != nullptr && one[x] && ok[x];
+        if (near[x] && !oneSurface && buildShape(x, y, sc.shape, ok[x] != 0)) {
           matchShapePixel(x, y, sc.shape);
           continue;
         }
@@ -1553,7 +1557,14 @@ bool matchLevelBuild(const LevelInput& in, const LevelSettings& settings, LevelO
             [&] { pad(in.otherValid, 0, padded.otherValid); },
             [&] { pad(in.refEdges, 0, padded.refEdges); },
             [&] { pad(in.lo, 1, padded.lo); },  // lo > hi: not searched
-            [&] { pad(in.hi, 0, padded.hi); }},
+            [&] { pad(in.hi, 0, padded.hi); },
+            [&] {
+              if (in.oneSurface.empty()) {
+                padded.oneSurface.release();
+              } else {
+                pad(in.oneSurface, 0, padded.oneSurface);
+              }
+            }},
            settings.threads);
   padded.dmin = in.dmin;
   padded.dmax = in.dmax;

@@ -16,6 +16,10 @@ struct LevelInput {
   cv::Mat otherValid;  // CV_8U, 1 where other holds data
   cv::Mat refEdges;    // CV_8U, non-zero on contour pixels of ref
   cv::Mat lo, hi;      // CV_32S, per-pixel inclusive search interval (lo > hi: not searched)
+  // CV_8U, optional: non-zero where the window lies on one surface by the coarser level
+  // (oneSurfacePixels): the square window serves such a pixel even when its window holds
+  // contours, and the adaptive shape only where a depth step may lie.
+  cv::Mat oneSurface;
   int dmin = 0;        // the level's full range; an interval touching neither end of it whose
   int dmax = 0;        // peak lies on its border is rejected (true peak outside the interval)
 };

@@ -92,5 +92,42 @@ TEST(IntervalsFromCoarse, AnOddLevelSizeTakesTheLastCoarsePixel) {
   EXPECT_EQ(iv.hi.at<int>(12, 14), 12);
 }
 
+// A pixel's window lies on one surface when every coarse pixel within the radius of its parent
+// is validated and their values lie within the spread: not near a step, a rejected pixel or
+// the border; a gentle slope is one surface, a steeper one is not.
+TEST(OneSurfacePixels, OnlyWhereTheWholeNeighbourhoodIsValidatedAndWithinTheSpread) {
+  cv::Mat coarse(30, 40, CV_32F, cv::Scalar(10.0));
+  coarse(cv::Rect(20, 0, 20, 15)).setTo(20.0);  // a step at column 20 (upper half)
+  coarse.at<float>(24, 8) = kNaN;               // a rejected pixel
+  for (int y = 15; y < 30; ++y) {
+    for (int x = 20; x < 40; ++x) coarse.at<float>(y, x) = 30.0F + 0.05F * static_cast<float>(x);
+  }
+  for (int x = 30; x < 40; ++x) coarse.at<float>(20, x) += 0.2F * static_cast<float>(x - 29);
+  const int radius = 2;
+  const cv::Mat one = oneSurfacePixels(coarse, {80, 60}, radius, 0.5F, 2);
+  ASSERT_EQ(one.size(), cv::Size(80, 60));
+  ASSERT_EQ(one.type(), CV_8U);
+  const auto at = [&](int cx, int cy) {
+    // The four finer pixels under a coarse one agree.
+    const uchar v = one.at<uchar>(2 * cy, 2 * cx);
+    EXPECT_EQ(one.at<uchar>(2 * cy + 1, 2 * cx + 1), v) << cx << ", " << cy;
+    return v;
+  };
+  EXPECT_EQ(at(10, 7), 1);   // inside the flat surface
+  EXPECT_EQ(at(17, 7), 1);   // 3 px from the step
+  EXPECT_EQ(at(18, 7), 0);   // 2 px from it
+  EXPECT_EQ(at(21, 7), 0);   // on the step's other side, 1 px from it
+  EXPECT_EQ(at(8, 21), 1);   // 3 px above the rejected pixel
+  EXPECT_EQ(at(9, 23), 0);   // next to it
+  EXPECT_EQ(at(1, 7), 0);    // its neighbourhood leaves the image
+  EXPECT_EQ(at(2, 7), 1);    // it does not
+  EXPECT_EQ(at(25, 25), 1);  // a slope of 0.05 px a pixel: 0.2 over the neighbourhood
+  EXPECT_EQ(at(34, 20), 0);  // the row steeper by 0.2 px a pixel
+  EXPECT_EQ(at(34, 17), 1);  // 3 rows from it
+  // The odd size of a level takes the last coarse pixel.
+  const cv::Mat odd = oneSurfacePixels(coarse, {81, 61}, radius, 0.5F, 1);
+  EXPECT_EQ(odd.at<uchar>(60, 20), one.at<uchar>(59, 20));
+}
+
 }  // namespace
 }  // namespace delineo::stereo::detail

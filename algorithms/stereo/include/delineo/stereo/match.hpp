@@ -24,6 +24,8 @@ struct MatchParams {
   double tolerance = 1.0;            // px, τ of the symmetric left/right validation
   double coarseCheckScore = 0.9;     // NCC from which a finest-level match on a smooth surface
                                      // keeps the coarser level's check (0 = all checked anew)
+  bool squareOnOneSurface = true;    // full resolution: square windows where the coarser level
+                                     // saw one surface under the window (shapes elsewhere)
   bool stepCut = true;               // windows cut at the depth steps of the validated map
   int stepCutLevel = 10;             // coarsest pyramid level it runs on (0 = full resolution only)
   double edgeLow = 40.0;             // Canny low threshold on the 0..255-normalised image
@@ -86,6 +88,14 @@ struct MatchParams {
                       "resolution",
                       0, 1},
       coarseCheckScore);
+    v(core::ParamInfo{"square-on-one-surface", "Square windows on one surface", "",
+                      "At full resolution, a pixel whose window lies on one surface by the "
+                      "coarser level's validated map (every coarse disparity under the window "
+                      "and 2 coarse pixels around it validated, all within 1 px of each other) "
+                      "is matched on the square window even when contours cross it: they are "
+                      "texture there, not depth steps. Off: the adaptive shape wherever a "
+                      "contour is in the window (the paper)"},
+      squareOnOneSurface);
     v(core::ParamInfo{"step-cut", "Cut windows at depth steps", "",
                       "Near depth steps of the validated map, locate the step along the row and "
                       "match again on windows cut there"},
