@@ -663,8 +663,6 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   // facets): released there too, where their pages' return to the system (~5 ms at 1 Mpx)
   // runs beside the fill instead of alone at the end.
   const auto prepareImages = [&] {
-    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right);
-    if (plainPass) plain = detail::plainPixels(left, 3.0);
     const cv::Mat finestLeftEdges = pyramid[0].leftEdges;
     pyramid.assign(1, Level{});
     pyramid[0].leftEdges = finestLeftEdges;
@@ -672,6 +670,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     rightOut = {};
     coarseRight.release();
     finestBuffers = {};
+    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right);
+    if (plainPass) plain = detail::plainPixels(left, 3.0);
   };
   if (p.fillRegions && p.adaptive) {
     detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
