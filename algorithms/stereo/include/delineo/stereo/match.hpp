@@ -24,8 +24,8 @@ struct MatchParams {
   double tolerance = 1.0;            // px, τ of the symmetric left/right validation
   double coarseCheckScore = 0.9;     // NCC from which a finest-level match on a smooth surface
                                      // keeps the coarser level's check (0 = all checked anew)
-  bool squareOnOneSurface = true;    // full resolution: square windows where the coarser level
-                                     // saw one surface under the window (shapes elsewhere)
+  bool squareOnOneSurface = true;    // two finest levels: square windows where the coarser
+                                     // level saw one surface under the window (shapes elsewhere)
   bool stepCut = true;               // windows cut at the depth steps of the validated map
   int stepCutLevel = 10;             // coarsest pyramid level it runs on (0 = full resolution only)
   double edgeLow = 40.0;             // Canny low threshold on the 0..255-normalised image
@@ -89,7 +89,7 @@ struct MatchParams {
                       0, 1},
       coarseCheckScore);
     v(core::ParamInfo{"square-on-one-surface", "Square windows on one surface", "",
-                      "At full resolution, a pixel whose window lies on one surface by the "
+                      "At the two finest levels, a pixel whose window lies on one surface by the "
                       "coarser level's validated map (every coarse disparity under the window "
                       "and 2 coarse pixels around it validated, all within 1 px of each other) "
                       "is matched on the square window even when contours cross it: they are "
