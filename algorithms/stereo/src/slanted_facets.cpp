@@ -9,7 +9,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "delineo/core/nan_mask.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -292,10 +291,30 @@ int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Ma
   CV_Assert(score.type() == CV_32F && score.size() == left.size());
   CV_Assert(edges.type() == CV_8U && edges.size() == left.size());
   if (settings.maxSlope <= 0) return 0;
-  const cv::Mat unmatched = core::nanMask(disparity) & core::numberMask(left) & (edges == 0);
-  cv::Mat labels, stats, centroids;
-  const int count =
-      cv::connectedComponentsWithStats(unmatched, labels, stats, centroids, 4, CV_32S);
+  // The unmatched pixels with data off the contours, in one pass by bands of rows (a match is a
+  // number: NaN is the only value unequal to itself).
+  cv::Mat unmatched(disparity.size(), CV_8U);
+  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
+    for (int y = rowStart; y < rowEnd; ++y) {
+      const float* d = disparity.ptr<float>(y);
+      const float* a = left.ptr<float>(y);
+      const uchar* e = edges.ptr<uchar>(y);
+      uchar* u = unmatched.ptr<uchar>(y);
+      for (int x = 0; x < disparity.cols; ++x) {
+        u[x] = d[x] != d[x] && a[x] == a[x] && e[x] == 0 ? 255 : 0;
+      }
+    }
+  });
+  // Each region's result is written by its own task into its own pixels: no two tasks touch the
+  // same pixel, and the matches read around a region are ones no task writes (copied meanwhile).
+  cv::Mat labels, stats, centroids, matchedBefore;
+  int count = 0;
+  runTasks({[&] {
+              count =
+                  cv::connectedComponentsWithStats(unmatched, labels, stats, centroids, 4, CV_32S);
+            },
+            [&] { matchedBefore = disparity.clone(); }},
+           settings.threads);
   // The pixels of each region large enough, in one pass.
   std::vector<std::vector<cv::Point>> pixels(static_cast<size_t>(count));
   for (int y = 0; y < labels.rows; ++y) {
@@ -306,9 +325,6 @@ int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Ma
       }
     }
   }
-  // Each region's result is written by its own task into its own pixels: no two tasks touch the
-  // same pixel, and the matches read around a region are ones no task writes.
-  const cv::Mat matchedBefore = disparity.clone();
   std::vector<int> matchedPerRegion(static_cast<size_t>(count), 0);
   std::vector<std::function<void()>> tasks;
   for (int r = 1; r < count; ++r) {
