@@ -459,6 +459,13 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     lv.dmin = floorDiv(p.dmin, 1 << k);
     lv.dmax = ceilDiv(p.dmax, 1 << k);
   }
+  // The left image's 5x5 moments and noise, for the steps after the levels (the fill's flat
+  // regions, the plain pixels, the snapping's contrast): one more task here, where the edges
+  // leave a worker idle at times, instead of three computations of them after the levels.
+  const bool afterSteps = p.adaptive && (p.fillRegions || p.snapSteps || p.plainStepMinScore > 0 ||
+                                         p.unmatchedPlainMinScore > 0);
+  detail::LocalMoments leftMoments;
+  if (afterSteps) edgeTasks.emplace_back([&] { leftMoments = detail::localMoments(left); });
   runTasks(edgeTasks, threads);
 
   // Progress weight of each level ∝ its area.
@@ -672,13 +679,13 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     rightOut = {};
     coarseRight.release();
     finestBuffers = {};
-    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right);
-    if (plainPass) plain = detail::plainPixels(left, 3.0);
+    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right, leftMoments.noise);
+    if (plainPass) plain = detail::plainPixels(left, 3.0, &leftMoments);
   };
   if (p.fillRegions && p.adaptive) {
     detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
                             static_cast<float>(p.minScore), result.disparity, result.score, threads,
-                            prepareImages);
+                            prepareImages, &leftMoments);
   } else {
     prepareImages();
   }

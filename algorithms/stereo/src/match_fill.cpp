@@ -215,31 +215,18 @@ constexpr int kFlatReach = 2;
 // Pixels of `image` whose 5x5 standard deviation is below flatSigmas noise sigmas (CV_8U
 // 0/255); the image's noise sigma in `sigmaOut`.
 cv::Mat flatMask(const cv::Mat& image, const RegionFillSettings& settings,
-                 double* sigmaOut = nullptr) {
-  // Nodata as 0, and the squares, in one pass; then the two 5x5 means and the test in another.
-  cv::Mat finite(image.size(), CV_32F), squares(image.size(), CV_32F);
-  for (int y = 0; y < image.rows; ++y) {
-    const float* in = image.ptr<float>(y);
-    float* f = finite.ptr<float>(y);
-    float* q = squares.ptr<float>(y);
-    for (int x = 0; x < image.cols; ++x) {
-      f[x] = std::isfinite(in[x]) ? in[x] : 0.0F;
-      q[x] = f[x] * f[x];
-    }
-  }
-  const double sigma = std::max(1e-3, noiseSigma(finite));
+                 double* sigmaOut = nullptr, const LocalMoments* known = nullptr) {
+  const LocalMoments made = known != nullptr ? LocalMoments{} : localMoments(image);
+  const LocalMoments& moments = known != nullptr ? *known : made;
+  const double sigma = std::max(1e-3, moments.noise);
   if (sigmaOut != nullptr) *sigmaOut = sigma;
-  cv::Mat mean, meanSquare;
-  const cv::Size window(2 * kFlatReach + 1, 2 * kFlatReach + 1);
-  cv::blur(finite, mean, window);
-  cv::blur(squares, meanSquare, window);
   const auto flatVariance =
       static_cast<float>(settings.flatSigmas * settings.flatSigmas * sigma * sigma);
   cv::Mat flat(image.size(), CV_8U);
   for (int y = 0; y < image.rows; ++y) {
     const float* in = image.ptr<float>(y);
-    const float* m = mean.ptr<float>(y);
-    const float* mm = meanSquare.ptr<float>(y);
+    const float* m = moments.mean.ptr<float>(y);
+    const float* mm = moments.meanSquare.ptr<float>(y);
     uchar* out = flat.ptr<uchar>(y);
     for (int x = 0; x < image.cols; ++x) {
       out[x] = mm[x] - m[x] * m[x] < flatVariance && std::isfinite(in[x]) ? 255 : 0;
@@ -975,9 +962,9 @@ template <class GreyMapsOf, class RightFlat, class OfferRegions>
 int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                 int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                 const GreyMapsOf& greyMapsOf, const RightFlat& rightFlatRegionsOf, int helpers,
-                const OfferRegions& offerRegions) {
+                const OfferRegions& offerRegions, const LocalMoments* leftMoments) {
   double sigma = 0;
-  const cv::Mat flat = flatMask(left, settings, &sigma);
+  const cv::Mat flat = flatMask(left, settings, &sigma, leftMoments);
   // The regions without their thin parts (see RegionFillSettings::coreOpening).
   cv::Mat flatCores;
   if (settings.coreOpening > 1) {
@@ -1494,15 +1481,36 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
 
 }  // namespace
 
-cv::Mat plainPixels(const cv::Mat& image, double sigmas) {
+LocalMoments localMoments(const cv::Mat& image) {
+  // Nodata as 0, and the squares, in one pass; then the two 5x5 means.
+  cv::Mat finite(image.size(), CV_32F), squares(image.size(), CV_32F);
+  for (int y = 0; y < image.rows; ++y) {
+    const float* in = image.ptr<float>(y);
+    float* f = finite.ptr<float>(y);
+    float* q = squares.ptr<float>(y);
+    for (int x = 0; x < image.cols; ++x) {
+      f[x] = std::isfinite(in[x]) ? in[x] : 0.0F;
+      q[x] = f[x] * f[x];
+    }
+  }
+  LocalMoments out;
+  out.noise = noiseSigma(finite);
+  const cv::Size window(2 * kFlatReach + 1, 2 * kFlatReach + 1);
+  cv::blur(finite, out.mean, window);
+  cv::blur(squares, out.meanSquare, window);
+  return out;
+}
+
+cv::Mat plainPixels(const cv::Mat& image, double sigmas, const LocalMoments* moments) {
   RegionFillSettings settings;
   settings.flatSigmas = sigmas;
-  return flatMask(image, settings);
+  return flatMask(image, settings, nullptr, moments);
 }
 
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
-                    int threads, const std::function<void()>& alongside) {
+                    int threads, const std::function<void()>& alongside,
+                    const LocalMoments* leftMoments) {
   // With a second worker, it makes the grey maps, the right view's flat regions and then runs
   // `alongside`, while this one makes the left flat regions and fills them, waiting for each of
   // the other's results only when it first needs it (the grey maps come first: the fill needs
@@ -1528,7 +1536,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                     [&](RowOrderedTasks& tasks) {
                       regionTasks = &tasks;
                       regionsOffered.count_down();
-                    });
+                    },
+                    leftMoments);
               },
               [&] {
                 // Reads the disparities before the fill writes any: the fill waits for it first.
@@ -1555,7 +1564,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
           rightFlat = rightFlatRegions(flatMask(right, settings), right);
         return rightFlat;
       },
-      0, [](RowOrderedTasks&) {});
+      0, [](RowOrderedTasks&) {}, leftMoments);
   if (alongside) alongside();
   return filled;
 }

@@ -189,12 +189,24 @@ struct RegionFillSettings {
 // which then runs `alongside` (the caller's own work on the images: it must not touch the
 // disparities the fill writes) while the fill goes on; else `alongside` runs after the fill.
 // Same result on any number of threads.
+// The 5x5 means of an image's grey levels and of their squares, and its noise sigma, the nodata
+// (non-finite) pixels taken as 0: what the flat tests read. Made once for the left image, they
+// serve the fill's flat regions, the plain pixels and the snapping's contrast.
+struct LocalMoments {
+  cv::Mat mean, meanSquare;  // CV_32F
+  double noise = 0;          // noiseSigma (radiometry.hpp)
+};
+LocalMoments localMoments(const cv::Mat& image);
+
+// `leftMoments` (optional): localMoments(left), made beforehand.
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
-                    int threads = 1, const std::function<void()>& alongside = {});
+                    int threads = 1, const std::function<void()>& alongside = {},
+                    const LocalMoments* leftMoments = nullptr);
 
 // Pixels of `image` (CV_32F, NaN = nodata) whose 5x5 standard deviation is below `sigmas` times
-// the image's noise sigma (CV_8U 0/255): the fill's flat test, at another threshold.
-cv::Mat plainPixels(const cv::Mat& image, double sigmas);
+// the image's noise sigma (CV_8U 0/255): the fill's flat test, at another threshold. `moments`
+// (optional): localMoments(image), made beforehand.
+cv::Mat plainPixels(const cv::Mat& image, double sigmas, const LocalMoments* moments = nullptr);
 
 }  // namespace delineo::stereo::detail

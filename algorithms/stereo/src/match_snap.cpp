@@ -252,13 +252,13 @@ cv::Mat withoutNaN(const cv::Mat& m) {
 }
 }  // namespace
 
-StepContrast stepContrast(const cv::Mat& left, const cv::Mat& right) {
+StepContrast stepContrast(const cv::Mat& left, const cv::Mat& right, double leftNoise) {
   CV_Assert(left.type() == CV_32F && (right.empty() || right.size() == left.size()));
   StepContrast out;
   if (left.cols < 3 || left.rows < 1) return out;
   const cv::Mat filled = withoutNaN(left);
   out.contrast = rowContrast(filled);
-  out.sigma = noiseSigma(filled);
+  out.sigma = leftNoise >= 0 ? leftNoise : noiseSigma(filled);
   if (!right.empty()) out.rightContrast = rowContrast(withoutNaN(right));
   return out;
 }

@@ -114,13 +114,15 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepSna
 // What the snapping reads of the images alone, so that it can be prepared while the
 // disparities are still being filled: the contrast between x and x + 1 (the step between the
 // mean greys of 2 px on each side; CV_32F, (w − 1) × h, nodata as 0) of the left image and, when
-// `right` is given, of the right one, and the left image's noise sigma.
+// `right` is given, of the right one, and the left image's noise sigma (`leftNoise` when it is
+// given, ≥ 0: the caller's noiseSigma of the left image).
 struct StepContrast {
   cv::Mat contrast;
   cv::Mat rightContrast;
   double sigma = 1.0;
 };
-StepContrast stepContrast(const cv::Mat& left, const cv::Mat& right = cv::Mat());
+StepContrast stepContrast(const cv::Mat& left, const cv::Mat& right = cv::Mat(),
+                          double leftNoise = -1);
 
 // The same with the contrast prepared.
 int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepContrast& prepared,

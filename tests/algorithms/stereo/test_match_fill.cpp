@@ -121,6 +121,18 @@ TEST(PlainPixels, AreThePlainRoofNotTheTexturedGround) {
   EXPECT_LT(cv::countNonZero(plain(ground)), ground.area() / 20);
   // A lower threshold keeps fewer of the roof's pixels, never more.
   EXPECT_LE(cv::countNonZero(plainPixels(s.left, 1.0)(inner)), cv::countNonZero(plain(inner)));
+  // The image's moments made beforehand (as the matcher does, once for three steps) give the
+  // same pixels, nodata included.
+  cv::Mat withNodata = s.left.clone();
+  withNodata(cv::Rect(5, 5, 20, 10)).setTo(kNaN);
+  const LocalMoments moments = localMoments(withNodata);
+  EXPECT_GT(moments.noise, 0.0);
+  for (const double sigmas : {1.0, 3.0}) {
+    EXPECT_EQ(cv::countNonZero(plainPixels(withNodata, sigmas, &moments) !=
+                               plainPixels(withNodata, sigmas)),
+              0)
+        << sigmas;
+  }
 }
 
 TEST(FillFlatRegions, ReachesTheImageContourAndStopsThere) {
