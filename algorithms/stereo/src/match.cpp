@@ -668,10 +668,15 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   detail::StepContrast contrast;
   cv::Mat plain;
   const bool plainPass = p.adaptive && (p.plainStepMinScore > 0 || p.unmatchedPlainMinScore > 0);
-  // The levels' maps and images are no longer needed (but the finest left edges, for the
-  // facets): released there too, where their pages' return to the system (~5 ms at 1 Mpx)
-  // runs beside the fill instead of alone at the end.
   const auto prepareImages = [&] {
+    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right, leftMoments.noise);
+    if (plainPass) plain = detail::plainPixels(left, 3.0, &leftMoments);
+  };
+  // The levels' maps and images are no longer needed (but the finest left edges, for the
+  // facets): released by the fill's second worker once the regions are decided, where their
+  // pages' return to the system (~5 ms at 1 Mpx) fills the gaps of the regions' extension instead
+  // of running alone at the end.
+  const auto releaseLevels = [&] {
     const cv::Mat finestLeftEdges = pyramid[0].leftEdges;
     pyramid.assign(1, Level{});
     pyramid[0].leftEdges = finestLeftEdges;
@@ -679,15 +684,14 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     rightOut = {};
     coarseRight.release();
     finestBuffers = {};
-    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right, leftMoments.noise);
-    if (plainPass) plain = detail::plainPixels(left, 3.0, &leftMoments);
   };
   if (p.fillRegions && p.adaptive) {
     detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
                             static_cast<float>(p.minScore), result.disparity, result.score, threads,
-                            prepareImages, &leftMoments);
+                            prepareImages, &leftMoments, releaseLevels);
   } else {
     prepareImages();
+    releaseLevels();
   }
   // After the fill, whose candidates are the matches around a region (before it, a roof's weak
   // edge matches went and the fill took a box on it for the whole roof: sim seed 15 600², roof

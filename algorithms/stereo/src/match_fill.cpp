@@ -1510,7 +1510,7 @@ cv::Mat plainPixels(const cv::Mat& image, double sigmas, const LocalMoments* mom
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads, const std::function<void()>& alongside,
-                    const LocalMoments* leftMoments) {
+                    const LocalMoments* leftMoments, const std::function<void()>& afterRegions) {
   // With a second worker, it makes the grey maps, the right view's flat regions and then runs
   // `alongside`, while this one makes the left flat regions and fills them, waiting for each of
   // the other's results only when it first needs it (the grey maps come first: the fill needs
@@ -1549,6 +1549,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                 // Then it helps with the regions (the rest of the fill's time is theirs).
                 regionsOffered.wait();
                 regionTasks->help();
+                if (afterRegions) afterRegions();
               }},
              threads);
     return filled;
@@ -1566,6 +1567,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       },
       0, [](RowOrderedTasks&) {}, leftMoments);
   if (alongside) alongside();
+  if (afterRegions) afterRegions();
   return filled;
 }
 
