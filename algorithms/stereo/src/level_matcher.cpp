@@ -221,6 +221,26 @@ __attribute__((always_inline)) inline void addRowProducts(const Float8& a0, cons
   sum1 += a1 * b1;
 }
 
+// windowDot16 of the two windows at `b` and `c` (the lines above and below, the ±1 line probes)
+// in one pass: the rows of `a` are loaded once for the two (the same sums, in the same order, as
+// two calls).
+DELINEO_LEVEL_MATCHER_CLONES("avx2", "default")
+void windowDot16Pair(const float* a, size_t aStride, const float* b, const float* c, size_t bStride,
+                     int rows, const float* lanes, float out[2]) {
+  Float8 p0{}, p1{}, q0{}, q1{}, w0, w1;
+  load8(w0, lanes);
+  load8(w1, lanes + 8);
+  for (int v = 0; v < rows; ++v) {
+    Float8 a0, a1;
+    load8(a0, a + static_cast<size_t>(v) * aStride);
+    load8(a1, a + static_cast<size_t>(v) * aStride + 8);
+    addRowProducts(a0, a1, b + static_cast<size_t>(v) * bStride, p0, p1);
+    addRowProducts(a0, a1, c + static_cast<size_t>(v) * bStride, q0, q1);
+  }
+  out[0] = laneSum(p0 * w0 + p1 * w1);
+  out[1] = laneSum(q0 * w0 + q1 * w1);
+}
+
 // windowDot16 of the 4 windows b, b − 1, b − 2, b − 3 (main-line disparities d .. d + 3) in
 // one pass: the rows of `a` are loaded once for the four (the same sums, in the same order, as
 // four calls).
@@ -816,6 +836,27 @@ class LevelMatcher {
                      otherStats_.mean.at<float>(yb, xb), otherStats_.sd.at<float>(yb, xb));
   }
 
+  // squareScore(x, y, d, −1) and squareScore(x, y, d, +1) (windows ≤ 16 columns) in one pass over
+  // the template rows; false when either other window is missing or flat (scored one by one
+  // then).
+  bool squareScorePair(int x, int y, int d, float& minus, float& plus) const {
+    const int xb = x - d;
+    if (s_.window > 16 || y - 1 < 0 || y + 1 >= H_ || xb < 0 || xb >= W_ || !otherOk(y - 1, xb) ||
+        !otherOk(y + 1, xb)) {
+      return false;
+    }
+    float sab[2];
+    windowDot16Pair(
+        in_.ref.ptr<float>(y - r_) + x - r_, refStride_, in_.other.ptr<float>(y - 1 - r_) + xb - r_,
+        in_.other.ptr<float>(y + 1 - r_) + xb - r_, otherStride_, s_.window, squareLanes_, sab);
+    const float meanA = refStats_.mean.at<float>(y, x), sdA = refStats_.sd.at<float>(y, x);
+    minus = squareNcc(sab[0], meanA, sdA, otherStats_.mean.at<float>(y - 1, xb),
+                      otherStats_.sd.at<float>(y - 1, xb));
+    plus = squareNcc(sab[1], meanA, sdA, otherStats_.mean.at<float>(y + 1, xb),
+                     otherStats_.sd.at<float>(y + 1, xb));
+    return true;
+  }
+
   // NCC of a square window from its sum of products and both windows' means and deviations.
   float squareNcc(float sab, float meanA, float sdA, float meanB, float sdB) const {
     return (sab / static_cast<float>(n_) - meanA * meanB) / (sdA * sdB);
@@ -926,7 +967,8 @@ class LevelMatcher {
       finish(
           x, y, in_.lo.at<int>(y, x), in_.hi.at<int>(y, x), sc.peaks[static_cast<size_t>(i)],
           [&](int d, int dy) { return squareScore(x, y, d, dy); },
-          [](int, float&, float&) { return false; }, [](int, int, float*) { return false; });
+          [&](int d, float& minus, float& plus) { return squareScorePair(x, y, d, minus, plus); },
+          [](int, int, float*) { return false; });
     }
   }
 
