@@ -491,7 +491,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   double done = 0;
   detail::LevelOutput leftOut, rightOut;
   // The finest level's working buffers, kept past the loop to be released beside the fill (see
-  // prepareImages below) rather than alone at the end of the loop's last pass.
+  // releaseLevels below) rather than alone at the end of the loop's last pass.
   struct FinestLevelBuffers {
     detail::LevelInput left, right;
     cv::Mat rightLo, rightHi;
