@@ -640,6 +640,29 @@ class MainWindowTest : public QObject {
     tabs->setCurrentIndex(0);
   }
 
+  void squareWindowsOnOneSurfaceIsAMatchingParameterOfTheProject() {
+    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
+    if (!window_->document()) QVERIFY(window_->openProject(projectPath_));
+    auto* box =
+        window_->matchingForm()->findChild<QCheckBox*>(QStringLiteral("square-on-one-surface"));
+    QVERIFY(box);
+    QVERIFY(box->isChecked());
+    QVERIFY(!box->toolTip().isEmpty());
+    const auto stored = [&] {
+      return project::parameters<stereo::MatchParams>(window_->document()->project(), "matching")
+          .squareOnOneSurface;
+    };
+    QVERIFY(stored());
+    box->click();
+    QVERIFY(!stored());
+    window_->document()->undoStack()->undo();
+    QVERIFY(stored());
+    QVERIFY(box->isChecked());
+    QTabWidget* tabs = showOnMatchingTab(box, QStringLiteral("matching-tab-one-surface.png"));
+    QVERIFY(tabs);
+    tabs->setCurrentIndex(0);
+  }
+
   void cleanupTestCase() { window_.reset(); }
 };
 
