@@ -105,14 +105,8 @@ cv::Mat oneSurfacePixels(const cv::Mat& coarse, cv::Size size, int radius, float
   // the maximum, and so does the border.
   cv::Mat forMin, forMax, lowest, highest;
   rangeFilterInputs(coarse, -kInf, kInf, threads, forMin, forMax);
-  const cv::Mat square = cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_8U);
-  runTasks({[&] {
-              cv::erode(forMin, lowest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, -kInf);
-            },
-            [&] {
-              cv::dilate(forMax, highest, square, {-1, -1}, 1, cv::BORDER_CONSTANT, kInf);
-            }},
-           threads);
+  rangeFilters(forMin, forMax, cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_8U), -kInf, kInf,
+               threads, lowest, highest);
   const int cw = coarse.cols, ch = coarse.rows;
   cv::Mat out(size, CV_8U);
   forRowBands(size.height, threads, [&](int rowStart, int rowEnd) {

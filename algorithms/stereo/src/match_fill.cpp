@@ -1472,9 +1472,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
                                 dmax, settings, fillScore, labels, ownFill, disparity, score);
       },
       extensionHelpers);
-  std::vector<std::function<void()>> workers{[&] { extensions.run(); }};
-  for (int h = 0; h < extensionHelpers; ++h) workers.emplace_back([&] { extensions.help(); });
-  runTasks(workers, extensionHelpers + 1);
+  extensions.runWithHelpers();
   for (const int n : extendedIn) filled += n;
   return filled;
 }

@@ -64,6 +64,25 @@ double noiseSigma(const cv::Mat& image) {
 
 namespace {
 
+// Chunks of kChunk consecutive elements of [0, n), handed to `threads` workers:
+// work(chunk, begin, end) once per chunk.
+constexpr size_t kChunk = 32768;
+size_t chunkCount(size_t n) {
+  return (n + kChunk - 1) / kChunk;
+}
+template <class Work>
+void forEachChunk(size_t n, int threads, const Work& work) {
+  forRowBands(
+      static_cast<int>(chunkCount(n)), threads,
+      [&](int first, int last) {
+        for (int c = first; c < last; ++c) {
+          const size_t begin = static_cast<size_t>(c) * kChunk;
+          work(static_cast<size_t>(c), begin, std::min(n, begin + kChunk));
+        }
+      },
+      1);
+}
+
 // Sums of the left and right grey levels of pixel pairs and of their squares; map(): the gain and
 // offset that give the left ones the right ones' mean and standard deviation (none when either
 // side is flat).
@@ -163,32 +182,18 @@ double middleValue(const std::vector<double>& values, int threads) {
   }
   // Chunks of the values for the workers; every step below gives the same result in any split
   // (extremes, integer counts, and the bin's values, whose order nth_element does not depend on).
-  constexpr int kChunk = 32768;
-  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
-  const auto chunkRange = [&](int c) {
-    const size_t begin = static_cast<size_t>(c) * kChunk;
-    return std::pair{begin, std::min(n, begin + kChunk)};
-  };
-  const auto eachChunk = [&](const auto& work) {
-    forRowBands(
-        chunks, threads,
-        [&](int first, int last) {
-          for (int c = first; c < last; ++c) work(c);
-        },
-        1);
-  };
+  const size_t chunks = chunkCount(n);
   // The extremes without branches (vectorised; values hold no NaN).
-  std::vector<double> chunkLow(static_cast<size_t>(chunks)), chunkHigh(static_cast<size_t>(chunks));
-  eachChunk([&](int c) {
-    const auto [begin, end] = chunkRange(c);
+  std::vector<double> chunkLow(chunks), chunkHigh(chunks);
+  forEachChunk(n, threads, [&](size_t c, size_t begin, size_t end) {
     double low = values[begin], high = values[begin];
     for (size_t i = begin; i < end; ++i) {
       const double v = values[i];
       low = v < low ? v : low;
       high = v > high ? v : high;
     }
-    chunkLow[static_cast<size_t>(c)] = low;
-    chunkHigh[static_cast<size_t>(c)] = high;
+    chunkLow[c] = low;
+    chunkHigh[c] = high;
   });
   const double low = *std::min_element(chunkLow.begin(), chunkLow.end());
   const double high = *std::max_element(chunkHigh.begin(), chunkHigh.end());
@@ -197,14 +202,13 @@ double middleValue(const std::vector<double>& values, int threads) {
   const double scale = kBins / (high - low);
   // Each value's bin once (a loop without branches), then the counts.
   std::vector<uint16_t> bins(n);
-  std::vector<std::vector<size_t>> chunkCounts(static_cast<size_t>(chunks));
-  eachChunk([&](int c) {
-    const auto [begin, end] = chunkRange(c);
+  std::vector<std::vector<size_t>> chunkCounts(chunks);
+  forEachChunk(n, threads, [&](size_t c, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       bins[i] =
           static_cast<uint16_t>(std::min(kBins - 1, static_cast<int>((values[i] - low) * scale)));
     }
-    std::vector<size_t>& counts = chunkCounts[static_cast<size_t>(c)];
+    std::vector<size_t>& counts = chunkCounts[c];
     counts.assign(kBins, 0);
     for (size_t i = begin; i < end; ++i) ++counts[bins[i]];
   });
@@ -228,19 +232,6 @@ double middleValue(const std::vector<double>& values, int threads) {
 }
 
 namespace {
-
-// work(begin, end) over [0, n) in chunks shared by `threads` workers.
-template <class Work>
-void forEachPairChunk(size_t n, int threads, const Work& work) {
-  constexpr size_t kChunk = 32768;
-  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
-  forRowBands(
-      chunks, threads,
-      [&](int first, int last) {
-        work(static_cast<size_t>(first) * kChunk, std::min(n, static_cast<size_t>(last) * kChunk));
-      },
-      1);
-}
 
 // A first map of (left, right) pairs that wrong pairs cannot pull far: the median slope between
 // pairs of pairs at least kSlopeSpread grey levels apart in the right view (Theil-Sen, on up to
@@ -270,7 +261,7 @@ std::optional<std::pair<double, double>> medianSlopeMap(const std::vector<cv::Ve
   const double gain = middleValue(slopes);
   if (!(gain > 0)) return std::nullopt;
   std::vector<double> offsets(pairs.size());
-  forEachPairChunk(pairs.size(), threads, [&](size_t begin, size_t end) {
+  forEachChunk(pairs.size(), threads, [&](size_t, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) offsets[i] = pairs[i][0] - gain * pairs[i][1];
   });
   return std::pair{gain, middleValue(offsets, threads)};
@@ -324,7 +315,7 @@ std::pair<double, double> radiometricMapOfMatches(
   std::pair<double, double> map = *start;
   std::vector<double> residuals(pairs.size());
   for (int pass = 0; pass < 2; ++pass) {
-    forEachPairChunk(pairs.size(), threads, [&](size_t begin, size_t end) {
+    forEachChunk(pairs.size(), threads, [&](size_t, size_t begin, size_t end) {
       for (size_t i = begin; i < end; ++i) {
         residuals[i] = std::abs(pairs[i][0] - (map.first * pairs[i][1] + map.second));
       }

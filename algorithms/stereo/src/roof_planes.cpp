@@ -388,10 +388,7 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
       absorbedBy[task] = absorbed;
     };
     const int helpers = order.size() > 1 ? std::max(0, s.threads - 1) : 0;
-    RowOrderedTasks tasks(rows, absorb, helpers);
-    std::vector<std::function<void()>> workers{[&] { tasks.run(); }};
-    for (int h = 0; h < helpers; ++h) workers.emplace_back([&] { tasks.help(); });
-    runTasks(workers, helpers + 1);
+    RowOrderedTasks(rows, absorb, helpers).runWithHelpers();
     for (const int n : absorbedBy) counts.absorbed += n;
   }
   return counts;

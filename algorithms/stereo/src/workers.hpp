@@ -78,6 +78,16 @@ class RowOrderedTasks {
     for (size_t k = 0; k < cells.size(); ++k) link(k, cells[k], lastOn);
   }
 
+  // run() on this thread with the `helpers` given at construction each calling help() from a
+  // thread of their own: for an owner that has no workers at hand.
+  void runWithHelpers() {
+    const int helpers = helpersToCome_;  // (read before any helper runs: they decrement it)
+    std::vector<std::thread> pool;
+    for (int h = 0; h < helpers; ++h) pool.emplace_back([this] { help(); });
+    run();
+    for (auto& t : pool) t.join();
+  }
+
   void run() {
     std::unique_lock<std::mutex> lock(mutex_);
     workUntilAllFinished(lock);

@@ -98,6 +98,25 @@ TEST(RowOrderedTasks, AHelperRunsDisjointTasksAlongsideAndOverlappingOnesInOrder
   }
 }
 
+TEST(RowOrderedTasks, RunWithHelpersStartsTheHelpersItself) {
+  RowLogs logs(someRows());
+  std::atomic<int> concurrent{0}, mostConcurrent{0};
+  detail::RowOrderedTasks tasks(
+      logs.rows,
+      [&](size_t k) {
+        const int now = ++concurrent;
+        int seen = mostConcurrent.load();
+        while (now > seen && !mostConcurrent.compare_exchange_weak(seen, now)) {
+        }
+        logs.task(k);
+        --concurrent;
+      },
+      2);
+  tasks.runWithHelpers();
+  logs.expectSerialOrderPerRow();
+  EXPECT_GE(mostConcurrent.load(), 2);
+}
+
 // Tasks over the 10 x 10 tiles of an image, each on a rectangle of tiles (given as its tile ids):
 // a tile's log must list its tasks in increasing order, each task once, and tasks on disjoint
 // rectangles that share rows run side by side.
