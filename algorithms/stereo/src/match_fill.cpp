@@ -15,6 +15,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "components.hpp"
 #include "ordering.hpp"
 #include "radiometry.hpp"
 #include "workers.hpp"
@@ -244,13 +245,23 @@ struct RightFlatRegions {
 RightFlatRegions rightFlatRegions(const cv::Mat& flat, const cv::Mat& right) {
   RightFlatRegions out;
   const int count = cv::connectedComponents(flat, out.labels, 4, CV_32S);
+  // Each region's grey levels summed in raster order, run by run of its label; the pixels off the
+  // regions (label 0, whose mean nothing reads) are skipped.
   std::vector<double> sum(static_cast<size_t>(count), 0.0), n(static_cast<size_t>(count), 0.0);
   for (int y = 0; y < right.rows; ++y) {
     const int* l = out.labels.ptr<int>(y);
     const float* g = right.ptr<float>(y);
-    for (int x = 0; x < right.cols; ++x) {
-      sum[static_cast<size_t>(l[x])] += g[x];
-      n[static_cast<size_t>(l[x])] += 1;
+    for (int x = 0; x < right.cols;) {
+      const int label = l[x];
+      if (label == 0) {
+        ++x;
+        continue;
+      }
+      double total = sum[static_cast<size_t>(label)];
+      const int start = x;
+      for (; x < right.cols && l[x] == label; ++x) total += g[x];
+      sum[static_cast<size_t>(label)] = total;
+      n[static_cast<size_t>(label)] += x - start;
     }
   }
   out.meanGrey.resize(static_cast<size_t>(count));
@@ -973,7 +984,8 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         cv::getStructuringElement(cv::MORPH_RECT, {settings.coreOpening, settings.coreOpening}));
   }
   cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(flat, labels, stats, centroids, 4, CV_32S);
+  // (On this worker alone: the other prepares the grey maps and the right view's flat regions.)
+  const int count = componentsWithStats(flat, labels, stats, centroids, 4, 1);
   std::vector<int> unmatched(static_cast<size_t>(count), 0);
   for (int y = 0; y < labels.rows; ++y) {
     const int* l = labels.ptr<int>(y);
@@ -1508,7 +1520,8 @@ cv::Mat plainPixels(const cv::Mat& image, double sigmas, const LocalMoments* mom
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads, const std::function<void()>& alongside,
-                    const LocalMoments* leftMoments, const std::function<void()>& afterRegions) {
+                    const LocalMoments* leftMoments, const std::function<void()>& afterRegions,
+                    const LocalMoments* rightMoments) {
   // With a second worker, it makes the grey maps, the right view's flat regions and then runs
   // `alongside`, while this one makes the left flat regions and fills them, waiting for each of
   // the other's results only when it first needs it (the grey maps come first: the fill needs
@@ -1541,7 +1554,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                 // Reads the disparities before the fill writes any: the fill waits for it first.
                 maps = greyMaps(left, right, disparity, dmin, dmax);
                 mapsReady.count_down();
-                rightFlat = rightFlatRegions(flatMask(right, settings), right);
+                rightFlat =
+                    rightFlatRegions(flatMask(right, settings, nullptr, rightMoments), right);
                 rightReady.count_down();
                 if (alongside) alongside();
                 // Then it helps with the regions (the rest of the fill's time is theirs).
@@ -1560,7 +1574,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       [&]() -> const GreyMaps& { return maps; },
       [&]() -> const RightFlatRegions& {
         if (rightFlat.labels.empty())
-          rightFlat = rightFlatRegions(flatMask(right, settings), right);
+          rightFlat = rightFlatRegions(flatMask(right, settings, nullptr, rightMoments), right);
         return rightFlat;
       },
       0, [](RowOrderedTasks&) {}, leftMoments);

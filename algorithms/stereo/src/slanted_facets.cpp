@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "components.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -310,8 +311,7 @@ int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Ma
   cv::Mat labels, stats, centroids, matchedBefore;
   int count = 0;
   runTasks({[&] {
-              count =
-                  cv::connectedComponentsWithStats(unmatched, labels, stats, centroids, 4, CV_32S);
+              count = componentsWithStats(unmatched, labels, stats, centroids, 4, settings.threads);
             },
             [&] { matchedBefore = disparity.clone(); }},
            settings.threads);

@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "components.hpp"
 #include "neighbourhood_range.hpp"
 #include "workers.hpp"
 
@@ -83,7 +84,7 @@ int rejectWeakMatchesBesideUnmatchedPlain(const UnmatchedPlainSettings& settings
     }
   });
   cv::Mat labels, stats, centroids;
-  cv::connectedComponentsWithStats(unmatched, labels, stats, centroids, 4, CV_32S);
+  componentsWithStats(unmatched, labels, stats, centroids, 4, settings.threads);
   cv::Mat large(disparity.size(), CV_8U);
   forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
     for (int y = rowStart; y < rowEnd; ++y) {
