@@ -797,11 +797,7 @@ class LevelMatcher {
         core::report(progress, static_cast<double>(++done) / tiles);
       }
     };
-    const int threads = std::max(1, std::min(s_.threads, tiles));
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
+    runOnWorkers(worker, std::max(1, std::min(s_.threads, tiles)) - 1);
     return !canceled.load() && !core::isCanceled(progress);
   }
 

@@ -431,6 +431,9 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   result.levelsUsed = levels;
 
   const int threads = threadCount(p);
+  // Its helpers serve the match's parallel steps (see WorkerPool).
+  detail::WorkerPool workerPool(threads - 1);
+  const detail::WorkerPool::Scope poolScope(workerPool);
   core::setStage(progress, core::StageId::PreparingPyramids);
   const GreyMapping g = greyMapping(left, right, threads);
   std::vector<Level> pyramid(static_cast<size_t>(levels));

@@ -1,12 +1,14 @@
 #pragma once
 // The stereo code's worker model (internal to delineo_stereo): work is split into independent
 // tasks or bands of rows, handed out from an atomic counter to `threads` workers, the calling
-// thread one of them (threads == 1 runs everything inline, no pool). Each task writes only its
-// own outputs, so results never depend on the number of threads.
+// thread one of them (threads == 1 runs everything inline), the others a match's parked helpers
+// (WorkerPool) or threads started for the step. Each task writes only its own outputs, so
+// results never depend on the number of threads nor on which runs what.
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <set>
@@ -16,17 +18,138 @@
 
 namespace delineo::stereo::detail {
 
+// Helper threads parked between the many short parallel steps of a match (a few hundred a run
+// at 1 Mpx), lent to them instead of a thread started and joined for each (~38 us a start and
+// join on the development machine). A match makes one for its duration and makes it current on
+// its own thread (Scope): the steps called there borrow its helpers when all are idle; anywhere
+// else (on the helpers themselves, or while they are lent) threads are started as before. Which
+// thread runs a task never changes a result (see above).
+class WorkerPool {
+ public:
+  explicit WorkerPool(int helpers) {
+    for (int h = 0; h < helpers; ++h) threads_.emplace_back([this, h] { park(h); });
+  }
+  ~WorkerPool() {
+    post(kStop);
+    for (auto& t : threads_) t.join();
+  }
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  int helpers() const { return static_cast<int>(threads_.size()); }
+  std::vector<std::thread::id> helperIds() const {
+    std::vector<std::thread::id> ids;
+    for (const auto& t : threads_) ids.push_back(t.get_id());
+    return ids;
+  }
+
+  // Runs work() once on each of `count` helpers (count ≤ helpers()) when none is lent: returns
+  // false, doing nothing, otherwise. Then waitLent() before `work` goes.
+  bool lend(const std::function<void()>& work, int count) {
+    if (count <= 0 || count > helpers() || lent_.exchange(true)) return false;
+    work_ = &work;
+    pending_.store(count);
+    post(static_cast<uint64_t>(count));
+    return true;
+  }
+  void waitLent() {
+    // Briefly spinning first: the helpers mostly finish within microseconds of the caller.
+    for (int spin = 0; spin < kSpins && pending_.load() != 0; ++spin) pause();
+    for (int left = pending_.load(); left != 0; left = pending_.load()) pending_.wait(left);
+    lent_.store(false);
+  }
+
+  // The pool current on the constructing thread while the Scope lives (the only state the
+  // workers keep outside their calls).
+  class Scope {
+   public:
+    explicit Scope(WorkerPool& pool) : previous_(current_) { current_ = &pool; }
+    ~Scope() { current_ = previous_; }
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+
+   private:
+    WorkerPool* previous_;
+  };
+  static WorkerPool* current() { return current_; }
+
+ private:
+  // The posted word: a sequence number above, the helper count of the post (or kStop) below,
+  // read together so that a helper never pairs one post's number with another's count.
+  static constexpr uint64_t kCountBits = 16, kCountMask = (uint64_t{1} << kCountBits) - 1;
+  static constexpr uint64_t kStop = kCountMask;
+  static constexpr int kSpins = 4000;  // ~20-60 us
+
+  void post(uint64_t count) {
+    posts_ += uint64_t{1} << kCountBits;
+    state_.store(posts_ | count);
+    state_.notify_all();
+  }
+  static void pause() {
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#endif
+  }
+  void park(int index) {
+    uint64_t seen = 0;
+    for (;;) {
+      // Spinning a little before sleeping: the next step mostly follows within microseconds.
+      for (int spin = 0; spin < kSpins && state_.load() == seen; ++spin) pause();
+      state_.wait(seen);
+      seen = state_.load();
+      const uint64_t count = seen & kCountMask;
+      if (count == kStop) return;
+      // A helper counted in a post is waited for before the next post: `work_` is this one's.
+      if (static_cast<uint64_t>(index) < count) {
+        (*work_)();
+        if (pending_.fetch_sub(1) == 1) pending_.notify_one();
+      }
+    }
+  }
+
+  static inline thread_local WorkerPool* current_ = nullptr;
+  std::vector<std::thread> threads_;
+  std::atomic<uint64_t> state_{0};
+  uint64_t posts_ = 0;  // (the posting thread's only)
+  std::atomic<int> pending_{0};
+  std::atomic<bool> lent_{false};
+  const std::function<void()>* work_ = nullptr;
+};
+
+// worker() on the calling thread and on `helpers` more: the current pool's when it can lend
+// them, threads started for the call otherwise. Returns once every call has returned.
+template <class Worker>
+void runOnWorkers(const Worker& worker, int helpers) {
+  if (helpers <= 0) {
+    worker();
+    return;
+  }
+  WorkerPool* pool = WorkerPool::current();
+  if (pool != nullptr) {
+    const std::function<void()> work = [&worker] { worker(); };
+    if (pool->lend(work, helpers)) {
+      try {
+        worker();
+      } catch (...) {
+        pool->waitLent();  // the helpers still read `work`
+        throw;
+      }
+      pool->waitLent();
+      return;
+    }
+  }
+  std::vector<std::thread> started;
+  for (int t = 0; t < helpers; ++t) started.emplace_back([&worker] { worker(); });
+  worker();
+  for (auto& t : started) t.join();
+}
+
 inline void runTasks(const std::vector<std::function<void()>>& tasks, int threads) {
   std::atomic<size_t> next{0};
   auto worker = [&] {
     for (size_t i = next++; i < tasks.size(); i = next++) tasks[i]();
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, static_cast<int>(tasks.size())); ++t) {
-    pool.emplace_back(worker);
-  }
-  worker();
-  for (auto& t : pool) t.join();
+  runOnWorkers(worker, std::min<int>(threads, static_cast<int>(tasks.size())) - 1);
 }
 
 // band(rowStart, rowEnd) over rows 0..rows−1 in bands of `bandRows`.
@@ -39,11 +162,7 @@ void forRowBands(int rows, int threads, const BandFn& band, int bandRows = 16) {
       band(b * bandRows, std::min(rows, (b + 1) * bandRows));
     }
   };
-  const int workers = std::max(1, std::min(threads, bands));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  runOnWorkers(worker, std::max(1, std::min(threads, bands)) - 1);
 }
 
 // Tasks 0 .. n−1 whose result must be that of running them in this order, where task k reads and
@@ -82,10 +201,17 @@ class RowOrderedTasks {
   // thread of their own: for an owner that has no workers at hand.
   void runWithHelpers() {
     const int helpers = helpersToCome_;  // (read before any helper runs: they decrement it)
-    std::vector<std::thread> pool;
-    for (int h = 0; h < helpers; ++h) pool.emplace_back([this] { help(); });
-    run();
-    for (auto& t : pool) t.join();
+    // The owner's run() and the helpers' help() as one worker, told apart by a counter.
+    std::atomic<int> arrived{0};
+    runOnWorkers(
+        [&] {
+          if (arrived++ == 0) {
+            run();
+          } else {
+            help();
+          }
+        },
+        helpers);
   }
 
   void run() {

@@ -3,7 +3,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -192,3 +194,94 @@ TEST(RowOrderedTasks, TasksOnTilesRunInOrderWhereTheyShareOne) {
 }
 
 }  // namespace
+
+namespace {
+
+// The ids of the threads that ran a parallel step's workers.
+struct ThreadsSeen {
+  std::mutex mutex;
+  std::vector<std::thread::id> ids;
+  void add() {
+    std::lock_guard<std::mutex> lock(mutex);
+    ids.push_back(std::this_thread::get_id());
+  }
+};
+
+}  // namespace
+
+TEST(WorkerPool, LendsItsHelpersToTheStepsOnItsScopesThread) {
+  detail::WorkerPool pool(2);
+  const detail::WorkerPool::Scope scope(pool);
+  ASSERT_EQ(detail::WorkerPool::current(), &pool);
+  // Many short steps in a row, as in a match: every task runs once, on the caller or the pool's
+  // two helpers (no thread is started per step).
+  const std::vector<std::thread::id> poolIds = pool.helperIds();
+  const std::set<std::thread::id> allowed(poolIds.begin(), poolIds.end());
+  std::set<std::thread::id> helpers;
+  for (int step = 0; step < 200; ++step) {
+    std::vector<std::atomic<int>> runs(6);
+    ThreadsSeen seen;
+    std::vector<std::function<void()>> tasks;
+    for (size_t k = 0; k < runs.size(); ++k) {
+      tasks.emplace_back([&, k] {
+        ++runs[k];
+        seen.add();
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
+      });
+    }
+    detail::runTasks(tasks, 3);
+    for (const auto& r : runs) ASSERT_EQ(r.load(), 1);
+    for (const auto& id : seen.ids) {
+      if (id != std::this_thread::get_id()) helpers.insert(id);
+    }
+  }
+  EXPECT_GE(helpers.size(), 1U);
+  for (const auto& id : helpers) EXPECT_EQ(allowed.count(id), 1U);
+}
+
+TEST(WorkerPool, StepsNestedInALentStepStartThreadsAndFinish) {
+  detail::WorkerPool pool(1);
+  const detail::WorkerPool::Scope scope(pool);
+  // Two tasks that wait for each other (as the fill's two workers do) while each runs a parallel
+  // step of its own: the outer step has the pool's helper, the inner ones must start threads
+  // (the helper is lent; on the helper no pool is current) rather than wait for it.
+  std::atomic<int> arrived{0};
+  std::atomic<int> innerRuns{0};
+  const auto task = [&] {
+    ++arrived;
+    while (arrived.load() < 2) std::this_thread::yield();
+    detail::forRowBands(64, 2, [&](int, int) { ++innerRuns; });
+  };
+  detail::runTasks({task, task}, 2);
+  EXPECT_EQ(arrived.load(), 2);
+  EXPECT_EQ(innerRuns.load(), 2 * 4);  // 64 rows in bands of 16, twice
+}
+
+TEST(WorkerPool, ScopeRestoresThePreviousPoolAndOtherThreadsSeeNone) {
+  EXPECT_EQ(detail::WorkerPool::current(), nullptr);
+  detail::WorkerPool outer(1), inner(1);
+  {
+    const detail::WorkerPool::Scope a(outer);
+    {
+      const detail::WorkerPool::Scope b(inner);
+      EXPECT_EQ(detail::WorkerPool::current(), &inner);
+      detail::WorkerPool* elsewhere = &inner;
+      std::thread([&] { elsewhere = detail::WorkerPool::current(); }).join();
+      EXPECT_EQ(elsewhere, nullptr);
+    }
+    EXPECT_EQ(detail::WorkerPool::current(), &outer);
+  }
+  EXPECT_EQ(detail::WorkerPool::current(), nullptr);
+}
+
+TEST(WorkerPool, OrderedTasksGiveTheSameLogsWithThePoolsHelpers) {
+  detail::WorkerPool pool(2);
+  const detail::WorkerPool::Scope scope(pool);
+  for (int round = 0; round < 20; ++round) {
+    RowLogs logs(someRows());
+    detail::RowOrderedTasks tasks(
+        logs.rows, [&](size_t k) { logs.task(k); }, 2);
+    tasks.runWithHelpers();
+    logs.expectSerialOrderPerRow();
+  }
+}
