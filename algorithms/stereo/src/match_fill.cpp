@@ -24,15 +24,6 @@ namespace delineo::stereo::detail {
 
 namespace {
 
-// The disparity a region is filled with: c + a·x + b·y in image coordinates (a = b = 0 for the
-// constant of the outline's matches).
-struct FillPlane {
-  double c = 0, a = 0, b = 0;
-  double at(int x, int y) const { return c + a * x + b * y; }
-  // How far a row-end point (x, y, disparity) lies from the plane, signed.
-  double residual(const cv::Point3d& p) const { return p.z - (c + a * p.x + b * p.y); }
-};
-
 // The points within `within` px of the plane.
 std::vector<cv::Point3d> pointsNear(const std::vector<cv::Point3d>& points, const FillPlane& plane,
                                     double within) {
@@ -965,6 +956,13 @@ GreyMaps greyMaps(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disp
   return maps;
 }
 
+// A region filled by the fill, which it extends over the unmatched pixels beside it.
+struct FilledRegion {
+  cv::Rect box;
+  cv::Mat grown;
+  FillPlane plane;
+};
+
 // The fill itself; `greyMapsOf()` gives greyMaps() of the disparities as they come in (read
 // before the fill writes any), `rightFlatRegionsOf()` the right view's flat regions.
 // `offerRegions(tasks)` hands the regions' tasks to `helpers` other threads, which each call
@@ -1012,11 +1010,6 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     ownFill[static_cast<size_t>(r)] = unmatched[static_cast<size_t>(r)] >= settings.minUnmatched &&
                                       stats.at<int>(r, cv::CC_STAT_AREA) <= maxArea;
   }
-  struct FilledRegion {
-    cv::Rect box;
-    cv::Mat grown;
-    FillPlane plane;
-  };
   // The regions decided here, in label order, each in its bounding box grown by 4 px. A region
   // reads and writes the disparities (and scores) of its box's rows only: the matches around it,
   // those its plane would hide left of it on its rows, its own pixels. Regions on disjoint rows
@@ -1451,32 +1444,19 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     if (filledRegion[k]) filledRegions.push_back(std::move(*filledRegion[k]));
   }
   // Once every region is filled (the extension's pixels do not become another region's
-  // candidates). In the regions' order where they may meet: an extension writes only within its
-  // box ± extendReach and reads the maps one row beyond it and, along its rows, up to the range's
-  // width beyond it (the right-view positions of a pixel's candidates, see matchesAt); extensions
-  // whose such rectangles share no tile of kExtensionTile px run side by side, with the result of
-  // running them in order.
-  constexpr int kExtensionTile = 32;
-  const int tilesX = (left.cols + kExtensionTile - 1) / kExtensionTile;
-  const int tilesY = (left.rows + kExtensionTile - 1) / kExtensionTile;
-  std::vector<std::vector<int>> extensionTiles;
-  extensionTiles.reserve(filledRegions.size());
+  // candidates). In the regions' order where they may meet, which extensionFootprints() tells.
+  std::vector<cv::Rect> filledBoxes;
+  std::vector<FillPlane> filledPlanes;
   for (const FilledRegion& f : filledRegions) {
-    const int across = settings.extendReach + (dmax - dmin) + 2, down = settings.extendReach + 1;
-    const cv::Rect reads = cv::Rect(f.box.x - across, f.box.y - down, f.box.width + 2 * across,
-                                    f.box.height + 2 * down) &
-                           image;
-    std::vector<int>& tiles = extensionTiles.emplace_back();
-    for (int ty = reads.y / kExtensionTile; ty <= (reads.br().y - 1) / kExtensionTile; ++ty) {
-      for (int tx = reads.x / kExtensionTile; tx <= (reads.br().x - 1) / kExtensionTile; ++tx) {
-        tiles.push_back(ty * tilesX + tx);
-      }
-    }
+    filledBoxes.push_back(f.box);
+    filledPlanes.push_back(f.plane);
   }
+  const ExtensionFootprints footprints =
+      extensionFootprints(filledBoxes, filledPlanes, settings, dmin, dmax, disparity);
   std::vector<int> extendedIn(filledRegions.size(), 0);
   const int extensionHelpers = filledRegions.size() > 1 ? helpers : 0;
   RowOrderedTasks extensions(
-      extensionTiles, tilesX * tilesY,
+      footprints.cells, footprints.cellCount,
       [&](size_t k) {
         const FilledRegion& f = filledRegions[k];
         extendedIn[k] =
@@ -1490,6 +1470,96 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
 }
 
 }  // namespace
+
+ExtensionFootprints extensionFootprints(const std::vector<cv::Rect>& boxes,
+                                        const std::vector<FillPlane>& planes,
+                                        const RegionFillSettings& settings, int dmin, int dmax,
+                                        const cv::Mat& disparity) {
+  CV_Assert(boxes.size() == planes.size() && disparity.type() == CV_32F);
+  constexpr int kImageTile = 32, kRightTile = 16;
+  const int cols = disparity.cols, rows = disparity.rows;
+  const cv::Rect image(0, 0, cols, rows);
+  const int tilesX = (cols + kImageTile - 1) / kImageTile;
+  const int tilesY = (rows + kImageTile - 1) / kImageTile;
+  // Right-view positions x − d lie in [−dmax, cols − 1 − dmin]; shifted to start at 0, with
+  // room for the margins below.
+  const double shift = dmax + 4.0;
+  const int rightTilesX = (cols + (dmax - dmin) + 8 + kRightTile - 1) / kRightTile;
+  ExtensionFootprints out;
+  out.cellCount = tilesX * tilesY + rightTilesX * tilesY;
+  const int reach = settings.extendReach;
+  // Each extension's `outer` and the right-view positions of its candidates (lo > hi: none).
+  struct Span {
+    double lo = 1, hi = 0;
+  };
+  std::vector<cv::Rect> outers;
+  std::vector<Span> candidates;
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    const cv::Rect& box = boxes[k];
+    const FillPlane& plane = planes[k];
+    const cv::Rect outer =
+        cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) &
+        image;
+    outers.push_back(outer);
+    // The plane's extremes over `outer` lie at its corners; a candidate out of the range is
+    // never tested (matchesAt).
+    double pmin = std::numeric_limits<double>::infinity(), pmax = -pmin;
+    for (const int x : {outer.x, outer.br().x - 1}) {
+      for (const int y : {outer.y, outer.br().y - 1}) {
+        pmin = std::min(pmin, plane.at(x, y));
+        pmax = std::max(pmax, plane.at(x, y));
+      }
+    }
+    pmin = std::max(pmin, static_cast<double>(dmin));
+    pmax = std::min(pmax, static_cast<double>(dmax));
+    Span span;
+    if (pmin <= pmax && !outer.empty()) span = {outer.x - pmax, outer.br().x - 1 - pmin};
+    candidates.push_back(span);
+  }
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    const cv::Rect& outer = outers[k];
+    std::vector<int>& cells = out.cells.emplace_back();
+    const cv::Rect reads =
+        cv::Rect(outer.x - 1, outer.y - 1, outer.width + 2, outer.height + 2) & image;
+    for (int ty = reads.y / kImageTile; ty <= (reads.br().y - 1) / kImageTile; ++ty) {
+      for (int tx = reads.x / kImageTile; tx <= (reads.br().x - 1) / kImageTile; ++tx) {
+        cells.push_back(ty * tilesX + tx);
+      }
+    }
+    if (outer.empty()) continue;
+    // The right-view positions it reads or changes, with a margin: the test's 0.5 px and the
+    // values' rounding to float.
+    std::vector<Span> spans;
+    if (candidates[k].lo <= candidates[k].hi) spans.push_back(candidates[k]);
+    if (settings.extendReplaceOff > 0) {
+      Span now{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+      for (int y = outer.y; y < outer.br().y; ++y) {
+        const float* d = disparity.ptr<float>(y);
+        for (int x = outer.x; x < outer.br().x; ++x) {
+          if (!std::isfinite(d[x])) continue;
+          now.lo = std::min(now.lo, x - static_cast<double>(d[x]));
+          now.hi = std::max(now.hi, x - static_cast<double>(d[x]));
+        }
+      }
+      if (now.lo <= now.hi) spans.push_back(now);
+      for (size_t h = 0; h < k; ++h) {
+        if ((outers[h] & outer).empty() || candidates[h].lo > candidates[h].hi) continue;
+        spans.push_back(candidates[h]);
+      }
+    }
+    const int base = tilesX * tilesY;
+    for (const Span& span : spans) {
+      const int first = std::clamp(
+          static_cast<int>(std::floor((span.lo - 2.0 + shift) / kRightTile)), 0, rightTilesX - 1);
+      const int last = std::clamp(
+          static_cast<int>(std::floor((span.hi + 2.0 + shift) / kRightTile)), 0, rightTilesX - 1);
+      for (int ty = outer.y / kImageTile; ty <= (outer.br().y - 1) / kImageTile; ++ty) {
+        for (int rx = first; rx <= last; ++rx) cells.push_back(base + ty * rightTilesX + rx);
+      }
+    }
+  }
+  return out;
+}
 
 LocalMoments localMoments(const cv::Mat& image) {
   // Nodata as 0, and the squares, in one pass; then the two 5x5 means.

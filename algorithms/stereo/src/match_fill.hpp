@@ -2,6 +2,7 @@
 // Disparity of flat (textureless) regions from the matches along their outline (internal to
 // delineo_stereo).
 #include <functional>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -214,5 +215,34 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
 // the image's noise sigma (CV_8U 0/255): the fill's flat test, at another threshold. `moments`
 // (optional): localMoments(image), made beforehand.
 cv::Mat plainPixels(const cv::Mat& image, double sigmas, const LocalMoments* moments = nullptr);
+
+// The disparity a region is filled with: c + a·x + b·y in image coordinates (a = b = 0 for the
+// constant of the outline's matches).
+struct FillPlane {
+  double c = 0, a = 0, b = 0;
+  double at(int x, int y) const { return c + a * x + b * y; }
+  // How far a row-end point (x, y, disparity) lies from the plane, signed.
+  double residual(const cv::Point3d& p) const { return p.z - (c + a * p.x + b * p.y); }
+};
+
+// What the fill's extensions over unmatched pixels share, one per filled region (its box and
+// plane, in the fill's order): cells (ids 0 .. cellCount − 1) for RowOrderedTasks, the extensions
+// that share none giving the same maps side by side as in order. An extension writes the
+// disparities and scores only within its box ± extendReach (`outer`) and reads the maps there and
+// one pixel beyond: the 32 px tiles of the image these cover. Further along its rows it reads only
+// whether a match maps to the right-view position x − d of one of its candidates: the right-view
+// positions its candidates map to on its rows, those of the values it writes (the same) and those
+// of the values it may replace (the matches in `outer` in `disparity`, the map before the
+// extensions, and the values of the earlier extensions whose `outer` meets its own) are its cells
+// in the right view, 16 px tiles by 32 rows. (The rectangles of the range's width beyond the box,
+// its cells before, kept most of them in order: at 1000² / 128 d they ran at ~110 % of one core.)
+struct ExtensionFootprints {
+  std::vector<std::vector<int>> cells;
+  int cellCount = 0;
+};
+ExtensionFootprints extensionFootprints(const std::vector<cv::Rect>& boxes,
+                                        const std::vector<FillPlane>& planes,
+                                        const RegionFillSettings& settings, int dmin, int dmax,
+                                        const cv::Mat& disparity);
 
 }  // namespace delineo::stereo::detail

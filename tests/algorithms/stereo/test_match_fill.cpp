@@ -960,3 +960,60 @@ TEST(FillFlatRegions, ItsOwnMatchesCloseToTheFillStay) {
 }
 }  // namespace
 }  // namespace delineo::stereo::detail
+
+namespace delineo::stereo::detail {
+namespace {
+
+bool shareACell(const ExtensionFootprints& f, size_t a, size_t b) {
+  for (const int x : f.cells[a]) {
+    for (const int y : f.cells[b]) {
+      if (x == y) return true;
+    }
+  }
+  return false;
+}
+
+// Two roofs on the same rows, 300 px apart in the image (their extensions' pixels far apart), with
+// their candidates mapping to the same right-view columns (x − d about 200 for both): one's writes
+// change what the other's test reads, so they must share a cell; a third whose candidates map far
+// from both shares none with them; a fourth whose pixels hold a match mapping among the first's
+// candidates (a value it may replace) shares one with the first.
+TEST(ExtensionFootprints, ExtensionsShareACellWhereTheirRightViewPositionsMeet) {
+  RegionFillSettings settings;  // extendReach 40, extendReplaceOff 4
+  cv::Mat disparity(400, 1000, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  const std::vector<cv::Rect> boxes{{290, 100, 20, 20},   // d = 100: x − d in 150 .. 250
+                                    {590, 100, 20, 20},   // d = 400: x − d in 150 .. 250
+                                    {850, 100, 20, 20},   // d = 10: x − d in 800 .. 900
+                                    {850, 300, 20, 20}};  // rows apart, but see below
+  const std::vector<FillPlane> planes{{100, 0, 0}, {400, 0, 0}, {10, 0, 0}, {10, 0, 0}};
+  // A match inside the fourth's box ± reach mapping to x − d = 200, on other rows than the first:
+  // the fourth may replace it; nothing else ties them (rows apart).
+  disparity.at<float>(300, 860) = 660.0F;
+  const ExtensionFootprints f = extensionFootprints(boxes, planes, settings, 0, 700, disparity);
+  ASSERT_EQ(f.cells.size(), 4U);
+  EXPECT_TRUE(shareACell(f, 0, 1));
+  EXPECT_FALSE(shareACell(f, 0, 2));
+  EXPECT_FALSE(shareACell(f, 1, 2));
+  // The fourth reads and writes right-view columns 800 .. 900 on rows 260 .. 360 and may replace
+  // the match mapping to 200 there; the first reads 150 .. 250 on rows 60 .. 160: other rows.
+  EXPECT_FALSE(shareACell(f, 0, 3));
+  for (const auto& cells : f.cells) {
+    for (const int c : cells) {
+      EXPECT_GE(c, 0);
+      EXPECT_LT(c, f.cellCount);
+    }
+  }
+  // On the first's rows, the same match ties the fourth to the first.
+  cv::Mat besideTheFirst = disparity.clone();
+  besideTheFirst.at<float>(300, 860) = std::numeric_limits<float>::quiet_NaN();
+  besideTheFirst.at<float>(110, 860) = 660.0F;
+  std::vector<cv::Rect> sameRows = boxes;
+  sameRows[3] = {850, 90, 20, 20};
+  const ExtensionFootprints g =
+      extensionFootprints(sameRows, planes, settings, 0, 700, besideTheFirst);
+  EXPECT_TRUE(shareACell(g, 0, 3));
+  EXPECT_TRUE(shareACell(g, 2, 3));  // the same image tiles
+}
+
+}  // namespace
+}  // namespace delineo::stereo::detail

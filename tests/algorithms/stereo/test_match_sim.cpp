@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 #include <opencv2/core.hpp>
@@ -156,6 +157,49 @@ TEST(MatchSimulated, WeakGroundMatchesBesideAnUndecidedPlainRoofAreRejected) {
   }
   ASSERT_GT(roof, 3000);  // the roof is where it was measured
   EXPECT_LT(carried, 80) << carried << " of " << roof;
+}
+
+}  // namespace
+}  // namespace delineo::stereo
+
+namespace delineo::stereo {
+namespace {
+
+// Every step's tasks write their own outputs, and the ordered ones (the fill's regions and their
+// extensions over unmatched pixels, the roofs' absorption) wait for the earlier ones whose
+// footprints they share: on a city block of many roofs, whose extensions read across each other's
+// rows, the map is the same bits on one, two and three threads (three: two parked helpers).
+TEST(MatchSimulated, ACityBlockGivesTheSameBitsOnOneTwoAndThreeThreads) {
+  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(600, 7));
+  cv::Mat left, right;
+  scene.left.convertTo(left, CV_32F);
+  scene.right.convertTo(right, CV_32F);
+  MatchParams p;
+  p.dmin = scene.disparityMin;
+  p.dmax = scene.disparityMax;
+  p.threads = 1;
+  const MatchResult one = matchStereo(left, right, p);
+  long matched = 0;
+  for (int y = 0; y < one.disparity.rows; ++y) {
+    for (int x = 0; x < one.disparity.cols; ++x) {
+      matched += std::isfinite(one.disparity.at<float>(y, x)) ? 1 : 0;
+    }
+  }
+  ASSERT_GT(matched, static_cast<long>(one.disparity.total()) / 2);
+  for (const int threads : {2, 3}) {
+    p.threads = threads;
+    const MatchResult many = matchStereo(left, right, p);
+    ASSERT_EQ(many.disparity.size(), one.disparity.size());
+    // memcmp: NaN == NaN bit for bit, and any other bit differs.
+    long differing = 0;
+    for (int y = 0; y < one.disparity.rows; ++y) {
+      differing += std::memcmp(one.disparity.ptr<float>(y), many.disparity.ptr<float>(y),
+                               sizeof(float) * static_cast<size_t>(one.disparity.cols)) != 0
+                       ? 1
+                       : 0;
+    }
+    EXPECT_EQ(differing, 0) << threads << " threads: rows differing";
+  }
 }
 
 }  // namespace
