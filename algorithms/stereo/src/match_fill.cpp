@@ -1516,6 +1516,35 @@ ExtensionFootprints extensionFootprints(const std::vector<cv::Rect>& boxes,
     if (pmin <= pmax && !outer.empty()) span = {outer.x - pmax, outer.br().x - 1 - pmin};
     candidates.push_back(span);
   }
+  // The right-view positions x − d of the matches now, their least and greatest by row over
+  // blocks of kBlock columns: one pass over the map instead of one over each `outer` (those
+  // overlap, and took ~3 ms at 1000² alone on one worker).
+  constexpr int kBlock = 32;
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const bool replaces = settings.extendReplaceOff > 0 && boxes.size() > 1;
+  const int blocksX = (cols + kBlock - 1) / kBlock;
+  const auto idx = [blocksX](int y, int b) {
+    return static_cast<size_t>(y) * static_cast<size_t>(blocksX) + static_cast<size_t>(b);
+  };
+  std::vector<float> blockLo, blockHi;
+  if (replaces) {
+    blockLo.assign(static_cast<size_t>(rows) * static_cast<size_t>(blocksX), kInf);
+    blockHi.assign(blockLo.size(), -kInf);
+    for (int y = 0; y < rows; ++y) {
+      const float* d = disparity.ptr<float>(y);
+      for (int b = 0; b < blocksX; ++b) {
+        float lo = kInf, hi = -kInf;
+        for (int x = b * kBlock; x < std::min(cols, (b + 1) * kBlock); ++x) {
+          const bool isNumber = d[x] == d[x];  // (inf would give inf positions: as safe)
+          const float p = static_cast<float>(x) - d[x];
+          lo = std::min(lo, isNumber ? p : kInf);
+          hi = std::max(hi, isNumber ? p : -kInf);
+        }
+        blockLo[idx(y, b)] = lo;
+        blockHi[idx(y, b)] = hi;
+      }
+    }
+  }
   for (size_t k = 0; k < boxes.size(); ++k) {
     const cv::Rect& outer = outers[k];
     std::vector<int>& cells = out.cells.emplace_back();
@@ -1531,14 +1560,13 @@ ExtensionFootprints extensionFootprints(const std::vector<cv::Rect>& boxes,
     // values' rounding to float.
     std::vector<Span> spans;
     if (candidates[k].lo <= candidates[k].hi) spans.push_back(candidates[k]);
-    if (settings.extendReplaceOff > 0) {
-      Span now{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    if (replaces) {
+      // The matches' positions over the blocks `outer` meets (a few pixels more: as safe).
+      Span now{kInf, -kInf};
       for (int y = outer.y; y < outer.br().y; ++y) {
-        const float* d = disparity.ptr<float>(y);
-        for (int x = outer.x; x < outer.br().x; ++x) {
-          if (!std::isfinite(d[x])) continue;
-          now.lo = std::min(now.lo, x - static_cast<double>(d[x]));
-          now.hi = std::max(now.hi, x - static_cast<double>(d[x]));
+        for (int b = outer.x / kBlock; b <= (outer.br().x - 1) / kBlock; ++b) {
+          now.lo = std::min(now.lo, static_cast<double>(blockLo[idx(y, b)]));
+          now.hi = std::max(now.hi, static_cast<double>(blockHi[idx(y, b)]));
         }
       }
       if (now.lo <= now.hi) spans.push_back(now);
