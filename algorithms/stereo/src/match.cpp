@@ -459,10 +459,12 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   const bool afterSteps = p.adaptive && (p.fillRegions || p.snapSteps || p.plainStepMinScore > 0 ||
                                          p.unmatchedPlainMinScore > 0);
   detail::LocalMoments leftMoments;
-  // The right image's, for the fill's right flat regions, which its regions wait for: made here,
-  // where they lengthen the stage by less than they did the fill's wait (1000² / 128 d, ~6 ms).
+  // The right image's flat pixels, for the fill's right flat regions, which its regions wait for:
+  // made here, where they lengthen the stage by less than they did the fill's wait (1000² /
+  // 128 d, ~6 ms); the mask only is kept (the moments took 32 MB more at 2000² up to the fill).
   const bool fillsRegions = p.adaptive && p.fillRegions;
-  detail::LocalMoments rightMoments;
+  const detail::RegionFillSettings fillSettings;
+  cv::Mat rightFlat;
   std::vector<std::function<void()>> edgeTasks;
   for (int k = 0; k < levels; ++k) {
     Level& lv = pyramid[static_cast<size_t>(k)];
@@ -477,7 +479,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
       edgeTasks.emplace_back([&] { leftMoments = detail::localMoments(left); });
     }
     if (k == 0 && fillsRegions) {
-      edgeTasks.emplace_back([&] { rightMoments = detail::localMoments(right); });
+      edgeTasks.emplace_back(
+          [&] { rightFlat = detail::plainPixels(right, fillSettings.flatSigmas); });
     }
   }
   runTasks(edgeTasks, threads);
@@ -703,12 +706,12 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     rightOut = {};
     coarseRight.release();
     finestBuffers = {};
-    rightMoments = {};  // the right flat regions are made by then
+    rightFlat.release();  // the right flat regions are made by then
   };
   if (p.fillRegions && p.adaptive) {
-    detail::fillFlatRegions(left, right, detail::RegionFillSettings{}, p.dmin, p.dmax,
+    detail::fillFlatRegions(left, right, fillSettings, p.dmin, p.dmax,
                             static_cast<float>(p.minScore), result.disparity, result.score, threads,
-                            prepareImages, &leftMoments, releaseLevels, &rightMoments);
+                            prepareImages, &leftMoments, releaseLevels, &rightFlat);
   } else {
     prepareImages();
     releaseLevels();

@@ -1631,7 +1631,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads, const std::function<void()>& alongside,
                     const LocalMoments* leftMoments, const std::function<void()>& afterRegions,
-                    const LocalMoments* rightMoments) {
+                    const cv::Mat* rightFlatPixels) {
   // With a second worker, it makes the grey maps, the right view's flat regions and then runs
   // `alongside`, while this one makes the left flat regions and fills them, waiting for each of
   // the other's results only when it first needs it (the grey maps come first: the fill needs
@@ -1664,8 +1664,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                 // Reads the disparities before the fill writes any: the fill waits for it first.
                 maps = greyMaps(left, right, disparity, dmin, dmax);
                 mapsReady.count_down();
-                rightFlat =
-                    rightFlatRegions(flatMask(right, settings, nullptr, rightMoments), right);
+                rightFlat = rightFlatRegions(
+                    rightFlatPixels ? *rightFlatPixels : flatMask(right, settings), right);
                 rightReady.count_down();
                 if (alongside) alongside();
                 // Then it helps with the regions (the rest of the fill's time is theirs).
@@ -1684,7 +1684,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       [&]() -> const GreyMaps& { return maps; },
       [&]() -> const RightFlatRegions& {
         if (rightFlat.labels.empty())
-          rightFlat = rightFlatRegions(flatMask(right, settings, nullptr, rightMoments), right);
+          rightFlat = rightFlatRegions(
+              rightFlatPixels ? *rightFlatPixels : flatMask(right, settings), right);
         return rightFlat;
       },
       0, [](RowOrderedTasks&) {}, leftMoments);

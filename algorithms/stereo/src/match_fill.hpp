@@ -199,17 +199,18 @@ struct LocalMoments {
 };
 LocalMoments localMoments(const cv::Mat& image);
 
-// `leftMoments`, `rightMoments` (optional): localMoments() of the views, made beforehand (the
-// right one's serve the right view's flat regions, which the fill waits for). `afterRegions`
-// (optional, the caller's work that touches neither the images nor the maps): run by the second
-// worker once the regions are decided, while this one extends them over the unmatched pixels (a
-// step that leaves a worker idle at times); after the fill on one thread.
+// `leftMoments` (optional): localMoments(left), made beforehand; `rightFlatPixels` (optional):
+// the right view's flat pixels, plainPixels(right, settings.flatSigmas), made beforehand (the
+// right flat regions, which the fill waits for, start from them). `afterRegions` (optional, the
+// caller's work that touches neither the images nor the maps): run by the second worker once the
+// regions are decided, while this one extends them over the unmatched pixels (a step that leaves
+// a worker idle at times); after the fill on one thread.
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads = 1, const std::function<void()>& alongside = {},
                     const LocalMoments* leftMoments = nullptr,
                     const std::function<void()>& afterRegions = {},
-                    const LocalMoments* rightMoments = nullptr);
+                    const cv::Mat* rightFlatPixels = nullptr);
 
 // Pixels of `image` (CV_32F, NaN = nodata) whose 5x5 standard deviation is below `sigmas` times
 // the image's noise sigma (CV_8U 0/255): the fill's flat test, at another threshold. `moments`
