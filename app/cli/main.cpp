@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cli_support.hpp"
+#include "delineo/core/allocator.hpp"
 
 namespace {
 extern "C" void onInterrupt(int) {
@@ -14,6 +15,7 @@ extern "C" void onInterrupt(int) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  delineo::core::tuneAllocatorForLargeImages();  // before any image is allocated
   delineo::cli::commandProgress();  // construct before any signal can arrive
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);

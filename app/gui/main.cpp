@@ -10,6 +10,7 @@
 #include <QSurfaceFormat>
 #include <QTranslator>
 
+#include "delineo/core/allocator.hpp"
 #include "main_window.hpp"
 #include "screenshot_tour.hpp"
 
@@ -32,6 +33,7 @@ void installTranslations(QApplication& app) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  delineo::core::tuneAllocatorForLargeImages();  // before any image is allocated
   // The 3D view (VTK) needs this format before the application exists (docs/qt6-vtk-facts.md).
   QSurfaceFormat format;
   format.setVersion(3, 2);

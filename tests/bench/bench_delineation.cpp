@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "delineo/core/allocator.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/delineation/delineate.hpp"
 #include "delineo/sim/scene.hpp"
@@ -310,6 +311,7 @@ void printDiag(const DiagTable& t, const char* indent, bool detailed) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  delineo::core::tuneAllocatorForLargeImages();  // as the CLI and the GUI do
   int scenes = 3, referenceRuns = 3, firstSeed = 1;
   std::string dumpDir;  // --dump DIR: one diagnostic PNG per run
   std::string onlyInit;  // --init box+8|jit6: run one initialisation only

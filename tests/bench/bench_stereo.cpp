@@ -51,6 +51,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "delineo/core/allocator.hpp"
 #include "delineo/core/nan_mask.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/core/progress.hpp"
@@ -581,6 +582,8 @@ std::vector<Case> realCases(const fs::path& data) {
 
 }  // namespace
 int main(int argc, char** argv) {
+  // As the CLI and the GUI do (docs/stereo.md, session 34).
+  delineo::core::tuneAllocatorForLargeImages();
   int size = 1000;
   std::string data = "/work/shared/data";
   bool useData = true;
