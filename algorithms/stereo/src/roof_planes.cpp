@@ -36,27 +36,43 @@ struct Surface {
 // surfaces of minPixels or more (kPiece on the matched pixels of those under maxPiece, −1
 // elsewhere), with their pixel counts and centroids.
 cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int maxPiece,
-                      std::vector<Surface>& surfaces) {
+                      int threads, std::vector<Surface>& surfaces) {
   const int W = disparity.cols, H = disparity.rows;
   // Runs of a row's matched pixels whose left neighbours are within `link`, joined across rows
   // where a pixel of one and the pixel below it in the other are within `link` (the union-find
-  // then works on runs, not pixels).
+  // then works on runs, not pixels). The runs are found by bands of rows on `threads` workers and
+  // put together in row order (one pass on one worker, they were most of this labelling's
+  // ~2.5 ms at 1000²).
   struct Run {
     int y, x0, x1;
   };
+  constexpr int kBandRows = 32;
+  std::vector<std::vector<Run>> bandRuns(static_cast<size_t>((H + kBandRows - 1) / kBandRows));
+  std::vector<size_t> runsInRow(static_cast<size_t>(H), 0);
+  forRowBands(
+      H, threads,
+      [&](int rowStart, int rowEnd) {
+        std::vector<Run>& out = bandRuns[static_cast<size_t>(rowStart / kBandRows)];
+        for (int y = rowStart; y < rowEnd; ++y) {
+          const size_t before = out.size();
+          const float* d = disparity.ptr<float>(y);
+          for (int x = 0; x < W; ++x) {
+            if (!std::isfinite(d[x])) continue;
+            const int x0 = x;
+            while (x + 1 < W && std::abs(d[x + 1] - d[x]) <= link) ++x;  // (NaN fails the test)
+            out.push_back({y, x0, x});
+          }
+          runsInRow[static_cast<size_t>(y)] = out.size() - before;
+        }
+      },
+      kBandRows);
   std::vector<Run> runs;
-  std::vector<size_t> rowStart(static_cast<size_t>(H) + 1);
+  for (const std::vector<Run>& band : bandRuns) runs.insert(runs.end(), band.begin(), band.end());
+  std::vector<size_t> rowStart(static_cast<size_t>(H) + 1, 0);
   for (int y = 0; y < H; ++y) {
-    rowStart[static_cast<size_t>(y)] = runs.size();
-    const float* d = disparity.ptr<float>(y);
-    for (int x = 0; x < W; ++x) {
-      if (!std::isfinite(d[x])) continue;
-      const int x0 = x;
-      while (x + 1 < W && std::abs(d[x + 1] - d[x]) <= link) ++x;  // (NaN fails the test)
-      runs.push_back({y, x0, x});
-    }
+    rowStart[static_cast<size_t>(y) + 1] =
+        rowStart[static_cast<size_t>(y)] + runsInRow[static_cast<size_t>(y)];
   }
-  rowStart[static_cast<size_t>(H)] = runs.size();
   std::vector<int> parent(runs.size());
   for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
   for (int y = 1; y < H; ++y) {
@@ -224,7 +240,8 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
   // The roofs' other pixels (below) come from small pieces only: a piece as large as a surface is
   // a structure (a box on a roof, a parapet), not the matches' noise.
   const int maxPiece = s.minPixels;
-  const cv::Mat labels = labelSurfaces(disparity, s.link, s.minPixels, maxPiece, surfaces);
+  const cv::Mat labels =
+      labelSurfaces(disparity, s.link, s.minPixels, maxPiece, s.threads, surfaces);
   if (surfaces.empty()) return counts;
   cv::Mat keep(disparity.size(), CV_8U);
   keep.setTo(1);
