@@ -24,6 +24,16 @@ namespace delineo::stereo::detail {
 
 namespace {
 
+// Appends to `cells` the ids base + ty·tilesX + tx of the tile × tile squares that `rect`
+// (non-empty) meets: a task's cells for RowOrderedTasks.
+void addTileCells(const cv::Rect& rect, int tile, int tilesX, int base, std::vector<int>& cells) {
+  for (int ty = rect.y / tile; ty <= (rect.br().y - 1) / tile; ++ty) {
+    for (int tx = rect.x / tile; tx <= (rect.br().x - 1) / tile; ++tx) {
+      cells.push_back(base + ty * tilesX + tx);
+    }
+  }
+}
+
 // The points within `within` px of the plane.
 std::vector<cv::Point3d> pointsNear(const std::vector<cv::Point3d>& points, const FillPlane& plane,
                                     double within) {
@@ -1033,12 +1043,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     boxes.push_back(box);
     const cv::Rect reads =
         cv::Rect(box.x - (dmax - dmin), box.y, box.width + (dmax - dmin), box.height) & image;
-    std::vector<int>& cells = regionCells.emplace_back();
-    for (int ty = reads.y / kRegionTile; ty <= (reads.br().y - 1) / kRegionTile; ++ty) {
-      for (int tx = reads.x / kRegionTile; tx <= (reads.br().x - 1) / kRegionTile; ++tx) {
-        cells.push_back(ty * regionTilesX + tx);
-      }
-    }
+    addTileCells(reads, kRegionTile, regionTilesX, 0, regionCells.emplace_back());
   }
   std::vector<int> filledIn(decided.size(), 0);
   std::vector<std::optional<FilledRegion>> filledRegion(decided.size());
@@ -1560,14 +1565,9 @@ ExtensionFootprints extensionFootprints(const std::vector<cv::Rect>& boxes,
   for (size_t k = 0; k < boxes.size(); ++k) {
     const cv::Rect& outer = outers[k];
     std::vector<int>& cells = out.cells.emplace_back();
-    const cv::Rect reads =
-        cv::Rect(outer.x - 1, outer.y - 1, outer.width + 2, outer.height + 2) & image;
-    for (int ty = reads.y / kImageTile; ty <= (reads.br().y - 1) / kImageTile; ++ty) {
-      for (int tx = reads.x / kImageTile; tx <= (reads.br().x - 1) / kImageTile; ++tx) {
-        cells.push_back(ty * tilesX + tx);
-      }
-    }
     if (outer.empty()) continue;
+    addTileCells(cv::Rect(outer.x - 1, outer.y - 1, outer.width + 2, outer.height + 2) & image,
+                 kImageTile, tilesX, 0, cells);
     // The right-view positions it reads or changes, with a margin: the test's 0.5 px and the
     // values' rounding to float.
     std::vector<Span> spans;
@@ -1587,15 +1587,15 @@ ExtensionFootprints extensionFootprints(const std::vector<cv::Rect>& boxes,
         spans.push_back(candidates[h]);
       }
     }
-    const int base = tilesX * tilesY;
+    // In the right view's cells: columns of kRightTile positions by rows of kImageTile.
     for (const Span& span : spans) {
       const int first = std::clamp(
           static_cast<int>(std::floor((span.lo - 2.0 + shift) / kRightTile)), 0, rightTilesX - 1);
       const int last = std::clamp(
           static_cast<int>(std::floor((span.hi + 2.0 + shift) / kRightTile)), 0, rightTilesX - 1);
-      for (int ty = outer.y / kImageTile; ty <= (outer.br().y - 1) / kImageTile; ++ty) {
-        for (int rx = first; rx <= last; ++rx) cells.push_back(base + ty * rightTilesX + rx);
-      }
+      const cv::Rect columns(first, outer.y / kImageTile, last - first + 1,
+                             (outer.br().y - 1) / kImageTile - outer.y / kImageTile + 1);
+      addTileCells(columns, 1, rightTilesX, tilesX * tilesY, cells);
     }
   }
   return out;
@@ -1636,6 +1636,9 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
   // `alongside`, while this one makes the left flat regions and fills them, waiting for each of
   // the other's results only when it first needs it (the grey maps come first: the fill needs
   // them before its first region, the right flat regions only at a region's edges or facets).
+  const auto rightFlatMask = [&] {
+    return rightFlatPixels != nullptr ? *rightFlatPixels : flatMask(right, settings);
+  };
   if (threads > 1 && settings.planeMinRows > 0) {
     GreyMaps maps;
     RightFlatRegions rightFlat;
@@ -1664,8 +1667,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                 // Reads the disparities before the fill writes any: the fill waits for it first.
                 maps = greyMaps(left, right, disparity, dmin, dmax);
                 mapsReady.count_down();
-                rightFlat = rightFlatRegions(
-                    rightFlatPixels ? *rightFlatPixels : flatMask(right, settings), right);
+                rightFlat = rightFlatRegions(rightFlatMask(), right);
                 rightReady.count_down();
                 if (alongside) alongside();
                 // Then it helps with the regions (the rest of the fill's time is theirs).
@@ -1683,10 +1685,8 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       left, right, settings, dmin, dmax, fillScore, disparity, score,
       [&]() -> const GreyMaps& { return maps; },
       [&]() -> const RightFlatRegions& {
-        if (rightFlat.labels.empty())
-          rightFlat = rightFlatRegions(
-              rightFlatPixels ? *rightFlatPixels : flatMask(right, settings), right);
-        return rightFlat;
+    if (rightFlat.labels.empty()) rightFlat = rightFlatRegions(rightFlatMask(), right);
+    return rightFlat;
       },
       0, [](RowOrderedTasks&) {}, leftMoments);
   if (alongside) alongside();
