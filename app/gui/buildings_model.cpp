@@ -66,6 +66,7 @@ QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
       default: return {};
     }
   }
+  if (role == Qt::ToolTipRole && index.column() == Energy) return energyTermsText(b);
   if (role != Qt::DisplayRole) return {};
   switch (index.column()) {
     case Id: return b.id;
@@ -82,6 +83,19 @@ QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
       return std::isfinite(b.energy) ? QVariant(QString::number(b.energy, 'f', 1)) : QVariant(QStringLiteral("–"));
     default: return {};
   }
+}
+
+QString BuildingsModel::energyTermsText(const project::Building& b) {
+  if (!b.energyTerms) {
+    return b.hasOutline() ? tr("Energy F(C) of the outline: being computed, or not computable") : QString();
+  }
+  const QStringList names = {tr("roof"), tr("ground"), tr("occlusion"), tr("left edges"), tr("right edges"),
+                             tr("shape")};
+  QStringList lines{tr("Energy F(C) = %1, of which:").arg(b.energy, 0, 'f', 1)};
+  for (int t = 0; t < names.size(); ++t) {
+    lines << QStringLiteral("  %1  %2").arg(names[t], -12).arg((*b.energyTerms)[static_cast<size_t>(t)], 0, 'f', 1);
+  }
+  return lines.join(QLatin1Char('\n'));
 }
 
 QVariant BuildingsModel::headerData(int section, Qt::Orientation orientation, int role) const {

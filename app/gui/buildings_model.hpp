@@ -25,6 +25,8 @@ class BuildingsModel : public QAbstractTableModel {
   int idAt(int row) const;
   int rowOf(int id) const;  // -1 when absent
   static QString statusText(project::BuildingStatus status);
+  // The energy and its terms, one per line (the energy column's tooltip).
+  static QString energyTermsText(const project::Building& building);
 
  private:
   Document* document_ = nullptr;

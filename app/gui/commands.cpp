@@ -52,4 +52,11 @@ DisparityCommand::DisparityCommand(Document* document, cv::Mat before, std::stri
 void DisparityCommand::undo() { document_->restoreDisparity(before_, beforePath_); }
 void DisparityCommand::redo() { document_->restoreDisparity(after_, {}); }
 
+SettingsCommand::SettingsCommand(Document* document, Document::Settings before, Document::Settings after,
+                                 const QString& text)
+    : QUndoCommand(text), document_(document), before_(std::move(before)), after_(std::move(after)) {}
+
+void SettingsCommand::undo() { document_->restoreSettings(before_); }
+void SettingsCommand::redo() { document_->restoreSettings(after_); }
+
 }  // namespace delineo::gui

@@ -7,10 +7,9 @@
 #include <opencv2/core.hpp>
 
 #include "delineo/project/project.hpp"
+#include "document.hpp"
 
 namespace delineo::gui {
-
-class Document;
 
 // A building's full state before and after (nullopt = absent): add, remove, edit, result.
 class BuildingCommand : public QUndoCommand {
@@ -56,6 +55,19 @@ class DisparityCommand : public QUndoCommand {
   Document* document_;
   cv::Mat before_, after_;
   std::string beforePath_;
+};
+
+// Project-wide settings (output folder, disparity range, height model with the roof heights
+// it gives) before and after.
+class SettingsCommand : public QUndoCommand {
+ public:
+  SettingsCommand(Document* document, Document::Settings before, Document::Settings after, const QString& text);
+  void undo() override;
+  void redo() override;
+
+ private:
+  Document* document_;
+  Document::Settings before_, after_;
 };
 
 // Merge keys of BuildingCommand.

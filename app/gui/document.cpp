@@ -1,7 +1,10 @@
 #include "document.hpp"
 
 #include <QCoreApplication>
+#include <QDir>
 #include <QFileInfo>
+#include <QSettings>
+#include <cmath>
 #include <filesystem>
 
 #include <opencv2/imgproc.hpp>
@@ -54,7 +57,7 @@ std::unique_ptr<Document> Document::fromPair(const QString& left, const QString&
   p.name = QFileInfo(left).completeBaseName().toStdString();
   p.left = fs::absolute(left.toStdString()).lexically_normal().string();
   p.right = fs::absolute(right.toStdString()).lexically_normal().string();
-  p.outputDir = (fs::path(p.left).parent_path() / "output").string();
+  // Outputs go to "output" beside the project file once it is saved, never beside the images.
   auto doc = fromProject(std::move(p), QString());
   doc->extraDirty_ = true;  // never saved
   return doc;
@@ -138,6 +141,9 @@ void Document::editRing(int id, int ringIndex, const core::Ring& ring, const QSt
   }
   if (after.status != BuildingStatus::Pending) after.status = BuildingStatus::Corrected;
   if (after.hasOutline()) after.roofHeight = project::roofHeight(project_, disparity_, after.outline);
+  // The energy belongs to the old outline; the window scores the new one in the background.
+  after.energy = std::nan("");
+  after.energyTerms.reset();
   after.addHistory("edited", description.toStdString());
   undo_.push(new BuildingCommand(this, id, *current, after,
                                  description.isEmpty() ? tr("Edit building %1").arg(id) : description));
@@ -149,6 +155,7 @@ void Document::setDelineationResult(int id, const project::DelineationOutcome& o
   Building after = *current;
   after.outline = outcome.outline;
   after.energy = outcome.energy;
+  after.energyTerms = outcome.terms;
   after.status = BuildingStatus::Automatic;
   after.roofHeight = project::roofHeight(project_, disparity_, after.outline);
   after.addHistory("delineated", std::to_string(outcome.outline.outer.size()) + " vertices, " +
@@ -196,6 +203,82 @@ void Document::setDisparity(const cv::Mat& disparity) {
   undo_.push(new DisparityCommand(this, disparity_, project_.disparity, disparity, tr("Compute disparity")));
 }
 
+Document::Settings Document::settings() const {
+  Settings s{project_.outputDir, project_.disparityRange, project_.height, {}};
+  for (const Building& b : project_.buildings) s.roofHeights[b.id] = b.roofHeight;
+  return s;
+}
+
+void Document::pushSettings(const Settings& after, const QString& description) {
+  undo_.push(new SettingsCommand(this, settings(), after, description));
+}
+
+void Document::setOutputDir(const std::string& dir) {
+  if (dir.empty() || dir == project_.outputDir) return;
+  Settings after = settings();
+  after.outputDir = dir;
+  pushSettings(after, tr("Output folder: %1").arg(QString::fromStdString(dir)));
+}
+
+void Document::setDisparityRange(const std::optional<project::DisparityInterval>& range, const QString& description) {
+  if (range == project_.disparityRange) return;
+  Settings after = settings();
+  after.disparityRange = range;
+  pushSettings(after, description);
+}
+
+void Document::setHeightModel(const project::HeightModel& model) {
+  if (model == project_.height) return;
+  Settings after = settings();
+  after.height = model;
+  project::Project withModel = project_;
+  withModel.height = model;
+  for (const Building& b : project_.buildings) {
+    after.roofHeights[b.id] =
+        b.hasOutline() ? project::roofHeight(withModel, disparity_, b.outline) : std::nan("");
+  }
+  pushSettings(after, tr("Height model"));
+}
+
+void Document::restoreSettings(const Settings& settings) {
+  const bool newModel = !(settings.height == project_.height);
+  project_.outputDir = settings.outputDir;
+  project_.disparityRange = settings.disparityRange;
+  project_.height = settings.height;
+  for (Building& b : project_.buildings) {
+    auto it = settings.roofHeights.find(b.id);
+    if (it != settings.roofHeights.end()) b.roofHeight = it->second;
+  }
+  if (newModel) deriveDem();
+  emit settingsChanged();
+  emit buildingsReset();
+}
+
+void Document::setOutlineEnergy(int id, const core::Polygon& outline, double energy,
+                                const std::optional<project::EnergyTerms>& terms) {
+  Building* b = project_.find(id);
+  if (b == nullptr || !b->hasOutline() || !(b->outline.outer == outline.outer && b->outline.holes == outline.holes)) {
+    return;
+  }
+  b->energy = energy;
+  b->energyTerms = terms;
+  emit buildingChanged(id);
+}
+
+QString Document::outputDirectory() const {
+  try {
+    return QString::fromStdString(project::outputDirectory(project_, path_.toStdString()));
+  } catch (const core::Error&) {
+    return {};
+  }
+}
+
+QString Document::dialogFolder() const {
+  if (!path_.isEmpty()) return QFileInfo(path_).absolutePath();
+  const QString last = QSettings().value(QStringLiteral("lastProjectFolder")).toString();
+  return !last.isEmpty() && QFileInfo(last).isDir() ? last : QDir::homePath();
+}
+
 void Document::restoreBuilding(int id, const std::optional<Building>& state) {
   auto& list = project_.buildings;
   Building* existing = project_.find(id);
@@ -226,9 +309,11 @@ void Document::restoreDisparity(const cv::Mat& disparity, const std::string& pat
 void Document::save(const QString& path) {
   project::Project toSave = project_;
   if (!disparityOnDisk_ && !disparity_.empty()) {
-    const std::string out = (fs::path(project_.outputDir) / "disparity.tif").string();
+    // The output folder of the project at its new place (relative folders follow the file).
+    const std::string dir = project::outputDirectory(project_, path.toStdString());
+    const std::string out = (fs::path(dir) / "disparity.tif").string();
     std::error_code ec;
-    fs::create_directories(project_.outputDir, ec);
+    fs::create_directories(dir, ec);
     io::writeFloatGeoTiff(out, disparity_, pair_.geo);
     project_.disparity = out;
     toSave.disparity = out;

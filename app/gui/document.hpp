@@ -5,6 +5,7 @@
 #include <QObject>
 #include <QString>
 #include <QUndoStack>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -53,11 +54,36 @@ class Document : public QObject {
   void setRoofInterval(int id, project::DisparityInterval interval);
   void setParameters(const std::string& group, const nlohmann::json& values);
   void setDisparity(const cv::Mat& disparity);
+  // Project-wide settings. A new height model recomputes every building's roof height in the
+  // same step.
+  void setOutputDir(const std::string& dir);
+  void setDisparityRange(const std::optional<project::DisparityInterval>& range, const QString& description);
+  void setHeightModel(const project::HeightModel& model);
+  // A derived value, not an edit (no undo step): the energy of a building's outline, recorded
+  // only while the building's outline is still `outline`.
+  void setOutlineEnergy(int id, const core::Polygon& outline, double energy,
+                        const std::optional<project::EnergyTerms>& terms);
+
+  // The absolute folder outputs are written to; empty while a relative folder has no project
+  // file to be relative to (an unsaved project writes nothing).
+  QString outputDirectory() const;
+  // The folder file dialogs start in: the project's folder, else the last folder used.
+  QString dialogFolder() const;
+
+  // What setOutputDir/setDisparityRange/setHeightModel change, for their undo command.
+  struct Settings {
+    std::string outputDir;
+    std::optional<project::DisparityInterval> disparityRange;
+    project::HeightModel height;
+    std::map<int, double> roofHeights;
+  };
+  Settings settings() const;
 
   // ---- used by the undo commands only ----
   void restoreBuilding(int id, const std::optional<project::Building>& state);
   void restoreParameters(const std::string& group, const nlohmann::json& values);
   void restoreDisparity(const cv::Mat& disparity, const std::string& path);
+  void restoreSettings(const Settings& settings);
 
   // Atomic save (writes a freshly computed disparity next to the outputs first). Throws
   // core::Error(WriteFailed). Marks the document clean and removes the autosave.
@@ -72,6 +98,7 @@ class Document : public QObject {
   void buildingsReset();
   void parametersChanged(const QString& group);
   void disparityChanged();
+  void settingsChanged();  // output folder, disparity range or height model
   void modifiedChanged(bool modified);
 
  private:
@@ -79,6 +106,7 @@ class Document : public QObject {
   void loadRasters();
   void deriveDem();
   void setExtraDirty(bool dirty);
+  void pushSettings(const Settings& after, const QString& description);
 
   project::Project project_;
   QString path_;

@@ -16,24 +16,71 @@
 
 namespace {
 // Loads the application's and Qt's own translations for the chosen language ("" = system).
-void installTranslations(QApplication& app) {
+void installTranslations(QCoreApplication& app) {
   const QString code = QSettings().value(QStringLiteral("language")).toString();
   const QLocale locale = code.isEmpty() ? QLocale::system() : QLocale(code);
   QLocale::setDefault(locale);
   auto* appTranslator = new QTranslator(&app);
   if (appTranslator->load(locale, QStringLiteral("delineo"), QStringLiteral("_"), QStringLiteral(":/i18n"))) {
-    QApplication::installTranslator(appTranslator);
+    QCoreApplication::installTranslator(appTranslator);
   }
   auto* qtTranslator = new QTranslator(&app);
   if (qtTranslator->load(locale, QStringLiteral("qtbase"), QStringLiteral("_"),
                          QLibraryInfo::path(QLibraryInfo::TranslationsPath))) {
-    QApplication::installTranslator(qtTranslator);
+    QCoreApplication::installTranslator(qtTranslator);
   }
+}
+
+void setApplicationNames() {
+  QCoreApplication::setOrganizationName(QStringLiteral("Delineo"));
+  QCoreApplication::setApplicationName(QStringLiteral("delineo"));
+  QCoreApplication::setApplicationVersion(QStringLiteral("0.1.0"));
+}
+
+// The command line, the same whether a display is needed or not.
+struct CommandLine {
+  QCommandLineParser parser;
+  QCommandLineOption left{QStringLiteral("left"), QCoreApplication::translate("main", "Left (reference) image"),
+                          QStringLiteral("file")};
+  QCommandLineOption right{QStringLiteral("right"), QCoreApplication::translate("main", "Right image"),
+                           QStringLiteral("file")};
+  // Hidden: scripted tour that saves a PNG of each main state (scripts/screenshots.sh).
+  QCommandLineOption screenshots{QStringLiteral("screenshot-dir"), QString(), QStringLiteral("dir")};
+
+  CommandLine() {
+    parser.setApplicationDescription(QCoreApplication::translate("main", "Building delineation on stereo pairs"));
+    parser.addHelpOption();
+    parser.addVersionOption();
+    parser.addPositionalArgument(QStringLiteral("project"), QCoreApplication::translate("main", "Project file to open"));
+    screenshots.setFlags(QCommandLineOption::HiddenFromHelp);
+    parser.addOption(left);
+    parser.addOption(right);
+    parser.addOption(screenshots);
+  }
+};
+
+// --help and --version print and exit: they must work without a display (over ssh, in scripts).
+bool onlyPrints(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const QByteArray arg(argv[i]);
+    if (arg == "-h" || arg == "--help" || arg == "--help-all" || arg == "-?" || arg == "-v" || arg == "--version") {
+      return true;
+    }
+  }
+  return false;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
   delineo::core::tuneAllocatorForLargeImages();  // before any image is allocated
+  if (onlyPrints(argc, argv)) {
+    QCoreApplication app(argc, argv);
+    setApplicationNames();
+    installTranslations(app);
+    CommandLine commandLine;
+    commandLine.parser.process(app);  // prints and exits
+    return 0;
+  }
   // The 3D view (VTK) needs this format before the application exists (docs/qt6-vtk-facts.md).
   QSurfaceFormat format;
   format.setVersion(3, 2);
@@ -43,40 +90,24 @@ int main(int argc, char** argv) {
   QSurfaceFormat::setDefaultFormat(format);
 
   QApplication app(argc, argv);
-  QApplication::setOrganizationName(QStringLiteral("Delineo"));
-  QApplication::setApplicationName(QStringLiteral("delineo"));
-  QApplication::setApplicationVersion(QStringLiteral("0.1.0"));
+  setApplicationNames();
   installTranslations(app);
-
-  QCommandLineParser parser;
-  parser.setApplicationDescription(QApplication::translate("main", "Building delineation on stereo pairs"));
-  parser.addHelpOption();
-  parser.addVersionOption();
-  parser.addPositionalArgument(QStringLiteral("project"), QApplication::translate("main", "Project file to open"));
-  QCommandLineOption leftOption(QStringLiteral("left"), QApplication::translate("main", "Left (reference) image"),
-                                QStringLiteral("file"));
-  QCommandLineOption rightOption(QStringLiteral("right"), QApplication::translate("main", "Right image"),
-                                 QStringLiteral("file"));
-  // Hidden: scripted tour that saves a PNG of each main state (scripts/screenshots.sh).
-  QCommandLineOption screenshotOption(QStringLiteral("screenshot-dir"), QString(), QStringLiteral("dir"));
-  screenshotOption.setFlags(QCommandLineOption::HiddenFromHelp);
-  parser.addOption(leftOption);
-  parser.addOption(rightOption);
-  parser.addOption(screenshotOption);
+  CommandLine commandLine;
+  QCommandLineParser& parser = commandLine.parser;
   parser.process(app);
 
   delineo::gui::MainWindow window;
-  if (parser.isSet(screenshotOption)) {
+  if (parser.isSet(commandLine.screenshots)) {
     window.setInteractive(false);
     window.show();
-    return delineo::gui::runScreenshotTour(window, parser.value(screenshotOption)) ? 0 : 1;
+    return delineo::gui::runScreenshotTour(window, parser.value(commandLine.screenshots)) ? 0 : 1;
   }
   window.show();
-  if (parser.isSet(leftOption) || parser.isSet(rightOption)) {
-    if (!parser.isSet(leftOption) || !parser.isSet(rightOption)) {
+  if (parser.isSet(commandLine.left) || parser.isSet(commandLine.right)) {
+    if (!parser.isSet(commandLine.left) || !parser.isSet(commandLine.right)) {
       parser.showHelp(2);
     }
-    window.openPair(parser.value(leftOption), parser.value(rightOption));
+    window.openPair(parser.value(commandLine.left), parser.value(commandLine.right));
   } else if (!parser.positionalArguments().isEmpty()) {
     window.openProject(parser.positionalArguments().first());
   } else {

@@ -11,6 +11,9 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
+#include <QGridLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
 #include <QGuiApplication>
 #include <QHeaderView>
 #include <QLabel>
@@ -20,6 +23,7 @@
 #include <QMetaObject>
 #include <QPushButton>
 #include <QSignalBlocker>
+#include <QSpinBox>
 #include <QScrollArea>
 #include <QSettings>
 #include <QStandardPaths>
@@ -47,6 +51,7 @@
 #include "delineo/widgets/terrain3d_view.hpp"
 #include "document.hpp"
 #include "error_text.hpp"
+#include "project_settings_dialog.hpp"
 
 #ifdef DELINEO_HAVE_DELINEATION
 #include "delineo/delineation/params.hpp"
@@ -239,9 +244,21 @@ void MainWindow::createDocks() {
   demLegend_->setColourMap(widgets::ColourMap::Terrain);
   demLegend_->setTitle(tr("Height"));
   demLegend_->setUnit(tr("m"));
+  heightModelNotice_ = new QWidget;
+  heightModelNotice_->setObjectName(QStringLiteral("heightModelNotice"));
+  auto* noticeLayout = new QHBoxLayout(heightModelNotice_);
+  auto* noticeText = new QLabel(tr("Heights need the height model of the pair."));
+  noticeText->setWordWrap(true);
+  auto* noticeButton = new QPushButton(tr("Set the height model…"));
+  noticeButton->setObjectName(QStringLiteral("setHeightModel"));
+  connect(noticeButton, &QPushButton::clicked, this, &MainWindow::openProjectSettings);
+  noticeLayout->addWidget(noticeText, 1);
+  noticeLayout->addWidget(noticeButton);
+  heightModelNotice_->hide();
   demLayout->addWidget(demMode_, 0, 0, 1, 2);
-  demLayout->addWidget(demView_, 1, 0);
-  demLayout->addWidget(demLegend_, 1, 1);
+  demLayout->addWidget(heightModelNotice_, 1, 0, 1, 2);
+  demLayout->addWidget(demView_, 2, 0);
+  demLayout->addWidget(demLegend_, 2, 1);
   connect(demMode_, &QComboBox::currentIndexChanged, this, [this] { refreshRasters(); });
   auto* demDock = makeDock(QStringLiteral("demDock"), tr("DEM"), demPage, Qt::RightDockWidgetArea);
 
@@ -278,7 +295,8 @@ void MainWindow::createDocks() {
     frame3D();
   });
   connect(frameButton, &QPushButton::clicked, this, &MainWindow::frame3D);
-  view3DPlaceholder_ = new QLabel(tr("The 3D view appears when a DEM is available."));
+  view3DPlaceholder_ = new QLabel(tr("The 3D view appears when a DEM is available: compute the disparity "
+                                     "and set the height model (File → Project settings)."));
   view3DPlaceholder_->setAlignment(Qt::AlignCenter);
   view3DPlaceholder_->setWordWrap(true);
   host3D->addWidget(view3DPlaceholder_);
@@ -350,8 +368,14 @@ void MainWindow::createDocks() {
   auto* delineationScroll = new QScrollArea;
   delineationScroll->setWidget(delineationForm_);
   delineationScroll->setWidgetResizable(true);
+  auto* matchingPage = new QWidget;
+  auto* matchingLayout = new QVBoxLayout(matchingPage);
+  matchingLayout->setContentsMargins(0, 0, 0, 0);
+  matchingLayout->addWidget(createRangeEditor());
+  matchingLayout->addWidget(matchingForm_);
+  matchingLayout->addStretch(1);
   auto* matchingScroll = new QScrollArea;
-  matchingScroll->setWidget(matchingForm_);
+  matchingScroll->setWidget(matchingPage);
   matchingScroll->setWidgetResizable(true);
   tabs->addTab(delineationScroll, tr("Active polygon"));
   tabs->addTab(matchingScroll, tr("Matching"));
@@ -370,16 +394,19 @@ void MainWindow::createActions() {
   };
   connect(make(QStringLiteral("actionOpen"), tr("&Open project…"), QKeySequence::Open), &QAction::triggered, this, [this] {
     if (!maybeSave()) return;
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open project"), {}, tr("Delineo projects (*.json)"));
+    const QString start = document_ ? document_->dialogFolder() : QSettings().value(QStringLiteral("lastProjectFolder")).toString();
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open project"), start, tr("Delineo projects (*.json)"));
     if (!path.isEmpty()) openProject(path);
   });
   connect(make(QStringLiteral("actionNewFromPair"), tr("&New project from a stereo pair…"), QKeySequence::New),
           &QAction::triggered, this, [this] {
             if (!maybeSave()) return;
             const QString filter = tr("Images (*.tif *.tiff *.png *.jpg)");
-            const QString left = QFileDialog::getOpenFileName(this, tr("Left image (reference)"), {}, filter);
+            const QString left = QFileDialog::getOpenFileName(
+                this, tr("Left image (reference)"), QSettings().value(QStringLiteral("lastImageFolder")).toString(), filter);
             if (left.isEmpty()) return;
             const QString right = QFileDialog::getOpenFileName(this, tr("Right image"), QFileInfo(left).path(), filter);
+            QSettings().setValue(QStringLiteral("lastImageFolder"), QFileInfo(left).absolutePath());
             if (!right.isEmpty()) openPair(left, right);
           });
   connect(make(QStringLiteral("actionOpenSample"), tr("Open the &sample project")), &QAction::triggered, this, [this] {
@@ -387,12 +414,18 @@ void MainWindow::createActions() {
   });
   connect(make(QStringLiteral("actionSave"), tr("&Save"), QKeySequence::Save), &QAction::triggered, this, &MainWindow::save);
   connect(make(QStringLiteral("actionSaveAs"), tr("Save &as…"), QKeySequence::SaveAs), &QAction::triggered, this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Save project"), {}, tr("Delineo projects (*.json)"));
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save project"), document_ ? document_->dialogFolder() : QString(),
+                                                      tr("Delineo projects (*.json)"));
     if (!path.isEmpty()) saveAs(path);
   });
+  connect(make(QStringLiteral("actionProjectSettings"), tr("Project se&ttings…")), &QAction::triggered, this,
+          &MainWindow::openProjectSettings);
   connect(make(QStringLiteral("actionExport"), tr("&Export accepted buildings…"), QKeySequence(tr("Ctrl+E"))),
           &QAction::triggered, this, [this] {
-            const QString path = QFileDialog::getSaveFileName(this, tr("Export accepted buildings"), {},
+            QString start = document_ ? document_->outputDirectory() : QString();
+            if (start.isEmpty() && document_) start = document_->dialogFolder();
+            const QString path = QFileDialog::getSaveFileName(this, tr("Export accepted buildings"),
+                                                              start + QStringLiteral("/buildings.geojson"),
                                                               tr("GeoJSON (*.geojson);;GeoPackage (*.gpkg)"));
             if (!path.isEmpty()) exportAccepted(path);
           });
@@ -510,6 +543,7 @@ void MainWindow::createMenus() {
   file->addAction(action(QStringLiteral("actionSave")));
   file->addAction(action(QStringLiteral("actionSaveAs")));
   file->addAction(action(QStringLiteral("actionExport")));
+  file->addAction(action(QStringLiteral("actionProjectSettings")));
   file->addSeparator();
   file->addAction(action(QStringLiteral("actionQuit")));
 
@@ -651,6 +685,7 @@ bool MainWindow::openProject(const QString& path) {
     }
     auto doc = Document::fromProject(std::move(loaded), path);
     installDocument(std::move(doc));
+    rememberFolder(path);
   } catch (const core::Error& e) {
     showMessage(tr("Cannot open the project"), errorMessage(e));
     return false;
@@ -714,6 +749,7 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
     updateActions();
   });
   connect(doc, &Document::disparityChanged, this, [this] {
+    refreshHeightModelNotice();
     refreshRasters();
     refreshOverlays();
     refreshHistogram();
@@ -721,6 +757,19 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
     updateActions();
   });
   connect(doc, &Document::parametersChanged, this, [this] { loadFormsFromDocument(); });
+  connect(doc, &Document::settingsChanged, this, [this] {
+    loadRangeFromDocument();
+    refreshRasters();
+    refreshHeightModelNotice();
+    refreshHistogram();
+    refresh3D();
+  });
+  connect(doc, &Document::buildingsReset, this, [this] {
+    refreshOverlays();
+    refresh3D();
+  });
+  // A manual edit leaves the outline's energy unknown: it is scored again in the background.
+  connect(doc, &Document::buildingChanged, this, [this](int id) { startEnergyUpdate(id); });
   connect(doc, &Document::modifiedChanged, this, [this] { refreshTitle(); });
   connect(doc->undoStack(), &QUndoStack::indexChanged, this, [this] {
     refreshTitle();
@@ -743,7 +792,10 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   syncRightView();
   leftView_->polygons().clearEvolvingContour();
   leftView_->polygons().setRoi({});
+  energyAsked_.clear();
   loadFormsFromDocument();
+  loadRangeFromDocument();
+  refreshHeightModelNotice();
   refreshRasters();
   refreshOverlays();
   refreshHistogram();
@@ -774,7 +826,8 @@ bool MainWindow::save() {
   if (!document_) return false;
   if (document_->path().isEmpty()) {
     if (!interactive_) return false;
-    const QString path = QFileDialog::getSaveFileName(this, tr("Save project"), {}, tr("Delineo projects (*.json)"));
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save project"), document_->dialogFolder(),
+                                                      tr("Delineo projects (*.json)"));
     return !path.isEmpty() && saveAs(path);
   }
   return saveAs(document_->path());
@@ -789,6 +842,7 @@ bool MainWindow::saveAs(const QString& path) {
     return false;
   }
   addRecent(path);
+  rememberFolder(path);
   refreshTitle();
   statusBar()->showMessage(tr("Saved %1").arg(path), 5000);
   return true;
@@ -988,14 +1042,166 @@ void MainWindow::refreshHistogram() {
   }
   const cv::Rect r(static_cast<int>(roi.left()), static_cast<int>(roi.top()), static_cast<int>(roi.width()),
                    static_cast<int>(roi.height()));
-  histogram_->setDisparities(disparity(r & cv::Rect(0, 0, disparity.cols, disparity.rows)));
+  const cv::Mat roiDisparities = disparity(r & cv::Rect(0, 0, disparity.cols, disparity.rows));
+  histogram_->setDisparities(roiDisparities);
   if (auto ground = ringMedian(disparity, b->initial, 8)) histogram_->setGroundLevel(*ground);
   std::optional<project::DisparityInterval> interval = b->roofInterval;
   if (!interval) interval = project::suggestRoofInterval(disparity, b->initial);
+  QString text;
   if (interval) {
     histogram_->setInterval(interval->low, interval->high);
-    intervalLabel_->setText(tr("Roof: %1 .. %2 px").arg(interval->low).arg(interval->high));
+    text = tr("Roof: %1 .. %2 px").arg(interval->low).arg(interval->high);
   }
+  const QString warning = rangeEndWarning(roiDisparities);
+  if (!warning.isEmpty()) {
+    text += QStringLiteral("<br><span style=\"color:#b00000\">%1</span>").arg(warning.toHtmlEscaped());
+    statusBar()->showMessage(warning, 15000);
+  }
+  intervalLabel_->setText(text);
+}
+
+QString MainWindow::rangeEndWarning(const cv::Mat& roiDisparities) const {
+  const auto& range = document_->project().disparityRange;
+  if (!range || roiDisparities.empty()) return {};
+  // Matches piled up against an end of the searched range stand for disparities beyond it
+  // (the matcher cannot return what it did not search).
+  int finite = 0, atEnd = 0;
+  for (int y = 0; y < roiDisparities.rows; ++y) {
+    const float* row = roiDisparities.ptr<float>(y);
+    for (int x = 0; x < roiDisparities.cols; ++x) {
+      if (!std::isfinite(row[x])) continue;
+      ++finite;
+      if (row[x] >= static_cast<float>(range->high) - 1.0f || row[x] <= static_cast<float>(range->low) + 1.0f) ++atEnd;
+    }
+  }
+  const double total = static_cast<double>(roiDisparities.total());
+  if (finite > 0 && atEnd >= std::max(20.0, 0.02 * finite)) {
+    return tr("%1 % of the disparities here lie at an end of the matched range (%2..%3 px): the roof may lie "
+              "beyond it. Widen the range on the Matching tab and compute the disparity again.")
+        .arg(100.0 * atEnd / finite, 0, 'f', 0)
+        .arg(range->low)
+        .arg(range->high);
+  }
+  if (finite < 0.5 * total) {
+    return tr("Most of this region has no disparity: the roof may lie outside the matched range (%1..%2 px).")
+        .arg(range->low)
+        .arg(range->high);
+  }
+  return {};
+}
+
+QWidget* MainWindow::createRangeEditor() {
+  auto* box = new QGroupBox(tr("Disparity search range of the pair"));
+  box->setObjectName(QStringLiteral("rangeEditor"));
+  auto* layout = new QGridLayout(box);
+  rangeMin_ = new QSpinBox;
+  rangeMin_->setObjectName(QStringLiteral("rangeMin"));
+  rangeMax_ = new QSpinBox;
+  rangeMax_->setObjectName(QStringLiteral("rangeMax"));
+  for (QSpinBox* spin : {rangeMin_, rangeMax_}) {
+    spin->setRange(-100000, 100000);
+    spin->setSuffix(tr(" px"));
+    spin->setKeyboardTracking(false);
+  }
+  rangeMin_->setToolTip(tr("Smallest disparity searched (x_right = x_left − d)"));
+  rangeMax_->setToolTip(tr("Largest disparity searched; the roofs' disparities must lie below it"));
+  layout->addWidget(new QLabel(tr("Minimum")), 0, 0);
+  layout->addWidget(rangeMin_, 0, 1);
+  layout->addWidget(new QLabel(tr("Maximum")), 0, 2);
+  layout->addWidget(rangeMax_, 0, 3);
+  rangeNote_ = new QLabel;
+  rangeNote_->setObjectName(QStringLiteral("rangeNote"));
+  rangeNote_->setWordWrap(true);
+  layout->addWidget(rangeNote_, 1, 0, 1, 4);
+  auto commit = [this] {
+    if (!document_ || updatingForms_) return;
+    const int lo = rangeMin_->value(), hi = rangeMax_->value();
+    if (lo > hi) {
+      showMessage(tr("Disparity range"), tr("The minimum disparity must not exceed the maximum."));
+      loadRangeFromDocument();
+      return;
+    }
+    document_->setDisparityRange(project::DisparityInterval{lo, hi}, tr("Disparity range %1..%2 px").arg(lo).arg(hi));
+  };
+  connect(rangeMin_, &QSpinBox::valueChanged, this, commit);
+  connect(rangeMax_, &QSpinBox::valueChanged, this, commit);
+  return box;
+}
+
+void MainWindow::loadRangeFromDocument() {
+  if (!document_) return;
+  updatingForms_ = true;
+  const auto& range = document_->project().disparityRange;
+  rangeMin_->setValue(range ? range->low : 0);
+  rangeMax_->setValue(range ? range->high : 0);
+  updatingForms_ = false;
+  rangeNote_->setText(range ? tr("Every computation (matching, the active polygon) searches this range; "
+                                 "compute the disparity again after changing it.")
+                            : tr("Not set yet."));
+}
+
+void MainWindow::refreshHeightModelNotice() {
+  const bool missing = document_ && document_->dem().empty() && document_->project().dem.empty() &&
+                       !document_->project().height.known();
+  heightModelNotice_->setVisible(missing);
+  view3DPlaceholder_->setText(missing ? tr("The 3D view needs heights: set the height model (File → Project settings).")
+                                      : tr("The 3D view appears when a DEM is available."));
+}
+
+void MainWindow::openProjectSettings() {
+  if (!document_) return;
+  ProjectSettingsDialog dialog(document_->project(), document_->path().isEmpty() ? QString() : document_->dialogFolder(),
+                               std::nullopt, this);
+  bool accepted = false;
+  if (projectSettingsHandler_) accepted = projectSettingsHandler_(dialog);
+  else if (interactive_) accepted = dialog.exec() == QDialog::Accepted;
+  if (!accepted) return;
+  QUndoStack* stack = document_->undoStack();
+  stack->beginMacro(tr("Project settings"));
+  document_->setOutputDir(dialog.outputDir());
+  document_->setHeightModel(dialog.heightModel());
+  stack->endMacro();
+}
+
+widgets::JobId MainWindow::startEnergyUpdate(int id) {
+  if (!document_ || !project::delineationAvailable()) return 0;
+  const Building* b = document_->project().find(id);
+  if (b == nullptr || !b->hasOutline() || std::isfinite(b->energy) || !b->roofInterval) return 0;
+  const auto asked = energyAsked_.find(id);
+  if (asked != energyAsked_.end() && asked->second.outer == b->outline.outer && asked->second.holes == b->outline.holes) {
+    return 0;
+  }
+  energyAsked_[id] = b->outline;
+  const project::Project projectCopy = document_->project();
+  const Building building = *b;
+  const project::StereoPair pair = document_->pair();
+  QPointer<Document> doc(document_.get());
+  struct Scored {
+    core::Polygon outline;
+    std::optional<project::EnergyOutcome> outcome;  // none: the outline cannot be scored
+  };
+  return jobs_->run<Scored>(
+      tr("Energy of building %1").arg(id),
+      [projectCopy, building, pair](core::Progress& p) {
+        Scored scored{building.outline, std::nullopt};
+        try {
+          scored.outcome = project::outlineEnergy(projectCopy, building, pair, building.outline, &p);
+        } catch (const core::Error&) {
+          // An outline the energy cannot score (degenerate on the pixel grid): shown as unknown.
+        }
+        return scored;
+      },
+      [this, doc, id](Scored scored) {
+        if (!doc || doc != document_.get()) return;
+        if (scored.outcome && scored.outcome->status != core::RunStatus::Completed) return;
+        if (scored.outcome) doc->setOutlineEnergy(id, scored.outline, scored.outcome->energy, scored.outcome->terms);
+        emit energyUpdated(id);
+      },
+      QStringLiteral("energy-%1").arg(id));
+}
+
+void MainWindow::rememberFolder(const QString& path) {
+  QSettings().setValue(QStringLiteral("lastProjectFolder"), QFileInfo(path).absolutePath());
 }
 
 void MainWindow::ensure3DView() {

@@ -7,6 +7,7 @@
 #include <QPointer>
 #include <QTimer>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -25,6 +26,7 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QStackedWidget;
+class QSpinBox;
 
 namespace delineo::widgets {
 class ImageView;
@@ -38,6 +40,7 @@ namespace delineo::gui {
 
 class Document;
 class BuildingsModel;
+class ProjectSettingsDialog;
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
@@ -70,6 +73,11 @@ class MainWindow : public QMainWindow {
   void acceptSelected();
   void rejectSelected();
   void autosaveNow();
+  // The project settings dialog (output folder, height model); applied as one undoable step.
+  void openProjectSettings();
+  // Scores the building's current outline (after a manual edit) in the background; returns the
+  // job id or 0 when there is nothing to score.
+  widgets::JobId startEnergyUpdate(int id);
 
   // ---- accessors for tests and the screenshot tour ----
   widgets::ImageView* leftView() const { return leftView_; }
@@ -105,6 +113,15 @@ class MainWindow : public QMainWindow {
   void setRelocateHandler(std::function<QString(const QString& missing)> handler) {
     relocate_ = std::move(handler);
   }
+  // Fills and answers the project settings dialog when not interactive (true = OK).
+  void setProjectSettingsHandler(std::function<bool(ProjectSettingsDialog&)> handler) {
+    projectSettingsHandler_ = std::move(handler);
+  }
+  QSpinBox* rangeMinBox() const { return rangeMin_; }
+  QSpinBox* rangeMaxBox() const { return rangeMax_; }
+  QLabel* rangeNote() const { return rangeNote_; }
+  QLabel* intervalLabel() const { return intervalLabel_; }
+  QWidget* heightModelNotice() const { return heightModelNotice_; }
 
  signals:
   void documentOpened();
@@ -112,6 +129,7 @@ class MainWindow : public QMainWindow {
   void selectedBuildingChanged(int id);
   void delineationFinished(int id);
   void matchingFinished();
+  void energyUpdated(int id);
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -147,6 +165,12 @@ class MainWindow : public QMainWindow {
   void ensure3DView();
   void readFormIntoDocument(const widgets::ParameterForm* form);
   void loadFormsFromDocument();
+  QWidget* createRangeEditor();
+  void loadRangeFromDocument();
+  void refreshHeightModelNotice();
+  // The warning shown when the selected building's disparities reach the matched range's end.
+  QString rangeEndWarning(const cv::Mat& roiDisparities) const;
+  void rememberFolder(const QString& path);
 
   std::unique_ptr<Document> document_;
   widgets::JobRunner* jobs_ = nullptr;
@@ -180,6 +204,14 @@ class MainWindow : public QMainWindow {
   bool updatingSelection_ = false;
   QString lastMessage_;
   std::function<QString(const QString&)> relocate_;
+  std::function<bool(ProjectSettingsDialog&)> projectSettingsHandler_;
+  QSpinBox* rangeMin_ = nullptr;
+  QSpinBox* rangeMax_ = nullptr;
+  QLabel* rangeNote_ = nullptr;
+  QWidget* heightModelNotice_ = nullptr;
+  QLabel* view3DNotice_ = nullptr;
+  // Outlines whose energy was asked for, so that one that cannot be scored is not asked again.
+  std::map<int, core::Polygon> energyAsked_;
   widgets::JobId matchingJob_ = 0;
   cv::Mat edgeMap_;
   double rightShift_ = 0.0;

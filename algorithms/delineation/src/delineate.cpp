@@ -497,33 +497,87 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   return out;
 }
 
+namespace {
+
+// The disparities the correlation costs are computed over: the full search range when known,
+// else the roof and ground intervals' hull.
+DisparityInterval costSearchInterval(const DelineationRequest& request, const DelineationParams& params) {
+  if (request.searchRange) return *request.searchRange;
+  if (request.ground) {
+    const auto [r, g] = costIntervals(request.roof, *request.ground, params.balanceIntervals);
+    return {std::min(r.min, g.min), std::max(r.max, g.max)};
+  }
+  // Ground assumed below the roof, with an interval of 2 * ground-tolerance + 1 disparities.
+  const int below = request.roof.min - params.groundSearch;
+  const auto [r, g] =
+      costIntervals(request.roof, {below, below + 2 * params.groundTolerance}, params.balanceIntervals);
+  return {std::min(r.min, g.min), std::max(r.max, request.roof.max)};
+}
+
+std::unique_ptr<stereo::CorrelationCostService> costsOver(const cv::Mat& left, const cv::Mat& right, cv::Rect roi,
+                                                             const DelineationRequest& request,
+                                                        const DelineationParams& params, core::Progress* progress) {
+  const DisparityInterval search = costSearchInterval(request, params);
+  stereo::CostParams costParams;
+  costParams.window = params.costWindow;
+  costParams.brightnessScale = params.costBrightness;
+  return stereo::CorrelationCostService::compute(toFloat(left), toFloat(right), roi, search.min, search.max,
+                                                 costParams, progress);
+}
+
+// An outline in left-image pixels as the energy's integer polygon in ROI coordinates (vertices
+// rounded to pixel corners, clamped to the ROI, repeated vertices dropped).
+IntPolygon toRoiPolygon(const core::Polygon& outline, cv::Rect roi) {
+  auto convert = [&](const core::Ring& ring) {
+    IntRing out;
+    for (const auto& v : ring) {
+      const cv::Point p(std::clamp(static_cast<int>(std::lround(v.x)) - roi.x, 0, roi.width),
+                        std::clamp(static_cast<int>(std::lround(v.y)) - roi.y, 0, roi.height));
+      if (out.empty() || out.back() != p) out.push_back(p);
+    }
+    while (out.size() > 1 && out.front() == out.back()) out.pop_back();
+    return out;
+  };
+  IntPolygon out;
+  out.outer = convert(outline.outer);
+  for (const auto& hole : outline.holes) out.holes.push_back(convert(hole));
+  return out;
+}
+
+}  // namespace
+
+OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
+                              const DelineationParams& params, const core::Polygon& outline,
+                              core::Progress* progress) {
+  OutlineEnergy result;
+  const cv::Rect roi = regionOfInterest(left, right, request, params);
+  const auto costs = costsOver(left, right, roi, request, params, progress);
+  if (!costs || core::isCanceled(progress)) {
+    result.status = core::RunStatus::Canceled;
+    return result;
+  }
+  const IntPolygon polygon = toRoiPolygon(outline, roi);
+  if (!isValidPolygon(polygon)) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the outline is not a valid polygon on the pixel grid of its region of interest "
+                "(a ring with fewer than 3 distinct corners, crossing itself or another ring)");
+  }
+  const PreparedEnergy prepared = prepareEnergy(*costs, left, right, request, params);
+  const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle,
+                              params.minGap};
+  result.terms = referenceEnergy(prepared.images, weights, polygon);
+  return result;
+}
+
 DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
                             const DelineationRequest& request, const DelineationParams& params,
                             const IterationObserver& observer, core::Progress* progress) {
   DelineationResult result;
   result.roi = regionOfInterest(left, right, request, params);
   result.roof = request.roof;
-  DisparityInterval search;
-  if (request.searchRange) {
-    search = *request.searchRange;
-  } else if (request.ground) {
-    const auto [r, g] = costIntervals(request.roof, *request.ground, params.balanceIntervals);
-    search = {std::min(r.min, g.min), std::max(r.max, g.max)};
-  } else {
-    // Ground assumed below the roof, with an interval of 2 * ground-tolerance + 1 disparities.
-    const int below = request.roof.min - params.groundSearch;
-    const auto [r, g] = costIntervals(
-        request.roof, {below, below + 2 * params.groundTolerance}, params.balanceIntervals);
-    search = {std::min(r.min, g.min), std::max(r.max, request.roof.max)};
-  }
   core::setStage(progress, core::StageId::CorrelationCosts);
   core::Progress::Range costProgress(progress, 0.0, 0.3);
-  stereo::CostParams costParams;
-  costParams.window = params.costWindow;
-  costParams.brightnessScale = params.costBrightness;
-  const auto costs = stereo::CorrelationCostService::compute(toFloat(left), toFloat(right), result.roi,
-                                                            search.min, search.max, costParams,
-                                                            progress ? &costProgress : nullptr);
+  const auto costs = costsOver(left, right, result.roi, request, params, progress ? &costProgress : nullptr);
   result.polygon = initialPolygon(request, left.size());
   if (!costs || core::isCanceled(progress)) {
     result.status = core::RunStatus::Canceled;

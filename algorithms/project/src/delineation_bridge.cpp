@@ -5,25 +5,37 @@
 
 namespace delineo::project {
 
-DelineationOutcome runActivePolygon(const Project& project, const Building& building,
-                                    const StereoPair& pair, core::Progress* progress,
-                                    const ContourListener& onContour) {
+namespace {
+
+// The active polygon's request for a building of the project.
+delineation::DelineationRequest requestFor(const Project& project, const Building& building,
+                                           const StereoPair& pair) {
   if (!building.roofInterval) {
     throw core::Error(core::ErrorCode::InvalidParameter,
                       "building " + std::to_string(building.id) + " has no roof disparity interval");
   }
-  const auto params = parameters<delineation::DelineationParams>(project, "delineation");
   delineation::DelineationRequest request;
   request.init = building.initial;
   request.roof = {building.roofInterval->low, building.roofInterval->high};
-  request.searchRange = delineation::DisparityInterval{project.disparityMin, project.disparityMax};
+  if (project.disparityRange) {
+    request.searchRange = delineation::DisparityInterval{project.disparityRange->low, project.disparityRange->high};
+  }
   request.excludeMask = pair.exclude;
-  // The optimiser reports ROI coordinates; the listener wants left-image pixels.
-  const cv::Rect roi = delineation::regionOfInterest(pair.left, pair.right, request, params);
+  return request;
+}
+
+}  // namespace
+
+DelineationOutcome runActivePolygon(const Project& project, const Building& building,
+                                    const StereoPair& pair, core::Progress* progress,
+                                    const ContourListener& onContour) {
+  const delineation::DelineationRequest request = requestFor(project, building, pair);
+  const auto params = parameters<delineation::DelineationParams>(project, "delineation");
+  // delineate() reports its contours in left-image pixels already, as the listener wants them.
   delineation::IterationObserver observer;
   if (onContour) {
-    observer = [&onContour, roi](const delineation::IterationReport& report) {
-      onContour(delineation::toPolygon(report.polygon, cv::Point2d(roi.x, roi.y)));
+    observer = [&onContour](const delineation::IterationReport& report) {
+      onContour(delineation::toPolygon(report.polygon));
     };
   }
   const delineation::DelineationResult result =
@@ -32,7 +44,22 @@ DelineationOutcome runActivePolygon(const Project& project, const Building& buil
   outcome.status = result.status;
   outcome.outline = result.polygon;
   outcome.energy = result.terms.total();
+  outcome.terms = result.terms.term;
   outcome.iterations = result.iterations;
+  return outcome;
+}
+
+EnergyOutcome evaluateBuildingOutline(const Project& project, const Building& building,
+                                      const StereoPair& pair, const core::Polygon& outline,
+                                      core::Progress* progress) {
+  const delineation::DelineationRequest request = requestFor(project, building, pair);
+  const auto params = parameters<delineation::DelineationParams>(project, "delineation");
+  const delineation::OutlineEnergy energy =
+      delineation::evaluateOutline(pair.left, pair.right, request, params, outline, progress);
+  EnergyOutcome outcome;
+  outcome.status = energy.status;
+  outcome.energy = energy.terms.total();
+  outcome.terms = energy.terms.term;
   return outcome;
 }
 

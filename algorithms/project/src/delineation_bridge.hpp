@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the call into delineo::delineation, compiled only when that library is built.
+// Internal: the calls into delineo::delineation, compiled only when that library is built.
 #include "delineo/project/pipeline.hpp"
 
 namespace delineo::project {
@@ -7,5 +7,9 @@ namespace delineo::project {
 DelineationOutcome runActivePolygon(const Project& project, const Building& building,
                                     const StereoPair& pair, core::Progress* progress,
                                     const ContourListener& onContour);
+
+EnergyOutcome evaluateBuildingOutline(const Project& project, const Building& building,
+                                      const StereoPair& pair, const core::Polygon& outline,
+                                      core::Progress* progress);
 
 }  // namespace delineo::project

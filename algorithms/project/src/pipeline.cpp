@@ -84,9 +84,12 @@ cv::Mat readDisparity(const Project& project, cv::Size size) {
 MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, const cv::Mat& right,
                                  core::Progress* progress) {
 #ifdef DELINEO_HAVE_STEREO
+  if (!project.disparityRange) {
+    throw Error(ErrorCode::InvalidParameter, "the project has no disparity range: estimate or give it first");
+  }
   auto params = parameters<stereo::MatchParams>(project, "matching");
-  params.dmin = project.disparityMin;
-  params.dmax = project.disparityMax;
+  params.dmin = project.disparityRange->low;
+  params.dmax = project.disparityRange->high;
   params.validate();
   stereo::MatchResult result = stereo::matchStereo(left, right, params, progress);
   MatchingOutcome outcome;
@@ -158,6 +161,16 @@ DelineationOutcome delineateBuilding(const Project& project, const Building& bui
 #endif
 }
 
+EnergyOutcome outlineEnergy(const Project& project, const Building& building, const StereoPair& pair,
+                            const core::Polygon& outline, core::Progress* progress) {
+#ifdef DELINEO_HAVE_DELINEATION
+  return evaluateBuildingOutline(project, building, pair, outline, progress);
+#else
+  (void)project, (void)building, (void)pair, (void)outline, (void)progress;
+  throw Error(ErrorCode::ProcessingFailed, "the active polygon is not part of this build");
+#endif
+}
+
 std::vector<core::Feature> buildingFeatures(const Project& project,
                                             const std::vector<BuildingStatus>& statuses) {
   std::vector<core::Feature> features;
@@ -195,7 +208,7 @@ int exportBuildings(const Project& project, const std::string& path,
   return static_cast<int>(features.size());
 }
 
-RunSummary runPendingSteps(Project& project, core::Progress* progress) {
+RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress) {
   RunSummary summary;
   const StereoPair pair = readStereoPair(project);
   const std::vector<int> pending = project.pendingBuildings();
@@ -209,8 +222,8 @@ RunSummary runPendingSteps(Project& project, core::Progress* progress) {
       summary.status = core::RunStatus::Canceled;
       return summary;
     }
-    const std::string out = (fs::path(project.outputDir) / "disparity.tif").string();
-    fs::create_directories(project.outputDir);
+    const std::string out = (fs::path(outputDir) / "disparity.tif").string();
+    fs::create_directories(outputDir);
     io::writeFloatGeoTiff(out, matched.disparity, pair.geo);
     project.disparity = out;
     disparity = matched.disparity;
@@ -233,6 +246,7 @@ RunSummary runPendingSteps(Project& project, core::Progress* progress) {
       }
       b.outline = outcome.outline;
       b.energy = outcome.energy;
+      b.energyTerms = outcome.terms;
       b.roofHeight = roofHeight(project, disparity, b.outline);
       b.status = BuildingStatus::Automatic;
       b.addHistory("delineated", "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices");
@@ -249,7 +263,7 @@ RunSummary runPendingSteps(Project& project, core::Progress* progress) {
   const auto features = buildingFeatures(
       project, {BuildingStatus::Automatic, BuildingStatus::Corrected, BuildingStatus::Accepted});
   if (!features.empty()) {
-    summary.exported = (fs::path(project.outputDir) / "buildings.geojson").string();
+    summary.exported = (fs::path(outputDir) / "buildings.geojson").string();
     exportBuildings(project, summary.exported,
                     {BuildingStatus::Automatic, BuildingStatus::Corrected, BuildingStatus::Accepted});
   }
@@ -258,7 +272,7 @@ RunSummary runPendingSteps(Project& project, core::Progress* progress) {
 }
 
 std::string ensureSampleProject(const std::string& directory, core::Progress* progress) {
-  const fs::path dir(directory);
+  const fs::path dir = fs::absolute(directory).lexically_normal();
   const fs::path projectPath = dir / "sample.delineo.json";
   std::error_code ec;
   if (fs::exists(projectPath, ec) && fs::exists(dir / "left.tif", ec) && fs::exists(dir / "right.tif", ec)) {
@@ -286,9 +300,8 @@ std::string ensureSampleProject(const std::string& directory, core::Progress* pr
   p.right = (dir / "right.tif").string();
   p.dem = (dir / "dem.tif").string();
   p.labels = (dir / "labels.tif").string();
-  p.outputDir = (dir / "output").string();
-  p.disparityMin = scene.disparityMin;
-  p.disparityMax = scene.disparityMax;
+  p.outputDir = "output";
+  p.disparityRange = DisparityInterval{scene.disparityMin, scene.disparityMax};
   p.height = {scene.groundDisparity, scene.metresPerDisparity, scene.gsd};
   saveProject(p, projectPath.string());
   return projectPath.string();

@@ -91,6 +91,7 @@ bool sameBuilding(const Building& a, const Building& b) {
   return a.id == b.id && samePolygon(a.initial, b.initial) && samePolygon(a.outline, b.outline) &&
          a.status == b.status && a.roofInterval == b.roofInterval &&
          sameNumber(a.roofHeight, b.roofHeight) && sameNumber(a.energy, b.energy) &&
+         a.energyTerms == b.energyTerms &&
          a.history == b.history;
 }
 
@@ -178,7 +179,7 @@ bool Project::operator==(const Project& other) const {
   if (!(name == other.name && left == other.left && right == other.right &&
         disparity == other.disparity && dem == other.dem && labels == other.labels &&
         exclude == other.exclude && outputDir == other.outputDir &&
-        disparityMin == other.disparityMin && disparityMax == other.disparityMax &&
+        disparityRange == other.disparityRange &&
         height == other.height && parameters == other.parameters &&
         buildings.size() == other.buildings.size())) {
     return false;
@@ -200,8 +201,11 @@ json toJson(const Project& project, const std::string& baseDir) {
                    {"dem", relativeTo(project.dem, baseDir)},
                    {"labels", relativeTo(project.labels, baseDir)},
                    {"exclude", relativeTo(project.exclude, baseDir)}};
-  out["outputDir"] = relativeTo(project.outputDir, baseDir);
-  out["disparityRange"] = {project.disparityMin, project.disparityMax};
+  out["outputDir"] = fs::path(project.outputDir).is_absolute() ? relativeTo(project.outputDir, baseDir)
+                                                               : project.outputDir;
+  out["disparityRange"] = project.disparityRange
+                              ? json{project.disparityRange->low, project.disparityRange->high}
+                              : json(nullptr);
   out["heightModel"] = {{"groundDisparity", project.height.groundDisparity},
                         {"metresPerPixel", project.height.metresPerPixel},
                         {"gsd", project.height.gsd}};
@@ -216,6 +220,11 @@ json toJson(const Project& project, const std::string& baseDir) {
     jb["roofInterval"] = b.roofInterval ? json{b.roofInterval->low, b.roofInterval->high} : json(nullptr);
     jb["roofHeight"] = numberOrNull(b.roofHeight);
     jb["energy"] = numberOrNull(b.energy);
+    if (b.energyTerms) {
+      json terms = json::object();
+      for (size_t t = 0; t < kEnergyTermNames.size(); ++t) terms[kEnergyTermNames[t]] = (*b.energyTerms)[t];
+      jb["energyTerms"] = std::move(terms);
+    }
     json history = json::array();
     for (const auto& h : b.history) {
       history.push_back({{"action", h.action}, {"time", h.time}, {"detail", h.detail}});
@@ -250,14 +259,15 @@ Project fromJson(const json& in, const std::string& baseDir) {
   p.labels = resolveAgainst(get<std::string>(images, "labels", "", "images."), baseDir);
   p.exclude = resolveAgainst(get<std::string>(images, "exclude", "", "images."), baseDir);
   if (p.left.empty() || p.right.empty()) badField("images", "left and right images are required");
-  p.outputDir = resolveAgainst(get<std::string>(in, "outputDir", "output", ""), baseDir);
-  if (auto it = in.find("disparityRange"); it != in.end()) {
+  // Relative output folders stay relative (to wherever the project file is saved next).
+  p.outputDir = get<std::string>(in, "outputDir", "output", "");
+  if (p.outputDir.empty()) badField("outputDir", "must not be empty (the default is \"output\")");
+  if (auto it = in.find("disparityRange"); it != in.end() && !it->is_null()) {
     if (!it->is_array() || it->size() != 2 || !(*it)[0].is_number_integer() ||
         !(*it)[1].is_number_integer() || (*it)[0].get<int>() > (*it)[1].get<int>()) {
-      badField("disparityRange", "must be [min, max] integers with min <= max");
+      badField("disparityRange", "must be [min, max] integers with min <= max, or null");
     }
-    p.disparityMin = (*it)[0].get<int>();
-    p.disparityMax = (*it)[1].get<int>();
+    p.disparityRange = DisparityInterval{(*it)[0].get<int>(), (*it)[1].get<int>()};
   }
   if (auto it = in.find("heightModel"); it != in.end() && it->is_object()) {
     p.height.groundDisparity = get<double>(*it, "groundDisparity", 0.0, "heightModel.");
@@ -269,6 +279,21 @@ Project fromJson(const json& in, const std::string& baseDir) {
   if (!p.parameters.is_object()) badField("parameters", "must be an object of groups");
   for (auto it = p.parameters.begin(); it != p.parameters.end(); ++it) {
     if (!it->is_object()) badField("parameters." + it.key(), "must be an object");
+  }
+  // Older files also kept the search range among the matcher's parameters: it is the pair's
+  // disparityRange now (one range drives every computation).
+  if (auto matching = p.parameters.find("matching"); matching != p.parameters.end()) {
+    const bool hasMin = matching->contains("dmin"), hasMax = matching->contains("dmax");
+    if (hasMin && hasMax && !p.disparityRange) {
+      const json& lo = (*matching)["dmin"];
+      const json& hi = (*matching)["dmax"];
+      if (!lo.is_number_integer() || !hi.is_number_integer() || lo.get<int>() > hi.get<int>()) {
+        badField("parameters.matching.dmin", "dmin and dmax must be integers with dmin <= dmax");
+      }
+      p.disparityRange = DisparityInterval{lo.get<int>(), hi.get<int>()};
+    }
+    matching->erase("dmin");
+    matching->erase("dmax");
   }
   const json buildings = in.value("buildings", json::array());
   if (!buildings.is_array()) badField("buildings", "must be an array");
@@ -293,6 +318,14 @@ Project fromJson(const json& in, const std::string& baseDir) {
     }
     b.roofHeight = get<double>(jb, "roofHeight", std::nan(""), where);
     b.energy = get<double>(jb, "energy", std::nan(""), where);
+    if (auto it = jb.find("energyTerms"); it != jb.end() && !it->is_null()) {
+      if (!it->is_object()) badField(where + "energyTerms", "must be an object of numbers");
+      EnergyTerms terms{};
+      for (size_t t = 0; t < kEnergyTermNames.size(); ++t) {
+        terms[t] = get<double>(*it, kEnergyTermNames[t], std::nan(""), where + "energyTerms.");
+      }
+      b.energyTerms = terms;
+    }
     const json history = jb.value("history", json::array());
     if (!history.is_array()) badField(where + "history", "must be an array");
     for (const auto& h : history) {
@@ -351,6 +384,17 @@ void saveProject(const Project& project, const std::string& path) {
     fs::remove(temp, ec);
     throw Error(ErrorCode::WriteFailed, "cannot replace the project file: " + ec.message(), path);
   }
+}
+
+std::string outputDirectory(const Project& project, const std::string& projectPath) {
+  const fs::path dir(project.outputDir.empty() ? std::string("output") : project.outputDir);
+  if (dir.is_absolute()) return dir.lexically_normal().string();
+  if (projectPath.empty()) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the output folder '" + dir.string() +
+                    "' is relative to the project file, and the project has not been saved yet");
+  }
+  return (fs::absolute(projectPath).parent_path() / dir).lexically_normal().string();
 }
 
 std::string autosavePath(const std::string& projectPath) {

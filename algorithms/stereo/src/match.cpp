@@ -5,6 +5,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -902,6 +903,10 @@ MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchPara
 
 void MatchParams::validate() const {
   core::checkDeclaredRanges(*this);
+  if (std::abs(dmin) > 100000 || std::abs(dmax) > 100000) {
+    throw Error(ErrorCode::InvalidParameter, "disparity range [" + std::to_string(dmin) + ", " +
+                                                 std::to_string(dmax) + "] is outside [-100000, 100000] px");
+  }
   if (dmin > dmax) {
     throw Error(ErrorCode::InvalidParameter,
                 "empty disparity range: dmin = " + std::to_string(dmin) +

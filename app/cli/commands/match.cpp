@@ -20,6 +20,8 @@ int run(const std::vector<std::string>& args) {
   opts.required("left", "FILE", "left (reference) image")
       .required("right", "FILE", "right image, same size, epipolar with the left")
       .required("out", "FILE", "output disparity GeoTIFF (float32, NaN = rejected)")
+      .value("dmin", "PX", "smallest disparity searched (x_right = x_left - d)")
+      .value("dmax", "PX", "largest disparity searched")
       .value("score", "FILE", "optional output of the correlation score (NCC of the match)", "")
       .flag("quiet", "no progress on stderr");
   opts.params(stereo::MatchParams{});
@@ -37,6 +39,9 @@ int run(const std::vector<std::string>& args) {
   }
   stereo::MatchParams params;
   opts.apply(params);
+  params.dmin = opts.getInt("dmin");
+  params.dmax = opts.getInt("dmax");
+  params.validate();
 
   auto& progress = cli::commandProgress();
   const bool quiet = opts.has("quiet");

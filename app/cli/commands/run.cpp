@@ -43,7 +43,8 @@ int run(const std::vector<std::string>& args) {
   for (const auto& missing : proj.missingFiles()) {
     throw core::Error(core::ErrorCode::FileNotFound, "referenced by the project " + projectPath, missing);
   }
-  const project::RunSummary summary = project::runPendingSteps(proj, &progress);
+  const project::RunSummary summary =
+      project::runPendingSteps(proj, project::outputDirectory(proj, projectPath), &progress);
   cli::throwIfCanceled(progress);
   if (summary.status == core::RunStatus::Canceled) throw cli::Canceled();
   progress.finish();

@@ -59,9 +59,8 @@ Project sampleProject(const TempDir& dir) {
   p.right = dir.file("images/right.tif");
   p.disparity = dir.file("output/disparity.tif");
   p.exclude = dir.file("images/vegetation.tif");
-  p.outputDir = dir.file("output");
-  p.disparityMin = -4;
-  p.disparityMax = 40;
+  p.outputDir = "output";
+  p.disparityRange = project::DisparityInterval{-4, 40};
   p.height = {2.0, 0.5, 0.25};
   project::setParameters(p, "delineation", DemoParams{7.5, 9});
   Building b;
@@ -73,6 +72,7 @@ Project sampleProject(const TempDir& dir) {
   b.roofInterval = project::DisparityInterval{18, 24};
   b.roofHeight = 9.5;
   b.energy = -1234.5;
+  b.energyTerms = project::EnergyTerms{-1000, 200, 15.5, -300, -200, 50};
   b.history = {{"picked", "2024-01-01T00:00:00Z", ""}, {"delineated", "2024-01-01T00:01:00Z", "12 vertices"}};
   p.buildings.push_back(b);
   Building pending;
@@ -102,6 +102,7 @@ TEST(ProjectFile, PathsUnderTheProjectFolderAreStoredRelative) {
   TempDir dir;
   Project p = sampleProject(dir);
   p.dem = "/elsewhere/dem.tif";
+  p.outputDir = dir.file("output");
   const nlohmann::json j = project::toJson(p, dir.path().string());
   EXPECT_EQ(j["images"]["left"], "images/left.tif");
   EXPECT_EQ(j["images"]["exclude"], "images/vegetation.tif");
@@ -122,6 +123,53 @@ TEST(ProjectFile, MovedProjectFolderStillFindsItsImages) {
   const Project moved = project::loadProject(dir.file("b/p.json"));
   EXPECT_EQ(moved.left, dir.file("b/images/left.tif"));
   EXPECT_TRUE(moved.missingFiles().empty());
+}
+
+TEST(ProjectFile, OutputFolderFollowsTheProjectFileWhenSavedElsewhere) {
+  TempDir dir;
+  Project p = sampleProject(dir);
+  project::saveProject(p, dir.file("a/p.json"));
+  EXPECT_EQ(project::outputDirectory(project::loadProject(dir.file("a/p.json")), dir.file("a/p.json")),
+            dir.file("a/output"));
+  // "Save as" into another folder: the outputs go beside the new file, not the old one.
+  project::saveProject(project::loadProject(dir.file("a/p.json")), dir.file("b/p.json"));
+  EXPECT_EQ(project::outputDirectory(project::loadProject(dir.file("b/p.json")), dir.file("b/p.json")),
+            dir.file("b/output"));
+  p.outputDir = "/data/results";
+  EXPECT_EQ(project::outputDirectory(p, dir.file("a/p.json")), "/data/results");
+}
+
+TEST(ProjectFile, AnUnsavedProjectHasNoRelativeOutputFolder) {
+  Project p;
+  EXPECT_EQ(p.outputDir, "output");
+  try {
+    (void)project::outputDirectory(p, "");
+    FAIL() << "an unsaved project must not resolve its output folder against the working folder";
+  } catch (const core::Error& e) {
+    EXPECT_EQ(e.code(), core::ErrorCode::InvalidParameter);
+  }
+}
+
+TEST(ProjectFile, AProjectWithoutADisparityRangeKeepsItUnset) {
+  TempDir dir;
+  Project p = sampleProject(dir);
+  p.disparityRange.reset();
+  project::saveProject(p, dir.file("p.json"));
+  EXPECT_TRUE(project::toJson(p, dir.path().string())["disparityRange"].is_null());
+  EXPECT_FALSE(project::loadProject(dir.file("p.json")).disparityRange.has_value());
+}
+
+TEST(ProjectFile, ARangeAmongTheMatcherParametersBecomesTheProjectRange) {
+  TempDir dir;
+  Project p = sampleProject(dir);
+  nlohmann::json j = project::toJson(p, dir.path().string());
+  j["disparityRange"] = nullptr;
+  j["parameters"]["matching"] = {{"dmin", -2}, {"dmax", 90}, {"window", 11}};
+  const Project loaded = project::fromJson(j, dir.path().string());
+  ASSERT_TRUE(loaded.disparityRange.has_value());
+  EXPECT_EQ(*loaded.disparityRange, (project::DisparityInterval{-2, 90}));
+  EXPECT_FALSE(loaded.parameters["matching"].contains("dmin"));
+  EXPECT_EQ(loaded.parameters["matching"]["window"], 11);
 }
 
 TEST(ProjectFile, MissingFilesNamesEachAbsentImage) {

@@ -92,4 +92,16 @@ DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
                             const IterationObserver& observer = {},
                             core::Progress* progress = nullptr);
 
+// The energy F(C) of a given outline (left-image pixels: an operator's edit, an imported or a
+// regularised outline) with the same costs, weights and region of interest as delineate() would
+// use for `request`; vertices are rounded to the pixel grid. Throws InvalidParameter when the
+// rounded outline is not a valid polygon. Cancel returns status Canceled and no terms.
+struct OutlineEnergy {
+  EnergyTerms terms;
+  core::RunStatus status = core::RunStatus::Completed;
+};
+OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
+                              const DelineationParams& params, const core::Polygon& outline,
+                              core::Progress* progress = nullptr);
+
 }  // namespace delineo::delineation

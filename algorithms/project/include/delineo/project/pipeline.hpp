@@ -35,7 +35,8 @@ StereoPair readStereoPair(const Project& project);
 cv::Mat readDisparity(const Project& project, cv::Size size);
 
 // Dense matching with the project's "matching" parameters; dmin/dmax come from the project's
-// disparity range. Canceled → empty disparity and status Canceled.
+// disparity range (InvalidParameter when it has none). Canceled → empty disparity and status
+// Canceled.
 struct MatchingOutcome {
   cv::Mat disparity;
   core::RunStatus status = core::RunStatus::Completed;
@@ -57,6 +58,7 @@ double roofHeight(const Project& project, const cv::Mat& disparity, const core::
 struct DelineationOutcome {
   core::Polygon outline;
   double energy = 0.0;
+  EnergyTerms terms{};  // the energy's terms, summing to `energy`
   int iterations = 0;
   core::RunStatus status = core::RunStatus::Completed;
 };
@@ -65,10 +67,23 @@ DelineationOutcome delineateBuilding(const Project& project, const Building& bui
                                      const StereoPair& pair, core::Progress* progress,
                                      const ContourListener& onContour = {});
 
-// `delineo-cli run`: matching when the disparity is missing (written to outputDir/disparity.tif
-// and recorded in the project), then the active polygon for every Pending building (status
-// becomes Automatic, history updated), then export of accepted + automatic + corrected outlines
-// to outputDir/buildings.geojson. The caller saves the project.
+// The active polygon's energy F(C) of `outline` (an operator's edit of the building's outline),
+// with the building's roof interval and the project's parameters, as delineateBuilding() would
+// score it. Throws InvalidParameter without a roof interval or for an outline that is not a
+// valid polygon on the pixel grid.
+struct EnergyOutcome {
+  double energy = 0.0;
+  EnergyTerms terms{};
+  core::RunStatus status = core::RunStatus::Completed;
+};
+EnergyOutcome outlineEnergy(const Project& project, const Building& building, const StereoPair& pair,
+                            const core::Polygon& outline, core::Progress* progress);
+
+// `delineo-cli run`: matching when the disparity is missing (written to
+// `outputDir`/disparity.tif and recorded in the project), then the active polygon for every
+// Pending building (status becomes Automatic, history updated), then export of accepted +
+// automatic + corrected outlines to `outputDir`/buildings.geojson. `outputDir` is the resolved
+// folder (outputDirectory()). The caller saves the project.
 struct RunSummary {
   bool matched = false;
   int delineated = 0;
@@ -77,7 +92,7 @@ struct RunSummary {
   std::string exported;  // path of the written GeoJSON, empty when nothing was written
   core::RunStatus status = core::RunStatus::Completed;
 };
-RunSummary runPendingSteps(Project& project, core::Progress* progress);
+RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress);
 
 // Features of the buildings with the given statuses (attributes: id, status, vertices,
 // roof_height_m, energy), in left-image pixels.

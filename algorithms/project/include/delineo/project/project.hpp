@@ -6,6 +6,7 @@
 // On disk a project is a JSON file (format in docs/project-file.md). In memory every path is
 // absolute; on disk paths are stored relative to the project file's folder when they lie under
 // it (so a project folder can be moved or shared), absolute otherwise.
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -47,6 +48,12 @@ struct DisparityInterval {
   bool operator==(const DisparityInterval&) const = default;
 };
 
+// The active polygon's energy terms, weighted and signed as they add up to F(C):
+// roof, ground, occlusion, left edges, right edges, shape prior (docs/delineation.md).
+using EnergyTerms = std::array<double, 6>;
+inline constexpr std::array<const char*, 6> kEnergyTermNames = {"roof",      "ground",     "occlusion",
+                                                                "leftEdges", "rightEdges", "shape"};
+
 struct Building {
   int id = 0;
   core::Polygon initial;   // the operator's rough polygon or rectangle (left-image pixels)
@@ -54,7 +61,8 @@ struct Building {
   BuildingStatus status = BuildingStatus::Pending;
   std::optional<DisparityInterval> roofInterval;  // chosen on the ROI histogram
   double roofHeight = std::nan("");  // m above ground, NaN when unknown
-  double energy = std::nan("");      // final active polygon energy F(C), NaN when not run
+  double energy = std::nan("");      // active polygon energy F(C) of the outline, NaN when unknown
+  std::optional<EnergyTerms> energyTerms;  // its terms, when known
   std::vector<HistoryEntry> history;
 
   bool hasOutline() const { return outline.outer.size() >= 3; }
@@ -83,9 +91,12 @@ struct Project {
   std::string dem;         // float32 heights in left geometry, optional
   std::string labels;      // ground truth / classification labels, optional
   std::string exclude;     // mask of pixels that are not roof (vegetation...), optional
-  std::string outputDir;   // where `run` and exports write; default: "<project dir>/output"
-  int disparityMin = 0;    // px, full search range of the pair
-  int disparityMax = 64;
+  // Where computed rasters and exports go: relative to the project file's folder (the default,
+  // "output", so outputs follow the project when it is saved elsewhere) or absolute. Resolve it
+  // with outputDirectory().
+  std::string outputDir = "output";
+  // The pair's full disparity search range (px); unset until estimated from the images or given.
+  std::optional<DisparityInterval> disparityRange;
   HeightModel height;
   // Algorithm parameters by group ("matching", "delineation", ...): each value is the JSON of a
   // parameter struct (core::toJson). Kept as JSON so the project does not depend on every
@@ -132,6 +143,11 @@ void saveProject(const Project& project, const std::string& path);
 std::string autosavePath(const std::string& projectPath);
 // True when an autosave exists and is newer than the project file (e.g. after a crash).
 bool hasNewerAutosave(const std::string& projectPath);
+
+// The absolute output folder of a project saved at `projectPath`. Throws InvalidParameter when
+// the folder is relative and the project has no file yet (nothing is written for an unsaved
+// project: its outputs would otherwise land in the current folder or beside the images).
+std::string outputDirectory(const Project& project, const std::string& projectPath);
 
 // "2024-05-01T12:34:56Z".
 std::string currentUtcTime();

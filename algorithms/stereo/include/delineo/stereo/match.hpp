@@ -17,6 +17,8 @@ namespace delineo::stereo {
 
 struct MatchParams {
   std::string method = "adaptive";  // adaptive | sgbm
+  // The search range belongs to the pair, not to the method: it is not among the visited
+  // fields (the CLI's --dmin/--dmax, the project's disparityRange).
   int dmin = 0;                      // px, smallest disparity searched (x_right = x_left - d)
   int dmax = 64;                     // px, largest disparity searched
   int levels = 0;                    // pyramid levels, 0 = auto: ceil(1 + log2(range / 20))
@@ -63,12 +65,6 @@ struct MatchParams {
     v(core::ParamInfo{"method", "Method", "", "Matcher: adaptive (Cord et al.) or sgbm (OpenCV)",
                       0, 0, "adaptive|sgbm"},
       method);
-    v(core::ParamInfo{"dmin", "Minimum disparity", "px",
-                      "Smallest disparity searched, x_right = x_left - d", -100000, 100000},
-      dmin);
-    v(core::ParamInfo{"dmax", "Maximum disparity", "px", "Largest disparity searched", -100000,
-                      100000},
-      dmax);
     v(core::ParamInfo{"levels", "Pyramid levels", "",
                       "Resolution levels, 0 = automatic from the range (coarsest range ~20 px)",
                       0, 10},

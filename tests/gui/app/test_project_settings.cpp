@@ -1,0 +1,207 @@
+// The project's own settings in the main window: the disparity range the Matching tab edits and
+// every computation uses, where outputs go, the height model and the roof heights it gives, the
+// warning when a roof reaches the matched range's end, and the energy of an edited outline.
+#include <QAction>
+#include <QDoubleSpinBox>
+#include <QLabel>
+#include <QLineEdit>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QSpinBox>
+#include <QStandardPaths>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QUndoStack>
+#include <filesystem>
+#include <thread>
+
+#include "delineo/io/raster.hpp"
+#include "delineo/project/pipeline.hpp"
+#include "delineo/widgets/parameter_form.hpp"
+#include "document.hpp"
+#include "main_window.hpp"
+#include "project_settings_dialog.hpp"
+
+using namespace delineo;
+using gui::MainWindow;
+
+namespace fs = std::filesystem;
+
+class ProjectSettingsTest : public QObject {
+  Q_OBJECT
+ private:
+  QTemporaryDir dir_;
+  QString projectPath_;
+  std::unique_ptr<MainWindow> window_;
+
+  // A synthetic disparity: ground at 8 px, a 60x40 roof at 30 px from (100, 90).
+  static cv::Mat roofDisparity(cv::Size size) {
+    cv::Mat d(size, CV_32F, cv::Scalar(8.0f));
+    d(cv::Rect(100, 90, 60, 40)).setTo(30.0f);
+    return d;
+  }
+
+  int addRoofBuilding() {
+    core::Polygon pick;
+    pick.outer = {{92, 82}, {168, 82}, {168, 138}, {92, 138}};
+    return window_->document()->addBuilding(pick);
+  }
+
+ private slots:
+  void initTestCase() {
+    QStandardPaths::setTestModeEnabled(true);
+    QCoreApplication::setOrganizationName(QStringLiteral("DelineoSettingsTest"));
+    QSettings().clear();
+    QSettings().setValue(QStringLiteral("autoMatch"), false);
+    QVERIFY(dir_.isValid());
+    if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
+    const std::string sampleDir = dir_.filePath(QStringLiteral("sample")).toStdString();
+    std::string made;
+    std::thread maker([&] { made = project::ensureSampleProject(sampleDir); });
+    maker.join();
+    projectPath_ = QString::fromStdString(made);
+    window_ = std::make_unique<MainWindow>();
+    window_->setInteractive(false);
+    window_->resize(1300, 850);
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
+  }
+
+  void theMatchingTabEditsTheProjectsOneRange() {
+    QVERIFY(window_->openProject(projectPath_));
+    gui::Document* doc = window_->document();
+    const auto range = doc->project().disparityRange;
+    QVERIFY(range.has_value());
+    QCOMPARE(window_->rangeMinBox()->value(), range->low);
+    QCOMPARE(window_->rangeMaxBox()->value(), range->high);
+    // The matcher's form has no range of its own any more (it was a second, unused one).
+    QVERIFY(window_->matchingForm()->findChild<QWidget*>(QStringLiteral("dmax")) == nullptr);
+    window_->rangeMaxBox()->setValue(range->high + 36);
+    QCOMPARE(doc->project().disparityRange->high, range->high + 36);
+    QCOMPARE(doc->undoStack()->undoText(),
+             QStringLiteral("Disparity range %1..%2 px").arg(range->low).arg(range->high + 36));
+    doc->undoStack()->undo();
+    QCOMPARE(doc->project().disparityRange->high, range->high);
+    QCOMPARE(window_->rangeMaxBox()->value(), range->high);
+    // An inverted range is refused with a message and the boxes come back.
+    window_->rangeMinBox()->setValue(range->high + 5);
+    QCOMPARE(doc->project().disparityRange->low, range->low);
+    QCOMPARE(window_->rangeMinBox()->value(), range->low);
+  }
+
+  void aRoofBeyondTheMatchedRangeIsWarnedAbout() {
+    gui::Document* doc = window_->document();
+    doc->setDisparity(roofDisparity(doc->leftGrey().size()));
+    doc->setDisparityRange(project::DisparityInterval{0, 64}, QStringLiteral("range"));
+    const int id = addRoofBuilding();
+    window_->selectBuilding(id);
+    QVERIFY(!window_->intervalLabel()->text().contains(QStringLiteral("end of the matched range")));
+    // Matched with a range that ends at the roof: the values pile up at its end.
+    doc->setDisparityRange(project::DisparityInterval{0, 30}, QStringLiteral("range"));
+    QVERIFY2(window_->intervalLabel()->text().contains(QStringLiteral("end of the matched range")),
+             qPrintable(window_->intervalLabel()->text()));
+    doc->setDisparityRange(project::DisparityInterval{0, 64}, QStringLiteral("range"));
+    QVERIFY(!window_->intervalLabel()->text().contains(QStringLiteral("end of the matched range")));
+  }
+
+  void theHeightModelIsSetInTheWindowAndRoofHeightsFollow() {
+    gui::Document* doc = window_->document();
+    core::Polygon outline;
+    outline.outer = {{100, 90}, {160, 90}, {160, 130}, {100, 130}};
+    const int id = addRoofBuilding();
+    project::DelineationOutcome result;
+    result.outline = outline;
+    doc->setDelineationResult(id, result);
+    const double before = doc->project().find(id)->roofHeight;
+    // B = 100 m, H = 1000 m, f = 10000 px: k = H² / (B f) = 1 m/px, GSD = H / f = 0.1 m.
+    QCOMPARE(gui::metresPerPixelFromCamera(100, 1000, 10000), 1.0);
+    QCOMPARE(gui::metresPerPixelFromCamera(0, 1000, 10000), 0.0);
+    window_->setProjectSettingsHandler([](gui::ProjectSettingsDialog& dialog) {
+      dialog.findChild<QDoubleSpinBox*>(QStringLiteral("groundDisparity"))->setValue(8.0);
+      dialog.setCamera(100, 1000, 10000);
+      return true;
+    });
+    const int entries = doc->undoStack()->count();
+    window_->openProjectSettings();
+    QCOMPARE(doc->undoStack()->count(), entries + 1);
+    QCOMPARE(doc->project().height.metresPerPixel, 1.0);
+    QCOMPARE(doc->project().height.gsd, 0.1);
+    QCOMPARE(doc->project().find(id)->roofHeight, 22.0);
+    QVERIFY(before != 22.0);
+    doc->undoStack()->undo();
+    QCOMPARE(doc->project().find(id)->roofHeight, before);
+    doc->undoStack()->redo();
+    QCOMPARE(doc->project().find(id)->roofHeight, 22.0);
+  }
+
+  void withoutAHeightModelTheDemViewSaysHowToGetOne() {
+    // A new project on the sample's pair: no DEM file and no height model.
+    const project::Project sample = project::loadProject(projectPath_.toStdString());
+    QVERIFY(window_->openPair(QString::fromStdString(sample.left),
+                              QString::fromStdString(sample.right)));
+    QVERIFY(!window_->heightModelNotice()->isHidden());
+    gui::Document* doc = window_->document();
+    doc->setDisparity(roofDisparity(doc->leftGrey().size()));
+    QVERIFY(doc->dem().empty());
+    project::HeightModel model;
+    model.groundDisparity = 8;
+    model.metresPerPixel = 0.25;
+    doc->setHeightModel(model);
+    QVERIFY(window_->heightModelNotice()->isHidden());
+    QVERIFY(!doc->dem().empty());
+    QCOMPARE(doc->dem().at<float>(100, 120), 22.0f * 0.25f);
+  }
+
+  void outputsFollowTheProjectFileNotTheImages() {
+    gui::Document* doc = window_->document();  // the unsaved project on the sample's pair
+    const fs::path imagesDir = fs::path(doc->project().left).parent_path();
+    QVERIFY(doc->outputDirectory().isEmpty());  // nowhere to write before the first save
+    const QString elsewhere = dir_.filePath(QStringLiteral("work/site.delineo.json"));
+    QVERIFY(window_->saveAs(elsewhere));
+    QVERIFY(fs::exists(dir_.filePath(QStringLiteral("work/output/disparity.tif")).toStdString()));
+    QVERIFY(!fs::exists(imagesDir / "output" / "disparity.tif"));
+    QCOMPARE(doc->outputDirectory(), dir_.filePath(QStringLiteral("work/output")));
+    QCOMPARE(QString::fromStdString(project::loadProject(elsewhere.toStdString()).outputDir),
+             QStringLiteral("output"));
+    // The operator's own output folder, relative to the project file.
+    window_->setProjectSettingsHandler([](gui::ProjectSettingsDialog& dialog) {
+      dialog.findChild<QLineEdit*>(QStringLiteral("outputDir"))->setText(QStringLiteral("results"));
+      return true;
+    });
+    window_->openProjectSettings();
+    QCOMPARE(doc->outputDirectory(), dir_.filePath(QStringLiteral("work/results")));
+    QCOMPARE(doc->dialogFolder(), dir_.filePath(QStringLiteral("work")));
+  }
+
+  void anEditedOutlineGetsItsEnergyBack() {
+    if (!project::delineationAvailable()) QSKIP("no active polygon in this build");
+    QVERIFY(window_->openProject(projectPath_));
+    gui::Document* doc = window_->document();
+    const int id = addRoofBuilding();
+    doc->setRoofInterval(id, project::DisparityInterval{28, 32});
+    doc->setDisparity(roofDisparity(doc->leftGrey().size()));
+    project::DelineationOutcome result;
+    result.outline.outer = {{100, 90}, {160, 90}, {160, 130}, {100, 130}};
+    result.energy = -1.0;
+    doc->setDelineationResult(id, result);
+    QSignalSpy updated(window_.get(), &MainWindow::energyUpdated);
+    const core::Ring moved = {{104, 90}, {160, 90}, {160, 130}, {100, 130}};
+    doc->editRing(id, 0, moved, QStringLiteral("Move vertex"));
+    QVERIFY(std::isnan(doc->project().find(id)->energy));
+    QTRY_COMPARE_WITH_TIMEOUT(updated.count(), 1, 60000);
+    const project::Building* b = doc->project().find(id);
+    QVERIFY(std::isfinite(b->energy));
+    QVERIFY(b->energyTerms.has_value());
+    double sum = 0;
+    for (double t : *b->energyTerms) sum += t;
+    QVERIFY(std::abs(sum - b->energy) < 1e-6 * std::abs(b->energy) + 1e-6);
+    // Undo brings the old outline's energy back without a new job.
+    doc->undoStack()->undo();
+    QCOMPARE(doc->project().find(id)->energy, -1.0);
+  }
+
+  void cleanupTestCase() { window_.reset(); }
+};
+
+QTEST_MAIN(ProjectSettingsTest)
+#include "test_project_settings.moc"
