@@ -582,7 +582,7 @@ std::vector<Case> realCases(const fs::path& data) {
 
 }  // namespace
 int main(int argc, char** argv) {
-  // As the CLI and the GUI do (docs/stereo.md, session 34).
+  // As the CLI and the GUI do (architecture.md, "Process set-up").
   delineo::core::tuneAllocatorForLargeImages();
   int size = 1000;
   std::string data = "/work/shared/data";

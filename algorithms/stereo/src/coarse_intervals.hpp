@@ -22,10 +22,10 @@ namespace delineo::stereo::detail {
 // widest neighbourhood's interval (the paper gives the full range to the rejected pixels only):
 // next to a rejected pixel the coarse disparities are the least sure (a tree's carried into the
 // roof beside it, 2000²), and a wrong interval is never left again. Only above the finest level:
-// there the finest level's repeated seams lined up elsewhere (1000² / 128 d, docs/stereo.md,
-// session 22). Until session 30 such pixels searched the full range: 41 % of the pixels of the
-// level below the finest at 1000² / 128 d, a fifth of the matching's time; the widest
-// neighbourhood (50 px at the finer level) holds the surfaces on both sides of such a boundary.
+// there the finest level's repeated seams lined up elsewhere (1000² / 128 d). The widest
+// neighbourhood (50 px at the finer level) holds the surfaces on both sides of such a boundary;
+// the full range there (41 % of the pixels of the level below the finest at 1000² / 128 d) cost a
+// fifth of the matching's time with the same targets met (docs/stereo.md, step 4).
 //
 // `coarse`: CV_32F, NaN where rejected; `size`: the level's size (twice the coarse one, ±1);
 // `lo`, `hi`: out, CV_32S, the inclusive interval of each pixel within dmin..dmax.

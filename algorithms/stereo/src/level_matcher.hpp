@@ -34,7 +34,8 @@ struct LevelSettings {
   // Uniqueness of the peak in wide intervals: a pixel searching at least uniqueMinInterval
   // disparities is rejected when a score 3 or more disparities from its peak comes within
   // uniqueMargin of it in 1 − NCC (second ≥ 1 − (1 − best)(1 + uniqueMargin)). Wide intervals
-  // are the full range next to rejected pixels (above the finest level) and the 9x9 fallbacks,
+  // are the widest neighbourhood's next to rejected pixels (above the finest level) and the
+  // fallbacks of rejected parents (coarse_intervals.hpp),
   // where repeated structure (a roof's seams, a tree beside a roof) can line up elsewhere; guided
   // intervals of a few disparities are not tested, nor, with automatic levels, the coarsest
   // level's range (at most about 20 disparities). 0 = off.

@@ -742,7 +742,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   // Then the weak matches on plain pixels beside a plain region the fill could not decide (a roof
   // and the ground of one grey): the windows of the surface beside it that reached into it (sim
-  // seed 15 1000²: roof RMS 0.260 -> 0.134 px; see docs/stereo.md, session 30).
+  // seed 15 1000²: roof RMS 0.260 -> 0.134 px; see docs/stereo.md, step 11).
   if (plainPass && p.unmatchedPlainMinScore > 0) {
     detail::UnmatchedPlainSettings beside;
     beside.minScore = p.unmatchedPlainMinScore;
@@ -788,7 +788,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   // On the final map, after every step that sets matches (the fill's matches can be hidden too)
   // and before the smoothing, which would average a hidden match into the surface hiding it.
-  // (600² roof RMS over all matches 2.121 -> 0.226 px; see docs/stereo.md, session 20.)
+  // (600² roof RMS over all matches 2.121 -> 0.226 px; see docs/stereo.md, step 16.)
   if (p.orderingCheck) {
     detail::OrderingSettings ordering;
     ordering.threads = threads;
@@ -801,8 +801,8 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     detail::smoothSurfaces(result.disparity, p.smoothWindow, p.smoothTolerance, threads);
   }
   // After the smoothing: a roof's matches are noisy at the scale of the correlation window, which
-  // a 5x5 mean cannot average out; a plane over the whole roof does (see docs/stereo.md, session
-  // 28).
+  // a 5x5 mean cannot average out; a plane over the whole roof does (see docs/stereo.md, step
+  // 18).
   if (p.planeResidual > 0) {
     if (reachedButCanceled(0.99)) return result;
     core::setStage(progress, core::StageId::FittingRoofPlanes);

@@ -1008,8 +1008,8 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
   // the one of the matched pairs does (seed 5's dark hip facet: the images' moments put its
   // counterpart 5.9 levels off, the matches 0.8). So does the scan that confirms an unclear
   // candidate (see scanConfirms below). The other tests keep the images' map, which their
-  // tolerances were measured with (all of them on the matches' map: 600² edge 92.0 -> 89.9 in
-  // session 15; in session 26, hip facets filled with a constant on seeds 6 and 38 600²).
+  // tolerances were measured with (all of them on the matches' map: 600² edge 92.0 -> 89.9, and
+  // hip facets filled with a constant on seeds 6 and 38 600²).
   const auto [matchedGain, matchedOffset] = greyMaps.matches;
   const std::pair<double, double> imagesMap{gain, offset}, matchesMap{matchedGain, matchedOffset};
   const double maxArea = settings.maxShare * static_cast<double>(left.total());
@@ -1224,12 +1224,12 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       // The candidates are ranked by their clusters' means; the value filled in is the chosen
       // cluster's median, refocused (see refocusReach). The matches next to a plain roof's
       // outline are skewed: some windows along it match 1-1.7 px too far (seed 5's plain roof,
-      // filled +0.57 px off with the mean, +0.39 with the median; see docs/stereo.md, sessions
-      // 17 and 18). It is taken from the matches on the region's rows when there are enough:
+      // filled +0.57 px off with the mean, +0.39 with the median; see docs/stereo.md, step 10).
+      // It is taken from the matches on the region's rows when there are enough:
       // above and below it, along an outline parallel to the epipolar lines, the windows hold
       // no step across the lines to fix them, and those matches ran 0.8-1.8 px high on seed 5's
       // plain roof (filled 0.54 px high once the wide intervals' uniqueness test had rejected
-      // most of the good matches beside it; docs/stereo.md, session 22).
+      // most of the good matches beside it).
       const std::vector<float>& valueFrom =
           static_cast<int>(matchesBeside.size()) >= settings.minMatched ? matchesBeside : matches;
       float value = clusterMedian(valueFrom, best, settings.refocusReach);
@@ -1363,7 +1363,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         // a plane must over a constant that passed: a plain roof nearly level, whose row ends
         // were fitted with a slope (sim seed 24 600²: a roof at 53.45 given a plane rising 2.7
         // px over it, 52.65 at its centroid, ring error 14.67 against 14.57 for its edges'
-        // 53.33; see docs/stereo.md, session 28).
+        // 53.33).
         const double centreValue = plane.at(centroids.at<double>(r, 0), centroids.at<double>(r, 1));
         if (const auto edges = edgeConstantNear(centreValue)) {
           const FillPlane level{*edges, 0, 0};

@@ -32,8 +32,8 @@ struct RegionFillSettings {
   double edgeDecideShare = 0.7;   // where the ring cannot tell the candidate from other
                                   //   disparities (the scan does not confirm it), the edges decide
                                   //   when this share of the row ends read agree (0 = off;
-                                  //   0.8 until session 30: seed 49 600²'s plain roof agreed
-                                  //   on 26 of 36 and stayed unmatched) ...
+                                  //   at 0.8, seed 49 600²'s plain roof, which agreed on 26 of
+                                  //   36, stayed unmatched) ...
   int edgeDecidePerSide = 5;      //   and this many of those on each side of the region (a facet
                                   //   sloping along the rows agrees on one side only)
   int growReach = 3;              // px: the filled region grows back to its contour by at most this
@@ -144,7 +144,7 @@ struct RegionFillSettings {
 // Matches off the fill by `extendReplaceOff` px or more do not stop the walk: they are taken
 // by the same test as an unmatched pixel, which their own disparity must then fail clearly
 // (windows that met a surface as plain as the roof in the right view, such as the facade
-// beside it; 2000² edge 89.6 -> 89.9 %). The reach, 40 px (32 until session 16): 2000² edge
+// beside it; 2000² edge 89.6 -> 89.9 %). The reach, 40 px (against 32): 2000² edge
 // 89.9 -> 90.1 %, a roof whose one filled patch lies about 40 steps from its outline's
 // unmatched end; 48 px cost seed 5 0.2 points.
 // A region's own matches off its fill by `inRegionReplaceOff` px or more take the fill when its
@@ -155,8 +155,8 @@ struct RegionFillSettings {
 // carry the far side's disparity (seed 3 600²: 469 of 37 240 roof matches > 5 px off, roof RMS
 // 5.38 px). A plain pixel is explained alike at both disparities, so the region's fill wins;
 // where its own disparity explains it clearly better it is kept. Smaller offsets are left alone
-// (matches within 3 px of a fill are mostly the surface's own, sub-pixel ones). At 8 px (until
-// session 20) a plain roof kept, around the raised boxes on it, the boxes' disparity 3.5 px above
+// (matches within 3 px of a fill are mostly the surface's own, sub-pixel ones). At 8 px a plain
+// roof kept, around the raised boxes on it, the boxes' disparity 3.5 px above
 // it (seed 5 600²: roof RMS 0.285 px, 0.245 at 3 px). A plain slanted surface (Aloe's leaves)
 // differs from its constant fill by a few px and its matches are right: Aloe bad-2 2.51 -> 2.55 %
 // at 3 px (2 / 2.5 / 3.5 / 4 px: seed 5 0.246 / 0.245 / 0.256 / 0.284 px).
@@ -183,8 +183,7 @@ struct RegionFillSettings {
 // those within 0.75 px of their median is filled when it lies within edgeReach of the candidate
 // (that roof: 70.82; four others of that scene within 0.1 px of the truth). The reach is 2 px
 // rather than the arbiter's 1.5: beside a rooftop box the matches' candidate can be 1.9 px off
-// (sim seed 18 1000²: a roof at 43.29 filled at 45.2, 43.3 from its edges; docs/stereo.md,
-// session 28).
+// (sim seed 18 1000²: a roof at 43.29 filled at 45.2, 43.3 from its edges).
 // `left`/`right`: the original images (CV_32F, NaN = nodata). Returns the pixels filled.
 // `threads` > 1: the grey maps and the right view's flat regions are made on a second worker,
 // which then runs `alongside` (the caller's own work on the images: it must not touch the

@@ -341,7 +341,8 @@ int snapStepsToContours(const cv::Mat& left, const cv::Mat& right, const StepCon
   };
   // Brightness offset (noise sigmas) that tells two surfaces apart: above the sensor noise and
   // above the few grey levels by which two views of one surface differ (exposure, non-Lambertian
-  // surfaces). The grey levels are the mapped ones (step 1), alike for every input.
+  // surfaces). The grey levels are the input's own (the snapping reads the original images): the
+  // floor suits 8-bit data; for images scaled to [0, 1] it is never reached.
   const double offsetBound = std::max(settings.carriedOffset, settings.carriedOffsetGrey / sigma);
   // Two surfaces by brightness: the pixels past a contour are offset from their counterparts by
   // at least offsetBound on average while the run's pixels before it agree within half that

@@ -34,9 +34,9 @@ struct StepSnapSettings {
   int lineRows = 6;            // rows each side of a row's line through the cuts (0 = off)
   double lineCap = 5.0;        // noise sigmas: most a row off the line adds to its cost
   double linkDisparity = 1.5;  // px: same step in the next row when both sides are this close
-  double maxSlope = 6.0;       // px per row: steepest line tried (3 until session 23: a roof's
-                               //   outline at 3.7 px per row was left to each row alone, and
-                               //   rows 2-5 px fattened stayed; 38 scenes' mean edge +0.1)
+  double maxSlope = 6.0;       // px per row: steepest line tried (at 3, a roof's outline at
+                               //   3.7 px per row was left to each row alone, and rows 2-5 px
+                               //   fattened stayed; 6 against 3: 38 scenes' mean edge +0.1)
   int slopeSteps = 24;         // slopes tried on each side of vertical (0.25 px per row apart)
   int threads = 1;             // workers over bands of rows (same result on any number)
 };

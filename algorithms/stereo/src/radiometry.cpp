@@ -273,7 +273,7 @@ std::optional<std::pair<double, double>> medianSlopeMap(const std::vector<cv::Ve
 // The moments are taken over the pairs within kInlierMads median absolute residuals (× 1.4826, a
 // Gaussian's sigma) of the current map, twice, starting from the median-slope map. Wrong matches
 // (an occluded pixel paired with the roof that hides it, a roof's value carried onto the ground)
-// are far off; started from the moments of all pairs, as until session 26, a few of them at the
+// are far off; started from the moments of all pairs, a few of them at the
 // end of the grey range pulled the map towards themselves and were kept by the refits (a unit
 // scene of the snapping: gain 0.768 and offset 32.5 where the views' exposures are the same).
 constexpr double kInlierMads = 2.5;

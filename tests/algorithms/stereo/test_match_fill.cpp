@@ -896,7 +896,7 @@ TEST(FillFlatRegions, ItsOwnMatchesStayWhereTheirDisparityExplainsThemClearlyBet
 
 TEST(FillFlatRegions, ItsOwnMatchesAFewPixelsOffTheFillTakeItWhereItExplainsThemAsWell) {
   // 3.5 px above the fill: a raised box's disparity carried onto the plain roof around it by
-  // windows that reached the box's edges (seed 5 600²). Kept with the session-19 offset (8 px).
+  // windows that reached the box's edges (seed 5 600²). Kept with an offset of 8 px.
   RegionFillSettings farOnly;
   farOnly.inRegionReplaceOff = 8.0;
   const auto [replaced, kept] =

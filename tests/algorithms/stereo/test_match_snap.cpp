@@ -332,7 +332,7 @@ TEST(SnapSteps, ARoofRunCarriedOverAShadowStopsAtTheContour) {
 }
 
 // Carried only 2 px: the contour is split however few run pixels lie past it (requiring 3 on
-// each side, as before session 10, left these runs alone).
+// each side, as carriedRuns 3 does, left these runs alone).
 TEST(SnapSteps, ARoofRunCarriedAFewPixelsOverAShadowStopsAtTheContourToo) {
   StepSnapSettings threeEachSide;
   threeEachSide.carriedRuns = 3;
