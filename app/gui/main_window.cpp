@@ -36,6 +36,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -347,7 +348,14 @@ void MainWindow::createDocks() {
     intervalLabel_->setText(tr("Roof: %1 .. %2 px").arg(a).arg(b));
   });
   connect(histogram_, &widgets::DisparityHistogramWidget::intervalEditingFinished, this, [this](int a, int b) {
-    if (document_ && selectedId_ > 0) document_->setRoofInterval(selectedId_, {a, b});
+    if (!document_ || selectedId_ <= 0) return;
+    document_->setRoofInterval(selectedId_, {a, b});
+    // A new interval for an outline nobody has edited yet: the active polygon runs again with it.
+    const Building* building = document_->project().find(selectedId_);
+    if (building != nullptr && action(QStringLiteral("actionDelineateOnPick"))->isChecked() &&
+        (building->status == BuildingStatus::Pending || building->status == BuildingStatus::Automatic)) {
+      startDelineation(selectedId_);
+    }
   });
   auto* tabs = new QTabWidget;
   delineationForm_ = new widgets::ParameterForm;
@@ -465,6 +473,11 @@ void MainWindow::createActions() {
           &QAction::triggered, this, &MainWindow::startMatching);
   connect(make(QStringLiteral("actionDelineate"), tr("Run the active &polygon"), QKeySequence(tr("Ctrl+R"))),
           &QAction::triggered, this, [this] { startDelineation(selectedId_); });
+  auto* onPick = make(QStringLiteral("actionDelineateOnPick"), tr("Delineate on &pick"));
+  onPick->setCheckable(true);
+  onPick->setChecked(QSettings().value(QStringLiteral("delineateOnPick"), true).toBool());
+  onPick->setStatusTip(tr("Run the active polygon as soon as a building is picked, and again when its roof interval changes"));
+  connect(onPick, &QAction::toggled, this, [](bool on) { QSettings().setValue(QStringLiteral("delineateOnPick"), on); });
   connect(make(QStringLiteral("actionAccept"), tr("&Accept building"), QKeySequence(QStringLiteral("A"))),
           &QAction::triggered, this, &MainWindow::acceptSelected);
   connect(make(QStringLiteral("actionReject"), tr("Re&ject building"), QKeySequence(QStringLiteral("X"))),
@@ -560,6 +573,7 @@ void MainWindow::createMenus() {
   }
   building->addSeparator();
   building->addAction(action(QStringLiteral("actionDelineate")));
+  building->addAction(action(QStringLiteral("actionDelineateOnPick")));
   building->addAction(action(QStringLiteral("actionAccept")));
   building->addAction(action(QStringLiteral("actionReject")));
   building->addAction(action(QStringLiteral("actionReopen")));
@@ -730,6 +744,7 @@ bool MainWindow::openSample() {
 void MainWindow::installDocument(std::unique_ptr<Document> document) {
   jobs_->cancelAll();
   selectedId_ = -1;
+  awaitingDisparity_ = -1;
   // The model lets go of the old document while it still exists.
   buildingsModel_->setDocument(document.get());
   document_ = std::move(document);
@@ -1357,6 +1372,12 @@ void MainWindow::onPicked(const core::Polygon& polygon) {
   const int id = document_->addBuilding(polygon);
   selectBuilding(id);
   leftView_->setInteractionMode(InteractionMode::Navigate);
+  // The pick is the request: the active polygon starts at once with the proposed interval (or
+  // as soon as the disparity is there).
+  if (action(QStringLiteral("actionDelineateOnPick"))->isChecked()) {
+    if (document_->disparity().empty()) awaitingDisparity_ = id;
+    else startDelineation(id);
+  }
 }
 
 void MainWindow::onObjectPicked(QPointF imagePos) {
@@ -1481,6 +1502,9 @@ widgets::JobId MainWindow::startMatching() {
         if (!doc || doc != document_.get() || outcome.status != core::RunStatus::Completed) return;
         doc->setDisparity(outcome.disparity);
         statusBar()->showMessage(tr("Disparity computed."), 5000);
+        const int waiting = std::exchange(awaitingDisparity_, -1);
+        const Building* b = doc->project().find(waiting);
+        if (b != nullptr && b->status == BuildingStatus::Pending) startDelineation(waiting);
         emit matchingFinished();
       },
       QStringLiteral("matching"));

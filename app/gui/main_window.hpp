@@ -212,6 +212,7 @@ class MainWindow : public QMainWindow {
   QLabel* view3DNotice_ = nullptr;
   // Outlines whose energy was asked for, so that one that cannot be scored is not asked again.
   std::map<int, core::Polygon> energyAsked_;
+  int awaitingDisparity_ = -1;  // picked while matching ran: delineated when the disparity arrives
   widgets::JobId matchingJob_ = 0;
   cv::Mat edgeMap_;
   double rightShift_ = 0.0;

@@ -101,3 +101,26 @@ TEST(Pipeline, AnEditedOutlineIsScoredLikeTheActivePolygonScoresItsOwn) {
   const auto worse = project::outlineEnergy(s.project, s.building, s.pair, shifted, nullptr);
   EXPECT_GT(worse.energy, outcome.energy + 0.01 * std::abs(outcome.energy));
 }
+
+TEST(Pipeline, TheProjectsRangeIsTheRangeTheMatcherSearches) {
+  SceneProject s = makeSceneProject();
+  // Share of the roof pixels (true disparity above 16 px) matched within 1 px of the truth.
+  const auto roofsFound = [&](const cv::Mat& d) {
+    int roof = 0, right = 0;
+    for (int y = 0; y < d.rows; ++y) {
+      for (int x = 0; x < d.cols; ++x) {
+        const float truth = s.scene.disparity.at<float>(y, x);
+        if (!(truth > 16.0f)) continue;
+        ++roof;
+        right += std::abs(d.at<float>(y, x) - truth) <= 1.0f;
+      }
+    }
+    return roof > 0 ? static_cast<double>(right) / roof : 0.0;
+  };
+  s.project.disparityRange = project::DisparityInterval{s.scene.disparityMin, 12};
+  const double narrow = roofsFound(project::computeDisparity(s.project, s.pair.left, s.pair.right, nullptr).disparity);
+  s.project.disparityRange = project::DisparityInterval{s.scene.disparityMin, s.scene.disparityMax};
+  const double full = roofsFound(project::computeDisparity(s.project, s.pair.left, s.pair.right, nullptr).disparity);
+  EXPECT_LT(narrow, 0.05);
+  EXPECT_GT(full, 0.6);
+}

@@ -117,6 +117,8 @@ class MainWindowTest : public QObject {
     QCoreApplication::setOrganizationName(QStringLiteral("DelineoTest"));
     QSettings().clear();
     QSettings().setValue(QStringLiteral("autoMatch"), false);
+    // Each step is driven by the test (the automatic run on pick is tested on its own).
+    QSettings().setValue(QStringLiteral("delineateOnPick"), false);
     QVERIFY(dir_.isValid());
     if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
     // Made on a worker thread, as the application does (its job runner).

@@ -17,6 +17,8 @@
 
 #include "delineo/io/raster.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/widgets/image_view.hpp"
+#include "delineo/widgets/job_runner.hpp"
 #include "delineo/widgets/parameter_form.hpp"
 #include "document.hpp"
 #include "main_window.hpp"
@@ -198,6 +200,30 @@ class ProjectSettingsTest : public QObject {
     // Undo brings the old outline's energy back without a new job.
     doc->undoStack()->undo();
     QCOMPARE(doc->project().find(id)->energy, -1.0);
+  }
+
+  void aPickStartsTheActivePolygonOnceTheDisparityIsThere() {
+    if (!project::delineationAvailable() || !project::matchingAvailable()) QSKIP("needs the matcher and the active polygon");
+    QVERIFY(window_->openProject(projectPath_));  // no disparity yet, automatic matching off
+    QVERIFY(window_->action(QStringLiteral("actionDelineateOnPick"))->isChecked());
+    gui::Document* doc = window_->document();
+    QSignalSpy finished(window_.get(), &MainWindow::delineationFinished);
+    QSignalSpy started(window_->jobs(), &widgets::JobRunner::started);
+    // Picked while there is no disparity: it waits for the matching.
+    emit window_->leftView()->rectanglePicked(QRectF(92, 82, 76, 56));
+    const int id = window_->selectedBuilding();
+    QVERIFY(id > 0);
+    QCOMPARE(started.count(), 0);
+    window_->startMatching();
+    QTRY_COMPARE_WITH_TIMEOUT(finished.count(), 1, 120000);
+    QCOMPARE(finished.takeFirst().at(0).toInt(), id);
+    QVERIFY(doc->project().find(id)->status == project::BuildingStatus::Automatic);
+    // With the disparity there, the next pick runs at once.
+    emit window_->leftView()->rectanglePicked(QRectF(300, 200, 60, 50));
+    const int second = window_->selectedBuilding();
+    QVERIFY(second != id);
+    QTRY_COMPARE_WITH_TIMEOUT(finished.count(), 1, 120000);
+    QCOMPARE(finished.takeFirst().at(0).toInt(), second);
   }
 
   void cleanupTestCase() { window_.reset(); }
