@@ -136,8 +136,13 @@ double groundLevelOf(const std::vector<float>& band, const RoofIntervalParams& p
   size_t i = 0;
   while (i < mass.size() && mass[i] < needed) ++i;
   if (i == mass.size()) i = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
-  while (i + 1 < mass.size() && mass[i + 1] >= mass[i]) ++i;
-  const double level = h.centre(i);
+  // Ground is not one level (terrain slope, kerbs, a car park lower than the lawn): the most
+  // populated level within `groundSpan` above the lowest well-populated one.
+  size_t best = i;
+  for (size_t j = i; j < mass.size() && h.centre(j) <= h.centre(i) + params.groundSpan; ++j) {
+    if (mass[j] > mass[best]) best = j;
+  }
+  const double level = h.centre(best);
   std::vector<float> near;
   for (float v : band) {
     if (std::abs(v - level) <= params.groundWindow) near.push_back(v);
@@ -178,8 +183,12 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
   const Histogram h = histogram(roof, params.binWidth);
   const std::vector<double> smooth = smoothed(h.counts, params.smoothing / params.binWidth);
   const std::vector<double> mass = windowSums(h.counts, std::max(1, static_cast<int>(std::lround(1.0 / params.binWidth))));
-  const double floorLevel = std::isfinite(out.groundLevel) ? out.groundLevel + params.minRoofHeight
-                                                           : -std::numeric_limits<double>::infinity();
+  // A ground level above the core's most populated level is a neighbour's roof (the band saw no
+  // ground): then it does not bound the roof peak.
+  const size_t mode = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  const double floorLevel = std::isfinite(out.groundLevel) && out.groundLevel < h.centre(mode) + params.minRoofHeight
+                                ? out.groundLevel + params.minRoofHeight
+                                : -std::numeric_limits<double>::infinity();
   // The most populated level above the ground (mass within ±1 px), then its highest bin.
   size_t best = h.counts.size();
   for (size_t i = 0; i < h.counts.size(); ++i) {
@@ -203,7 +212,7 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
   while (hi + 1 < smooth.size() && smooth[hi + 1] >= threshold) ++hi;
   out.low = static_cast<int>(std::floor(h.centre(lo) - 0.5 * h.width)) - params.padding;
   out.high = static_cast<int>(std::ceil(h.centre(hi) + 0.5 * h.width)) + params.padding;
-  if (std::isfinite(out.groundLevel)) {
+  if (std::isfinite(floorLevel)) {
     // Never down to the ground itself, or the roof and ground costs would agree there.
     out.low = std::max(out.low, static_cast<int>(std::floor(out.groundLevel)) + 1);
     out.low = std::min(out.low, static_cast<int>(std::floor(out.peak)));

@@ -16,9 +16,10 @@ struct RoofIntervalParams {
   double minRoofHeight = 3.0;   // px of disparity: a roof peak lies at least this above the ground level
   double peakFraction = 0.2;    // the interval spans the peak down to this share of its height
   int padding = 1;              // px added on each side of the interval
-  double groundMargin = 40.0;   // px, width of the neighbourhood outside the polygon searched for ground
-  double groundShare = 0.1;     // share of the neighbourhood's matched pixels a ground level must hold
+  double groundMargin = 120.0;  // px, width of the neighbourhood outside the polygon searched for ground
+  double groundShare = 0.05;    // share of the neighbourhood's matched pixels a ground level must hold
   double groundWindow = 2.0;    // px, half width of the disparity window counted around a ground level
+  double groundSpan = 8.0;      // px, the ground is the most populated level this far above the lowest one
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"bin-width", "Bin width", "px", "Width of a bin of the disparity histograms", 0.05, 10},
@@ -45,6 +46,9 @@ struct RoofIntervalParams {
     v(core::ParamInfo{"ground-window", "Ground window", "px",
                       "Half width of the disparity window counted around a candidate ground level", 0.25, 50},
       groundWindow);
+    v(core::ParamInfo{"ground-span", "Ground span", "px",
+                      "The ground is the most populated level up to this far above the lowest well-populated one", 0, 100},
+      groundSpan);
   }
   void validate() const;
 };
@@ -58,15 +62,17 @@ struct RoofIntervalProposal {
   int groundSamples = 0;     // matched pixels of the neighbourhood
 };
 
-// Ground level (px) around `polygon`: the lowest disparity level that holds at least
-// `groundShare` of the matched pixels of a band `groundMargin` px wide outside the polygon
-// (the median of the pixels within `groundWindow` of that level). NaN when the band holds no
+// Ground level (px) around `polygon`, from the matched pixels of a band `groundMargin` px wide
+// outside it: the lowest level holding at least `groundShare` of them (counted within
+// `groundWindow`), then the most populated level up to `groundSpan` above it, refined as the
+// median of the pixels within `groundWindow` of that level. NaN when the band holds no
 // matched pixel. `disparity` is float32 in left-image geometry, NaN = no value.
 double estimateGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon,
                            const RoofIntervalParams& params = {});
 
 // Roof interval: the most populated histogram peak of the polygon's core (the polygon shrunk by
-// `coreShrink`) at least `minRoofHeight` above the ground level, widened to where the smoothed
+// `coreShrink`) at least `minRoofHeight` above the ground level (unless that level lies above
+// the core's own most populated level, i.e. is a neighbour's roof), widened to where the smoothed
 // histogram falls under `peakFraction` of the peak, plus `padding`. Throws InvalidParameter for
 // a wrong map type or bad parameters; `found` is false when the polygon holds < 10 matched pixels.
 RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon,

@@ -49,7 +49,7 @@ MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, co
 // holds fewer than 10 finite disparities or the active polygon is not part of this build.
 std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon);
 
-// Ground level (px) around a polygon: the lowest well-populated disparity level of a 40 px band
+// Ground level (px) around a polygon: the main low disparity level of a 120 px band
 // outside it (delineation::estimateGroundLevel). The histogram's ground line and the roof
 // interval above use the same estimate. nullopt when no disparity is finite there.
 std::optional<double> suggestGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon);
