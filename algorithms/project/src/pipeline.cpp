@@ -17,6 +17,7 @@
 #endif
 #ifdef DELINEO_HAVE_DELINEATION
 #include "delineation_bridge.hpp"
+#include "delineo/delineation/roof_interval.hpp"
 #endif
 
 namespace delineo::project {
@@ -125,22 +126,27 @@ float percentile(std::vector<float>& values, double q) {
 }  // namespace
 
 std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon) {
-  std::vector<float> values = finiteValuesInside(disparity, polygon);
-  if (values.size() < 10) return std::nullopt;
-  // A rough polygon holds ground as well as roof: the low decile stands for the ground, and the
-  // roof is what lies clearly above it. Its 10th..95th percentiles make the band, which drops
-  // stray matches and walls.
-  const float ground = percentile(values, 0.1);
-  const float high = percentile(values, 0.98);
-  const float threshold = ground + std::max(2.0f, 0.3f * (high - ground));
-  std::vector<float> above;
-  for (float v : values) {
-    if (v > threshold) above.push_back(v);
-  }
-  if (above.size() < 10) above = values;
-  const float low = percentile(above, 0.1);
-  const float top = percentile(above, 0.95);
-  return DisparityInterval{static_cast<int>(std::floor(low)), static_cast<int>(std::ceil(top))};
+#ifdef DELINEO_HAVE_DELINEATION
+  if (disparity.empty()) return std::nullopt;
+  const delineation::RoofIntervalProposal p = delineation::proposeRoofInterval(disparity, polygon);
+  if (!p.found) return std::nullopt;
+  return DisparityInterval{p.low, p.high};
+#else
+  (void)disparity, (void)polygon;
+  return std::nullopt;
+#endif
+}
+
+std::optional<double> suggestGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon) {
+#ifdef DELINEO_HAVE_DELINEATION
+  if (disparity.empty()) return std::nullopt;
+  const double level = delineation::estimateGroundLevel(disparity, polygon);
+  if (!std::isfinite(level)) return std::nullopt;
+  return level;
+#else
+  (void)disparity, (void)polygon;
+  return std::nullopt;
+#endif
 }
 
 double roofHeight(const Project& project, const cv::Mat& disparity, const core::Polygon& polygon) {

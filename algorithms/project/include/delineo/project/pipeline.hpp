@@ -44,10 +44,16 @@ struct MatchingOutcome {
 MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, const cv::Mat& right,
                                  core::Progress* progress);
 
-// Roof disparity interval suggested from the disparities inside a polygon: the 20th..90th
-// percentile band of its finite values (ground and walls inside a rough polygon sit below the
-// roof). nullopt when the polygon holds fewer than 10 finite disparities.
+// Roof disparity interval suggested for an operator's rough polygon: the most populated
+// histogram peak inside it, away from its border and above the ground level, as wide as the
+// peak's spread (delineation::proposeRoofInterval, default parameters). nullopt when the polygon
+// holds fewer than 10 finite disparities or the active polygon is not part of this build.
 std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon);
+
+// Ground level (px) around a polygon: the main low disparity level of a 120 px band
+// outside it (delineation::estimateGroundLevel). The histogram's ground line and the roof
+// interval above use the same estimate. nullopt when no disparity is finite there.
+std::optional<double> suggestGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon);
 
 // Median disparity inside `polygon` turned into metres by the project's height model; NaN when
 // the model is unknown or no disparity is finite there.

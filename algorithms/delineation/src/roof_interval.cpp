@@ -1,0 +1,224 @@
+#include "delineo/delineation/roof_interval.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+
+namespace delineo::delineation {
+
+using core::Error;
+using core::ErrorCode;
+
+void RoofIntervalParams::validate() const { core::checkDeclaredRanges(*this); }
+
+namespace {
+
+// The polygon's neighbourhood: its box grown by `margin` (clipped to the image), the polygon
+// rasterised there, and each pixel's distance to the polygon's inside and outside.
+struct Neighbourhood {
+  cv::Rect roi;
+  cv::Mat inside;        // CV_8U, 255 inside the polygon (holes excluded)
+  cv::Mat depth;         // CV_32F, distance of an inside pixel to the nearest outside pixel
+  cv::Mat outerDistance; // CV_32F, distance of a pixel to the polygon's outer ring's inside
+};
+
+Neighbourhood neighbourhood(const cv::Mat& disparity, const core::Polygon& polygon, double margin) {
+  if (disparity.empty() || disparity.type() != CV_32FC1) {
+    throw Error(ErrorCode::UnsupportedInput, "the disparity map must be single-band float32");
+  }
+  Neighbourhood n;
+  if (polygon.outer.size() < 3) return n;
+  const cv::Rect2d box = core::boundingBox(polygon.outer);
+  const int m = static_cast<int>(std::ceil(margin)) + 2;
+  const int x0 = static_cast<int>(std::floor(box.x)) - m, y0 = static_cast<int>(std::floor(box.y)) - m;
+  const int x1 = static_cast<int>(std::ceil(box.x + box.width)) + m;
+  const int y1 = static_cast<int>(std::ceil(box.y + box.height)) + m;
+  n.roi = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, disparity.cols, disparity.rows);
+  if (n.roi.empty()) return n;
+  core::Polygon local = polygon;
+  const cv::Point2d shift(n.roi.x, n.roi.y);
+  for (auto& p : local.outer) p -= shift;
+  for (auto& hole : local.holes) {
+    for (auto& p : hole) p -= shift;
+  }
+  n.inside = core::rasterize(local, n.roi.size());
+  // Pixels outside the image count as outside: pad by one pixel before the distance transform.
+  cv::Mat padded;
+  cv::copyMakeBorder(n.inside, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  cv::distanceTransform(padded, n.depth, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  n.depth = n.depth(cv::Rect(1, 1, n.roi.width, n.roi.height)).clone();
+  local.holes.clear();
+  const cv::Mat outer = core::rasterize(local, n.roi.size());
+  cv::distanceTransform(outer == 0, n.outerDistance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  return n;
+}
+
+std::vector<float> samples(const cv::Mat& disparity, const cv::Rect& roi, const cv::Mat& mask) {
+  std::vector<float> out;
+  for (int y = 0; y < roi.height; ++y) {
+    const float* d = disparity.ptr<float>(roi.y + y) + roi.x;
+    const uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      if (m[x] != 0 && std::isfinite(d[x])) out.push_back(d[x]);
+    }
+  }
+  return out;
+}
+
+// Histogram of `values` in bins of `width` starting at `origin`.
+struct Histogram {
+  double origin = 0.0, width = 1.0;
+  std::vector<double> counts;
+  double centre(size_t i) const { return origin + (static_cast<double>(i) + 0.5) * width; }
+};
+
+Histogram histogram(const std::vector<float>& values, double width) {
+  Histogram h;
+  h.width = width;
+  const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  h.origin = std::floor(*lo / width) * width;
+  h.counts.assign(static_cast<size_t>((*hi - h.origin) / width) + 1, 0.0);
+  for (float v : values) {
+    const size_t i = std::min(h.counts.size() - 1, static_cast<size_t>((v - h.origin) / width));
+    h.counts[i] += 1.0;
+  }
+  return h;
+}
+
+std::vector<double> smoothed(const std::vector<double>& counts, double sigmaBins) {
+  if (sigmaBins <= 0.0) return counts;
+  const int r = static_cast<int>(std::ceil(3.0 * sigmaBins));
+  std::vector<double> kernel(static_cast<size_t>(2 * r + 1));
+  for (int k = -r; k <= r; ++k) kernel[static_cast<size_t>(k + r)] = std::exp(-0.5 * k * k / (sigmaBins * sigmaBins));
+  std::vector<double> out(counts.size(), 0.0);
+  const int n = static_cast<int>(counts.size());
+  for (int i = 0; i < n; ++i) {
+    for (int k = -r; k <= r; ++k) {
+      const int j = i + k;
+      if (j >= 0 && j < n) out[static_cast<size_t>(i)] += kernel[static_cast<size_t>(k + r)] * counts[static_cast<size_t>(j)];
+    }
+  }
+  return out;
+}
+
+// Sum of the counts within `halfBins` bins of each bin.
+std::vector<double> windowSums(const std::vector<double>& counts, int halfBins) {
+  const int n = static_cast<int>(counts.size());
+  std::vector<double> prefix(counts.size() + 1, 0.0);
+  for (int i = 0; i < n; ++i) prefix[static_cast<size_t>(i + 1)] = prefix[static_cast<size_t>(i)] + counts[static_cast<size_t>(i)];
+  std::vector<double> out(counts.size());
+  for (int i = 0; i < n; ++i) {
+    const int a = std::max(0, i - halfBins), b = std::min(n, i + halfBins + 1);
+    out[static_cast<size_t>(i)] = prefix[static_cast<size_t>(b)] - prefix[static_cast<size_t>(a)];
+  }
+  return out;
+}
+
+double median(std::vector<float> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+double groundLevelOf(const std::vector<float>& band, const RoofIntervalParams& params) {
+  if (band.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const Histogram h = histogram(band, params.binWidth);
+  const int half = std::max(1, static_cast<int>(std::lround(params.groundWindow / params.binWidth)));
+  const std::vector<double> mass = windowSums(h.counts, half);
+  const double needed = params.groundShare * static_cast<double>(band.size());
+  // The lowest level holding enough of the band, then up to the top of that mass's peak.
+  size_t i = 0;
+  while (i < mass.size() && mass[i] < needed) ++i;
+  if (i == mass.size()) i = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  // Ground is not one level (terrain slope, kerbs, a car park lower than the lawn): the most
+  // populated level within `groundSpan` above the lowest well-populated one.
+  size_t best = i;
+  for (size_t j = i; j < mass.size() && h.centre(j) <= h.centre(i) + params.groundSpan; ++j) {
+    if (mass[j] > mass[best]) best = j;
+  }
+  const double level = h.centre(best);
+  std::vector<float> near;
+  for (float v : band) {
+    if (std::abs(v - level) <= params.groundWindow) near.push_back(v);
+  }
+  return median(near);
+}
+
+}  // namespace
+
+double estimateGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon, const RoofIntervalParams& params) {
+  params.validate();
+  const Neighbourhood n = neighbourhood(disparity, polygon, params.groundMargin);
+  if (n.inside.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const cv::Mat band = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
+  return groundLevelOf(samples(disparity, n.roi, band), params);
+}
+
+RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon,
+                                         const RoofIntervalParams& params) {
+  params.validate();
+  RoofIntervalProposal out;
+  const Neighbourhood n = neighbourhood(disparity, polygon, params.groundMargin);
+  if (n.inside.empty()) return out;
+  const cv::Mat band = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
+  const std::vector<float> ground = samples(disparity, n.roi, band);
+  out.groundSamples = static_cast<int>(ground.size());
+  out.groundLevel = groundLevelOf(ground, params);
+
+  // The polygon's core: away from its border, where a rough outline holds ground, walls and
+  // parapets. A small polygon keeps at least half of its inradius.
+  const cv::Rect2d box = core::boundingBox(polygon.outer);
+  const double shrink = std::min(params.coreShrink, 0.25 * std::min(box.width, box.height));
+  std::vector<float> roof = samples(disparity, n.roi, n.depth > static_cast<float>(shrink));
+  if (roof.size() < 10) roof = samples(disparity, n.roi, n.inside);
+  out.roofSamples = static_cast<int>(roof.size());
+  if (roof.size() < 10) return out;
+
+  const Histogram h = histogram(roof, params.binWidth);
+  const std::vector<double> smooth = smoothed(h.counts, params.smoothing / params.binWidth);
+  const std::vector<double> mass = windowSums(h.counts, std::max(1, static_cast<int>(std::lround(1.0 / params.binWidth))));
+  // A ground level above the core's most populated level is a neighbour's roof (the band saw no
+  // ground): then it does not bound the roof peak.
+  const size_t mode = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  const double floorLevel = std::isfinite(out.groundLevel) && out.groundLevel < h.centre(mode) + params.minRoofHeight
+                                ? out.groundLevel + params.minRoofHeight
+                                : -std::numeric_limits<double>::infinity();
+  // The most populated level above the ground (mass within ±1 px), then its highest bin.
+  size_t best = h.counts.size();
+  for (size_t i = 0; i < h.counts.size(); ++i) {
+    if (h.centre(i) >= floorLevel && (best == h.counts.size() || mass[i] > mass[best])) best = i;
+  }
+  if (best == h.counts.size() || mass[best] <= 0.0) {
+    best = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  }
+  const int reach = std::max(1, static_cast<int>(std::lround(1.0 / params.binWidth)));
+  size_t peak = best;
+  for (size_t i = best > static_cast<size_t>(reach) ? best - static_cast<size_t>(reach) : 0;
+       i <= std::min(h.counts.size() - 1, best + static_cast<size_t>(reach)); ++i) {
+    if (smooth[i] > smooth[peak]) peak = i;
+  }
+  out.peak = h.centre(peak);
+
+  // The peak's spread: down to `peakFraction` of its height on each side.
+  const double threshold = params.peakFraction * smooth[peak];
+  size_t lo = peak, hi = peak;
+  while (lo > 0 && smooth[lo - 1] >= threshold && h.centre(lo - 1) >= floorLevel) --lo;
+  while (hi + 1 < smooth.size() && smooth[hi + 1] >= threshold) ++hi;
+  out.low = static_cast<int>(std::floor(h.centre(lo) - 0.5 * h.width)) - params.padding;
+  out.high = static_cast<int>(std::ceil(h.centre(hi) + 0.5 * h.width)) + params.padding;
+  if (std::isfinite(floorLevel)) {
+    // Never down to the ground itself, or the roof and ground costs would agree there.
+    out.low = std::max(out.low, static_cast<int>(std::floor(out.groundLevel)) + 1);
+    out.low = std::min(out.low, static_cast<int>(std::floor(out.peak)));
+  }
+  out.found = true;
+  return out;
+}
+
+}  // namespace delineo::delineation

@@ -1,0 +1,134 @@
+// Roof interval and ground level proposal on synthetic disparity maps.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "delineo/core/error.hpp"
+#include "delineo/delineation/roof_interval.hpp"
+
+namespace {
+
+using delineo::core::Polygon;
+using delineo::delineation::estimateGroundLevel;
+using delineo::delineation::proposeRoofInterval;
+using delineo::delineation::RoofIntervalParams;
+
+Polygon rectangle(double x0, double y0, double x1, double y1) {
+  Polygon p;
+  p.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  return p;
+}
+
+// Deterministic noise of about ±0.4 px.
+void addNoise(cv::Mat& map) {
+  cv::Mat noise(map.size(), CV_32F);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::UNIFORM, -0.4, 0.4);
+  map += noise;
+}
+
+// The scene of the real case that motivated the proposal: a large flat roof at 71.5 px with a
+// 4 px parapet at 75 px, a neighbouring roof at 59.5 px along its whole north side, ground at 8 px.
+cv::Mat bigRoofScene() {
+  cv::Mat map(400, 400, CV_32F, cv::Scalar(8.0f));
+  map(cv::Rect(0, 0, 400, 100)).setTo(59.5f);              // neighbour north of the roof
+  map(cv::Rect(100, 100, 220, 200)).setTo(75.0f);          // parapet
+  map(cv::Rect(104, 104, 212, 192)).setTo(71.5f);          // roof
+  addNoise(map);
+  return map;
+}
+
+TEST(RoofInterval, ContainsTheMainPeakOfARoofWithParapetsAndFindsTheGroundBesideTheNeighbour) {
+  const cv::Mat map = bigRoofScene();
+  // A rough rectangle 10 px larger than the roof on each side, except on the north where it
+  // stops at the neighbour.
+  const auto p = proposeRoofInterval(map, rectangle(90, 100, 330, 310));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.peak, 71.5, 0.5);
+  EXPECT_LE(p.low, 71);
+  EXPECT_GE(p.high, 72);
+  EXPECT_LT(p.high - p.low, 8);
+  EXPECT_GT(p.low, 60);  // the neighbour's level is not roof
+  EXPECT_NEAR(p.groundLevel, 8.0, 1.0);  // not the neighbour at 59.5, which the north band holds
+}
+
+TEST(RoofInterval, TightPolygonStillFindsTheRoofPeakAndNotTheParapet) {
+  const cv::Mat map = bigRoofScene();
+  const auto p = proposeRoofInterval(map, rectangle(100, 100, 320, 300));
+  ASSERT_TRUE(p.found);
+  EXPECT_LE(p.low, 71);
+  EXPECT_GE(p.high, 72);
+}
+
+TEST(RoofInterval, RoughRectangleMostlyOverGroundStillProposesTheRoof) {
+  cv::Mat map(300, 300, CV_32F, cv::Scalar(-4.0f));
+  map(cv::Rect(120, 120, 40, 40)).setTo(30.0f);
+  addNoise(map);
+  // 30 px larger than the roof on each side: ground is 80 % of the rectangle.
+  const auto p = proposeRoofInterval(map, rectangle(90, 90, 190, 190));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.peak, 30.0, 0.5);
+  EXPECT_LE(p.low, 30);
+  EXPECT_GE(p.high, 30);
+  EXPECT_GT(p.low, 0);
+  EXPECT_NEAR(p.groundLevel, -4.0, 0.5);
+}
+
+TEST(RoofInterval, SlopedRoofGetsAnIntervalAsWideAsItsSpread) {
+  cv::Mat map(300, 300, CV_32F, cv::Scalar(5.0f));
+  for (int y = 100; y < 200; ++y) {
+    for (int x = 100; x < 200; ++x) map.at<float>(y, x) = 40.0f + 0.1f * static_cast<float>(x - 100);  // 40..50
+  }
+  const auto p = proposeRoofInterval(map, rectangle(95, 95, 205, 205));
+  ASSERT_TRUE(p.found);
+  EXPECT_LE(p.low, 42);
+  EXPECT_GE(p.high, 48);
+}
+
+TEST(GroundLevel, IsTheLowestWellPopulatedLevelNotTheMostFrequentOne) {
+  cv::Mat map(300, 300, CV_32F, cv::Scalar(20.0f));  // neighbouring roofs all around
+  map(cv::Rect(0, 200, 300, 100)).setTo(6.0f);       // a street along the south side
+  map(cv::Rect(0, 0, 20, 20)).setTo(-10.0f);         // a few stray low matches
+  addNoise(map);
+  const double g = estimateGroundLevel(map, rectangle(100, 100, 200, 180));
+  EXPECT_NEAR(g, 6.0, 0.5);
+}
+
+TEST(GroundLevel, NaNWhenTheNeighbourhoodHasNoMatchedPixel) {
+  cv::Mat map(100, 100, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  map(cv::Rect(40, 40, 20, 20)).setTo(30.0f);
+  EXPECT_TRUE(std::isnan(estimateGroundLevel(map, rectangle(40, 40, 60, 60))));
+  const auto p = proposeRoofInterval(map, rectangle(40, 40, 60, 60));
+  ASSERT_TRUE(p.found);  // a roof without known ground: the most populated peak
+  EXPECT_LE(p.low, 30);
+  EXPECT_GE(p.high, 30);
+}
+
+TEST(RoofInterval, NotFoundWithTooFewMatchedPixels) {
+  cv::Mat map(100, 100, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  EXPECT_FALSE(proposeRoofInterval(map, rectangle(40, 40, 60, 60)).found);
+}
+
+TEST(RoofInterval, RejectsAMapThatIsNotFloat) {
+  const cv::Mat map(50, 50, CV_8U, cv::Scalar(3));
+  try {
+    proposeRoofInterval(map, rectangle(10, 10, 20, 20));
+    FAIL() << "expected an error";
+  } catch (const delineo::core::Error& e) {
+    EXPECT_EQ(e.code(), delineo::core::ErrorCode::UnsupportedInput);
+  }
+}
+
+TEST(RoofInterval, ParametersOutsideTheirDomainAreRejected) {
+  RoofIntervalParams params;
+  params.peakFraction = 1.5;
+  EXPECT_THROW(params.validate(), delineo::core::Error);
+  params = {};
+  params.groundShare = 0.0;
+  EXPECT_THROW(params.validate(), delineo::core::Error);
+  EXPECT_NO_THROW(RoofIntervalParams{}.validate());
+}
+
+}  // namespace

@@ -1,0 +1,50 @@
+// project::suggestRoofInterval and project::suggestGroundLevel: the proposal the GUI's histogram
+// and `delineo-cli run` share.
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "delineo/project/pipeline.hpp"
+
+using namespace delineo;
+
+namespace {
+
+core::Polygon rectangle(double x0, double y0, double x1, double y1) {
+  core::Polygon p;
+  p.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  return p;
+}
+
+// A flat roof at 71.5 px inside a 75 px parapet, a neighbour at 59.5 px north of it, ground at
+// 8 px: the polygon percentiles used before proposed the parapet's [73, 76] and the ring around
+// the polygon the neighbour's 59.5 px.
+cv::Mat roofScene() {
+  cv::Mat map(400, 400, CV_32F, cv::Scalar(8.0f));
+  map(cv::Rect(0, 0, 400, 100)).setTo(59.5f);
+  map(cv::Rect(100, 100, 220, 200)).setTo(75.0f);
+  map(cv::Rect(104, 104, 212, 192)).setTo(71.5f);
+  cv::Mat noise(map.size(), CV_32F);
+  cv::RNG rng(3);
+  rng.fill(noise, cv::RNG::UNIFORM, -0.4, 0.4);
+  return map + noise;
+}
+
+}  // namespace
+
+TEST(Suggestions, RoofIntervalHoldsTheRoofPeakAndGroundLevelIsTheStreet) {
+  if (!project::delineationAvailable()) GTEST_SKIP() << "the active polygon is not part of this build";
+  const cv::Mat map = roofScene();
+  const core::Polygon picked = rectangle(96, 100, 324, 304);
+  const auto interval = project::suggestRoofInterval(map, picked);
+  ASSERT_TRUE(interval.has_value());
+  EXPECT_LE(interval->low, 71);
+  EXPECT_GE(interval->high, 72);
+  const auto ground = project::suggestGroundLevel(map, picked);
+  ASSERT_TRUE(ground.has_value());
+  EXPECT_NEAR(*ground, 8.0, 1.0);
+}
+
+TEST(Suggestions, NothingWithoutADisparityMap) {
+  EXPECT_FALSE(project::suggestRoofInterval(cv::Mat(), rectangle(0, 0, 10, 10)).has_value());
+  EXPECT_FALSE(project::suggestGroundLevel(cv::Mat(), rectangle(0, 0, 10, 10)).has_value());
+}

@@ -1,0 +1,209 @@
+// Roof interval and ground level proposal on hand-labelled real roofs (tests/bench/data/
+// real_roofs.json). For each roof and each operator rectangle (the outline's box grown by 8, 15
+// and 30 px, clipped to the image) it prints the roof's main peak (mode of the matcher's
+// disparities inside the outline shrunk by 3 px), the proposed interval and whether it holds the
+// peak, and the ground level against the roof's ground reference; "before" columns show the
+// functions the GUI used until now (polygon percentiles, median of an 8 px ring).
+// Skips cleanly (exit 0) when the data folder is missing. Disparity maps are cached.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/allocator.hpp"
+#include "delineo/core/error.hpp"
+#include "delineo/core/geometry.hpp"
+#include "delineo/delineation/roof_interval.hpp"
+#include "delineo/io/raster.hpp"
+#include "delineo/stereo/match.hpp"
+
+namespace fs = std::filesystem;
+using namespace delineo;
+
+namespace {
+
+core::Polygon ringOf(const nlohmann::json& points) {
+  core::Polygon p;
+  for (const auto& v : points) p.outer.emplace_back(v.at(0).get<double>(), v.at(1).get<double>());
+  return p;
+}
+
+std::vector<float> valuesIn(const cv::Mat& map, const cv::Mat& mask) {
+  std::vector<float> out;
+  for (int y = 0; y < map.rows; ++y) {
+    for (int x = 0; x < map.cols; ++x) {
+      const float v = map.at<float>(y, x);
+      if (mask.at<uchar>(y, x) != 0 && std::isfinite(v)) out.push_back(v);
+    }
+  }
+  return out;
+}
+
+double quantile(std::vector<float> v, double q) {
+  if (v.empty()) return std::nan("");
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// Mode of the disparities inside the outline shrunk by 3 px, in 1 px bins centred on integers.
+int mainPeak(const cv::Mat& map, const core::Polygon& outline) {
+  cv::Mat inside = core::rasterize(outline, map.size()), depth;
+  cv::Mat padded;
+  cv::copyMakeBorder(inside, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  cv::distanceTransform(padded, depth, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  const cv::Mat core = depth(cv::Rect(1, 1, map.cols, map.rows)) > 3.0f;
+  std::map<int, int> counts;
+  for (float v : valuesIn(map, core)) ++counts[static_cast<int>(std::lround(v))];
+  int best = 0, n = -1;
+  for (const auto& [d, c] : counts) {
+    if (c > n) best = d, n = c;
+  }
+  return best;
+}
+
+// Before: the polygon's 10th..95th percentiles above "low decile + 30 % of the span".
+std::pair<int, int> oldInterval(const cv::Mat& map, const core::Polygon& polygon) {
+  std::vector<float> values = valuesIn(map, core::rasterize(polygon, map.size()));
+  if (values.size() < 10) return {0, -1};
+  const float ground = static_cast<float>(quantile(values, 0.1));
+  const float high = static_cast<float>(quantile(values, 0.98));
+  const float threshold = ground + std::max(2.0f, 0.3f * (high - ground));
+  std::vector<float> above;
+  for (float v : values) {
+    if (v > threshold) above.push_back(v);
+  }
+  if (above.size() < 10) above = values;
+  return {static_cast<int>(std::floor(quantile(above, 0.1))), static_cast<int>(std::ceil(quantile(above, 0.95)))};
+}
+
+// Before: median of an 8 px ring outside the polygon.
+double oldGround(const cv::Mat& map, const core::Polygon& polygon) {
+  const cv::Mat inside = core::rasterize(polygon, map.size());
+  cv::Mat grown;
+  cv::dilate(inside, grown, cv::getStructuringElement(cv::MORPH_RECT, {17, 17}));
+  return quantile(valuesIn(map, grown & ~inside), 0.5);
+}
+
+cv::Mat readGroundTruth(const std::string& path, double scale) {
+  io::ReadOptions options;
+  options.type = io::PixelType::Float32;
+  cv::Mat gt = io::readRaster(path, options).data;
+  gt /= scale;
+  gt.setTo(std::nanf(""), gt <= 0.0f);
+  return gt;
+}
+
+cv::Mat disparityFor(const std::string& name, const std::string& left, const std::string& right, int dmin,
+                     int dmax, const fs::path& cache) {
+  const fs::path cached = cache / (name + "_" + std::to_string(dmin) + "_" + std::to_string(dmax) + ".tif");
+  if (fs::exists(cached)) {
+    io::ReadOptions options;
+    options.type = io::PixelType::Float32;
+    return io::readRaster(cached.string(), options).data;
+  }
+  stereo::MatchParams params;
+  params.dmin = dmin;
+  params.dmax = dmax;
+  std::fprintf(stderr, "matching %s (%d..%d px)...\n", name.c_str(), dmin, dmax);
+  const cv::Mat disparity = stereo::matchStereo(io::readGreyFloat(left), io::readGreyFloat(right), params).disparity;
+  fs::create_directories(cache);
+  io::writeFloatGeoTiff(cached.string(), disparity);
+  return disparity;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  core::tuneAllocatorForLargeImages();
+  std::string dataRoot = "/work/shared/data";
+  std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
+  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
+      dataRoot = argv[++i];
+    } else if (!std::strcmp(argv[i], "--labels") && i + 1 < argc) {
+      labels = argv[++i];
+    } else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) {
+      cache = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: bench_roof_interval [--data DIR] [--labels real_roofs.json] [--cache DIR]\n");
+      return 2;
+    }
+  }
+  if (!fs::is_directory(dataRoot)) {
+    std::printf("skipped: no data folder %s\n", dataRoot.c_str());
+    return 0;
+  }
+  delineation::RoofIntervalParams params;
+  if (const char* json = std::getenv("BENCH_PARAMS")) core::fromJson(params, nlohmann::json::parse(json));
+  std::ifstream in(labels);
+  const nlohmann::json data = nlohmann::json::parse(in);
+  std::printf("%-18s %4s %5s %6s | %-9s %3s %6s %5s | %-9s %3s %6s %5s %5s\n", "roof", "grow", "peak", "ground",
+              "before", "in", "ground", "err", "after", "in", "ground", "err", "peak*");
+  int runs = 0, oldHits = 0, newHits = 0, oldGroundOk = 0, newGroundOk = 0;
+  double oldErrSum = 0.0, newErrSum = 0.0;
+  std::map<std::string, cv::Mat> maps;
+  for (const auto& roof : data.at("roofs")) {
+    const std::string pairName = roof.at("pair");
+    const auto& pair = data.at("pairs").at(pairName);
+    const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
+    if (!fs::exists(left)) {
+      std::printf("skipped %s: %s missing\n", roof.at("name").get<std::string>().c_str(), left.c_str());
+      continue;
+    }
+    if (!maps.count(pairName)) {
+      maps[pairName] = disparityFor(pairName, left, (fs::path(dataRoot) / pair.at("right").get<std::string>()).string(),
+                                    pair.at("disparity_range").at(0), pair.at("disparity_range").at(1), cache);
+    }
+    const cv::Mat& map = maps[pairName];
+    const core::Polygon outline = ringOf(roof.at("outline"));
+    const core::Polygon groundPolygon = ringOf(roof.at("ground"));
+    double groundRef;
+    if (pair.contains("ground_truth_disparity")) {
+      const cv::Mat gt = readGroundTruth((fs::path(dataRoot) / pair.at("ground_truth_disparity").get<std::string>()).string(),
+                                         pair.value("ground_truth_scale", 1.0));
+      groundRef = quantile(valuesIn(gt, core::rasterize(groundPolygon, gt.size())), 0.5);
+    } else {
+      groundRef = quantile(valuesIn(map, core::rasterize(groundPolygon, map.size())), 0.5);
+    }
+    const int peak = mainPeak(map, outline);
+    const cv::Rect2d box = core::boundingBox(outline.outer);
+    for (int grow : {8, 15, 30}) {
+      const double x0 = std::max(0.0, box.x - grow), y0 = std::max(0.0, box.y - grow);
+      const double x1 = std::min<double>(map.cols, box.x + box.width + grow);
+      const double y1 = std::min<double>(map.rows, box.y + box.height + grow);
+      core::Polygon rect;
+      rect.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+      const auto [ol, oh] = oldInterval(map, rect);
+      const double og = oldGround(map, rect);
+      const auto p = delineation::proposeRoofInterval(map, rect, params);
+      const bool oldIn = ol <= peak && peak <= oh, newIn = p.found && p.low <= peak && peak <= p.high;
+      const double oe = og - groundRef, ne = p.groundLevel - groundRef;
+      std::printf("%-18s %4d %5d %6.1f | [%3d,%3d] %3s %6.1f %+5.1f | [%3d,%3d] %3s %6.1f %+5.1f %5.1f\n",
+                  roof.at("name").get<std::string>().c_str(), grow, peak, groundRef, ol, oh, oldIn ? "yes" : "NO", og,
+                  oe, p.low, p.high, newIn ? "yes" : "NO", p.groundLevel, ne, p.peak);
+      ++runs;
+      oldHits += oldIn, newHits += newIn;
+      oldGroundOk += std::abs(oe) <= 2.0, newGroundOk += std::abs(ne) <= 2.0;
+      oldErrSum += std::abs(oe), newErrSum += std::abs(ne);
+    }
+  }
+  if (runs == 0) {
+    std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
+    return 0;
+  }
+  std::printf("\n%d runs: interval holds the main peak before %d, after %d; ground within 2 px before %d, after %d; "
+              "mean |ground error| before %.1f px, after %.1f px\n",
+              runs, oldHits, newHits, oldGroundOk, newGroundOk, oldErrSum / runs, newErrSum / runs);
+  return 0;
+}
