@@ -1059,7 +1059,7 @@ void MainWindow::refreshHistogram() {
                    static_cast<int>(roi.height()));
   const cv::Mat roiDisparities = disparity(r & cv::Rect(0, 0, disparity.cols, disparity.rows));
   histogram_->setDisparities(roiDisparities);
-  if (auto ground = ringMedian(disparity, b->initial, 8)) histogram_->setGroundLevel(*ground);
+  if (auto ground = project::suggestGroundLevel(disparity, b->initial)) histogram_->setGroundLevel(*ground);
   std::optional<project::DisparityInterval> interval = b->roofInterval;
   if (!interval) interval = project::suggestRoofInterval(disparity, b->initial);
   QString text;
@@ -1166,7 +1166,7 @@ void MainWindow::refreshHeightModelNotice() {
 void MainWindow::openProjectSettings() {
   if (!document_) return;
   ProjectSettingsDialog dialog(document_->project(), document_->path().isEmpty() ? QString() : document_->dialogFolder(),
-                               std::nullopt, this);
+                               project::suggestSceneGroundLevel(document_->disparity()), this);
   bool accepted = false;
   if (projectSettingsHandler_) accepted = projectSettingsHandler_(dialog);
   else if (interactive_) accepted = dialog.exec() == QDialog::Accepted;

@@ -149,6 +149,24 @@ std::optional<double> suggestGroundLevel(const cv::Mat& disparity, const core::P
 #endif
 }
 
+std::optional<double> suggestSceneGroundLevel(const cv::Mat& disparity) {
+#ifdef DELINEO_HAVE_DELINEATION
+  if (disparity.empty()) return std::nullopt;
+  // The same estimate with a band that covers the whole map, around its centre pixel.
+  delineation::RoofIntervalParams params;
+  params.groundMargin = std::max(disparity.cols, disparity.rows);
+  const double cx = disparity.cols / 2, cy = disparity.rows / 2;
+  core::Polygon centre;
+  centre.outer = {{cx, cy}, {cx + 1, cy}, {cx + 1, cy + 1}, {cx, cy + 1}};
+  const double level = delineation::estimateGroundLevel(disparity, centre, params);
+  if (!std::isfinite(level)) return std::nullopt;
+  return level;
+#else
+  (void)disparity;
+  return std::nullopt;
+#endif
+}
+
 double roofHeight(const Project& project, const cv::Mat& disparity, const core::Polygon& polygon) {
   if (!project.height.known()) return std::nan("");
   std::vector<float> values = finiteValuesInside(disparity, polygon);

@@ -48,3 +48,11 @@ TEST(Suggestions, NothingWithoutADisparityMap) {
   EXPECT_FALSE(project::suggestRoofInterval(cv::Mat(), rectangle(0, 0, 10, 10)).has_value());
   EXPECT_FALSE(project::suggestGroundLevel(cv::Mat(), rectangle(0, 0, 10, 10)).has_value());
 }
+
+TEST(Suggestions, TheScenesGroundLevelIsTheStreetNotTheBiggestRoof) {
+  if (!project::delineationAvailable()) GTEST_SKIP() << "the active polygon is not part of this build";
+  const auto ground = project::suggestSceneGroundLevel(roofScene());
+  ASSERT_TRUE(ground.has_value());
+  EXPECT_NEAR(*ground, 8.0, 1.0);
+  EXPECT_FALSE(project::suggestSceneGroundLevel(cv::Mat()).has_value());
+}

@@ -17,6 +17,7 @@
 
 #include "delineo/io/raster.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/widgets/disparity_histogram.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/job_runner.hpp"
 #include "delineo/widgets/parameter_form.hpp"
@@ -104,6 +105,23 @@ class ProjectSettingsTest : public QObject {
              qPrintable(window_->intervalLabel()->text()));
     doc->setDisparityRange(project::DisparityInterval{0, 64}, QStringLiteral("range"));
     QVERIFY(!window_->intervalLabel()->text().contains(QStringLiteral("end of the matched range")));
+  }
+
+  void theHistogramsGroundLineIsTheStreetNotANeighbouringRoof() {
+    gui::Document* doc = window_->document();
+    // A neighbour's roof at 59.5 px wrapped around three sides of the building: the thin ring
+    // around the pick used to land on it.
+    cv::Mat map = roofDisparity(doc->leftGrey().size());
+    map(cv::Rect(40, 30, 180, 54)).setTo(59.5f);
+    map(cv::Rect(40, 84, 52, 60)).setTo(59.5f);
+    map(cv::Rect(168, 84, 52, 60)).setTo(59.5f);
+    doc->setDisparity(map);
+    const int id = addRoofBuilding();
+    window_->selectBuilding(id);
+    QVERIFY(window_->histogram()->groundLevel().has_value());
+    QVERIFY2(std::abs(*window_->histogram()->groundLevel() - 8.0) < 1.0,
+             qPrintable(QString::number(*window_->histogram()->groundLevel())));
+    doc->setDisparity(roofDisparity(doc->leftGrey().size()));
   }
 
   void theHeightModelIsSetInTheWindowAndRoofHeightsFollow() {

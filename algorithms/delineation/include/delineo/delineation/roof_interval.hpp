@@ -38,7 +38,7 @@ struct RoofIntervalParams {
     v(core::ParamInfo{"padding", "Padding", "px", "Disparities added on each side of the interval", 0, 50},
       padding);
     v(core::ParamInfo{"ground-margin", "Ground margin", "px",
-                      "Width of the neighbourhood outside the polygon where the ground level is sought", 4, 1000},
+                      "Width of the neighbourhood outside the polygon where the ground level is sought", 4, 100000},
       groundMargin);
     v(core::ParamInfo{"ground-share", "Ground share", "",
                       "Share of the neighbourhood's matched pixels a level needs to count as ground", 0.001, 1},

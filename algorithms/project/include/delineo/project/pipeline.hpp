@@ -54,6 +54,9 @@ std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, c
 // outside it (delineation::estimateGroundLevel). The histogram's ground line and the roof
 // interval above use the same estimate. nullopt when no disparity is finite there.
 std::optional<double> suggestGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon);
+// The ground level (px) of the whole map, by the same estimate (the height model's ground
+// disparity, proposed to the operator). nullopt when nothing is finite.
+std::optional<double> suggestSceneGroundLevel(const cv::Mat& disparity);
 
 // Median disparity inside `polygon` turned into metres by the project's height model; NaN when
 // the model is unknown or no disparity is finite there.
