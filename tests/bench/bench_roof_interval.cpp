@@ -3,7 +3,8 @@
 // and 30 px, clipped to the image) it prints the roof's main peak (mode of the matcher's
 // disparities inside the outline shrunk by 3 px), the proposed interval and whether it holds the
 // peak, and the ground level against the roof's ground reference; "before" columns show the
-// functions the GUI used until now (polygon percentiles, median of an 8 px ring).
+// functions the GUI used until now (polygon percentiles, median of an 8 px ring). Roofs marked
+// "heldOut" are counted apart: they were not used to choose the method or its defaults.
 // Skips cleanly (exit 0) when the data folder is missing. Disparity maps are cached.
 #include <algorithm>
 #include <cmath>
@@ -121,6 +122,25 @@ cv::Mat disparityFor(const std::string& name, const std::string& left, const std
   return disparity;
 }
 
+// Counts of one set of roofs (the tuning set, or the held-out set marked "heldOut").
+struct Tally {
+  int runs = 0, oldHits = 0, newHits = 0, oldGroundOk = 0, newGroundOk = 0;
+  double oldErrSum = 0.0, newErrSum = 0.0, oldErrMax = 0.0, newErrMax = 0.0;
+  void add(bool oldIn, bool newIn, double oldErr, double newErr) {
+    ++runs;
+    oldHits += oldIn, newHits += newIn;
+    oldGroundOk += std::abs(oldErr) <= 2.0, newGroundOk += std::abs(newErr) <= 2.0;
+    oldErrSum += std::abs(oldErr), newErrSum += std::abs(newErr);
+    oldErrMax = std::max(oldErrMax, std::abs(oldErr)), newErrMax = std::max(newErrMax, std::abs(newErr));
+  }
+  void print(const char* name) const {
+    if (runs == 0) return;
+    std::printf("%s, %d runs: interval holds the main peak before %d, after %d; ground within 2 px before %d, after %d; "
+                "mean |ground error| before %.1f px, after %.1f px; max after %.1f px\n",
+                name, runs, oldHits, newHits, oldGroundOk, newGroundOk, oldErrSum / runs, newErrSum / runs, newErrMax);
+  }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -150,11 +170,14 @@ int main(int argc, char** argv) {
   const nlohmann::json data = nlohmann::json::parse(in);
   std::printf("%-18s %4s %5s %6s | %-9s %3s %6s %5s | %-9s %3s %6s %5s %5s\n", "roof", "grow", "peak", "ground",
               "before", "in", "ground", "err", "after", "in", "ground", "err", "peak*");
-  int runs = 0, oldHits = 0, newHits = 0, oldGroundOk = 0, newGroundOk = 0;
-  double oldErrSum = 0.0, newErrSum = 0.0;
+  Tally sets[2];  // tuning set, held-out set
   std::map<std::string, cv::Mat> maps;
+  bool heldOutShown = false;
   for (const auto& roof : data.at("roofs")) {
     const std::string pairName = roof.at("pair");
+    const bool heldOut = roof.value("heldOut", false);
+    if (heldOut && !heldOutShown) std::printf("-- held out (not used to choose the method or its defaults) --\n");
+    heldOutShown = heldOutShown || heldOut;
     const auto& pair = data.at("pairs").at(pairName);
     const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
     if (!fs::exists(left)) {
@@ -192,18 +215,15 @@ int main(int argc, char** argv) {
       std::printf("%-18s %4d %5d %6.1f | [%3d,%3d] %3s %6.1f %+5.1f | [%3d,%3d] %3s %6.1f %+5.1f %5.1f\n",
                   roof.at("name").get<std::string>().c_str(), grow, peak, groundRef, ol, oh, oldIn ? "yes" : "NO", og,
                   oe, p.low, p.high, newIn ? "yes" : "NO", p.groundLevel, ne, p.peak);
-      ++runs;
-      oldHits += oldIn, newHits += newIn;
-      oldGroundOk += std::abs(oe) <= 2.0, newGroundOk += std::abs(ne) <= 2.0;
-      oldErrSum += std::abs(oe), newErrSum += std::abs(ne);
+      sets[heldOut ? 1 : 0].add(oldIn, newIn, oe, ne);
     }
   }
-  if (runs == 0) {
+  if (sets[0].runs + sets[1].runs == 0) {
     std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
     return 0;
   }
-  std::printf("\n%d runs: interval holds the main peak before %d, after %d; ground within 2 px before %d, after %d; "
-              "mean |ground error| before %.1f px, after %.1f px\n",
-              runs, oldHits, newHits, oldGroundOk, newGroundOk, oldErrSum / runs, newErrSum / runs);
+  std::printf("\n");
+  sets[0].print("tuning set");
+  sets[1].print("held-out set");
   return 0;
 }
