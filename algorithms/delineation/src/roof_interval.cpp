@@ -150,14 +150,112 @@ double groundLevelOf(const std::vector<float>& band, const RoofIntervalParams& p
   return median(near);
 }
 
+// A band pixel: ROI coordinates and disparity.
+struct GroundSample {
+  float x, y, d;
+};
+
+std::vector<GroundSample> bandSamples(const cv::Mat& disparity, const cv::Rect& roi, const cv::Mat& mask) {
+  std::vector<GroundSample> out;
+  for (int y = 0; y < roi.height; ++y) {
+    const float* d = disparity.ptr<float>(roi.y + y) + roi.x;
+    const uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      if (m[x] != 0 && std::isfinite(d[x])) out.push_back({static_cast<float>(x), static_cast<float>(y), d[x]});
+    }
+  }
+  return out;
+}
+
+// Plane d = a + b (x - cx) + c (y - cy) through `samples` by least squares; false when degenerate.
+struct Plane {
+  double a = 0.0, b = 0.0, c = 0.0, cx = 0.0, cy = 0.0;
+  double at(double x, double y) const { return a + b * (x - cx) + c * (y - cy); }
+};
+
+bool fitPlane(const std::vector<GroundSample>& samples, const std::vector<char>& use, Plane& plane) {
+  double n = 0.0, sx = 0.0, sy = 0.0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (use[i]) n += 1.0, sx += samples[i].x, sy += samples[i].y;
+  }
+  if (n < 3.0) return false;
+  Plane p;
+  p.cx = sx / n, p.cy = sy / n;
+  cv::Matx33d normal = cv::Matx33d::zeros();
+  cv::Vec3d rhs(0.0, 0.0, 0.0);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (!use[i]) continue;
+    const cv::Vec3d row(1.0, samples[i].x - p.cx, samples[i].y - p.cy);
+    normal += row * row.t();
+    rhs += row * static_cast<double>(samples[i].d);
+  }
+  cv::Vec3d solution;
+  if (!cv::solve(normal, rhs, solution, cv::DECOMP_CHOLESKY)) return false;
+  p.a = solution[0], p.b = solution[1], p.c = solution[2];
+  plane = p;
+  return true;
+}
+
+// The ground next to the polygon: a plane fitted to the band's pixels near the ground level
+// (refitted to the pixels near the plane, so that a sloping ground is followed beyond the
+// level's window), averaged along the polygon's outer ring where band ground lies within
+// `groundReach` (elsewhere the plane would be extrapolated, e.g. along a side lined by other
+// roofs). Falls back to `level` when there is too little ground to fit.
+double groundNextTo(const Neighbourhood& n, const std::vector<GroundSample>& band, double level,
+                    const RoofIntervalParams& params) {
+  if (params.groundReach <= 0.0 || !std::isfinite(level)) return level;
+  std::vector<char> near(band.size());
+  for (size_t i = 0; i < band.size(); ++i) near[i] = std::abs(band[i].d - level) <= params.groundWindow;
+  Plane plane;
+  constexpr int kRefits = 5;  // more refits let the window creep up onto cars and low vegetation
+  for (int k = 0; k < kRefits; ++k) {
+    if (!fitPlane(band, near, plane)) return level;
+    for (size_t i = 0; i < band.size(); ++i) {
+      near[i] = std::abs(band[i].d - plane.at(band[i].x, band[i].y)) <= params.groundWindow;
+    }
+  }
+  cv::Mat ground(n.roi.size(), CV_8U, cv::Scalar(255));  // 0 on the plane's ground pixels
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (size_t i = 0; i < band.size(); ++i) {
+    if (!near[i]) continue;
+    ground.at<uchar>(static_cast<int>(band[i].y), static_cast<int>(band[i].x)) = 0;
+    lo = std::min(lo, band[i].d), hi = std::max(hi, band[i].d);
+  }
+  if (!(lo <= hi)) return level;
+  cv::Mat reach;
+  cv::distanceTransform(ground, reach, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  constexpr float kRing = 4.0f;  // px, width of the outer ring the plane is read on
+  double sum = 0.0;
+  int count = 0;
+  for (int y = 0; y < n.roi.height; ++y) {
+    const float* o = n.outerDistance.ptr<float>(y);
+    const float* r = reach.ptr<float>(y);
+    for (int x = 0; x < n.roi.width; ++x) {
+      if (o[x] > 0.0f && o[x] <= kRing && r[x] <= params.groundReach) sum += plane.at(x, y), ++count;
+    }
+  }
+  if (count == 0) return level;
+  // Never beyond the disparities the plane was fitted to.
+  return std::clamp(sum / count, static_cast<double>(lo), static_cast<double>(hi));
+}
+
+double groundLevelAround(const cv::Mat& disparity, const Neighbourhood& n, const RoofIntervalParams& params,
+                         int* samplesCount) {
+  const cv::Mat bandMask = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
+  const std::vector<GroundSample> band = bandSamples(disparity, n.roi, bandMask);
+  if (samplesCount) *samplesCount = static_cast<int>(band.size());
+  std::vector<float> values(band.size());
+  for (size_t i = 0; i < band.size(); ++i) values[i] = band[i].d;
+  return groundNextTo(n, band, groundLevelOf(values, params), params);
+}
+
 }  // namespace
 
 double estimateGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon, const RoofIntervalParams& params) {
   params.validate();
   const Neighbourhood n = neighbourhood(disparity, polygon, params.groundMargin);
   if (n.inside.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const cv::Mat band = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
-  return groundLevelOf(samples(disparity, n.roi, band), params);
+  return groundLevelAround(disparity, n, params, nullptr);
 }
 
 RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon,
@@ -166,10 +264,7 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
   RoofIntervalProposal out;
   const Neighbourhood n = neighbourhood(disparity, polygon, params.groundMargin);
   if (n.inside.empty()) return out;
-  const cv::Mat band = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
-  const std::vector<float> ground = samples(disparity, n.roi, band);
-  out.groundSamples = static_cast<int>(ground.size());
-  out.groundLevel = groundLevelOf(ground, params);
+  out.groundLevel = groundLevelAround(disparity, n, params, &out.groundSamples);
 
   // The polygon's core: away from its border, where a rough outline holds ground, walls and
   // parapets. A small polygon keeps at least half of its inradius.

@@ -96,6 +96,30 @@ TEST(GroundLevel, IsTheLowestWellPopulatedLevelNotTheMostFrequentOne) {
   EXPECT_NEAR(g, 6.0, 0.5);
 }
 
+// Ground sloping by 0.08 px per px along x (as across the Dublin tile), a tower at 90 px.
+cv::Mat slopedGroundScene() {
+  cv::Mat map(400, 700, CV_32F);
+  for (int y = 0; y < map.rows; ++y) {
+    for (int x = 0; x < map.cols; ++x) map.at<float>(y, x) = 10.0f + 0.08f * static_cast<float>(x);
+  }
+  map(cv::Rect(400, 170, 60, 60)).setTo(90.0f);
+  addNoise(map);
+  return map;
+}
+
+TEST(GroundLevel, OnASlopingGroundIsTheGroundNextToTheBuilding) {
+  const cv::Mat map = slopedGroundScene();
+  // The ground along the tower's sides averages 10 + 0.08 * 430 = 44.4 px; the 120 px band
+  // around a rough rectangle spans 33..58 px. From rectangles 8 and 30 px larger than the tower.
+  EXPECT_NEAR(estimateGroundLevel(map, rectangle(392, 162, 468, 238)), 44.4, 0.5);
+  EXPECT_NEAR(estimateGroundLevel(map, rectangle(370, 140, 490, 260)), 44.4, 0.5);
+  const auto p = proposeRoofInterval(map, rectangle(392, 162, 468, 238));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.groundLevel, 44.4, 0.5);
+  EXPECT_LE(p.low, 90);
+  EXPECT_GE(p.high, 90);
+}
+
 TEST(GroundLevel, NaNWhenTheNeighbourhoodHasNoMatchedPixel) {
   cv::Mat map(100, 100, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   map(cv::Rect(40, 40, 20, 20)).setTo(30.0f);

@@ -20,6 +20,7 @@ struct RoofIntervalParams {
   double groundShare = 0.05;    // share of the neighbourhood's matched pixels a ground level must hold
   double groundWindow = 2.0;    // px, half width of the disparity window counted around a ground level
   double groundSpan = 8.0;      // px, the ground is the most populated level this far above the lowest one
+  double groundReach = 40.0;    // px, the ground plane is read along the polygon where band ground lies this near (0: no plane)
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"bin-width", "Bin width", "px", "Width of a bin of the disparity histograms", 0.05, 10},
@@ -49,6 +50,10 @@ struct RoofIntervalParams {
     v(core::ParamInfo{"ground-span", "Ground span", "px",
                       "The ground is the most populated level up to this far above the lowest well-populated one", 0, 100},
       groundSpan);
+    v(core::ParamInfo{"ground-reach", "Ground reach", "px",
+                      "The ground plane is read along the polygon where ground was seen this near (0: the band's level)",
+                      0, 100000},
+      groundReach);
   }
   void validate() const;
 };
@@ -62,11 +67,15 @@ struct RoofIntervalProposal {
   int groundSamples = 0;     // matched pixels of the neighbourhood
 };
 
-// Ground level (px) around `polygon`, from the matched pixels of a band `groundMargin` px wide
+// Ground level (px) next to `polygon`, from the matched pixels of a band `groundMargin` px wide
 // outside it: the lowest level holding at least `groundShare` of them (counted within
 // `groundWindow`), then the most populated level up to `groundSpan` above it, refined as the
-// median of the pixels within `groundWindow` of that level. NaN when the band holds no
-// matched pixel. `disparity` is float32 in left-image geometry, NaN = no value.
+// median of the pixels within `groundWindow` of that level. A plane is then fitted to the band's
+// pixels within `groundWindow` of that level (five refits to the pixels within `groundWindow` of
+// the plane) and averaged along the polygon's outer ring where that ground lies within
+// `groundReach` px: on a sloping ground, the level beside the building rather than the band's.
+// NaN when the band holds no matched pixel. `disparity` is float32 in left-image geometry,
+// NaN = no value.
 double estimateGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon,
                            const RoofIntervalParams& params = {});
 
