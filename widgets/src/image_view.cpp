@@ -423,11 +423,16 @@ void ImageView::setInteractionMode(InteractionMode mode) {
   mode_ = mode;
   rectDragging_ = false;
   pickPolygon_.clear();
-  setCursor(mode == InteractionMode::Navigate ? Qt::OpenHandCursor
-            : mode == InteractionMode::EditPolygon ? Qt::ArrowCursor
-                                                   : Qt::CrossCursor);
+  polygons_->clearVertexSelection();
+  restoreModeCursor();
   update();
   emit interactionModeChanged(mode);
+}
+
+void ImageView::restoreModeCursor() {
+  setCursor(mode_ == InteractionMode::Navigate      ? Qt::OpenHandCursor
+            : mode_ == InteractionMode::EditPolygon ? Qt::ArrowCursor
+                                                    : Qt::CrossCursor);
 }
 
 void ImageView::beginPan(QPointF widgetPos) {
@@ -497,12 +502,12 @@ void ImageView::mouseReleaseEvent(QMouseEvent* event) {
   if (panning_ && (event->button() == Qt::MiddleButton || event->button() == Qt::RightButton ||
                    event->button() == Qt::LeftButton)) {
     panning_ = false;
-    setCursor(mode_ == InteractionMode::Navigate ? Qt::OpenHandCursor
-              : mode_ == InteractionMode::EditPolygon ? Qt::ArrowCursor
-                                                      : Qt::CrossCursor);
-    // A click without movement on a polygon selects it (Navigate and EditPolygon modes).
+    restoreModeCursor();
+    // A click without movement on a polygon selects it (Navigate and EditPolygon modes); in
+    // EditPolygon it also drops the vertex selection.
     if (event->button() == Qt::LeftButton && !pressMoved_ && !spaceHeld_) {
       const int id = polygons_->polygonAt(event->position());
+      if (mode_ == InteractionMode::EditPolygon) polygons_->clearVertexSelection();
       if (id >= 0 || mode_ == InteractionMode::Navigate) polygons_->setSelectedId(id);
     }
     return;
@@ -598,6 +603,28 @@ void ImageView::contextMenuEvent(QContextMenuEvent* event) {
     return;
   }
   event->ignore();
+}
+
+bool ImageView::wantsKey(const QKeyEvent& event) const {
+  if (mode_ == InteractionMode::EditPolygon && polygons_->wantsKey(event)) return true;
+  switch (event.key()) {
+    case Qt::Key_Escape:
+      return rectDragging_ || !pickPolygon_.isEmpty();
+    case Qt::Key_Backspace:
+      return mode_ == InteractionMode::PickPolygon && !pickPolygon_.isEmpty();
+    default:
+      return false;
+  }
+}
+
+bool ImageView::event(QEvent* event) {
+  // Shortcuts are matched before the focused widget sees the key; accepting the override gives
+  // the key to keyPressEvent instead (Delete on a hovered vertex must not remove the building).
+  if (event->type() == QEvent::ShortcutOverride && wantsKey(*static_cast<QKeyEvent*>(event))) {
+    event->accept();
+    return true;
+  }
+  return QWidget::event(event);
 }
 
 void ImageView::leaveEvent(QEvent*) {

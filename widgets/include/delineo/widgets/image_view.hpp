@@ -138,6 +138,7 @@ class ImageView : public QWidget {
   void keyReleaseEvent(QKeyEvent* event) override;
   void contextMenuEvent(QContextMenuEvent* event) override;
   void leaveEvent(QEvent* event) override;
+  bool event(QEvent* event) override;
 
  private:
   friend void linkViews(ImageView* a, ImageView* b);
@@ -165,6 +166,10 @@ class ImageView : public QWidget {
   void invalidateTiles(Layer layer);
   void clampView();
   void beginPan(QPointF widgetPos);
+  void restoreModeCursor();
+  // True when the view has a use for this key now (a gesture to cancel, a vertex to delete), so
+  // it takes precedence over a window shortcut on the same key.
+  bool wantsKey(const QKeyEvent& event) const;
 
   std::vector<cv::Mat> pyramid_;
   std::vector<cv::Mat> overlayPyramid_;
