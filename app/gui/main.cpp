@@ -68,10 +68,10 @@ int main(int argc, char** argv) {
   delineo::gui::MainWindow window;
   if (parser.isSet(screenshotOption)) {
     window.setInteractive(false);
-    window.show();
+    window.showActivated();
     return delineo::gui::runScreenshotTour(window, parser.value(screenshotOption)) ? 0 : 1;
   }
-  window.show();
+  window.showActivated();
   if (parser.isSet(leftOption) || parser.isSet(rightOption)) {
     if (!parser.isSet(leftOption) || !parser.isSet(rightOption)) {
       parser.showHelp(2);
