@@ -57,7 +57,8 @@ int main(int argc, char** argv) {
                                 QStringLiteral("file"));
   QCommandLineOption rightOption(QStringLiteral("right"), QApplication::translate("main", "Right image"),
                                  QStringLiteral("file"));
-  // Hidden: scripted tour that saves a PNG of each main state (scripts/screenshots.sh).
+  // Hidden: scripted tour that saves a PNG of each main state (scripts/screenshots.sh); with
+  // --left and --right, on that pair instead of the sample.
   QCommandLineOption screenshotOption(QStringLiteral("screenshot-dir"), QString(), QStringLiteral("dir"));
   screenshotOption.setFlags(QCommandLineOption::HiddenFromHelp);
   parser.addOption(leftOption);
@@ -69,7 +70,12 @@ int main(int argc, char** argv) {
   if (parser.isSet(screenshotOption)) {
     window.setInteractive(false);
     window.showActivated();
-    return delineo::gui::runScreenshotTour(window, parser.value(screenshotOption)) ? 0 : 1;
+    const QString dir = parser.value(screenshotOption);
+    const bool onPair = parser.isSet(leftOption) && parser.isSet(rightOption);
+    const bool done = onPair ? delineo::gui::runPairScreenshotTour(window, dir, parser.value(leftOption),
+                                                                   parser.value(rightOption))
+                             : delineo::gui::runScreenshotTour(window, dir);
+    return done ? 0 : 1;
   }
   window.showActivated();
   if (parser.isSet(leftOption) || parser.isSet(rightOption)) {
