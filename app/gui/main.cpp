@@ -99,10 +99,10 @@ int main(int argc, char** argv) {
   delineo::gui::MainWindow window;
   if (parser.isSet(commandLine.screenshots)) {
     window.setInteractive(false);
-    window.show();
+    window.showActivated();
     return delineo::gui::runScreenshotTour(window, parser.value(commandLine.screenshots)) ? 0 : 1;
   }
-  window.show();
+  window.showActivated();
   if (parser.isSet(commandLine.left) || parser.isSet(commandLine.right)) {
     if (!parser.isSet(commandLine.left) || !parser.isSet(commandLine.right)) {
       parser.showHelp(2);

@@ -22,6 +22,7 @@
 #include <QMessageBox>
 #include <QMetaObject>
 #include <QPushButton>
+#include <QScopedValueRollback>
 #include <QSignalBlocker>
 #include <QSpinBox>
 #include <QScrollArea>
@@ -143,6 +144,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   updateActions();
 }
 
+void MainWindow::showActivated() {
+  show();
+  raise();
+  activateWindow();
+}
+
 MainWindow::~MainWindow() {
   // Workers hold copies of their inputs, but their results are delivered to this window:
   // stop them before the views go away.
@@ -199,6 +206,13 @@ void MainWindow::createViews() {
   });
   connect(leftView_, &ImageView::pointPicked, this, &MainWindow::onObjectPicked);
   connect(&leftView_->polygons(), &widgets::PolygonOverlay::editRequested, this, &MainWindow::onEditRequested);
+  // Hole and rubber-band deletions: the overlay has checked the result is a valid polygon.
+  connect(&leftView_->polygons(), &widgets::PolygonOverlay::polygonEditRequested, this,
+          [this](int id, const QList<QPolygonF>& rings, const QString& description) {
+            if (document_) document_->setPolygon(id, widgets::toPolygon(rings), description);
+          });
+  connect(&leftView_->polygons(), &widgets::PolygonOverlay::editRefused, this,
+          [this](const QString& reason) { showMessage(tr("Edit outline"), reason); });
   connect(&leftView_->polygons(), &widgets::PolygonOverlay::selectionChanged, this,
           &MainWindow::onSelectionFromOverlay);
 
@@ -458,7 +472,8 @@ void MainWindow::createActions() {
   tool(QStringLiteral("actionPickObject"), tr("Pick an above-ground &object"), QStringLiteral("O"),
        InteractionMode::PickPoint, tr("Click a building: its above-ground region becomes the initial polygon"));
   tool(QStringLiteral("actionEdit"), tr("&Edit outline"), QStringLiteral("E"), InteractionMode::EditPolygon,
-       tr("Drag vertices or edges of the selected building; every change can be undone"));
+       tr("Drag a vertex or an edge of the selected building, Ctrl+drag to select vertices, "
+          "right-click for more; every change can be undone"));
   connect(leftView_, &ImageView::interactionModeChanged, this, [this](InteractionMode mode) {
     static const std::map<InteractionMode, QString> names = {
         {InteractionMode::Navigate, QStringLiteral("actionNavigate")},
@@ -790,8 +805,8 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
     refreshTitle();
     updateActions();
   });
-  leftView_->setImage(doc->leftGrey());
-  rightView_->setImage(doc->rightGrey());
+  leftView_->setImage(doc->leftDisplay());
+  rightView_->setImage(doc->rightDisplay());
   QAction* showLabels = action(QStringLiteral("actionShowLabels"));
   showLabels->setEnabled(!doc->labels().empty());
   if (!doc->labels().empty()) {
@@ -964,6 +979,9 @@ void MainWindow::refreshRasters() {
 }
 
 void MainWindow::refreshOverlays() {
+  // Pushing polygons is no choice of the operator's: a view that does not draw the selected
+  // building (the right view before its roof disparity is known) must not deselect it.
+  const QScopedValueRollback<bool> pushing(updatingSelection_, true);
   if (!document_) {
     leftView_->polygons().clearPolygons();
     return;

@@ -47,6 +47,9 @@ class MainWindow : public QMainWindow {
  public:
   explicit MainWindow(QWidget* parent = nullptr);
   ~MainWindow() override;
+  // Shows the window and asks for the keyboard focus: without it (a window started from a
+  // terminal, some window managers) no menu shortcut works until the operator clicks into it.
+  void showActivated();
 
   // ---- documents ----
   // Each returns false (with a message shown, the current document unchanged) on failure.

@@ -7,6 +7,7 @@
 #include <QDockWidget>
 #include <QElapsedTimer>
 #include <QEventLoop>
+#include <QMouseEvent>
 #include <QTimer>
 #include <cstdio>
 
@@ -77,7 +78,72 @@ core::Polygon roughPolygonOfABuilding(const cv::Mat& labels, int grow) {
   return p;
 }
 
+// Sends a left-button mouse event with `modifiers` to the view at image position `imagePos`.
+void sendMouse(widgets::ImageView* view, QEvent::Type type, QPointF imagePos,
+               Qt::KeyboardModifiers modifiers) {
+  const QPointF at = view->imageToWidget(imagePos);
+  const Qt::MouseButtons held = type == QEvent::MouseButtonRelease ? Qt::NoButton : Qt::LeftButton;
+  QMouseEvent event(type, at, view->mapToGlobal(at),
+                    type == QEvent::MouseMove ? Qt::NoButton : Qt::LeftButton, held, modifiers);
+  QApplication::sendEvent(view, &event);
+}
+
 }  // namespace
+
+bool runPairScreenshotTour(MainWindow& window, const QString& directory, const QString& left,
+                           const QString& right) {
+  QDir().mkpath(directory);
+  window.resize(1500, 950);
+  auto fail = [](const char* what) {
+    std::fprintf(stderr, "screenshot tour: %s\n", what);
+    return false;
+  };
+  if (!window.openPair(left, right)) return fail("cannot open the pair");
+  if (!waitUntil([&] { return window.jobs()->activeCount() == 0; }, 300000))
+    return fail("matching too slow");
+  window.showDock(QStringLiteral("rightDock"));
+  if (!shoot(window, directory, QStringLiteral("pair-01-opened"))) return false;
+
+  Document* doc = window.document();
+  const cv::Size size = doc->leftGrey().size();
+  const double half = std::min(size.width, size.height) / 10.0;
+  const cv::Point2d c(size.width / 2.0, size.height / 2.0);
+  // A rectangle with cut corners: eight vertices, so the selection below takes a few of them
+  // even when the active polygon cannot run on this pair.
+  const double cut = half / 3.0;
+  core::Polygon rough;
+  rough.outer = {{c.x - half + cut, c.y - half}, {c.x + half - cut, c.y - half},
+                 {c.x + half, c.y - half + cut}, {c.x + half, c.y + half - cut},
+                 {c.x + half - cut, c.y + half}, {c.x - half + cut, c.y + half},
+                 {c.x - half, c.y + half - cut}, {c.x - half, c.y - half + cut}};
+  const int id = doc->addBuilding(rough);
+  window.selectBuilding(id);
+  if (window.startDelineation(id) != 0 &&
+      !waitUntil([&] { return window.jobs()->activeCount() == 0; }, 120000)) {
+    return fail("active polygon too slow");
+  }
+  if (!doc->project().find(id)->hasOutline()) {
+    std::fprintf(stderr, "screenshot tour: no outline (%s); the rough polygon is shown\n",
+                 qPrintable(window.lastMessage()));
+  }
+  window.selectBuilding(id);
+  window.action(QStringLiteral("actionEdit"))->trigger();
+  widgets::ImageView* view = window.leftView();
+  const cv::Rect2d box = core::boundingBox(doc->project().find(id)->currentPolygon().outer);
+  view->setView(QPointF(box.x + box.width / 2, box.y + box.height / 2),
+                0.6 * std::min(view->width() / box.width, view->height() / box.height));
+  // A Ctrl+drag over the upper-left part of the outline.
+  const QPointF from(box.x - 4, box.y - 4);
+  const QPointF to(box.x + 0.55 * box.width, box.y + 0.45 * box.height);
+  sendMouse(view, QEvent::MouseButtonPress, from, Qt::ControlModifier);
+  sendMouse(view, QEvent::MouseMove, (from + to) / 2, Qt::ControlModifier);
+  sendMouse(view, QEvent::MouseMove, to, Qt::ControlModifier);
+  if (!shoot(window, directory, QStringLiteral("pair-02-rubber-band"))) return false;
+  sendMouse(view, QEvent::MouseButtonRelease, to, Qt::ControlModifier);
+  if (view->polygons().selectedVertices().empty())
+    return fail("the rubber band selected no vertex");
+  return shoot(window, directory, QStringLiteral("pair-03-vertices-selected"));
+}
 
 bool runScreenshotTour(MainWindow& window, const QString& directory) {
   QDir().mkpath(directory);
