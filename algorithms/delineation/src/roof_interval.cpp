@@ -249,6 +249,79 @@ double groundLevelAround(const cv::Mat& disparity, const Neighbourhood& n, const
   return groundNextTo(n, band, groundLevelOf(values, params), params);
 }
 
+// How many of the core's pixels within `halfWindow` of `level` belong to regions that enter the
+// polygon from outside, as a neighbour's roof crossing a rough outline does: 8-connected pixels
+// within that window, over the polygon and a band around it, that reach `reach` px outside the
+// polygon. Courtyards (holes) are not outside.
+int enteringCount(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, double level,
+                  double halfWindow, double reach) {
+  cv::Mat atLevel;
+  cv::inRange(disparity(n.roi), level - halfWindow, level + halfWindow, atLevel);  // NaN is out of range
+  atLevel &= n.outerDistance <= static_cast<float>(reach + 1.0);
+  cv::Mat labels;
+  const int count = cv::connectedComponents(atLevel, labels, 8, CV_32S);
+  std::vector<char> reachesOut(static_cast<size_t>(count), 0);
+  const cv::Mat farOut = atLevel & (n.outerDistance >= static_cast<float>(reach));
+  for (int y = 0; y < farOut.rows; ++y) {
+    const uchar* f = farOut.ptr<uchar>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < farOut.cols; ++x) {
+      if (f[x] != 0) reachesOut[static_cast<size_t>(l[x])] = 1;
+    }
+  }
+  int entering = 0;
+  for (int y = 0; y < atLevel.rows; ++y) {
+    const uchar* a = atLevel.ptr<uchar>(y);
+    const uchar* c = core.ptr<uchar>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < atLevel.cols; ++x) {
+      if (a[x] != 0 && c[x] != 0) entering += reachesOut[static_cast<size_t>(l[x])];
+    }
+  }
+  return entering;
+}
+
+// The roof level (bin): the most populated level above the floor, its pixels in regions that
+// enter the polygon from outside not counted. Candidates are the most populated level and the
+// other peaks of the mass holding at least a fifth of its mass; when every candidate keeps less
+// than that fifth (a polygon drawn inside its roof), the most populated level.
+size_t roofLevel(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, const Histogram& h,
+                 const std::vector<double>& mass, double floorLevel, int windowBins,
+                 const RoofIntervalParams& params) {
+  size_t first = mass.size();
+  for (size_t i = 0; i < mass.size(); ++i) {
+    if (h.centre(i) >= floorLevel && (first == mass.size() || mass[i] > mass[first])) first = i;
+  }
+  if (first == mass.size() || mass[first] <= 0.0) {
+    return static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  }
+  if (params.entryReach <= 0.0) return first;
+  const double bar = 0.2 * mass[first];
+  const auto near = [windowBins](size_t a, size_t b) {
+    return std::abs(static_cast<long>(a) - static_cast<long>(b)) <= windowBins;
+  };
+  std::vector<size_t> candidates = {first};  // then the other peaks, most populated first
+  for (size_t i = 0; i < mass.size(); ++i) {
+    const bool isMax = (i == 0 || mass[i] >= mass[i - 1]) && (i + 1 == mass.size() || mass[i] >= mass[i + 1]);
+    if (isMax && !near(i, first) && h.centre(i) >= floorLevel && mass[i] >= bar) candidates.push_back(i);
+  }
+  std::stable_sort(candidates.begin() + 1, candidates.end(), [&](size_t a, size_t b) { return mass[a] > mass[b]; });
+  const double halfWindow = (windowBins + 0.5) * h.width;  // the pixels counted in a level's mass
+  constexpr size_t kMaxChecks = 6;  // entry counts at most (each labels the polygon's neighbourhood)
+  std::vector<size_t> checked;
+  size_t best = first;
+  double bestKept = -1.0;
+  for (size_t i : candidates) {
+    if (mass[i] <= bestKept || checked.size() == kMaxChecks) break;
+    // A peak next to a checked one (a plateau of the mass) lies in the same regions.
+    if (std::any_of(checked.begin(), checked.end(), [&](size_t c) { return near(i, c); })) continue;
+    checked.push_back(i);
+    const double kept = mass[i] - enteringCount(disparity, n, core, h.centre(i), halfWindow, params.entryReach);
+    if (kept > bestKept) best = i, bestKept = kept;
+  }
+  return bestKept >= bar ? best : first;
+}
+
 }  // namespace
 
 double estimateGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon, const RoofIntervalParams& params) {
@@ -270,8 +343,9 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
   // parapets. A small polygon keeps at least half of its inradius.
   const cv::Rect2d box = core::boundingBox(polygon.outer);
   const double shrink = std::min(params.coreShrink, 0.25 * std::min(box.width, box.height));
-  std::vector<float> roof = samples(disparity, n.roi, n.depth > static_cast<float>(shrink));
-  if (roof.size() < 10) roof = samples(disparity, n.roi, n.inside);
+  cv::Mat core = n.depth > static_cast<float>(shrink);
+  std::vector<float> roof = samples(disparity, n.roi, core);
+  if (roof.size() < 10) core = n.inside, roof = samples(disparity, n.roi, core);
   out.roofSamples = static_cast<int>(roof.size());
   if (roof.size() < 10) return out;
 
@@ -285,14 +359,8 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
                                 ? out.groundLevel + params.minRoofHeight
                                 : -std::numeric_limits<double>::infinity();
   // The most populated level above the ground (mass within ±1 px), then its highest bin.
-  size_t best = h.counts.size();
-  for (size_t i = 0; i < h.counts.size(); ++i) {
-    if (h.centre(i) >= floorLevel && (best == h.counts.size() || mass[i] > mass[best])) best = i;
-  }
-  if (best == h.counts.size() || mass[best] <= 0.0) {
-    best = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
-  }
   const int reach = std::max(1, static_cast<int>(std::lround(1.0 / params.binWidth)));
+  const size_t best = roofLevel(disparity, n, core, h, mass, floorLevel, reach, params);
   size_t peak = best;
   for (size_t i = best > static_cast<size_t>(reach) ? best - static_cast<size_t>(reach) : 0;
        i <= std::min(h.counts.size() - 1, best + static_cast<size_t>(reach)); ++i) {
