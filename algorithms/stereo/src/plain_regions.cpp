@@ -17,7 +17,8 @@ constexpr double kSigmas = 3.0;     // a plain pixel's deviation is within this 
 constexpr double kMinDeviation = 1.5;  // grey levels: floor of that limit (8-bit quantisation)
 constexpr double kSharedRows = 0.8;  // share of its rows a region shares with its pair
 constexpr double kGreyTolerance = 20.0;  // grey levels, of the views' 0..255 stretches
-constexpr int kShiftSearch = 2;     // px, shifts tried around the centroids' difference
+constexpr int kShiftSearch = 2;     // px, shifts tried around the centroids' difference (plus
+                                    // a tenth of the regions' width: leaks move a centroid)
 constexpr double kClearlyBetter = 0.15;  // overlap: a pairing's lead over the regions' next one
 
 struct Region {
@@ -54,6 +55,9 @@ LabelledView plainRegions(const cv::Mat& grey, const cv::Mat& mask, int minArea)
     r.label = i;
     r.box = {stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP),
              stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT)};
+    // A region cut by the left or right border is cut at another place of the surface in the
+    // other view (the views are shifted along the rows): its shape does not tell its shift.
+    if (r.box.x == 0 || r.box.br().x == grey.cols) continue;
     r.cx = centroids.at<double>(i, 0);
     r.cy = centroids.at<double>(i, 1);
     r.grey = cv::mean(grey(r.box), view.labels(r.box) == i)[0];
@@ -155,8 +159,9 @@ std::vector<RegionSample> matchPlainRegions(const cv::Mat& leftGrey, const cv::M
       const Region& b = right.regions[j];
       if (!comparable(a, b)) continue;
       const int guess = static_cast<int>(std::lround(a.cx - b.cx));
+      const int search = kShiftSearch + std::max(a.box.width, b.box.width) / 10;
       Pairing p{i, j, guess, 0};
-      for (int dx = guess - kShiftSearch; dx <= guess + kShiftSearch; ++dx) {
+      for (int dx = guess - search; dx <= guess + search; ++dx) {
         const double o = overlap(left, a, right, b, dx);
         if (o > p.overlap) {
           p.overlap = o;
