@@ -124,6 +124,29 @@ TEST(DisparityRange, NoDataPixelsAreLeftOut) {
   for (const cv::Point3f& m : r.points) EXPECT_GE(m.y, 60.0F);
 }
 
+// A plain roof (one grey plus noise, no keypoint inside) 36 px above textured ground: only its
+// shape tells its disparity.
+TEST(DisparityRange, PlainRoofIsFoundByItsShape) {
+  const cv::Size size(400, 300);
+  const cv::Mat ground = testing::texture(size, 17);
+  cv::Mat left = ground.clone();
+  cv::Mat right = testing::shiftedRight(ground, 4.0);
+  cv::RNG rng(18);
+  cv::Mat roof(100, 120, CV_32F);
+  rng.fill(roof, cv::RNG::NORMAL, 200.0, 1.0);
+  roof.copyTo(left(cv::Rect(150, 100, 120, 100)));
+  roof.copyTo(right(cv::Rect(110, 100, 120, 100)));  // x_right = x_left - 40
+  RangeEstimateParams params;
+  params.plainRegions = false;
+  const RangeEstimate features = estimateDisparityRange(left, right, params);
+  EXPECT_LT(features.dmax, 40);
+  const RangeEstimate both = estimateDisparityRange(left, right);
+  EXPECT_GT(both.plainRegionSamples, 0);
+  EXPECT_GE(both.dmax, 40);
+  EXPECT_LE(both.dmax, 60);
+  EXPECT_LE(both.dmin, 4);
+}
+
 TEST(DisparityRange, SameInputsSameRange) {
   const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(400, 4));
   const FloatPair p = views(scene);
