@@ -26,17 +26,6 @@ Options& Options::flag(const std::string& key, const std::string& help) {
   return *this;
 }
 
-Options& Options::withoutDefault(const std::string& key, const std::string& help) {
-  for (auto& s : specs_) {
-    if (s.key == key) {
-      s.defaultValue.reset();
-      s.help = help;
-      return *this;
-    }
-  }
-  throw std::logic_error("withoutDefault: no option --" + key);
-}
-
 const Options::Spec* Options::find(const std::string& key) const {
   for (const auto& s : specs_) {
     if (s.key == key) return &s;

@@ -67,10 +67,6 @@ class Options {
     return *this;
   }
 
-  // Removes the default of a flag bound by params() and replaces its help: for a parameter
-  // whose absence means something else than its struct default (e.g. "estimated when absent").
-  Options& withoutDefault(const std::string& key, const std::string& help);
-
   // Parses argv after the command name. Throws UsageError. Returns false when --help was given
   // (help already printed to stdout).
   bool parse(const std::vector<std::string>& args);

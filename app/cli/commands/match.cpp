@@ -22,15 +22,11 @@ int run(const std::vector<std::string>& args) {
   opts.required("left", "FILE", "left (reference) image")
       .required("right", "FILE", "right image, same size, epipolar with the left")
       .required("out", "FILE", "output disparity GeoTIFF (float32, NaN = rejected)")
-      .value("dmin", "PX", "smallest disparity searched (x_right = x_left - d)")
-      .value("dmax", "PX", "largest disparity searched")
+      .value("dmin", "PX", "smallest disparity searched, x_right = x_left - d; estimated from the pair when absent")
+      .value("dmax", "PX", "largest disparity searched; estimated from the pair when absent")
       .value("score", "FILE", "optional output of the correlation score (NCC of the match)", "")
       .flag("quiet", "no progress on stderr");
   opts.params(stereo::MatchParams{});
-  opts.withoutDefault("dmin", "Smallest disparity searched, x_right = x_left - d; estimated "
-                              "from the pair when absent [px]")
-      .withoutDefault("dmax", "Largest disparity searched; estimated from the pair when absent "
-                              "[px]");
   // --levels also accepts "auto", the same as 0 (depth from the range, as in the paper).
   std::vector<std::string> normalised = args;
   for (size_t i = 0; i < normalised.size(); ++i) {
@@ -41,15 +37,12 @@ int run(const std::vector<std::string>& args) {
   }
   if (!opts.parse(normalised)) return cli::kExitOk;
   stereo::MatchParams params;
-  const bool rangeGiven = opts.has("dmin") && opts.has("dmax");
-  if (!rangeGiven) {
-    // Validated once the range is known: a lone --dmin above the default dmax is no error.
-    params.dmin = -100000;
-    params.dmax = 100000;
-  }
   opts.apply(params);
-  params.dmin = opts.getInt("dmin");
-  params.dmax = opts.getInt("dmax");
+  const bool rangeGiven = opts.has("dmin") && opts.has("dmax");
+  // Without both ends the range is validated once estimated: a lone --dmin above the default
+  // dmax is no error.
+  params.dmin = opts.has("dmin") ? opts.getInt("dmin") : -100000;
+  params.dmax = opts.has("dmax") ? opts.getInt("dmax") : 100000;
   params.validate();
 
   auto& progress = cli::commandProgress();

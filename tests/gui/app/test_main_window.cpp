@@ -256,11 +256,11 @@ class MainWindowTest : public QObject {
     const auto before = *doc->project().find(buildingId_)->roofInterval;
     widgets::DisparityHistogramWidget* histogram = window_->histogram();
     histogram->setFocus();
-    QTest::keyClick(histogram, Qt::Key_Right, Qt::ShiftModifier);  // upper bound + 1
+    QTest::keyClick(histogram, Qt::Key_Left, Qt::ShiftModifier);  // upper bound - 1
     auto after = *doc->project().find(buildingId_)->roofInterval;
-    QCOMPARE(after.high, before.high + 1);
+    QCOMPARE(after.high, before.high - 1);
     QCOMPARE(after.low, before.low);
-    QTest::keyClick(histogram, Qt::Key_Left, Qt::ShiftModifier);  // back
+    QTest::keyClick(histogram, Qt::Key_Right, Qt::ShiftModifier);  // back
     QCOMPARE(doc->project().find(buildingId_)->roofInterval->high, before.high);
     // Interval steps merge into one undo entry.
     QVERIFY(doc->undoStack()->undoText().contains(QStringLiteral("Roof interval")));
