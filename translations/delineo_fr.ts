@@ -271,10 +271,6 @@
         <translation>Pente maximale des pans inclinés</translation>
     </message>
     <message>
-        <source>Ordering check</source>
-        <translation>Contrôle de l’ordre</translation>
-    </message>
-    <message>
         <source>Fill flat regions</source>
         <translation>Remplir les régions uniformes</translation>
     </message>
@@ -337,10 +333,6 @@
     <message>
         <source>Roof plane area</source>
         <translation>Surface minimale d’un plan de toit</translation>
-    </message>
-    <message>
-        <source>Coarse-check score</source>
-        <translation>Score du contrôle au niveau grossier</translation>
     </message>
 </context>
 <context>
@@ -480,6 +472,38 @@
         <source>Energy</source>
         <translation>Énergie</translation>
     </message>
+    <message>
+        <source>Energy F(C) of the outline: being computed, or not computable</source>
+        <translation>Énergie F(C) du contour : en cours de calcul, ou incalculable</translation>
+    </message>
+    <message>
+        <source>roof</source>
+        <translation>toit</translation>
+    </message>
+    <message>
+        <source>ground</source>
+        <translation>sol</translation>
+    </message>
+    <message>
+        <source>occlusion</source>
+        <translation>occlusion</translation>
+    </message>
+    <message>
+        <source>left edges</source>
+        <translation>contours gauche</translation>
+    </message>
+    <message>
+        <source>right edges</source>
+        <translation>contours droite</translation>
+    </message>
+    <message>
+        <source>shape</source>
+        <translation>forme</translation>
+    </message>
+    <message>
+        <source>Energy F(C) = %1, of which:</source>
+        <translation>Énergie F(C) = %1, dont :</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::Document</name>
@@ -526,6 +550,14 @@
     <message>
         <source>Compute disparity</source>
         <translation>Calculer la disparité</translation>
+    </message>
+    <message>
+        <source>Output folder: %1</source>
+        <translation>Dossier de sortie : %1</translation>
+    </message>
+    <message>
+        <source>Height model</source>
+        <translation>Modèle de hauteur</translation>
     </message>
 </context>
 <context>
@@ -1040,6 +1072,232 @@
     <message>
         <source>Image edges</source>
         <translation>Contours de l’image</translation>
+    </message>
+    <message>
+        <source>Heights need the height model of the pair.</source>
+        <translation>Les hauteurs demandent le modèle de hauteur du couple.</translation>
+    </message>
+    <message>
+        <source>Set the height model…</source>
+        <translation>Définir le modèle de hauteur…</translation>
+    </message>
+    <message>
+        <source>The 3D view appears when a DEM is available: compute the disparity and set the height model (File → Project settings).</source>
+        <translation>La vue 3D apparaît quand un MNE est disponible : calculez la disparité et définissez le modèle de hauteur (Fichier → Réglages du projet).</translation>
+    </message>
+    <message>
+        <source>Project se&amp;ttings…</source>
+        <translation>Ré&amp;glages du projet…</translation>
+    </message>
+    <message>
+        <source>Delineate on &amp;pick</source>
+        <translation>Délinéer à la &amp;désignation</translation>
+    </message>
+    <message>
+        <source>Run the active polygon as soon as a building is picked, and again when its roof interval changes</source>
+        <translation>Lancer le polygone actif dès qu’un bâtiment est désigné, et de nouveau quand son intervalle de toit change</translation>
+    </message>
+    <message>
+        <source>%1 % of the disparities here lie at an end of the matched range (%2..%3 px): the roof may lie beyond it. Widen the range on the Matching tab and compute the disparity again.</source>
+        <translation>%1 % des disparités ici sont à une extrémité de l’intervalle apparié (%2..%3 px) : le toit est peut-être au-delà. Élargissez l’intervalle dans l’onglet Appariement et recalculez la disparité.</translation>
+    </message>
+    <message>
+        <source>Most of this region has no disparity: the roof may lie outside the matched range (%1..%2 px).</source>
+        <translation>La plus grande partie de cette région n’a pas de disparité : le toit est peut-être hors de l’intervalle apparié (%1..%2 px).</translation>
+    </message>
+    <message>
+        <source>Disparity search range of the pair</source>
+        <translation>Intervalle de recherche des disparités du couple</translation>
+    </message>
+    <message>
+        <source> px</source>
+        <translation> px</translation>
+    </message>
+    <message>
+        <source>Smallest disparity searched (x_right = x_left − d)</source>
+        <translation>Plus petite disparité cherchée (x_droite = x_gauche − d)</translation>
+    </message>
+    <message>
+        <source>Largest disparity searched; the roofs&apos; disparities must lie below it</source>
+        <translation>Plus grande disparité cherchée ; celles des toits doivent être en dessous</translation>
+    </message>
+    <message>
+        <source>Minimum</source>
+        <translation>Minimum</translation>
+    </message>
+    <message>
+        <source>Maximum</source>
+        <translation>Maximum</translation>
+    </message>
+    <message>
+        <source>Estimate from the images</source>
+        <translation>Estimer à partir des images</translation>
+    </message>
+    <message>
+        <source>Read the range from feature matches between the two images</source>
+        <translation>Lire l’intervalle dans les appariements de points d’intérêt des deux images</translation>
+    </message>
+    <message>
+        <source>Disparity range</source>
+        <translation>Intervalle de disparité</translation>
+    </message>
+    <message>
+        <source>The minimum disparity must not exceed the maximum.</source>
+        <translation>La disparité minimale ne doit pas dépasser la maximale.</translation>
+    </message>
+    <message>
+        <source>Disparity range %1..%2 px</source>
+        <translation>Intervalle de disparité %1..%2 px</translation>
+    </message>
+    <message>
+        <source>Every computation (matching, the active polygon) searches this range; compute the disparity again after changing it.</source>
+        <translation>Tous les calculs (appariement, polygone actif) cherchent dans cet intervalle ; recalculez la disparité après l’avoir changé.</translation>
+    </message>
+    <message>
+        <source>Not set yet: estimated from the images when the disparity is computed.</source>
+        <translation>Pas encore défini : estimé à partir des images au calcul de la disparité.</translation>
+    </message>
+    <message>
+        <source>The 3D view needs heights: set the height model (File → Project settings).</source>
+        <translation>La vue 3D a besoin des hauteurs : définissez le modèle de hauteur (Fichier → Réglages du projet).</translation>
+    </message>
+    <message>
+        <source>Project settings</source>
+        <translation>Réglages du projet</translation>
+    </message>
+    <message>
+        <source>Energy of building %1</source>
+        <translation>Énergie du bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Estimating the range from feature matches…</source>
+        <translation>Estimation de l’intervalle par appariement de points d’intérêt…</translation>
+    </message>
+    <message>
+        <source>Disparity range %1..%2 px, estimated from %3 feature matches</source>
+        <translation>Intervalle de disparité %1..%2 px, estimé sur %3 appariements de points d’intérêt</translation>
+    </message>
+    <message numerus="yes">
+        <source>Estimated from %n feature match(es) between the two images.</source>
+        <translation>
+            <numerusform>Estimé sur %n appariement de points d’intérêt entre les deux images.</numerusform>
+            <numerusform>Estimé sur %n appariements de points d’intérêt entre les deux images.</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Disparity range %1..%2 px (from %3 feature matches).</source>
+        <translation>Intervalle de disparité %1..%2 px (sur %3 appariements de points d’intérêt).</translation>
+    </message>
+</context>
+<context>
+    <name>delineo::gui::ProjectSettingsDialog</name>
+    <message>
+        <source>Project settings</source>
+        <translation>Réglages du projet</translation>
+    </message>
+    <message>
+        <source>Outputs</source>
+        <translation>Sorties</translation>
+    </message>
+    <message>
+        <source>Folder for the disparity map and exports; a relative folder is relative to the project file</source>
+        <translation>Dossier de la carte de disparité et des exports ; un dossier relatif l’est au fichier du projet</translation>
+    </message>
+    <message>
+        <source>Browse…</source>
+        <translation>Parcourir…</translation>
+    </message>
+    <message>
+        <source>Output folder</source>
+        <translation>Dossier de sortie</translation>
+    </message>
+    <message>
+        <source>Height model: height = (disparity − ground disparity) × metres per pixel</source>
+        <translation>Modèle de hauteur : hauteur = (disparité − disparité du sol) × mètres par pixel</translation>
+    </message>
+    <message>
+        <source> px</source>
+        <translation> px</translation>
+    </message>
+    <message>
+        <source>Disparity of the ground (height 0)</source>
+        <translation>Disparité du sol (hauteur 0)</translation>
+    </message>
+    <message>
+        <source>From the disparity map (%1 px)</source>
+        <translation>D’après la carte de disparité (%1 px)</translation>
+    </message>
+    <message>
+        <source>The ground level read from the disparity map</source>
+        <translation>Le niveau du sol lu dans la carte de disparité</translation>
+    </message>
+    <message>
+        <source>Ground disparity</source>
+        <translation>Disparité du sol</translation>
+    </message>
+    <message>
+        <source>Metres of height per pixel of disparity</source>
+        <translation>Mètres de hauteur par pixel de disparité</translation>
+    </message>
+    <message>
+        <source> m/px</source>
+        <translation> m/px</translation>
+    </message>
+    <message>
+        <source>Height difference of one pixel of disparity (0 = unknown)</source>
+        <translation>Différence de hauteur d’un pixel de disparité (0 = inconnue)</translation>
+    </message>
+    <message>
+        <source>Metres per pixel</source>
+        <translation>Mètres par pixel</translation>
+    </message>
+    <message>
+        <source>From the camera: k = H² / (B · f)</source>
+        <translation>D’après la prise de vue : k = H² / (B · f)</translation>
+    </message>
+    <message>
+        <source> m</source>
+        <translation> m</translation>
+    </message>
+    <message>
+        <source>Distance between the two exposures</source>
+        <translation>Distance entre les deux prises de vue</translation>
+    </message>
+    <message>
+        <source>Flying height above the ground</source>
+        <translation>Hauteur de vol au-dessus du sol</translation>
+    </message>
+    <message>
+        <source>Focal length in pixels of the epipolar images</source>
+        <translation>Focale en pixels des images épipolaires</translation>
+    </message>
+    <message>
+        <source>Base B</source>
+        <translation>Base B</translation>
+    </message>
+    <message>
+        <source>Flying height H</source>
+        <translation>Hauteur de vol H</translation>
+    </message>
+    <message>
+        <source>Focal length f</source>
+        <translation>Focale f</translation>
+    </message>
+    <message>
+        <source>Ground size of one image pixel (hillshade and 3D view)</source>
+        <translation>Taille au sol d’un pixel de l’image (ombrage et vue 3D)</translation>
+    </message>
+    <message>
+        <source>Ground sample distance</source>
+        <translation>Taille du pixel au sol</translation>
+    </message>
+    <message>
+        <source>Give B, H and f.</source>
+        <translation>Donnez B, H et f.</translation>
+    </message>
+    <message>
+        <source>k = (%1)² / (%2 × %3) = %4 m/px; ground sample distance H / f = %5 m</source>
+        <translation>k = (%1)² / (%2 × %3) = %4 m/px ; taille du pixel au sol H / f = %5 m</translation>
     </message>
 </context>
 <context>
