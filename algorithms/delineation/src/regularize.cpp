@@ -1,0 +1,699 @@
+#include "delineo/delineation/regularize.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/error.hpp"
+
+namespace delineo::delineation {
+
+namespace {
+
+using core::Error;
+using core::ErrorCode;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Lines closer than this in direction are one direction (merged or joined by a connector): the
+// intersection of two lines a few degrees apart lies far away. Also the snapping range of
+// any-angle mode.
+constexpr double kParallelAngle = 8.0 * kPi / 180.0;
+// Consecutive pieces along one direction whose offsets differ by less than this are one line;
+// farther apart they are joined by a perpendicular connector (a jog the short-edge step may merge).
+constexpr double kJogMerge = 1.0;
+
+cv::Point2d direction(double angle) { return {std::cos(angle), std::sin(angle)}; }
+cv::Point2d normal(double angle) { return {-std::sin(angle), std::cos(angle)}; }
+double cross(cv::Point2d a, cv::Point2d b) { return a.x * b.y - a.y * b.x; }
+
+double segmentDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
+  const cv::Point2d ab = b - a;
+  const double len2 = ab.dot(ab);
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  const cv::Point2d d = p - (a + t * ab);
+  return std::sqrt(d.dot(d));
+}
+
+double ringDistance(cv::Point2d p, const core::Ring& ring) {
+  double best = kInf;
+  for (size_t i = 0; i < ring.size(); ++i) best = std::min(best, segmentDistance(p, ring[i], ring[(i + 1) % ring.size()]));
+  return best;
+}
+
+// Farthest point of `result` (its vertices and samples every px along its edges) from the
+// outline `input`. Exact up to `stopAbove`; above it, any value above `stopAbove`.
+double maxDeviation(const core::Ring& result, const core::Ring& input, double stopAbove) {
+  double worst = 0;
+  std::vector<size_t> near;
+  for (size_t i = 0; i < result.size(); ++i) {
+    const cv::Point2d a = result[i], b = result[(i + 1) % result.size()];
+    const double reach = stopAbove + 1.0;
+    const double x0 = std::min(a.x, b.x) - reach, x1 = std::max(a.x, b.x) + reach;
+    const double y0 = std::min(a.y, b.y) - reach, y1 = std::max(a.y, b.y) + reach;
+    near.clear();
+    for (size_t k = 0; k < input.size(); ++k) {
+      const cv::Point2d p = input[k], q = input[(k + 1) % input.size()];
+      if (std::max(p.x, q.x) < x0 || std::min(p.x, q.x) > x1 || std::max(p.y, q.y) < y0 || std::min(p.y, q.y) > y1) continue;
+      near.push_back(k);
+    }
+    if (near.empty()) return kInf;
+    const double len = cv::norm(b - a);
+    const int steps = std::max(1, static_cast<int>(std::ceil(len)));
+    for (int s = 0; s < steps; ++s) {
+      const cv::Point2d p = a + (b - a) * (static_cast<double>(s) / steps);
+      double d = kInf;
+      for (size_t k : near) d = std::min(d, segmentDistance(p, input[k], input[(k + 1) % input.size()]));
+      worst = std::max(worst, d);
+      if (worst > stopAbove) return worst;
+    }
+  }
+  return worst;
+}
+
+// Mean distance between two outlines, both ways (input vertices to the result, result samples to
+// the input): the tie-break between candidates with as many vertices.
+double meanDistance(const core::Ring& result, const core::Ring& input) {
+  double sum = 0;
+  int n = 0;
+  for (const auto& p : input) sum += ringDistance(p, result), ++n;
+  for (size_t i = 0; i < result.size(); ++i) {
+    const cv::Point2d a = result[i], b = result[(i + 1) % result.size()];
+    const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a) / 2.0)));
+    for (int s = 0; s < steps; ++s) sum += ringDistance(a + (b - a) * (static_cast<double>(s) / steps), input), ++n;
+  }
+  return n ? sum / n : 0.0;
+}
+
+// ---- Dominant orientation -------------------------------------------------------------------
+
+struct Vote {
+  double angle;  // radians, modulo π/2
+  double weight;
+};
+
+double mod90(double angle) {
+  const double q = kPi / 2;
+  double a = std::fmod(angle, q);
+  if (a < 0) a += q;
+  return a;
+}
+
+std::vector<size_t> breakpoints(const core::Ring& ring, double epsilon);
+
+// The chords of the outline simplified at `epsilon` px (Douglas-Peucker), weighted by length: a
+// ragged outline's single edges zigzag around the true direction, its chords do not.
+void outlineVotes(const core::Ring& ring, double epsilon, std::vector<Vote>& votes, double& total) {
+  if (ring.size() < 3) return;
+  const std::vector<size_t> breaks = breakpoints(ring, epsilon);
+  for (size_t b = 0; b < breaks.size(); ++b) {
+    const cv::Point2d e = ring[breaks[(b + 1) % breaks.size()]] - ring[breaks[b]];
+    const double len = std::hypot(e.x, e.y);
+    if (len < 1e-9) continue;
+    votes.push_back({mod90(std::atan2(e.y, e.x)), len});
+    total += len;
+  }
+}
+
+// Gradient directions (modulo 90°, the same as the edge directions) of the image within 2 px of
+// the outline, weighted by the gradient magnitude above the band's median (flat texture's noise
+// votes nothing).
+void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<Vote>& votes, double& total) {
+  cv::Rect2d box = core::boundingBox(outline.outer);
+  const cv::Rect crop = cv::Rect(static_cast<int>(std::floor(box.x)) - 4, static_cast<int>(std::floor(box.y)) - 4,
+                                 static_cast<int>(std::ceil(box.width)) + 9, static_cast<int>(std::ceil(box.height)) + 9) &
+                        cv::Rect(0, 0, image.cols, image.rows);
+  if (crop.width < 3 || crop.height < 3) return;
+  cv::Mat f, gx, gy;
+  image(crop).convertTo(f, CV_32F);
+  cv::patchNaNs(f, 0.0);
+  cv::GaussianBlur(f, f, {0, 0}, 1.0);
+  cv::Sobel(f, gx, CV_32F, 1, 0, 3);
+  cv::Sobel(f, gy, CV_32F, 0, 1, 3);
+  cv::Mat band = cv::Mat::zeros(crop.size(), CV_8U);
+  auto drawRing = [&](const core::Ring& ring) {
+    std::vector<cv::Point> pts;
+    for (const auto& v : ring) pts.emplace_back(static_cast<int>(std::lround(v.x - crop.x - 0.5)), static_cast<int>(std::lround(v.y - crop.y - 0.5)));
+    cv::polylines(band, pts, true, cv::Scalar(255), 5);
+  };
+  drawRing(outline.outer);
+  for (const auto& h : outline.holes) drawRing(h);
+  std::vector<float> magnitudes;
+  std::vector<Vote> local;
+  for (int y = 0; y < band.rows; ++y) {
+    for (int x = 0; x < band.cols; ++x) {
+      if (!band.at<uchar>(y, x)) continue;
+      const float dx = gx.at<float>(y, x), dy = gy.at<float>(y, x);
+      const float m = std::hypot(dx, dy);
+      magnitudes.push_back(m);
+      local.push_back({mod90(std::atan2(dy, dx)), m});
+    }
+  }
+  if (magnitudes.empty()) return;
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + static_cast<long>(magnitudes.size() / 2), magnitudes.end());
+  const double floor = magnitudes[magnitudes.size() / 2];
+  for (auto& v : local) {
+    v.weight = std::max(0.0, v.weight - floor);
+    if (v.weight > 0) {
+      votes.push_back(v);
+      total += v.weight;
+    }
+  }
+}
+
+// Peak of the votes: histogram of 1° bins smoothed over ±6°, then the circular mean (of 4·angle)
+// of the votes within 10° of the peak. Zigzags of a pixel-grid outline vote ±7° around the true
+// direction; the smoothing merges the two lobes, the mean centres them.
+double votePeak(const std::vector<Vote>& votes) {
+  constexpr int kBins = 90;
+  std::vector<double> hist(kBins, 0.0), smooth(kBins, 0.0);
+  for (const auto& v : votes) hist[std::min(kBins - 1, static_cast<int>(v.angle * 180.0 / kPi))] += v.weight;
+  for (int b = 0; b < kBins; ++b) {
+    for (int k = -6; k <= 6; ++k) smooth[b] += hist[(b + k + kBins) % kBins] * std::exp(-0.5 * k * k / 9.0);
+  }
+  const int peak = static_cast<int>(std::max_element(smooth.begin(), smooth.end()) - smooth.begin());
+  double centre = (peak + 0.5) * kPi / 180.0;
+  for (int round = 0; round < 3; ++round) {  // the window re-centred on its mean
+    double s = 0, c = 0;
+    for (const auto& v : votes) {
+      double d = v.angle - centre;
+      d -= std::round(d / (kPi / 2)) * (kPi / 2);
+      if (std::abs(d) > 10.0 * kPi / 180.0) continue;
+      s += v.weight * std::sin(4 * v.angle);
+      c += v.weight * std::cos(4 * v.angle);
+    }
+    if (s == 0 && c == 0) break;
+    centre = mod90(0.25 * std::atan2(s, c));
+  }
+  return mod90(centre);
+}
+
+// ---- Lines along the outline ----------------------------------------------------------------
+
+struct Line {
+  double angle = 0;        // direction of travel along the ring, radians
+  double offset = 0;       // normal(angle) · p for the points p of the line
+  double weight = 0;       // px of input outline behind it
+  cv::Point2d centroid;    // length-weighted centre of that outline (offset = normal · centroid)
+  cv::Point2d start;       // input point where its piece of outline starts (connectors go there)
+  bool fixed = false;      // along the image border: keeps its direction and offset
+};
+
+bool parallel(const Line& a, const Line& b) { return std::abs(std::sin(a.angle - b.angle)) < std::sin(kParallelAngle); }
+bool sameDirection(const Line& a, const Line& b) { return std::cos(a.angle - b.angle) > 0; }
+
+Line merged(const Line& a, const Line& b) {
+  if (b.fixed && !a.fixed) return merged(b, a);
+  Line m = a;
+  m.weight = a.weight + b.weight;
+  if (a.fixed) return m;
+  const double w = m.weight > 0 ? m.weight : 1.0, wa = m.weight > 0 ? a.weight : 0.5, wb = m.weight > 0 ? b.weight : 0.5;
+  m.centroid = (a.centroid * wa + b.centroid * wb) / w;
+  const cv::Point2d d = direction(a.angle) * wa + direction(b.angle) * wb;  // same angle when snapped
+  m.angle = std::atan2(d.y, d.x);
+  m.offset = normal(m.angle).dot(m.centroid);
+  return m;
+}
+
+cv::Point2d intersection(const Line& a, const Line& b) {
+  const cv::Point2d na = normal(a.angle), nb = normal(b.angle);
+  const double det = cross(na, nb);
+  return {(a.offset * nb.y - b.offset * na.y) / det, (na.x * b.offset - nb.x * a.offset) / det};
+}
+
+core::Ring vertices(const std::vector<Line>& lines) {
+  core::Ring ring;
+  const size_t n = lines.size();
+  for (size_t k = 0; k < n; ++k) ring.push_back(intersection(lines[(k + n - 1) % n], lines[k]));
+  return ring;
+}
+
+// Length of each line's edge, signed along its direction (negative: the edge runs backwards, a
+// fold).
+std::vector<double> edgeLengths(const std::vector<Line>& lines, const core::Ring& ring) {
+  std::vector<double> out(lines.size());
+  for (size_t k = 0; k < lines.size(); ++k) out[k] = direction(lines[k].angle).dot(ring[(k + 1) % ring.size()] - ring[k]);
+  return out;
+}
+
+// Makes consecutive lines non-parallel: same direction → merged (or, with `connectors` and
+// offsets more than kJogMerge apart, joined by a perpendicular line through the junction);
+// opposite directions (a zero-width spike or slit) → both removed. False when fewer than
+// `minLines` remain.
+bool tidy(std::vector<Line>& lines, bool connectors, size_t minLines) {
+  for (size_t guard = 0; guard < 4 * lines.size() + 8 && lines.size() >= minLines; ++guard) {
+    bool changed = false;
+    for (size_t i = 0; i < lines.size() && lines.size() >= minLines; ++i) {
+      const size_t j = (i + 1) % lines.size();
+      if (!parallel(lines[i], lines[j])) continue;
+      if (!sameDirection(lines[i], lines[j])) {
+        const size_t first = std::max(i, j), second = std::min(i, j);
+        lines.erase(lines.begin() + static_cast<long>(first));
+        lines.erase(lines.begin() + static_cast<long>(second));
+      } else {
+        const double gap = normal(lines[i].angle).dot(lines[j].centroid) - lines[i].offset;
+        if (connectors && std::abs(gap) > kJogMerge) {
+          Line c;
+          c.angle = lines[i].angle + (gap > 0 ? kPi / 2 : -kPi / 2);
+          c.start = c.centroid = lines[j].start;
+          c.offset = normal(c.angle).dot(c.centroid);
+          lines.insert(lines.begin() + static_cast<long>(i) + 1, c);
+        } else {
+          lines[i] = merged(lines[i], lines[j]);
+          lines.erase(lines.begin() + static_cast<long>(j));
+        }
+      }
+      changed = true;
+      break;
+    }
+    if (!changed) return lines.size() >= minLines;
+  }
+  return lines.size() >= minLines;
+}
+
+// Douglas-Peucker on a closed ring: indices of the kept vertices, in ring order.
+void simplifyRange(const core::Ring& ring, size_t i0, size_t i1, double epsilon, std::vector<char>& keep) {
+  const size_t n = ring.size();
+  const size_t span = (i1 + n - i0) % n;
+  if (span < 2) return;
+  double worst = -1;
+  size_t at = i0;
+  for (size_t s = 1; s < span; ++s) {
+    const size_t k = (i0 + s) % n;
+    const double d = segmentDistance(ring[k], ring[i0], ring[i1]);
+    if (d > worst) worst = d, at = k;
+  }
+  if (worst <= epsilon) return;
+  keep[at] = 1;
+  simplifyRange(ring, i0, at, epsilon, keep);
+  simplifyRange(ring, at, i1, epsilon, keep);
+}
+
+std::vector<size_t> breakpoints(const core::Ring& ring, double epsilon) {
+  const size_t n = ring.size();
+  // Start from the vertex farthest from the first one, and the one farthest from that.
+  size_t a = 0;
+  double far = -1;
+  for (size_t k = 0; k < n; ++k) {
+    const double d = cv::norm(ring[k] - ring[0]);
+    if (d > far) far = d, a = k;
+  }
+  size_t b = a;
+  far = -1;
+  for (size_t k = 0; k < n; ++k) {
+    const double d = cv::norm(ring[k] - ring[a]);
+    if (d > far) far = d, b = k;
+  }
+  std::vector<char> keep(n, 0);
+  keep[a] = keep[b] = 1;
+  simplifyRange(ring, a, b, epsilon, keep);
+  simplifyRange(ring, b, a, epsilon, keep);
+  std::vector<size_t> out;
+  for (size_t k = 0; k < n; ++k) {
+    if (keep[k]) out.push_back(k);
+  }
+  return out;
+}
+
+struct RingContext {
+  RegularizationMode mode;
+  double theta;  // dominant orientation, radians in [0, π/2)
+  cv::Size bounds;  // image size, or empty
+};
+
+// The allowed direction nearest to `angle`; any-angle mode snaps only within kParallelAngle.
+double snapped(double angle, const RingContext& ctx) {
+  const double step = ctx.mode == RegularizationMode::RightAnglesAndDiagonals ? kPi / 4 : kPi / 2;
+  const double k = std::round((angle - ctx.theta) / step);
+  const double s = ctx.theta + k * step;
+  if (ctx.mode == RegularizationMode::AnyAngle && std::abs(angle - s) > kParallelAngle) return angle;
+  return s;
+}
+
+// The image border line that the piece ring[i0..i1] lies on (within 0.5 px), if any.
+bool borderLine(const core::Ring& ring, size_t i0, size_t i1, const RingContext& ctx, Line& line) {
+  if (ctx.bounds.empty()) return false;
+  const size_t n = ring.size();
+  const double w = ctx.bounds.width, h = ctx.bounds.height;
+  for (int side = 0; side < 4; ++side) {
+    bool all = true;
+    for (size_t k = i0;; k = (k + 1) % n) {
+      const cv::Point2d p = ring[k];
+      const double d = side == 0 ? std::abs(p.x) : side == 1 ? std::abs(p.x - w) : side == 2 ? std::abs(p.y) : std::abs(p.y - h);
+      if (d > 0.5) {
+        all = false;
+        break;
+      }
+      if (k == i1) break;
+    }
+    if (!all) continue;
+    const cv::Point2d chord = ring[i1] - ring[i0];
+    const bool vertical = side < 2;
+    line.angle = vertical ? (chord.y >= 0 ? kPi / 2 : -kPi / 2) : (chord.x >= 0 ? 0.0 : kPi);
+    line.centroid = side == 0 ? cv::Point2d(0, 0) : side == 1 ? cv::Point2d(w, 0) : side == 2 ? cv::Point2d(0, 0) : cv::Point2d(0, h);
+    line.offset = normal(line.angle).dot(line.centroid);
+    line.fixed = true;
+    return true;
+  }
+  return false;
+}
+
+// One line per piece of the ring between consecutive breakpoints: direction snapped, offset the
+// length-weighted mean over the piece's edges that run within 30° of that direction (corner
+// chamfers and zigzags across the edge do not pull it).
+std::vector<Line> piecesToLines(const core::Ring& ring, const std::vector<size_t>& breaks, const RingContext& ctx) {
+  const size_t n = ring.size();
+  std::vector<Line> lines;
+  for (size_t b = 0; b < breaks.size(); ++b) {
+    const size_t i0 = breaks[b], i1 = breaks[(b + 1) % breaks.size()];
+    Line line;
+    line.start = ring[i0];
+    double weight = 0;
+    if (!borderLine(ring, i0, i1, ctx, line)) {
+      // Direction: the length-weighted axis of the piece's edges, oriented along its chord.
+      double s2 = 0, c2 = 0;
+      for (size_t k = i0; k != i1; k = (k + 1) % n) {
+        const cv::Point2d e = ring[(k + 1) % n] - ring[k];
+        const double len = std::hypot(e.x, e.y), a = std::atan2(e.y, e.x);
+        s2 += len * std::sin(2 * a);
+        c2 += len * std::cos(2 * a);
+      }
+      double angle = 0.5 * std::atan2(s2, c2);
+      if (direction(angle).dot(ring[i1] - ring[i0]) < 0) angle += kPi;
+      line.angle = snapped(angle, ctx);
+      cv::Point2d sum(0, 0);
+      for (int pass = 0; pass < 2 && weight == 0; ++pass) {
+        for (size_t k = i0; k != i1; k = (k + 1) % n) {
+          const cv::Point2d e = ring[(k + 1) % n] - ring[k];
+          const double len = std::hypot(e.x, e.y);
+          if (len < 1e-9) continue;
+          if (pass == 0 && direction(line.angle).dot(e) < std::cos(kPi / 6) * len) continue;
+          sum += len * 0.5 * (ring[k] + ring[(k + 1) % n]);
+          weight += len;
+        }
+      }
+      line.centroid = weight > 0 ? sum / weight : 0.5 * (ring[i0] + ring[i1]);
+      line.offset = normal(line.angle).dot(line.centroid);
+    }
+    for (size_t k = i0; k != i1; k = (k + 1) % n) line.weight += cv::norm(ring[(k + 1) % n] - ring[k]);
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+bool insideBounds(const core::Ring& ring, cv::Size bounds) {
+  if (bounds.empty()) return true;
+  return std::all_of(ring.begin(), ring.end(), [&](const cv::Point2d& p) {
+    return p.x >= -1e-6 && p.y >= -1e-6 && p.x <= bounds.width + 1e-6 && p.y <= bounds.height + 1e-6;
+  });
+}
+
+// Removes the shortest edges (below minEdge, folds first) one at a time while the result stays
+// simple and within the tolerance of the input.
+void removeShortEdges(std::vector<Line>& lines, const core::Ring& input, const RegularizationParams& params,
+                      const RingContext& ctx, size_t minLines) {
+  for (size_t round = 0; round < 4 * input.size() + 16; ++round) {
+    const core::Ring ring = vertices(lines);
+    const std::vector<double> lengths = edgeLengths(lines, ring);
+    std::vector<size_t> order;
+    for (size_t k = 0; k < lines.size(); ++k) {
+      if (lengths[k] < params.minEdge) order.push_back(k);
+    }
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return lengths[a] < lengths[b]; });
+    bool removed = false;
+    for (size_t k : order) {
+      std::vector<Line> trial = lines;
+      trial.erase(trial.begin() + static_cast<long>(k));
+      if (!tidy(trial, false, minLines)) continue;
+      const core::Ring r = vertices(trial);
+      if (!core::isSimple(r) || !insideBounds(r, ctx.bounds)) continue;
+      if (maxDeviation(r, input, params.tolerance) > params.tolerance) continue;
+      lines = std::move(trial);
+      removed = true;
+      break;
+    }
+    if (!removed) return;
+  }
+}
+
+struct RingCandidate {
+  core::Ring ring;
+  double deviation = kInf;
+  double mean = kInf;
+  std::string failure;  // empty when it passes the ring's own checks
+};
+
+std::string formatPx(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", v);
+  return buf;
+}
+
+// Clamps vertices a hair outside the image (rounding of lines along its border) onto it.
+void clampToBounds(core::Ring& ring, cv::Size bounds) {
+  if (bounds.empty()) return;
+  for (auto& p : ring) {
+    if (p.x < 0 && p.x > -0.5) p.x = 0;
+    if (p.y < 0 && p.y > -0.5) p.y = 0;
+    if (p.x > bounds.width && p.x < bounds.width + 0.5) p.x = bounds.width;
+    if (p.y > bounds.height && p.y < bounds.height + 0.5) p.y = bounds.height;
+  }
+}
+
+RingCandidate regularizeRingAt(const core::Ring& input, double epsilon, const RegularizationParams& params,
+                               const RingContext& ctx) {
+  const size_t minLines = ctx.mode == RegularizationMode::RightAngles ? 4 : 3;
+  RingCandidate c;
+  std::vector<size_t> breaks = breakpoints(input, epsilon);
+  if (breaks.size() < 3) {
+    c.failure = "too few edges";
+    return c;
+  }
+  std::vector<Line> lines = piecesToLines(input, breaks, ctx);
+  if (!tidy(lines, true, minLines)) {
+    c.failure = "too few edges";
+    return c;
+  }
+  removeShortEdges(lines, input, params, ctx, minLines);
+  c.ring = vertices(lines);
+  clampToBounds(c.ring, ctx.bounds);
+  if (!core::isSimple(c.ring)) {
+    c.failure = "self-intersection";
+    return c;
+  }
+  if (!insideBounds(c.ring, ctx.bounds)) {
+    c.failure = "outside the image";
+    return c;
+  }
+  c.deviation = maxDeviation(c.ring, input, 4 * params.tolerance + 10);
+  if (c.deviation > params.tolerance + 1e-9) {
+    c.failure = "deviation " + formatPx(c.deviation) + " px > " + formatPx(params.tolerance) + " px";
+    return c;
+  }
+  c.mean = meanDistance(c.ring, input);
+  return c;
+}
+
+// The best of the candidates from several segmentation tolerances: fewest vertices, then the
+// closest to the input. The coarsest tolerance merges noise, the finer ones keep small wings.
+RingCandidate regularizeRing(const core::Ring& input, const RegularizationParams& params, const RingContext& ctx) {
+  std::vector<double> epsilons;
+  for (double f : {1.0, 0.7, 0.5, 0.35}) {
+    const double e = std::max(0.5, f * params.tolerance);
+    if (epsilons.empty() || e < epsilons.back() - 1e-9) epsilons.push_back(e);
+  }
+  RingCandidate best, firstFailure;
+  for (double e : epsilons) {
+    RingCandidate c = regularizeRingAt(input, e, params, ctx);
+    if (!c.failure.empty()) {
+      if (firstFailure.failure.empty()) firstFailure = std::move(c);
+      continue;
+    }
+    if (best.ring.empty() || c.ring.size() < best.ring.size() ||
+        (c.ring.size() == best.ring.size() && c.mean < best.mean)) {
+      best = std::move(c);
+    }
+  }
+  return best.ring.empty() ? firstFailure : best;
+}
+
+core::Ring cleaned(const core::Ring& ring) {
+  core::Ring out;
+  for (const auto& p : ring) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
+      throw Error(ErrorCode::InvalidParameter, "the outline to regularize has a non-finite coordinate");
+    }
+    if (out.empty() || cv::norm(p - out.back()) > 1e-9) out.push_back(p);
+  }
+  while (out.size() > 1 && cv::norm(out.front() - out.back()) <= 1e-9) out.pop_back();
+  return out;
+}
+
+bool ringsApart(const core::Polygon& p) {
+  std::vector<const core::Ring*> rings{&p.outer};
+  for (const auto& h : p.holes) rings.push_back(&h);
+  for (size_t a = 0; a < rings.size(); ++a) {
+    for (size_t b = a + 1; b < rings.size(); ++b) {
+      const core::Ring& ra = *rings[a];
+      const core::Ring& rb = *rings[b];
+      for (size_t i = 0; i < ra.size(); ++i) {
+        for (size_t j = 0; j < rb.size(); ++j) {
+          if (core::segmentsIntersect(ra[i], ra[(i + 1) % ra.size()], rb[j], rb[(j + 1) % rb.size()])) return false;
+        }
+      }
+    }
+  }
+  auto inside = [](const core::Ring& ring, cv::Point2d q) {
+    std::vector<cv::Point2f> contour;
+    for (const auto& v : ring) contour.emplace_back(static_cast<float>(v.x), static_cast<float>(v.y));
+    return cv::pointPolygonTest(contour, cv::Point2f(static_cast<float>(q.x), static_cast<float>(q.y)), false) > 0;
+  };
+  for (size_t h = 0; h < p.holes.size(); ++h) {
+    if (!inside(p.outer, p.holes[h].front())) return false;
+    for (size_t g = 0; g < p.holes.size(); ++g) {
+      if (g != h && inside(p.holes[g], p.holes[h].front())) return false;
+    }
+  }
+  return true;
+}
+
+// Radius of the circle the ring follows, or 0 when it does not: every point (sampled every px)
+// within max(0.4 tolerance, 5 % of the radius) of the least-squares circle (Kasa's fit). A
+// square's corners lie 17 % of the radius off its circle.
+double roundRadius(const core::Ring& ring, double tolerance) {
+  std::vector<cv::Point2d> pts;
+  for (size_t i = 0; i < ring.size(); ++i) {
+    const cv::Point2d a = ring[i], b = ring[(i + 1) % ring.size()];
+    const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a))));
+    for (int s = 0; s < steps; ++s) pts.push_back(a + (b - a) * (static_cast<double>(s) / steps));
+  }
+  cv::Point2d mean(0, 0);
+  for (const auto& p : pts) mean += p;
+  mean /= static_cast<double>(pts.size());
+  // x² + y² + D x + E y + F = 0 in coordinates centred on the mean (better conditioned).
+  cv::Matx33d a = cv::Matx33d::zeros();
+  cv::Vec3d rhs(0, 0, 0);
+  for (const auto& q : pts) {
+    const cv::Point2d p = q - mean;
+    const cv::Vec3d row(p.x, p.y, 1.0);
+    a += row * row.t();
+    rhs += row * -(p.x * p.x + p.y * p.y);
+  }
+  cv::Mat solution;
+  if (!cv::solve(cv::Mat(a), cv::Mat(rhs), solution, cv::DECOMP_SVD)) return 0;
+  const cv::Vec3d def(solution.at<double>(0), solution.at<double>(1), solution.at<double>(2));
+  const cv::Point2d centre(-def[0] / 2, -def[1] / 2);
+  const double r2 = centre.dot(centre) - def[2];
+  if (r2 <= 0) return 0;
+  const double radius = std::sqrt(r2);
+  const double allowed = std::max(0.4 * tolerance, 0.05 * radius);
+  for (const auto& q : pts) {
+    if (std::abs(cv::norm(q - mean - centre) - radius) > allowed) return 0;
+  }
+  return radius;
+}
+
+int vertexCount(const core::Polygon& p) {
+  size_t n = p.outer.size();
+  for (const auto& h : p.holes) n += h.size();
+  return static_cast<int>(n);
+}
+
+}  // namespace
+
+void RegularizationParams::validate() const { core::checkDeclaredRanges(*this); }
+
+RegularizationMode regularizationMode(const std::string& name) {
+  if (name == "none") return RegularizationMode::None;
+  if (name == "right-angles") return RegularizationMode::RightAngles;
+  if (name == "right-angles-and-diagonals") return RegularizationMode::RightAnglesAndDiagonals;
+  if (name == "any-angle") return RegularizationMode::AnyAngle;
+  throw Error(ErrorCode::InvalidParameter,
+              "regularize = '" + name + "' is not one of right-angles|right-angles-and-diagonals|any-angle|none");
+}
+
+std::string toString(RegularizationStatus status) {
+  switch (status) {
+    case RegularizationStatus::Regularized: return "regularized";
+    case RegularizationStatus::KeptRaw: return "kept-raw";
+    case RegularizationStatus::Off: break;
+  }
+  return "off";
+}
+
+double dominantOrientation(const core::Polygon& outline, const cv::Mat& image, double imageEdgeWeight,
+                           double epsilon) {
+  std::vector<Vote> shape, edges;
+  double shapeTotal = 0, edgeTotal = 0;
+  outlineVotes(outline.outer, epsilon, shape, shapeTotal);
+  for (const auto& h : outline.holes) outlineVotes(h, epsilon, shape, shapeTotal);
+  if (!image.empty() && imageEdgeWeight > 0 && image.channels() == 1) imageVotes(outline, image, edges, edgeTotal);
+  // Both sources normalised to a total weight of 1 (then the image's scaled by its weight).
+  std::vector<Vote> votes;
+  for (const auto& v : shape) votes.push_back({v.angle, v.weight / std::max(shapeTotal, 1e-12)});
+  for (const auto& v : edges) votes.push_back({v.angle, imageEdgeWeight * v.weight / std::max(edgeTotal, 1e-12)});
+  if (votes.empty()) return 0.0;
+  return votePeak(votes);
+}
+
+RegularizationOutcome regularizeOutline(const core::Polygon& outline, const RegularizationParams& params,
+                                        const cv::Mat& image) {
+  params.validate();
+  const RegularizationMode mode = regularizationMode(params.mode);
+  core::Polygon input{cleaned(outline.outer), {}};
+  for (const auto& h : outline.holes) input.holes.push_back(cleaned(h));
+  if (input.outer.size() < 3 || core::area(core::Polygon{input.outer, {}}) <= 1e-9) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the outline to regularize is not a polygon (fewer than 3 distinct vertices or zero area)");
+  }
+  if (!image.empty() && image.channels() != 1) {
+    throw Error(ErrorCode::UnsupportedInput, "regularization reads the edges of a single-band image only");
+  }
+  RegularizationOutcome out;
+  out.polygon = outline;
+  out.inputVertices = out.outputVertices = vertexCount(outline);
+  if (mode == RegularizationMode::None) return out;
+
+  RingContext ctx{mode, dominantOrientation(input, image, params.imageEdgeWeight, std::max(0.5, 0.5 * params.tolerance)),
+                  image.size()};
+  out.orientationDeg = ctx.theta * 180.0 / kPi;
+  auto keep = [&](const std::string& reason) {
+    out.status = RegularizationStatus::KeptRaw;
+    out.reason = reason;
+    return out;
+  };
+  if (const double radius = roundRadius(input.outer, params.tolerance); radius > 0) {
+    return keep("round outline (a circle of radius " + formatPx(radius) + " px)");
+  }
+  const RingCandidate outer = regularizeRing(input.outer, params, ctx);
+  if (!outer.failure.empty()) return keep(outer.failure);
+  core::Polygon result{outer.ring, {}};
+  out.deviation = outer.deviation;
+  for (const auto& hole : input.holes) {
+    // A hole that cannot be regularized is kept as it is: a ragged courtyard should not cost
+    // the building its clean outline.
+    if (hole.size() < 3) continue;
+    const RingCandidate h = regularizeRing(hole, params, ctx);
+    result.holes.push_back(h.failure.empty() ? h.ring : hole);
+    if (h.failure.empty()) out.deviation = std::max(out.deviation, h.deviation);
+  }
+  if (!ringsApart(result)) return keep("self-intersection");
+  const double before = core::area(input), after = core::area(result);
+  out.areaRatio = before > 0 ? after / before : 0.0;
+  if (std::abs(out.areaRatio - 1.0) * 100.0 > params.maxAreaChange) {
+    return keep("area change " + formatPx(100.0 * (out.areaRatio - 1.0)) + " % beyond " +
+                formatPx(params.maxAreaChange) + " %");
+  }
+  if (vertexCount(result) > vertexCount(input)) return keep("more vertices than the input");
+  out.polygon = std::move(result);
+  out.outputVertices = vertexCount(out.polygon);
+  out.status = RegularizationStatus::Regularized;
+  return out;
+}
+
+}  // namespace delineo::delineation
