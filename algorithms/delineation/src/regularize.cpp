@@ -1,9 +1,11 @@
 #include "delineo/delineation/regularize.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -48,11 +50,17 @@ double ringDistance(cv::Point2d p, const core::Ring& ring) {
 
 // Farthest point of `result` (its vertices and samples every px along its edges) from the
 // outline `input`. Exact up to `stopAbove`; above it, any value above `stopAbove`.
-double maxDeviation(const core::Ring& result, const core::Ring& input, double stopAbove) {
+// Edges in `skip` (end points as {ax, ay, bx, by}) are left out.
+using EdgeKey = std::array<double, 4>;
+EdgeKey edgeKey(cv::Point2d a, cv::Point2d b) { return {a.x, a.y, b.x, b.y}; }
+
+double maxDeviation(const core::Ring& result, const core::Ring& input, double stopAbove,
+                    const std::set<EdgeKey>* skip = nullptr) {
   double worst = 0;
   std::vector<size_t> near;
   for (size_t i = 0; i < result.size(); ++i) {
     const cv::Point2d a = result[i], b = result[(i + 1) % result.size()];
+    if (skip && skip->count(edgeKey(a, b))) continue;
     const double reach = stopAbove + 1.0;
     const double x0 = std::min(a.x, b.x) - reach, x1 = std::max(a.x, b.x) + reach;
     const double y0 = std::min(a.y, b.y) - reach, y1 = std::max(a.y, b.y) + reach;
@@ -120,40 +128,64 @@ void outlineVotes(const core::Ring& ring, double epsilon, std::vector<Vote>& vot
   }
 }
 
+// Grey level of a single-channel image of any common depth, NaN as 0.
+double grey(const cv::Mat& image, int x, int y) {
+  switch (image.depth()) {
+    case CV_8U: return image.at<uchar>(y, x);
+    case CV_16U: return image.at<ushort>(y, x);
+    case CV_16S: return image.at<short>(y, x);
+    case CV_32F: {
+      const float v = image.at<float>(y, x);
+      return std::isfinite(v) ? v : 0.0;
+    }
+    case CV_64F: {
+      const double v = image.at<double>(y, x);
+      return std::isfinite(v) ? v : 0.0;
+    }
+    default: return 0.0;
+  }
+}
+
 // Gradient directions (modulo 90°, the same as the edge directions) of the image within 2 px of
-// the outline, weighted by the gradient magnitude above the band's median (flat texture's noise
-// votes nothing).
+// the outline (every px along it, five offsets across it), weighted by the gradient magnitude
+// above the median of those samples (flat texture's noise votes nothing). The gradient is the
+// 3x3 Sobel, computed at the sampled pixels only (a large building's box is mostly roof).
 void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<Vote>& votes, double& total) {
-  cv::Rect2d box = core::boundingBox(outline.outer);
-  const cv::Rect crop = cv::Rect(static_cast<int>(std::floor(box.x)) - 4, static_cast<int>(std::floor(box.y)) - 4,
-                                 static_cast<int>(std::ceil(box.width)) + 9, static_cast<int>(std::ceil(box.height)) + 9) &
-                        cv::Rect(0, 0, image.cols, image.rows);
-  if (crop.width < 3 || crop.height < 3) return;
-  cv::Mat f, gx, gy;
-  image(crop).convertTo(f, CV_32F);
-  cv::patchNaNs(f, 0.0);
-  cv::GaussianBlur(f, f, {0, 0}, 1.0);
-  cv::Sobel(f, gx, CV_32F, 1, 0, 3);
-  cv::Sobel(f, gy, CV_32F, 0, 1, 3);
-  cv::Mat band = cv::Mat::zeros(crop.size(), CV_8U);
-  auto drawRing = [&](const core::Ring& ring) {
-    std::vector<cv::Point> pts;
-    for (const auto& v : ring) pts.emplace_back(static_cast<int>(std::lround(v.x - crop.x - 0.5)), static_cast<int>(std::lround(v.y - crop.y - 0.5)));
-    cv::polylines(band, pts, true, cv::Scalar(255), 5);
-  };
-  drawRing(outline.outer);
-  for (const auto& h : outline.holes) drawRing(h);
   std::vector<float> magnitudes;
   std::vector<Vote> local;
-  for (int y = 0; y < band.rows; ++y) {
-    for (int x = 0; x < band.cols; ++x) {
-      if (!band.at<uchar>(y, x)) continue;
-      const float dx = gx.at<float>(y, x), dy = gy.at<float>(y, x);
-      const float m = std::hypot(dx, dy);
-      magnitudes.push_back(m);
-      local.push_back({mod90(std::atan2(dy, dx)), m});
+  static const double w[3] = {1, 2, 1}, d[3] = {-1, 0, 1};
+  auto sample = [&](int x, int y) {
+    if (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1) return;
+    double gx = 0, gy = 0;
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 3; ++i) {
+        const double v = grey(image, x + i - 1, y + j - 1);
+        gx += w[j] * d[i] * v;
+        gy += d[j] * w[i] * v;
+      }
     }
-  }
+    const double m = std::hypot(gx, gy);
+    magnitudes.push_back(static_cast<float>(m));
+    local.push_back({mod90(std::atan2(gy, gx)), m});
+  };
+  auto walk = [&](const core::Ring& ring) {
+    for (size_t i = 0; i < ring.size(); ++i) {
+      const cv::Point2d a = ring[i], b = ring[(i + 1) % ring.size()];
+      const double len = cv::norm(b - a);
+      if (len < 1e-9) continue;
+      const cv::Point2d n(-(b - a).y / len, (b - a).x / len);
+      const int steps = static_cast<int>(std::ceil(len));
+      for (int s = 0; s < steps; ++s) {
+        const cv::Point2d p = a + (b - a) * (static_cast<double>(s) / steps);
+        for (int o = -2; o <= 2; ++o) {
+          const cv::Point2d q = p + n * static_cast<double>(o);
+          sample(static_cast<int>(std::floor(q.x)), static_cast<int>(std::floor(q.y)));
+        }
+      }
+    }
+  };
+  walk(outline.outer);
+  for (const auto& h : outline.holes) walk(h);
   if (magnitudes.empty()) return;
   std::nth_element(magnitudes.begin(), magnitudes.begin() + static_cast<long>(magnitudes.size() / 2), magnitudes.end());
   const double floor = magnitudes[magnitudes.size() / 2];
@@ -414,11 +446,15 @@ bool insideBounds(const core::Ring& ring, cv::Size bounds) {
 }
 
 // Removes the shortest edges (below minEdge, folds first) one at a time while the result stays
-// simple and within the tolerance of the input.
+// simple and the edges the removal changes stay within the tolerance of the input (the whole
+// ring is judged at the end: a removal may come before the one that brings a far edge back).
 void removeShortEdges(std::vector<Line>& lines, const core::Ring& input, const RegularizationParams& params,
                       const RingContext& ctx, size_t minLines) {
+  std::set<std::array<EdgeKey, 3>> failed;
   for (size_t round = 0; round < 4 * input.size() + 16; ++round) {
     const core::Ring ring = vertices(lines);
+    std::set<EdgeKey> unchanged;
+    for (size_t i = 0; i < ring.size(); ++i) unchanged.insert(edgeKey(ring[i], ring[(i + 1) % ring.size()]));
     const std::vector<double> lengths = edgeLengths(lines, ring);
     std::vector<size_t> order;
     for (size_t k = 0; k < lines.size(); ++k) {
@@ -427,12 +463,18 @@ void removeShortEdges(std::vector<Line>& lines, const core::Ring& input, const R
     std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return lengths[a] < lengths[b]; });
     bool removed = false;
     for (size_t k : order) {
+      // A removal that failed with the same edge and neighbours fails again: skip it.
+      const size_t n = ring.size();
+      const std::array<EdgeKey, 3> around{edgeKey(ring[(k + n - 1) % n], ring[k]), edgeKey(ring[k], ring[(k + 1) % n]),
+                                          edgeKey(ring[(k + 1) % n], ring[(k + 2) % n])};
+      if (failed.count(around)) continue;
+      failed.insert(around);
       std::vector<Line> trial = lines;
       trial.erase(trial.begin() + static_cast<long>(k));
       if (!tidy(trial, false, minLines)) continue;
       const core::Ring r = vertices(trial);
       if (!core::isSimple(r) || !insideBounds(r, ctx.bounds)) continue;
-      if (maxDeviation(r, input, params.tolerance) > params.tolerance) continue;
+      if (maxDeviation(r, input, params.tolerance, &unchanged) > params.tolerance) continue;
       lines = std::move(trial);
       removed = true;
       break;
@@ -651,8 +693,11 @@ RegularizationOutcome regularizeOutline(const core::Polygon& outline, const Regu
     throw Error(ErrorCode::InvalidParameter,
                 "the outline to regularize is not a polygon (fewer than 3 distinct vertices or zero area)");
   }
-  if (!image.empty() && image.channels() != 1) {
-    throw Error(ErrorCode::UnsupportedInput, "regularization reads the edges of a single-band image only");
+  if (!image.empty() && (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U &&
+                                                     image.depth() != CV_16S && image.depth() != CV_32F &&
+                                                     image.depth() != CV_64F))) {
+    throw Error(ErrorCode::UnsupportedInput,
+                "regularization reads the edges of a single-band 8-bit, 16-bit or floating-point image only");
   }
   RegularizationOutcome out;
   out.polygon = outline;

@@ -19,7 +19,7 @@ struct RegularizationParams {
   double tolerance = 3.0;       // px: farthest any point of the result may lie from the input outline
   double minEdge = 4.0;         // px: edges shorter than this are merged away when the tolerance allows
   double maxAreaChange = 8.0;   // %: largest change of the enclosed area
-  double energyMargin = 0.5;    // F per px of outline: how much worse the energy may get (delineate)
+  double energyMargin = 0.25;   // F per px of outline: how much worse the energy may get (delineate)
   double imageEdgeWeight = 1.0; // weight of the image edges along the outline in the orientation
   template <class V>
   void visit(V&& v) {
