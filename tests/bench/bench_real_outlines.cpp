@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
   std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
   std::string dumpDir;
   int grow = 30;
+  std::vector<double> tolerances;  // --tolerances A,B,...: the raw outline regularized at each too
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
       dataRoot = argv[++i];
@@ -119,9 +120,15 @@ int main(int argc, char** argv) {
       dumpDir = argv[++i];
     } else if (!std::strcmp(argv[i], "--grow") && i + 1 < argc) {
       grow = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--tolerances") && i + 1 < argc) {
+      for (const char* p = argv[++i]; *p;) {
+        char* end = nullptr;
+        tolerances.push_back(std::strtod(p, &end));
+        p = *end == ',' ? end + 1 : end;
+      }
     } else {
       std::fprintf(stderr, "usage: bench_real_outlines [--data DIR] [--labels real_roofs.json] [--cache DIR] "
-                           "[--grow PX] [--dump DIR]\n");
+                           "[--grow PX] [--tolerances A,B,...] [--dump DIR]\n");
       return 2;
     }
   }
@@ -137,9 +144,11 @@ int main(int argc, char** argv) {
               "regular. IoU/v", "reg ms", "regularization");
   std::map<std::string, cv::Mat> maps, lefts, rights;
   std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV, regMs;
+  std::map<double, std::vector<double>> tolIou, tolVertices;
   int runs = 0;
   for (const auto& roof : data.at("roofs")) {
     const std::string name = roof.at("name"), pairName = roof.at("pair");
+    if (const char* only = std::getenv("BENCH_ONLY"); only && name != only) continue;
     const auto& pair = data.at("pairs").at(pairName);
     const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
     const std::string right = (fs::path(dataRoot) / pair.at("right").get<std::string>()).string();
@@ -187,6 +196,29 @@ int main(int argc, char** argv) {
                   proposal.low, proposal.high, ni, vertices(naive), ri, vertices(r.rawPolygon), gi, r.vertexCount, ms,
                   delineation::toString(r.regularization.status).c_str(), r.regularization.reason.empty() ? "" : ": ",
                   r.regularization.reason.c_str(), r.regularization.energyChange, r.regularization.orientationDeg);
+      for (double t : tolerances) {
+        // The same raw outline through the public entry point (outline + energy gate) at tolerance t.
+        delineation::DelineationParams other = params;
+        other.regularization.tolerance = t;
+        const auto g = delineation::regularizeBuildingOutline(lefts[pairName], rights[pairName], request, other,
+                                                              r.rawPolygon);
+        std::printf("    tolerance %4.1f px: IoU %.3f, %3d vertices, %s%s%s\n", t, iou(g.polygon, truth, size), g.outputVertices,
+                    delineation::toString(g.status).c_str(), g.reason.empty() ? "" : ": ", g.reason.c_str());
+        tolIou[t].push_back(iou(g.polygon, truth, size));
+        tolVertices[t].push_back(g.outputVertices);
+      }
+      if (std::getenv("BENCH_VERBOSE")) {
+        const auto g = delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
+        for (const auto& [label, poly] : {std::pair{"raw", r.rawPolygon}, std::pair{"regularized", g.polygon}}) {
+          std::printf("    %s:", label);
+          for (const auto& v : poly.outer) std::printf(" (%.1f,%.1f)", v.x, v.y);
+          for (const auto& h : poly.holes) {
+            std::printf(" hole");
+            for (const auto& v : h) std::printf(" (%.1f,%.1f)", v.x, v.y);
+          }
+          std::printf("\n");
+        }
+      }
       naiveIou.push_back(ni), rawIou.push_back(ri), regIou.push_back(gi);
       naiveV.push_back(vertices(naive)), rawV.push_back(vertices(r.rawPolygon)), regV.push_back(r.vertexCount);
       regMs.push_back(ms);
@@ -215,5 +247,8 @@ int main(int argc, char** argv) {
               "median vertices naive %.0f, raw %.0f, regularized %.0f; regularization median %.2f ms, max %.2f ms\n",
               runs, grow, mean(naiveIou), mean(rawIou), mean(regIou), median(naiveV), median(rawV), median(regV),
               median(regMs), *std::max_element(regMs.begin(), regMs.end()));
+  for (const auto& [t, v] : tolIou) {
+    std::printf("  tolerance %4.1f px: mean IoU %.3f, median vertices %.0f\n", t, mean(v), median(tolVertices[t]));
+  }
   return 0;
 }

@@ -54,30 +54,59 @@ double ringDistance(cv::Point2d p, const core::Ring& ring) {
 using EdgeKey = std::array<double, 4>;
 EdgeKey edgeKey(cv::Point2d a, cv::Point2d b) { return {a.x, a.y, b.x, b.y}; }
 
-double maxDeviation(const core::Ring& result, const core::Ring& input, double stopAbove,
+// The edges of a ring bucketed on a square grid: distances to the ring near a point without
+// visiting every edge (an outline cleaned on the pixel grid has hundreds).
+class EdgeGrid {
+ public:
+  explicit EdgeGrid(const core::Ring& ring, double cell = 8.0) : ring_(ring), cell_(cell) {
+    const cv::Rect2d box = core::boundingBox(ring);
+    origin_ = {box.x, box.y};
+    cols_ = static_cast<int>(box.width / cell) + 1;
+    rows_ = static_cast<int>(box.height / cell) + 1;
+    cells_.resize(static_cast<size_t>(cols_ * rows_));
+    for (size_t k = 0; k < ring.size(); ++k) {
+      const cv::Point2d p = ring[k], q = ring[(k + 1) % ring.size()];
+      const int x0 = col(std::min(p.x, q.x)), x1 = col(std::max(p.x, q.x));
+      const int y0 = row(std::min(p.y, q.y)), y1 = row(std::max(p.y, q.y));
+      for (int y = y0; y <= y1; ++y) {
+        for (int x = x0; x <= x1; ++x) cells_[static_cast<size_t>(y * cols_ + x)].push_back(static_cast<int>(k));
+      }
+    }
+  }
+  // Distance from p to the ring when it is at most `limit`, else some value above `limit`.
+  double distance(cv::Point2d p, double limit) const {
+    double best = kInf;
+    const int x0 = col(p.x - limit), x1 = col(p.x + limit), y0 = row(p.y - limit), y1 = row(p.y + limit);
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        for (int k : cells_[static_cast<size_t>(y * cols_ + x)]) {
+          best = std::min(best, segmentDistance(p, ring_[static_cast<size_t>(k)], ring_[(static_cast<size_t>(k) + 1) % ring_.size()]));
+        }
+      }
+    }
+    return best;
+  }
+  const core::Ring& ring() const { return ring_; }
+
+ private:
+  int col(double x) const { return std::clamp(static_cast<int>(std::floor((x - origin_.x) / cell_)), 0, cols_ - 1); }
+  int row(double y) const { return std::clamp(static_cast<int>(std::floor((y - origin_.y) / cell_)), 0, rows_ - 1); }
+  const core::Ring& ring_;
+  double cell_;
+  cv::Point2d origin_;
+  int cols_ = 1, rows_ = 1;
+  std::vector<std::vector<int>> cells_;
+};
+
+double maxDeviation(const core::Ring& result, const EdgeGrid& input, double stopAbove,
                     const std::set<EdgeKey>* skip = nullptr) {
   double worst = 0;
-  std::vector<size_t> near;
   for (size_t i = 0; i < result.size(); ++i) {
     const cv::Point2d a = result[i], b = result[(i + 1) % result.size()];
     if (skip && skip->count(edgeKey(a, b))) continue;
-    const double reach = stopAbove + 1.0;
-    const double x0 = std::min(a.x, b.x) - reach, x1 = std::max(a.x, b.x) + reach;
-    const double y0 = std::min(a.y, b.y) - reach, y1 = std::max(a.y, b.y) + reach;
-    near.clear();
-    for (size_t k = 0; k < input.size(); ++k) {
-      const cv::Point2d p = input[k], q = input[(k + 1) % input.size()];
-      if (std::max(p.x, q.x) < x0 || std::min(p.x, q.x) > x1 || std::max(p.y, q.y) < y0 || std::min(p.y, q.y) > y1) continue;
-      near.push_back(k);
-    }
-    if (near.empty()) return kInf;
-    const double len = cv::norm(b - a);
-    const int steps = std::max(1, static_cast<int>(std::ceil(len)));
+    const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a))));
     for (int s = 0; s < steps; ++s) {
-      const cv::Point2d p = a + (b - a) * (static_cast<double>(s) / steps);
-      double d = kInf;
-      for (size_t k : near) d = std::min(d, segmentDistance(p, input[k], input[(k + 1) % input.size()]));
-      worst = std::max(worst, d);
+      worst = std::max(worst, input.distance(a + (b - a) * (static_cast<double>(s) / steps), stopAbove + 1.0));
       if (worst > stopAbove) return worst;
     }
   }
@@ -147,7 +176,7 @@ double grey(const cv::Mat& image, int x, int y) {
 }
 
 // Gradient directions (modulo 90°, the same as the edge directions) of the image within 2 px of
-// the outline (every px along it, five offsets across it), weighted by the gradient magnitude
+// the outline (every 2 px along it, five offsets across it), weighted by the gradient magnitude
 // above the median of those samples (flat texture's noise votes nothing). The gradient is the
 // 3x3 Sobel, computed at the sampled pixels only (a large building's box is mostly roof).
 void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<Vote>& votes, double& total) {
@@ -174,7 +203,7 @@ void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<
       const double len = cv::norm(b - a);
       if (len < 1e-9) continue;
       const cv::Point2d n(-(b - a).y / len, (b - a).x / len);
-      const int steps = static_cast<int>(std::ceil(len));
+      const int steps = static_cast<int>(std::ceil(len / 2));
       for (int s = 0; s < steps; ++s) {
         const cv::Point2d p = a + (b - a) * (static_cast<double>(s) / steps);
         for (int o = -2; o <= 2; ++o) {
@@ -395,45 +424,79 @@ bool borderLine(const core::Ring& ring, size_t i0, size_t i1, const RingContext&
   return false;
 }
 
-// One line per piece of the ring between consecutive breakpoints: direction snapped, offset the
-// length-weighted mean over the piece's edges that run within 30° of that direction (corner
-// chamfers and zigzags across the edge do not pull it).
-std::vector<Line> piecesToLines(const core::Ring& ring, const std::vector<size_t>& breaks, const RingContext& ctx) {
+// The line of the piece ring[i0..i1]: the image border when the piece runs along it; else the
+// length-weighted axis of its edges, oriented along its chord and snapped, at the length-weighted
+// mean offset of the edges that run within 30° of that direction (corner chamfers and zigzags
+// across the edge do not pull it).
+Line lineOfPiece(const core::Ring& ring, size_t i0, size_t i1, const RingContext& ctx) {
   const size_t n = ring.size();
+  Line line;
+  line.start = ring[i0];
+  for (size_t k = i0; k != i1; k = (k + 1) % n) line.weight += cv::norm(ring[(k + 1) % n] - ring[k]);
+  if (borderLine(ring, i0, i1, ctx, line)) return line;
+  double s2 = 0, c2 = 0;
+  for (size_t k = i0; k != i1; k = (k + 1) % n) {
+    const cv::Point2d e = ring[(k + 1) % n] - ring[k];
+    const double len = std::hypot(e.x, e.y), a = std::atan2(e.y, e.x);
+    s2 += len * std::sin(2 * a);
+    c2 += len * std::cos(2 * a);
+  }
+  double angle = 0.5 * std::atan2(s2, c2);
+  if (direction(angle).dot(ring[i1] - ring[i0]) < 0) angle += kPi;
+  line.angle = snapped(angle, ctx);
+  cv::Point2d sum(0, 0);
+  double weight = 0;
+  for (int pass = 0; pass < 2 && weight == 0; ++pass) {
+    for (size_t k = i0; k != i1; k = (k + 1) % n) {
+      const cv::Point2d e = ring[(k + 1) % n] - ring[k];
+      const double len = std::hypot(e.x, e.y);
+      if (len < 1e-9) continue;
+      if (pass == 0 && direction(line.angle).dot(e) < std::cos(kPi / 6) * len) continue;
+      sum += len * 0.5 * (ring[k] + ring[(k + 1) % n]);
+      weight += len;
+    }
+  }
+  line.centroid = weight > 0 ? sum / weight : 0.5 * (ring[i0] + ring[i1]);
+  line.offset = normal(line.angle).dot(line.centroid);
+  return line;
+}
+
+// Lines of the pieces between breakpoints; a piece whose vertices stray farther than `limit`
+// from its (snapped) line is split at its vertex farthest from its chord, until each fits or is
+// a single edge. A slanted piece in right-angles mode becomes a staircase that the short-edge
+// step may then merge.
+void addPieceLines(const core::Ring& ring, size_t i0, size_t i1, const RingContext& ctx, double limit, int depth,
+                   std::vector<Line>& lines) {
+  const size_t n = ring.size();
+  const Line line = lineOfPiece(ring, i0, i1, ctx);
+  const size_t span = (i1 + n - i0) % n;
+  if (span >= 2 && !line.fixed && depth < 12) {
+    const cv::Point2d nrm = normal(line.angle);
+    double far = 0;
+    for (size_t k = i0;; k = (k + 1) % n) {
+      far = std::max(far, std::abs(nrm.dot(ring[k]) - line.offset));
+      if (k == i1) break;
+    }
+    if (far > limit) {
+      size_t at = (i0 + 1) % n;
+      double worst = -1;
+      for (size_t k = (i0 + 1) % n; k != i1; k = (k + 1) % n) {
+        const double d = segmentDistance(ring[k], ring[i0], ring[i1]);
+        if (d > worst) worst = d, at = k;
+      }
+      addPieceLines(ring, i0, at, ctx, limit, depth + 1, lines);
+      addPieceLines(ring, at, i1, ctx, limit, depth + 1, lines);
+      return;
+    }
+  }
+  lines.push_back(line);
+}
+
+std::vector<Line> piecesToLines(const core::Ring& ring, const std::vector<size_t>& breaks, const RingContext& ctx,
+                                double limit) {
   std::vector<Line> lines;
   for (size_t b = 0; b < breaks.size(); ++b) {
-    const size_t i0 = breaks[b], i1 = breaks[(b + 1) % breaks.size()];
-    Line line;
-    line.start = ring[i0];
-    double weight = 0;
-    if (!borderLine(ring, i0, i1, ctx, line)) {
-      // Direction: the length-weighted axis of the piece's edges, oriented along its chord.
-      double s2 = 0, c2 = 0;
-      for (size_t k = i0; k != i1; k = (k + 1) % n) {
-        const cv::Point2d e = ring[(k + 1) % n] - ring[k];
-        const double len = std::hypot(e.x, e.y), a = std::atan2(e.y, e.x);
-        s2 += len * std::sin(2 * a);
-        c2 += len * std::cos(2 * a);
-      }
-      double angle = 0.5 * std::atan2(s2, c2);
-      if (direction(angle).dot(ring[i1] - ring[i0]) < 0) angle += kPi;
-      line.angle = snapped(angle, ctx);
-      cv::Point2d sum(0, 0);
-      for (int pass = 0; pass < 2 && weight == 0; ++pass) {
-        for (size_t k = i0; k != i1; k = (k + 1) % n) {
-          const cv::Point2d e = ring[(k + 1) % n] - ring[k];
-          const double len = std::hypot(e.x, e.y);
-          if (len < 1e-9) continue;
-          if (pass == 0 && direction(line.angle).dot(e) < std::cos(kPi / 6) * len) continue;
-          sum += len * 0.5 * (ring[k] + ring[(k + 1) % n]);
-          weight += len;
-        }
-      }
-      line.centroid = weight > 0 ? sum / weight : 0.5 * (ring[i0] + ring[i1]);
-      line.offset = normal(line.angle).dot(line.centroid);
-    }
-    for (size_t k = i0; k != i1; k = (k + 1) % n) line.weight += cv::norm(ring[(k + 1) % n] - ring[k]);
-    lines.push_back(line);
+    addPieceLines(ring, breaks[b], breaks[(b + 1) % breaks.size()], ctx, limit, 0, lines);
   }
   return lines;
 }
@@ -445,13 +508,33 @@ bool insideBounds(const core::Ring& ring, cv::Size bounds) {
   });
 }
 
+// isSimple() for a ring whose edges in `unchanged` are known not to cross each other: only the
+// other edges are tested (against all).
+bool simpleAround(const core::Ring& ring, const std::set<EdgeKey>& unchanged) {
+  const size_t n = ring.size();
+  if (n < 3) return false;
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point2d a = ring[i], b = ring[(i + 1) % n];
+    if (unchanged.count(edgeKey(a, b))) continue;
+    for (size_t j = 0; j < n; ++j) {
+      if (j == i || j == (i + 1) % n || (j + 1) % n == i) continue;  // itself and its neighbours
+      if (core::segmentsIntersect(a, b, ring[j], ring[(j + 1) % n])) return false;
+    }
+    // Adjacent edges must not fold back onto each other.
+    const cv::Point2d prev = ring[(i + n - 1) % n], next = ring[(i + 2) % n];
+    if (cross(a - prev, b - a) == 0 && (a - prev).dot(b - a) < 0) return false;
+    if (cross(b - a, next - b) == 0 && (b - a).dot(next - b) < 0) return false;
+  }
+  return true;
+}
+
 // Removes the shortest edges (below minEdge, folds first) one at a time while the result stays
 // simple and the edges the removal changes stay within the tolerance of the input (the whole
 // ring is judged at the end: a removal may come before the one that brings a far edge back).
-void removeShortEdges(std::vector<Line>& lines, const core::Ring& input, const RegularizationParams& params,
+void removeShortEdges(std::vector<Line>& lines, const EdgeGrid& input, const RegularizationParams& params,
                       const RingContext& ctx, size_t minLines) {
   std::set<std::array<EdgeKey, 3>> failed;
-  for (size_t round = 0; round < 4 * input.size() + 16; ++round) {
+  for (size_t round = 0; round < 4 * input.ring().size() + 16; ++round) {
     const core::Ring ring = vertices(lines);
     std::set<EdgeKey> unchanged;
     for (size_t i = 0; i < ring.size(); ++i) unchanged.insert(edgeKey(ring[i], ring[(i + 1) % ring.size()]));
@@ -473,7 +556,7 @@ void removeShortEdges(std::vector<Line>& lines, const core::Ring& input, const R
       trial.erase(trial.begin() + static_cast<long>(k));
       if (!tidy(trial, false, minLines)) continue;
       const core::Ring r = vertices(trial);
-      if (!core::isSimple(r) || !insideBounds(r, ctx.bounds)) continue;
+      if (!simpleAround(r, unchanged) || !insideBounds(r, ctx.bounds)) continue;
       if (maxDeviation(r, input, params.tolerance, &unchanged) > params.tolerance) continue;
       lines = std::move(trial);
       removed = true;
@@ -507,8 +590,8 @@ void clampToBounds(core::Ring& ring, cv::Size bounds) {
   }
 }
 
-RingCandidate regularizeRingAt(const core::Ring& input, double epsilon, const RegularizationParams& params,
-                               const RingContext& ctx) {
+RingCandidate regularizeRingAt(const core::Ring& input, const EdgeGrid& grid, double epsilon,
+                               const RegularizationParams& params, const RingContext& ctx) {
   const size_t minLines = ctx.mode == RegularizationMode::RightAngles ? 4 : 3;
   RingCandidate c;
   std::vector<size_t> breaks = breakpoints(input, epsilon);
@@ -516,12 +599,12 @@ RingCandidate regularizeRingAt(const core::Ring& input, double epsilon, const Re
     c.failure = "too few edges";
     return c;
   }
-  std::vector<Line> lines = piecesToLines(input, breaks, ctx);
+  std::vector<Line> lines = piecesToLines(input, breaks, ctx, 0.8 * params.tolerance);
   if (!tidy(lines, true, minLines)) {
     c.failure = "too few edges";
     return c;
   }
-  removeShortEdges(lines, input, params, ctx, minLines);
+  removeShortEdges(lines, grid, params, ctx, minLines);
   c.ring = vertices(lines);
   clampToBounds(c.ring, ctx.bounds);
   if (!core::isSimple(c.ring)) {
@@ -532,7 +615,7 @@ RingCandidate regularizeRingAt(const core::Ring& input, double epsilon, const Re
     c.failure = "outside the image";
     return c;
   }
-  c.deviation = maxDeviation(c.ring, input, 4 * params.tolerance + 10);
+  c.deviation = maxDeviation(c.ring, grid, 4 * params.tolerance + 10);
   if (c.deviation > params.tolerance + 1e-9) {
     c.failure = "deviation " + formatPx(c.deviation) + " px > " + formatPx(params.tolerance) + " px";
     return c;
@@ -545,13 +628,14 @@ RingCandidate regularizeRingAt(const core::Ring& input, double epsilon, const Re
 // closest to the input. The coarsest tolerance merges noise, the finer ones keep small wings.
 RingCandidate regularizeRing(const core::Ring& input, const RegularizationParams& params, const RingContext& ctx) {
   std::vector<double> epsilons;
-  for (double f : {1.0, 0.7, 0.5, 0.35}) {
+  for (double f : {1.0, 0.6, 0.35}) {
     const double e = std::max(0.5, f * params.tolerance);
     if (epsilons.empty() || e < epsilons.back() - 1e-9) epsilons.push_back(e);
   }
   RingCandidate best, firstFailure;
+  const EdgeGrid grid(input);
   for (double e : epsilons) {
-    RingCandidate c = regularizeRingAt(input, e, params, ctx);
+    RingCandidate c = regularizeRingAt(input, grid, e, params, ctx);
     if (!c.failure.empty()) {
       if (firstFailure.failure.empty()) firstFailure = std::move(c);
       continue;
@@ -602,6 +686,88 @@ bool ringsApart(const core::Polygon& p) {
     }
   }
   return true;
+}
+
+// The outline without its spikes, fingers and slits narrower than `minWidth` px: rasterized
+// (1 px), opened then closed with a disk of that diameter; the largest component's outline and
+// its holes, simplified at 0.5 px. False (and `out` untouched) when nothing of at least
+// minWidth² px² changed: the corners the disk rounds are not thin parts.
+// True when two non-adjacent edges of the ring pointing opposite ways (more than 135° apart)
+// come closer than `width`: the two sides of a spike, finger or slit.
+bool hasThinParts(const core::Ring& ring, double width) {
+  const size_t n = ring.size();
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point2d a = ring[i], b = ring[(i + 1) % n], u = b - a;
+    for (size_t j = i + 2; j < n; ++j) {
+      if ((j + 1) % n == i) continue;
+      const cv::Point2d c = ring[j], d = ring[(j + 1) % n], v = d - c;
+      if (u.dot(v) > -std::cos(kPi / 4) * cv::norm(u) * cv::norm(v)) continue;
+      const double gap = std::min({segmentDistance(a, c, d), segmentDistance(b, c, d), segmentDistance(c, a, b),
+                                   segmentDistance(d, a, b)});
+      if (gap < width) return true;
+    }
+  }
+  return false;
+}
+
+bool withoutThinParts(const core::Polygon& in, double minWidth, core::Polygon& out) {
+  const int r = static_cast<int>(std::floor(minWidth / 2));
+  if (r < 1) return false;
+  bool thinSides = hasThinParts(in.outer, minWidth);
+  for (const auto& h : in.holes) thinSides = thinSides || hasThinParts(h, minWidth);
+  if (!thinSides) return false;  // the raster below is the expensive part
+  const cv::Rect2d box = core::boundingBox(in.outer);
+  const cv::Point2d origin(std::floor(box.x) - 2 * r - 2, std::floor(box.y) - 2 * r - 2);
+  const cv::Size size(static_cast<int>(std::ceil(box.width)) + 4 * r + 6, static_cast<int>(std::ceil(box.height)) + 4 * r + 6);
+  core::Polygon local = in;
+  for (auto& v : local.outer) v -= origin;
+  for (auto& h : local.holes) {
+    for (auto& v : h) v -= origin;
+  }
+  const cv::Mat mask = core::rasterize(local, size);
+  cv::Mat cleaned;
+  const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1});
+  cv::morphologyEx(mask, cleaned, cv::MORPH_OPEN, disk);
+  cv::morphologyEx(cleaned, cleaned, cv::MORPH_CLOSE, disk);
+  cv::Mat changed = mask != cleaned, labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(changed, labels, stats, centroids, 8);
+  bool thin = false;
+  for (int i = 1; i < n && !thin; ++i) thin = stats.at<int>(i, cv::CC_STAT_AREA) >= minWidth * minWidth;
+  if (!thin) return false;
+  std::vector<std::vector<cv::Point>> contours;
+  std::vector<cv::Vec4i> hierarchy;
+  cv::findContours(cleaned, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+  int largest = -1;
+  double largestArea = 0;
+  for (size_t i = 0; i < contours.size(); ++i) {
+    if (hierarchy[i][3] >= 0) continue;  // a hole
+    const double a = cv::contourArea(contours[i]);
+    if (a > largestArea) largestArea = a, largest = static_cast<int>(i);
+  }
+  if (largest < 0) return false;
+  // Contour points are centres of border pixels: half a pixel inside the outline (outside for a
+  // hole); moved out along the local normal they are back on the pixel border.
+  auto toRing = [&](const std::vector<cv::Point>& c) {
+    std::vector<cv::Point2f> simplified;
+    std::vector<cv::Point2f> pts(c.begin(), c.end());
+    cv::approxPolyDP(pts, simplified, 0.5, true);
+    core::Ring ring;
+    for (const auto& v : simplified) ring.emplace_back(v.x + 0.5 + origin.x, v.y + 0.5 + origin.y);
+    return ring;
+  };
+  out = core::Polygon{toRing(contours[static_cast<size_t>(largest)]), {}};
+  for (int h = hierarchy[static_cast<size_t>(largest)][2]; h >= 0; h = hierarchy[static_cast<size_t>(h)][0]) {
+    if (contours[static_cast<size_t>(h)].size() >= 3) out.holes.push_back(toRing(contours[static_cast<size_t>(h)]));
+  }
+  return out.outer.size() >= 3;
+}
+
+// Smallest distance between two rings (vertex to edge, both ways).
+double ringGap(const core::Ring& a, const core::Ring& b) {
+  double best = kInf;
+  for (const auto& p : a) best = std::min(best, ringDistance(p, b));
+  for (const auto& p : b) best = std::min(best, ringDistance(p, a));
+  return best;
 }
 
 // Radius of the circle the ring follows, or 0 when it does not: every point (sampled every px)
@@ -715,16 +881,23 @@ RegularizationOutcome regularizeOutline(const core::Polygon& outline, const Regu
   if (const double radius = roundRadius(input.outer, params.tolerance); radius > 0) {
     return keep("round outline (a circle of radius " + formatPx(radius) + " px)");
   }
-  const RingCandidate outer = regularizeRing(input.outer, params, ctx);
+  // Spikes, fingers and slits thinner than min-width go first; the tolerance then applies to
+  // the outline without them.
+  core::Polygon target = input;
+  withoutThinParts(input, params.minWidth, target);
+  const RingCandidate outer = regularizeRing(target.outer, params, ctx);
   if (!outer.failure.empty()) return keep(outer.failure);
   core::Polygon result{outer.ring, {}};
   out.deviation = outer.deviation;
-  for (const auto& hole : input.holes) {
+  for (const auto& hole : target.holes) {
     // A hole that cannot be regularized is kept as it is: a ragged courtyard should not cost
-    // the building its clean outline.
+    // the building its clean outline. One closer than 1 px to the outer ring is dropped: it is a
+    // notch, not a courtyard.
     if (hole.size() < 3) continue;
     const RingCandidate h = regularizeRing(hole, params, ctx);
-    result.holes.push_back(h.failure.empty() ? h.ring : hole);
+    const core::Ring& ring = h.failure.empty() ? h.ring : hole;
+    if (ringGap(ring, result.outer) < 1.0) continue;
+    result.holes.push_back(ring);
     if (h.failure.empty()) out.deviation = std::max(out.deviation, h.deviation);
   }
   if (!ringsApart(result)) return keep("self-intersection");

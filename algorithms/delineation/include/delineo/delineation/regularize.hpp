@@ -18,6 +18,7 @@ struct RegularizationParams {
   std::string mode = "right-angles";
   double tolerance = 3.0;       // px: farthest any point of the result may lie from the input outline
   double minEdge = 4.0;         // px: edges shorter than this are merged away when the tolerance allows
+  double minWidth = 4.0;        // px: spikes, fingers and slits narrower than this are cut off first
   double maxAreaChange = 8.0;   // %: largest change of the enclosed area
   double energyMargin = 0.25;   // F per px of outline: how much worse the energy may get (delineate)
   double imageEdgeWeight = 1.0; // weight of the image edges along the outline in the orientation
@@ -37,6 +38,11 @@ struct RegularizationParams {
                       "allows",
                       0, 100},
       minEdge);
+    v(core::ParamInfo{"regularize-min-width", "Regularization min width", "px",
+                      "Spikes, fingers and slits narrower than this are cut off before regularizing "
+                      "(the tolerance applies to the outline without them; 0 = off)",
+                      0, 50},
+      minWidth);
     v(core::ParamInfo{"regularize-max-area-change", "Regularization max area change", "%",
                       "The raw outline is kept when regularizing changes its area by more than this",
                       0, 100},
@@ -88,7 +94,8 @@ double dominantOrientation(const core::Polygon& outline, const cv::Mat& image, d
 
 // Regularizes every ring of `outline` (left-image pixels) and gates the result: every ring
 // simple, holes inside the outer ring and apart, no point farther than `tolerance` from the
-// input, area within `maxAreaChange`, no more vertices than the input. When the gate fails the
+// input (once its parts narrower than `minWidth` are cut off), area within `maxAreaChange` of
+// the input's, no more vertices than the input, not a round outline. When the gate fails the
 // input comes back with status KeptRaw and the reason. `image` (optional, single-channel, the
 // image the outline was drawn on) adds its edges to the orientation and bounds the result: edges
 // running along the image border stay on it. Throws core::Error(InvalidParameter) for bad
