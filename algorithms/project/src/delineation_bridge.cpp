@@ -46,6 +46,9 @@ DelineationOutcome runActivePolygon(const Project& project, const Building& buil
   outcome.energy = result.terms.total();
   outcome.terms = result.terms.term;
   outcome.iterations = result.iterations;
+  outcome.rawOutline = result.rawPolygon;
+  outcome.regularization = delineation::toString(result.regularization.status);
+  outcome.regularizationNote = result.regularization.reason;
   return outcome;
 }
 

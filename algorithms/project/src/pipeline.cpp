@@ -273,7 +273,10 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
       b.energyTerms = outcome.terms;
       b.roofHeight = roofHeight(project, disparity, b.outline);
       b.status = BuildingStatus::Automatic;
-      b.addHistory("delineated", "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices");
+      std::string detail = "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices";
+      if (!outcome.regularization.empty()) detail += ", " + outcome.regularization;
+      if (!outcome.regularizationNote.empty()) detail += " (" + outcome.regularizationNote + ")";
+      b.addHistory("delineated", detail);
       ++summary.delineated;
     } catch (const Error& e) {
       if (!core::isInputError(e.code()) || e.code() == ErrorCode::InvalidParameter) {

@@ -65,11 +65,14 @@ double roofHeight(const Project& project, const cv::Mat& disparity, const core::
 // The active polygon for one building. `onContour` (may be empty) receives intermediate
 // contours in left-image pixels from the worker thread.
 struct DelineationOutcome {
-  core::Polygon outline;
+  core::Polygon outline;  // regularized when its last stage passed the gate
   double energy = 0.0;
   EnergyTerms terms{};  // the energy's terms, summing to `energy`
   int iterations = 0;
   core::RunStatus status = core::RunStatus::Completed;
+  core::Polygon rawOutline;       // the active polygon's outline before regularization
+  std::string regularization;     // "regularized", "kept-raw" or "off"
+  std::string regularizationNote; // why the raw outline was kept (empty otherwise)
 };
 using ContourListener = std::function<void(const core::Polygon&)>;
 DelineationOutcome delineateBuilding(const Project& project, const Building& building,
