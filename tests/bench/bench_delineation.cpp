@@ -462,6 +462,30 @@ int main(int argc, char** argv) {
                         r.regularization.energyChange / length, r.regularization.deviation, r.regularization.orientationDeg);
           }
           std::string regLineCopy = regLine;
+          if (const char* path = std::getenv("BENCH_DUMP_OUTLINES")) {
+            // One JSON line per run: the true and the raw outline, to compare other regularizers.
+            auto rings = [](const core::Polygon& p) {
+              nlohmann::json out = nlohmann::json::array();
+              for (const core::Ring* r : {&p.outer}) {
+                nlohmann::json ring = nlohmann::json::array();
+                for (const auto& v : *r) ring.push_back({v.x, v.y});
+                out.push_back(ring);
+              }
+              for (const auto& h : p.holes) {
+                nlohmann::json ring = nlohmann::json::array();
+                for (const auto& v : h) ring.push_back({v.x, v.y});
+                out.push_back(ring);
+              }
+              return out;
+            };
+            const nlohmann::json line{{"scene", sceneParams.seed}, {"id", id}, {"shape", text(fp, "shape")},
+                                      {"init", initName}, {"truth", rings(fp.polygon)}, {"raw", rings(r.rawPolygon)},
+                                      {"regularized", rings(r.polygon)}};
+            if (FILE* f = std::fopen(path, "a")) {
+              std::fprintf(f, "%s\n", line.dump().c_str());
+              std::fclose(f);
+            }
+          }
           ious[initName].push_back(sc.iou);
           corners[initName].push_back(sc.corner);
           hausdorffs[initName].push_back(sc.hausdorff);

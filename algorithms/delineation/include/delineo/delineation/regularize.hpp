@@ -29,30 +29,30 @@ struct RegularizationParams {
                       "diagonals, any angles (collinear edges merged), or none (the raw outline)",
                       0, 0, "right-angles|right-angles-and-diagonals|any-angle|none"},
       mode);
-    v(core::ParamInfo{"regularize-tolerance", "Regularization tolerance", "px",
+    v(core::ParamInfo{"regularize-tolerance", "Regularize tolerance", "px",
                       "Farthest any point of the regularized outline may lie from the raw outline",
                       0.5, 50},
       tolerance);
-    v(core::ParamInfo{"regularize-min-edge", "Regularization min edge", "px",
+    v(core::ParamInfo{"regularize-min-edge", "Regularize min edge", "px",
                       "Edges shorter than this are merged into their neighbours when the tolerance "
                       "allows",
                       0, 100},
       minEdge);
-    v(core::ParamInfo{"regularize-min-width", "Regularization min width", "px",
+    v(core::ParamInfo{"regularize-min-width", "Regularize min width", "px",
                       "Spikes, fingers and slits narrower than this are cut off before regularizing "
                       "(the tolerance applies to the outline without them; 0 = off)",
                       0, 50},
       minWidth);
-    v(core::ParamInfo{"regularize-max-area-change", "Regularization max area change", "%",
+    v(core::ParamInfo{"regularize-max-area-change", "Regularize area change", "%",
                       "The raw outline is kept when regularizing changes its area by more than this",
                       0, 100},
       maxAreaChange);
-    v(core::ParamInfo{"regularize-energy-margin", "Regularization energy margin", "per px",
+    v(core::ParamInfo{"regularize-energy-margin", "Regularize energy margin", "per px",
                       "The raw outline is kept when regularizing raises the active polygon's energy "
                       "by more than this per pixel of outline length",
                       0, 1000},
       energyMargin);
-    v(core::ParamInfo{"regularize-image-edges", "Regularization image edges", "",
+    v(core::ParamInfo{"regularize-image-edges", "Regularize image edges", "",
                       "Weight of the image edges along the outline against the outline's own edges "
                       "when finding the building's orientation (0 = outline only)",
                       0, 100},
