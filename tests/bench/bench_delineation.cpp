@@ -466,9 +466,9 @@ int main(int argc, char** argv) {
             // One JSON line per run: the true and the raw outline, to compare other regularizers.
             auto rings = [](const core::Polygon& p) {
               nlohmann::json out = nlohmann::json::array();
-              for (const core::Ring* r : {&p.outer}) {
+              for (const core::Ring* outer : {&p.outer}) {
                 nlohmann::json ring = nlohmann::json::array();
-                for (const auto& v : *r) ring.push_back({v.x, v.y});
+                for (const auto& v : *outer) ring.push_back({v.x, v.y});
                 out.push_back(ring);
               }
               for (const auto& h : p.holes) {
