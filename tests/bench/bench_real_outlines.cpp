@@ -7,11 +7,11 @@
 // green, rectangle blue, naive cyan, raw yellow, regularized red). Skips cleanly (exit 0) when the
 // data folder is missing. Disparity maps are cached as in bench_roof_interval.
 #include <algorithm>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -57,18 +57,21 @@ core::Polygon naiveOutline(const cv::Mat& disparity, const core::Polygon& rect, 
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
   if (contours.empty()) return {};
-  const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
-    return cv::contourArea(a) < cv::contourArea(b);
-  });
+  const auto largest = std::max_element(
+      contours.begin(), contours.end(),
+      [](const auto& a, const auto& b) { return cv::contourArea(a) < cv::contourArea(b); });
   std::vector<cv::Point> simplified;
   cv::approxPolyDP(*largest, simplified, 1.0, true);
   core::Polygon p;
-  for (const auto& v : simplified) p.outer.emplace_back(v.x + 0.5, v.y + 0.5);  // pixel centres → corners
+  for (const auto& v : simplified)
+    p.outer.emplace_back(v.x + 0.5, v.y + 0.5);  // pixel centres → corners
   return p;
 }
 
-void dump(const std::string& path, const cv::Mat& left, const cv::Rect& box, const std::vector<std::pair<core::Polygon, cv::Scalar>>& outlines) {
-  const cv::Rect crop = cv::Rect(box.x - 10, box.y - 10, box.width + 20, box.height + 20) & cv::Rect(0, 0, left.cols, left.rows);
+void dump(const std::string& path, const cv::Mat& left, const cv::Rect& box,
+          const std::vector<std::pair<core::Polygon, cv::Scalar>>& outlines) {
+  const cv::Rect crop = cv::Rect(box.x - 10, box.y - 10, box.width + 20, box.height + 20) &
+                        cv::Rect(0, 0, left.cols, left.rows);
   const int k = std::max(1, std::min(4, 900 / std::max(crop.width, crop.height)));
   cv::Mat img;
   cv::normalize(left(crop), img, 0, 255, cv::NORM_MINMAX, CV_8U);
@@ -77,7 +80,9 @@ void dump(const std::string& path, const cv::Mat& left, const cv::Rect& box, con
   for (const auto& [p, colour] : outlines) {
     auto ring = [&](const core::Ring& r) {
       std::vector<cv::Point> pts;
-      for (const auto& v : r) pts.emplace_back(static_cast<int>(std::lround((v.x - crop.x) * k)), static_cast<int>(std::lround((v.y - crop.y) * k)));
+      for (const auto& v : r)
+        pts.emplace_back(static_cast<int>(std::lround((v.x - crop.x) * k)),
+                         static_cast<int>(std::lround((v.y - crop.y) * k)));
       cv::polylines(img, pts, true, colour, 1);
       for (const auto& q : pts) cv::circle(img, q, 2, colour, cv::FILLED);
     };
@@ -127,8 +132,10 @@ int main(int argc, char** argv) {
         p = *end == ',' ? end + 1 : end;
       }
     } else {
-      std::fprintf(stderr, "usage: bench_real_outlines [--data DIR] [--labels real_roofs.json] [--cache DIR] "
-                           "[--grow PX] [--tolerances A,B,...] [--dump DIR]\n");
+      std::fprintf(
+          stderr,
+          "usage: bench_real_outlines [--data DIR] [--labels real_roofs.json] [--cache DIR] "
+          "[--grow PX] [--tolerances A,B,...] [--dump DIR]\n");
       return 2;
     }
   }
@@ -137,11 +144,12 @@ int main(int argc, char** argv) {
     return 0;
   }
   delineation::DelineationParams params;
-  if (const char* json = std::getenv("BENCH_PARAMS")) core::fromJson(params, nlohmann::json::parse(json));
+  if (const char* json = std::getenv("BENCH_PARAMS"))
+    core::fromJson(params, nlohmann::json::parse(json));
   std::ifstream in(labels);
   const nlohmann::json data = nlohmann::json::parse(in);
-  std::printf("%-18s %-9s | %-13s | %-13s | %-13s | %-11s %s\n", "roof", "interval", "naive IoU/v", "raw IoU/v",
-              "regular. IoU/v", "reg ms", "regularization");
+  std::printf("%-18s %-9s | %-13s | %-13s | %-13s | %-11s %s\n", "roof", "interval", "naive IoU/v",
+              "raw IoU/v", "regular. IoU/v", "reg ms", "regularization");
   std::map<std::string, cv::Mat> maps, lefts, rights;
   std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV, regMs;
   std::map<double, std::vector<double>> tolIou, tolVertices;
@@ -170,7 +178,8 @@ int main(int argc, char** argv) {
     const double y1 = std::min<double>(map.rows, box.y + box.height + grow);
     core::Polygon rect;
     rect.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-    const auto proposal = delineation::proposeRoofInterval(map, rect, delineation::RoofIntervalParams{});
+    const auto proposal =
+        delineation::proposeRoofInterval(map, rect, delineation::RoofIntervalParams{});
     if (!proposal.found) {
       std::printf("%-18s no roof interval proposed\n", name.c_str());
       continue;
@@ -192,24 +201,33 @@ int main(int argc, char** argv) {
       const cv::Size size = map.size();
       const double ni = naive.outer.empty() ? 0.0 : iou(naive, truth, size);
       const double ri = iou(r.rawPolygon, truth, size), gi = iou(r.polygon, truth, size);
-      std::printf("%-18s [%3d,%3d] | %6.3f %5d | %6.3f %5d | %6.3f %5d | %6.2f ms %s%s%s (dF %+.1f, %.1f deg)\n", name.c_str(),
-                  proposal.low, proposal.high, ni, vertices(naive), ri, vertices(r.rawPolygon), gi, r.vertexCount, ms,
-                  delineation::toString(r.regularization.status).c_str(), r.regularization.reason.empty() ? "" : ": ",
-                  r.regularization.reason.c_str(), r.regularization.energyChange, r.regularization.orientationDeg);
+      std::printf(
+          "%-18s [%3d,%3d] | %6.3f %5d | %6.3f %5d | %6.3f %5d | %6.2f ms %s%s%s (dF %+.1f, %.1f "
+          "deg)\n",
+          name.c_str(), proposal.low, proposal.high, ni, vertices(naive), ri,
+          vertices(r.rawPolygon), gi, r.vertexCount, ms,
+          delineation::toString(r.regularization.status).c_str(),
+          r.regularization.reason.empty() ? "" : ": ", r.regularization.reason.c_str(),
+          r.regularization.energyChange, r.regularization.orientationDeg);
       for (double t : tolerances) {
-        // The same raw outline through the public entry point (outline + energy gate) at tolerance t.
+        // The same raw outline through the public entry point (outline + energy gate) at tolerance
+        // t.
         delineation::DelineationParams other = params;
         other.regularization.tolerance = t;
-        const auto g = delineation::regularizeBuildingOutline(lefts[pairName], rights[pairName], request, other,
-                                                              r.rawPolygon);
-        std::printf("    tolerance %4.1f px: IoU %.3f, %3d vertices, %s%s%s\n", t, iou(g.polygon, truth, size), g.outputVertices,
-                    delineation::toString(g.status).c_str(), g.reason.empty() ? "" : ": ", g.reason.c_str());
+        const auto g = delineation::regularizeBuildingOutline(lefts[pairName], rights[pairName],
+                                                              request, other, r.rawPolygon);
+        std::printf("    tolerance %4.1f px: IoU %.3f, %3d vertices, %s%s%s\n", t,
+                    iou(g.polygon, truth, size), g.outputVertices,
+                    delineation::toString(g.status).c_str(), g.reason.empty() ? "" : ": ",
+                    g.reason.c_str());
         tolIou[t].push_back(iou(g.polygon, truth, size));
         tolVertices[t].push_back(g.outputVertices);
       }
       if (std::getenv("BENCH_VERBOSE")) {
-        const auto g = delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
-        for (const auto& [label, poly] : {std::pair{"raw", r.rawPolygon}, std::pair{"regularized", g.polygon}}) {
+        const auto g =
+            delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
+        for (const auto& [label, poly] :
+             {std::pair{"raw", r.rawPolygon}, std::pair{"regularized", g.polygon}}) {
           std::printf("    %s:", label);
           for (const auto& v : poly.outer) std::printf(" (%.1f,%.1f)", v.x, v.y);
           for (const auto& h : poly.holes) {
@@ -220,14 +238,19 @@ int main(int argc, char** argv) {
         }
       }
       naiveIou.push_back(ni), rawIou.push_back(ri), regIou.push_back(gi);
-      naiveV.push_back(vertices(naive)), rawV.push_back(vertices(r.rawPolygon)), regV.push_back(r.vertexCount);
+      naiveV.push_back(vertices(naive)), rawV.push_back(vertices(r.rawPolygon)),
+          regV.push_back(r.vertexCount);
       regMs.push_back(ms);
       ++runs;
       if (!dumpDir.empty()) {
         fs::create_directories(dumpDir);
         dump((fs::path(dumpDir) / (name + ".png")).string(), lefts[pairName],
-             cv::Rect(static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(x1 - x0), static_cast<int>(y1 - y0)),
-             {{rect, {255, 80, 0}}, {truth, {0, 200, 0}}, {naive, {255, 255, 0}}, {r.rawPolygon, {0, 220, 255}},
+             cv::Rect(static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(x1 - x0),
+                      static_cast<int>(y1 - y0)),
+             {{rect, {255, 80, 0}},
+              {truth, {0, 200, 0}},
+              {naive, {255, 255, 0}},
+              {r.rawPolygon, {0, 220, 255}},
               {r.polygon, {0, 0, 255}}});
       }
     } catch (const core::Error& e) {
@@ -243,12 +266,16 @@ int main(int argc, char** argv) {
     for (double x : v) s += x;
     return v.empty() ? std::nan("") : s / static_cast<double>(v.size());
   };
-  std::printf("\n%d roofs (rectangle = labelled box + %d px): mean IoU naive %.3f, raw %.3f, regularized %.3f; "
-              "median vertices naive %.0f, raw %.0f, regularized %.0f; regularization median %.2f ms, max %.2f ms\n",
-              runs, grow, mean(naiveIou), mean(rawIou), mean(regIou), median(naiveV), median(rawV), median(regV),
-              median(regMs), *std::max_element(regMs.begin(), regMs.end()));
+  std::printf(
+      "\n%d roofs (rectangle = labelled box + %d px): mean IoU naive %.3f, raw %.3f, regularized "
+      "%.3f; "
+      "median vertices naive %.0f, raw %.0f, regularized %.0f; regularization median %.2f ms, max "
+      "%.2f ms\n",
+      runs, grow, mean(naiveIou), mean(rawIou), mean(regIou), median(naiveV), median(rawV),
+      median(regV), median(regMs), *std::max_element(regMs.begin(), regMs.end()));
   for (const auto& [t, v] : tolIou) {
-    std::printf("  tolerance %4.1f px: mean IoU %.3f, median vertices %.0f\n", t, mean(v), median(tolVertices[t]));
+    std::printf("  tolerance %4.1f px: mean IoU %.3f, median vertices %.0f\n", t, mean(v),
+                median(tolVertices[t]));
   }
   return 0;
 }

@@ -21,10 +21,12 @@ inline core::Polygon ringOf(const nlohmann::json& points) {
   return p;
 }
 
-inline cv::Mat disparityFor(const std::string& name, const std::string& left, const std::string& right, int dmin,
-                            int dmax, const std::filesystem::path& cache) {
+inline cv::Mat disparityFor(const std::string& name, const std::string& left,
+                            const std::string& right, int dmin, int dmax,
+                            const std::filesystem::path& cache) {
   namespace fs = std::filesystem;
-  const fs::path cached = cache / (name + "_" + std::to_string(dmin) + "_" + std::to_string(dmax) + ".tif");
+  const fs::path cached =
+      cache / (name + "_" + std::to_string(dmin) + "_" + std::to_string(dmax) + ".tif");
   if (fs::exists(cached)) {
     io::ReadOptions options;
     options.type = io::PixelType::Float32;
@@ -34,7 +36,8 @@ inline cv::Mat disparityFor(const std::string& name, const std::string& left, co
   params.dmin = dmin;
   params.dmax = dmax;
   std::fprintf(stderr, "matching %s (%d..%d px)...\n", name.c_str(), dmin, dmax);
-  const cv::Mat disparity = stereo::matchStereo(io::readGreyFloat(left), io::readGreyFloat(right), params).disparity;
+  const cv::Mat disparity =
+      stereo::matchStereo(io::readGreyFloat(left), io::readGreyFloat(right), params).disparity;
   fs::create_directories(cache);
   io::writeFloatGeoTiff(cached.string(), disparity);
   return disparity;

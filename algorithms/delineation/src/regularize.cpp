@@ -30,9 +30,15 @@ constexpr double kParallelAngle = 8.0 * kPi / 180.0;
 // farther apart they are joined by a perpendicular connector (a jog the short-edge step may merge).
 constexpr double kJogMerge = 1.0;
 
-cv::Point2d direction(double angle) { return {std::cos(angle), std::sin(angle)}; }
-cv::Point2d normal(double angle) { return {-std::sin(angle), std::cos(angle)}; }
-double cross(cv::Point2d a, cv::Point2d b) { return a.x * b.y - a.y * b.x; }
+cv::Point2d direction(double angle) {
+  return {std::cos(angle), std::sin(angle)};
+}
+cv::Point2d normal(double angle) {
+  return {-std::sin(angle), std::cos(angle)};
+}
+double cross(cv::Point2d a, cv::Point2d b) {
+  return a.x * b.y - a.y * b.x;
+}
 
 double segmentDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
   const cv::Point2d ab = b - a;
@@ -44,7 +50,8 @@ double segmentDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
 
 double ringDistance(cv::Point2d p, const core::Ring& ring) {
   double best = kInf;
-  for (size_t i = 0; i < ring.size(); ++i) best = std::min(best, segmentDistance(p, ring[i], ring[(i + 1) % ring.size()]));
+  for (size_t i = 0; i < ring.size(); ++i)
+    best = std::min(best, segmentDistance(p, ring[i], ring[(i + 1) % ring.size()]));
   return best;
 }
 
@@ -52,7 +59,9 @@ double ringDistance(cv::Point2d p, const core::Ring& ring) {
 // outline `input`. Exact up to `stopAbove`; above it, any value above `stopAbove`.
 // Edges in `skip` (end points as {ax, ay, bx, by}) are left out.
 using EdgeKey = std::array<double, 4>;
-EdgeKey edgeKey(cv::Point2d a, cv::Point2d b) { return {a.x, a.y, b.x, b.y}; }
+EdgeKey edgeKey(cv::Point2d a, cv::Point2d b) {
+  return {a.x, a.y, b.x, b.y};
+}
 
 // The edges of a ring bucketed on a square grid: distances to the ring near a point without
 // visiting every edge (an outline cleaned on the pixel grid has hundreds).
@@ -69,18 +78,22 @@ class EdgeGrid {
       const int x0 = col(std::min(p.x, q.x)), x1 = col(std::max(p.x, q.x));
       const int y0 = row(std::min(p.y, q.y)), y1 = row(std::max(p.y, q.y));
       for (int y = y0; y <= y1; ++y) {
-        for (int x = x0; x <= x1; ++x) cells_[static_cast<size_t>(y * cols_ + x)].push_back(static_cast<int>(k));
+        for (int x = x0; x <= x1; ++x)
+          cells_[static_cast<size_t>(y * cols_ + x)].push_back(static_cast<int>(k));
       }
     }
   }
   // Distance from p to the ring when it is at most `limit`, else some value above `limit`.
   double distance(cv::Point2d p, double limit) const {
     double best = kInf;
-    const int x0 = col(p.x - limit), x1 = col(p.x + limit), y0 = row(p.y - limit), y1 = row(p.y + limit);
+    const int x0 = col(p.x - limit), x1 = col(p.x + limit), y0 = row(p.y - limit),
+              y1 = row(p.y + limit);
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         for (int k : cells_[static_cast<size_t>(y * cols_ + x)]) {
-          best = std::min(best, segmentDistance(p, ring_[static_cast<size_t>(k)], ring_[(static_cast<size_t>(k) + 1) % ring_.size()]));
+          best =
+              std::min(best, segmentDistance(p, ring_[static_cast<size_t>(k)],
+                                             ring_[(static_cast<size_t>(k) + 1) % ring_.size()]));
         }
       }
     }
@@ -89,8 +102,12 @@ class EdgeGrid {
   const core::Ring& ring() const { return ring_; }
 
  private:
-  int col(double x) const { return std::clamp(static_cast<int>(std::floor((x - origin_.x) / cell_)), 0, cols_ - 1); }
-  int row(double y) const { return std::clamp(static_cast<int>(std::floor((y - origin_.y) / cell_)), 0, rows_ - 1); }
+  int col(double x) const {
+    return std::clamp(static_cast<int>(std::floor((x - origin_.x) / cell_)), 0, cols_ - 1);
+  }
+  int row(double y) const {
+    return std::clamp(static_cast<int>(std::floor((y - origin_.y) / cell_)), 0, rows_ - 1);
+  }
   const core::Ring& ring_;
   double cell_;
   cv::Point2d origin_;
@@ -106,7 +123,8 @@ double maxDeviation(const core::Ring& result, const EdgeGrid& input, double stop
     if (skip && skip->count(edgeKey(a, b))) continue;
     const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a))));
     for (int s = 0; s < steps; ++s) {
-      worst = std::max(worst, input.distance(a + (b - a) * (static_cast<double>(s) / steps), stopAbove + 1.0));
+      worst = std::max(
+          worst, input.distance(a + (b - a) * (static_cast<double>(s) / steps), stopAbove + 1.0));
       if (worst > stopAbove) return worst;
     }
   }
@@ -122,7 +140,8 @@ double meanDistance(const core::Ring& result, const core::Ring& input) {
   for (size_t i = 0; i < result.size(); ++i) {
     const cv::Point2d a = result[i], b = result[(i + 1) % result.size()];
     const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a) / 2.0)));
-    for (int s = 0; s < steps; ++s) sum += ringDistance(a + (b - a) * (static_cast<double>(s) / steps), input), ++n;
+    for (int s = 0; s < steps; ++s)
+      sum += ringDistance(a + (b - a) * (static_cast<double>(s) / steps), input), ++n;
   }
   return n ? sum / n : 0.0;
 }
@@ -160,9 +179,12 @@ void outlineVotes(const core::Ring& ring, double epsilon, std::vector<Vote>& vot
 // Grey level of a single-channel image of any common depth, NaN as 0.
 double grey(const cv::Mat& image, int x, int y) {
   switch (image.depth()) {
-    case CV_8U: return image.at<uchar>(y, x);
-    case CV_16U: return image.at<ushort>(y, x);
-    case CV_16S: return image.at<short>(y, x);
+    case CV_8U:
+      return image.at<uchar>(y, x);
+    case CV_16U:
+      return image.at<ushort>(y, x);
+    case CV_16S:
+      return image.at<short>(y, x);
     case CV_32F: {
       const float v = image.at<float>(y, x);
       return std::isfinite(v) ? v : 0.0;
@@ -171,16 +193,18 @@ double grey(const cv::Mat& image, int x, int y) {
       const double v = image.at<double>(y, x);
       return std::isfinite(v) ? v : 0.0;
     }
-    default: return 0.0;
+    default:
+      return 0.0;
   }
 }
 
 // Gradient directions (modulo 90°, the same as the edge directions) of the image within 2 px of
 // the outline (every 2 px along it, five offsets across it) that run along the outline, weighted
-// by the gradient magnitude above the median of the samples (flat texture's noise votes nothing). The gradient is the
-// 5x5 Sobel (the 3x3 one leans about 1° towards the pixel axes on sharp edges), computed at the
-// sampled pixels only (a large building's box is mostly roof).
-void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<Vote>& votes, double& total) {
+// by the gradient magnitude above the median of the samples (flat texture's noise votes nothing).
+// The gradient is the 5x5 Sobel (the 3x3 one leans about 1° towards the pixel axes on sharp edges),
+// computed at the sampled pixels only (a large building's box is mostly roof).
+void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<Vote>& votes,
+                double& total) {
   std::vector<float> magnitudes;
   std::vector<Vote> local;
   static const double w[5] = {1, 4, 6, 4, 1}, d[5] = {-1, -2, 0, 2, 1};
@@ -222,7 +246,8 @@ void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<
   walk(outline.outer);
   for (const auto& h : outline.holes) walk(h);
   if (magnitudes.empty()) return;
-  std::nth_element(magnitudes.begin(), magnitudes.begin() + static_cast<long>(magnitudes.size() / 2), magnitudes.end());
+  std::nth_element(magnitudes.begin(),
+                   magnitudes.begin() + static_cast<long>(magnitudes.size() / 2), magnitudes.end());
   const double floor = magnitudes[magnitudes.size() / 2];
   for (auto& v : local) {
     v.weight = std::max(0.0, v.weight - floor);
@@ -233,16 +258,20 @@ void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<
   }
 }
 
-// Peak of the votes: histogram of 1° bins smoothed over ±6°, then refined (below). Zigzags of a pixel-grid outline vote ±7° around the true direction; the smoothing merges the
-// two lobes, the mean centres them.
+// Peak of the votes: histogram of 1° bins smoothed over ±6°, then refined (below). Zigzags of a
+// pixel-grid outline vote ±7° around the true direction; the smoothing merges the two lobes, the
+// mean centres them.
 double votePeak(const std::vector<Vote>& votes) {
   constexpr int kBins = 90;
   std::vector<double> hist(kBins, 0.0), smooth(kBins, 0.0);
-  for (const auto& v : votes) hist[std::min(kBins - 1, static_cast<int>(v.angle * 180.0 / kPi))] += v.weight;
+  for (const auto& v : votes)
+    hist[std::min(kBins - 1, static_cast<int>(v.angle * 180.0 / kPi))] += v.weight;
   for (int b = 0; b < kBins; ++b) {
-    for (int k = -6; k <= 6; ++k) smooth[b] += hist[(b + k + kBins) % kBins] * std::exp(-0.5 * k * k / 9.0);
+    for (int k = -6; k <= 6; ++k)
+      smooth[b] += hist[(b + k + kBins) % kBins] * std::exp(-0.5 * k * k / 9.0);
   }
-  const int peak = static_cast<int>(std::max_element(smooth.begin(), smooth.end()) - smooth.begin());
+  const int peak =
+      static_cast<int>(std::max_element(smooth.begin(), smooth.end()) - smooth.begin());
   double centre = (peak + 0.5) * kPi / 180.0;
   auto offset = [&](const Vote& v) {
     double d = v.angle - centre;
@@ -284,25 +313,31 @@ double votePeak(const std::vector<Vote>& votes) {
 // ---- Lines along the outline ----------------------------------------------------------------
 
 struct Line {
-  double angle = 0;        // direction of travel along the ring, radians
-  double offset = 0;       // normal(angle) · p for the points p of the line
-  double weight = 0;       // px of input outline behind it
-  cv::Point2d centroid;    // length-weighted centre of that outline (offset = normal · centroid)
-  cv::Point2d start;       // input point where its piece of outline starts (connectors go there)
-  bool fixed = false;      // along the image border: keeps its direction and offset
+  double angle = 0;      // direction of travel along the ring, radians
+  double offset = 0;     // normal(angle) · p for the points p of the line
+  double weight = 0;     // px of input outline behind it
+  cv::Point2d centroid;  // length-weighted centre of that outline (offset = normal · centroid)
+  cv::Point2d start;     // input point where its piece of outline starts (connectors go there)
+  bool fixed = false;    // along the image border: keeps its direction and offset
 };
 
-bool parallel(const Line& a, const Line& b) { return std::abs(std::sin(a.angle - b.angle)) < std::sin(kParallelAngle); }
-bool sameDirection(const Line& a, const Line& b) { return std::cos(a.angle - b.angle) > 0; }
+bool parallel(const Line& a, const Line& b) {
+  return std::abs(std::sin(a.angle - b.angle)) < std::sin(kParallelAngle);
+}
+bool sameDirection(const Line& a, const Line& b) {
+  return std::cos(a.angle - b.angle) > 0;
+}
 
 Line merged(const Line& a, const Line& b) {
   if (b.fixed && !a.fixed) return merged(b, a);
   Line m = a;
   m.weight = a.weight + b.weight;
   if (a.fixed) return m;
-  const double w = m.weight > 0 ? m.weight : 1.0, wa = m.weight > 0 ? a.weight : 0.5, wb = m.weight > 0 ? b.weight : 0.5;
+  const double w = m.weight > 0 ? m.weight : 1.0, wa = m.weight > 0 ? a.weight : 0.5,
+               wb = m.weight > 0 ? b.weight : 0.5;
   m.centroid = (a.centroid * wa + b.centroid * wb) / w;
-  const cv::Point2d d = direction(a.angle) * wa + direction(b.angle) * wb;  // same angle when snapped
+  const cv::Point2d d =
+      direction(a.angle) * wa + direction(b.angle) * wb;  // same angle when snapped
   m.angle = std::atan2(d.y, d.x);
   m.offset = normal(m.angle).dot(m.centroid);
   return m;
@@ -325,7 +360,8 @@ core::Ring vertices(const std::vector<Line>& lines) {
 // fold).
 std::vector<double> edgeLengths(const std::vector<Line>& lines, const core::Ring& ring) {
   std::vector<double> out(lines.size());
-  for (size_t k = 0; k < lines.size(); ++k) out[k] = direction(lines[k].angle).dot(ring[(k + 1) % ring.size()] - ring[k]);
+  for (size_t k = 0; k < lines.size(); ++k)
+    out[k] = direction(lines[k].angle).dot(ring[(k + 1) % ring.size()] - ring[k]);
   return out;
 }
 
@@ -365,7 +401,8 @@ bool tidy(std::vector<Line>& lines, bool connectors, size_t minLines) {
 }
 
 // Douglas-Peucker on a closed ring: indices of the kept vertices, in ring order.
-void simplifyRange(const core::Ring& ring, size_t i0, size_t i1, double epsilon, std::vector<char>& keep) {
+void simplifyRange(const core::Ring& ring, size_t i0, size_t i1, double epsilon,
+                   std::vector<char>& keep) {
   const size_t n = ring.size();
   const size_t span = (i1 + n - i0) % n;
   if (span < 2) return;
@@ -410,7 +447,7 @@ std::vector<size_t> breakpoints(const core::Ring& ring, double epsilon) {
 
 struct RingContext {
   RegularizationMode mode;
-  double theta;  // dominant orientation, radians in [0, π/2)
+  double theta;     // dominant orientation, radians in [0, π/2)
   cv::Size bounds;  // image size, or empty
 };
 
@@ -419,7 +456,8 @@ double snapped(double angle, const RingContext& ctx) {
   const double step = ctx.mode == RegularizationMode::RightAnglesAndDiagonals ? kPi / 4 : kPi / 2;
   const double k = std::round((angle - ctx.theta) / step);
   const double s = ctx.theta + k * step;
-  if (ctx.mode == RegularizationMode::AnyAngle && std::abs(angle - s) > kParallelAngle) return angle;
+  if (ctx.mode == RegularizationMode::AnyAngle && std::abs(angle - s) > kParallelAngle)
+    return angle;
   return s;
 }
 
@@ -432,7 +470,10 @@ bool borderLine(const core::Ring& ring, size_t i0, size_t i1, const RingContext&
     bool all = true;
     for (size_t k = i0;; k = (k + 1) % n) {
       const cv::Point2d p = ring[k];
-      const double d = side == 0 ? std::abs(p.x) : side == 1 ? std::abs(p.x - w) : side == 2 ? std::abs(p.y) : std::abs(p.y - h);
+      const double d = side == 0   ? std::abs(p.x)
+                       : side == 1 ? std::abs(p.x - w)
+                       : side == 2 ? std::abs(p.y)
+                                   : std::abs(p.y - h);
       if (d > 0.5) {
         all = false;
         break;
@@ -443,7 +484,10 @@ bool borderLine(const core::Ring& ring, size_t i0, size_t i1, const RingContext&
     const cv::Point2d chord = ring[i1] - ring[i0];
     const bool vertical = side < 2;
     line.angle = vertical ? (chord.y >= 0 ? kPi / 2 : -kPi / 2) : (chord.x >= 0 ? 0.0 : kPi);
-    line.centroid = side == 0 ? cv::Point2d(0, 0) : side == 1 ? cv::Point2d(w, 0) : side == 2 ? cv::Point2d(0, 0) : cv::Point2d(0, h);
+    line.centroid = side == 0   ? cv::Point2d(0, 0)
+                    : side == 1 ? cv::Point2d(w, 0)
+                    : side == 2 ? cv::Point2d(0, 0)
+                                : cv::Point2d(0, h);
     line.offset = normal(line.angle).dot(line.centroid);
     line.fixed = true;
     return true;
@@ -459,7 +503,8 @@ Line lineOfPiece(const core::Ring& ring, size_t i0, size_t i1, const RingContext
   const size_t n = ring.size();
   Line line;
   line.start = ring[i0];
-  for (size_t k = i0; k != i1; k = (k + 1) % n) line.weight += cv::norm(ring[(k + 1) % n] - ring[k]);
+  for (size_t k = i0; k != i1; k = (k + 1) % n)
+    line.weight += cv::norm(ring[(k + 1) % n] - ring[k]);
   if (borderLine(ring, i0, i1, ctx, line)) return line;
   double s2 = 0, c2 = 0;
   for (size_t k = i0; k != i1; k = (k + 1) % n) {
@@ -492,8 +537,8 @@ Line lineOfPiece(const core::Ring& ring, size_t i0, size_t i1, const RingContext
 // from its (snapped) line is split at its vertex farthest from its chord, until each fits or is
 // a single edge. A slanted piece in right-angles mode becomes a staircase that the short-edge
 // step may then merge.
-void addPieceLines(const core::Ring& ring, size_t i0, size_t i1, const RingContext& ctx, double limit, int depth,
-                   std::vector<Line>& lines) {
+void addPieceLines(const core::Ring& ring, size_t i0, size_t i1, const RingContext& ctx,
+                   double limit, int depth, std::vector<Line>& lines) {
   const size_t n = ring.size();
   const Line line = lineOfPiece(ring, i0, i1, ctx);
   const size_t span = (i1 + n - i0) % n;
@@ -519,8 +564,8 @@ void addPieceLines(const core::Ring& ring, size_t i0, size_t i1, const RingConte
   lines.push_back(line);
 }
 
-std::vector<Line> piecesToLines(const core::Ring& ring, const std::vector<size_t>& breaks, const RingContext& ctx,
-                                double limit) {
+std::vector<Line> piecesToLines(const core::Ring& ring, const std::vector<size_t>& breaks,
+                                const RingContext& ctx, double limit) {
   std::vector<Line> lines;
   for (size_t b = 0; b < breaks.size(); ++b) {
     addPieceLines(ring, breaks[b], breaks[(b + 1) % breaks.size()], ctx, limit, 0, lines);
@@ -531,7 +576,8 @@ std::vector<Line> piecesToLines(const core::Ring& ring, const std::vector<size_t
 bool insideBounds(const core::Ring& ring, cv::Size bounds) {
   if (bounds.empty()) return true;
   return std::all_of(ring.begin(), ring.end(), [&](const cv::Point2d& p) {
-    return p.x >= -1e-6 && p.y >= -1e-6 && p.x <= bounds.width + 1e-6 && p.y <= bounds.height + 1e-6;
+    return p.x >= -1e-6 && p.y >= -1e-6 && p.x <= bounds.width + 1e-6 &&
+           p.y <= bounds.height + 1e-6;
   });
 }
 
@@ -558,24 +604,27 @@ bool simpleAround(const core::Ring& ring, const std::set<EdgeKey>& unchanged) {
 // Removes the shortest edges (below minEdge, folds first) one at a time while the result stays
 // simple and the edges the removal changes stay within the tolerance of the input (the whole
 // ring is judged at the end: a removal may come before the one that brings a far edge back).
-void removeShortEdges(std::vector<Line>& lines, const EdgeGrid& input, const RegularizationParams& params,
-                      const RingContext& ctx, size_t minLines) {
+void removeShortEdges(std::vector<Line>& lines, const EdgeGrid& input,
+                      const RegularizationParams& params, const RingContext& ctx, size_t minLines) {
   std::set<std::array<EdgeKey, 3>> failed;
   for (size_t round = 0; round < 4 * input.ring().size() + 16; ++round) {
     const core::Ring ring = vertices(lines);
     std::set<EdgeKey> unchanged;
-    for (size_t i = 0; i < ring.size(); ++i) unchanged.insert(edgeKey(ring[i], ring[(i + 1) % ring.size()]));
+    for (size_t i = 0; i < ring.size(); ++i)
+      unchanged.insert(edgeKey(ring[i], ring[(i + 1) % ring.size()]));
     const std::vector<double> lengths = edgeLengths(lines, ring);
     std::vector<size_t> order;
     for (size_t k = 0; k < lines.size(); ++k) {
       if (lengths[k] < params.minEdge) order.push_back(k);
     }
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return lengths[a] < lengths[b]; });
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return lengths[a] < lengths[b]; });
     bool removed = false;
     for (size_t k : order) {
       // A removal that failed with the same edge and neighbours fails again: skip it.
       const size_t n = ring.size();
-      const std::array<EdgeKey, 3> around{edgeKey(ring[(k + n - 1) % n], ring[k]), edgeKey(ring[k], ring[(k + 1) % n]),
+      const std::array<EdgeKey, 3> around{edgeKey(ring[(k + n - 1) % n], ring[k]),
+                                          edgeKey(ring[k], ring[(k + 1) % n]),
                                           edgeKey(ring[(k + 1) % n], ring[(k + 2) % n])};
       if (failed.count(around)) continue;
       failed.insert(around);
@@ -644,7 +693,8 @@ RingCandidate regularizeRingAt(const core::Ring& input, const EdgeGrid& grid, do
   }
   c.deviation = maxDeviation(c.ring, grid, 4 * params.tolerance + 10);
   if (c.deviation > params.tolerance + 1e-9) {
-    c.failure = "deviation " + formatPx(c.deviation) + " px > " + formatPx(params.tolerance) + " px";
+    c.failure =
+        "deviation " + formatPx(c.deviation) + " px > " + formatPx(params.tolerance) + " px";
     return c;
   }
   c.mean = meanDistance(c.ring, input);
@@ -653,7 +703,8 @@ RingCandidate regularizeRingAt(const core::Ring& input, const EdgeGrid& grid, do
 
 // The best of the candidates from several segmentation tolerances: fewest vertices, then the
 // closest to the input. The coarsest tolerance merges noise, the finer ones keep small wings.
-RingCandidate regularizeRing(const core::Ring& input, const RegularizationParams& params, const RingContext& ctx) {
+RingCandidate regularizeRing(const core::Ring& input, const RegularizationParams& params,
+                             const RingContext& ctx) {
   std::vector<double> epsilons;
   for (double f : {1.0, 0.6, 0.35}) {
     const double e = std::max(0.5, f * params.tolerance);
@@ -679,7 +730,8 @@ core::Ring cleaned(const core::Ring& ring) {
   core::Ring out;
   for (const auto& p : ring) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
-      throw Error(ErrorCode::InvalidParameter, "the outline to regularize has a non-finite coordinate");
+      throw Error(ErrorCode::InvalidParameter,
+                  "the outline to regularize has a non-finite coordinate");
     }
     if (out.empty() || cv::norm(p - out.back()) > 1e-9) out.push_back(p);
   }
@@ -696,15 +748,19 @@ bool ringsApart(const core::Polygon& p) {
       const core::Ring& rb = *rings[b];
       for (size_t i = 0; i < ra.size(); ++i) {
         for (size_t j = 0; j < rb.size(); ++j) {
-          if (core::segmentsIntersect(ra[i], ra[(i + 1) % ra.size()], rb[j], rb[(j + 1) % rb.size()])) return false;
+          if (core::segmentsIntersect(ra[i], ra[(i + 1) % ra.size()], rb[j],
+                                      rb[(j + 1) % rb.size()]))
+            return false;
         }
       }
     }
   }
   auto inside = [](const core::Ring& ring, cv::Point2d q) {
     std::vector<cv::Point2f> contour;
-    for (const auto& v : ring) contour.emplace_back(static_cast<float>(v.x), static_cast<float>(v.y));
-    return cv::pointPolygonTest(contour, cv::Point2f(static_cast<float>(q.x), static_cast<float>(q.y)), false) > 0;
+    for (const auto& v : ring)
+      contour.emplace_back(static_cast<float>(v.x), static_cast<float>(v.y));
+    return cv::pointPolygonTest(
+               contour, cv::Point2f(static_cast<float>(q.x), static_cast<float>(q.y)), false) > 0;
   };
   for (size_t h = 0; h < p.holes.size(); ++h) {
     if (!inside(p.outer, p.holes[h].front())) return false;
@@ -729,8 +785,8 @@ bool hasThinParts(const core::Ring& ring, double width) {
       if ((j + 1) % n == i) continue;
       const cv::Point2d c = ring[j], d = ring[(j + 1) % n], v = d - c;
       if (u.dot(v) > -std::cos(kPi / 4) * cv::norm(u) * cv::norm(v)) continue;
-      const double gap = std::min({segmentDistance(a, c, d), segmentDistance(b, c, d), segmentDistance(c, a, b),
-                                   segmentDistance(d, a, b)});
+      const double gap = std::min({segmentDistance(a, c, d), segmentDistance(b, c, d),
+                                   segmentDistance(c, a, b), segmentDistance(d, a, b)});
       if (gap < width) return true;
     }
   }
@@ -745,7 +801,8 @@ bool withoutThinParts(const core::Polygon& in, double minWidth, core::Polygon& o
   if (!thinSides) return false;  // the raster below is the expensive part
   const cv::Rect2d box = core::boundingBox(in.outer);
   const cv::Point2d origin(std::floor(box.x) - 2 * r - 2, std::floor(box.y) - 2 * r - 2);
-  const cv::Size size(static_cast<int>(std::ceil(box.width)) + 4 * r + 6, static_cast<int>(std::ceil(box.height)) + 4 * r + 6);
+  const cv::Size size(static_cast<int>(std::ceil(box.width)) + 4 * r + 6,
+                      static_cast<int>(std::ceil(box.height)) + 4 * r + 6);
   core::Polygon local = in;
   for (auto& v : local.outer) v -= origin;
   for (auto& h : local.holes) {
@@ -759,7 +816,8 @@ bool withoutThinParts(const core::Polygon& in, double minWidth, core::Polygon& o
   cv::Mat changed = mask != cleaned, labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(changed, labels, stats, centroids, 8);
   bool thin = false;
-  for (int i = 1; i < n && !thin; ++i) thin = stats.at<int>(i, cv::CC_STAT_AREA) >= minWidth * minWidth;
+  for (int i = 1; i < n && !thin; ++i)
+    thin = stats.at<int>(i, cv::CC_STAT_AREA) >= minWidth * minWidth;
   if (!thin) return false;
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;
@@ -783,8 +841,10 @@ bool withoutThinParts(const core::Polygon& in, double minWidth, core::Polygon& o
     return ring;
   };
   out = core::Polygon{toRing(contours[static_cast<size_t>(largest)]), {}};
-  for (int h = hierarchy[static_cast<size_t>(largest)][2]; h >= 0; h = hierarchy[static_cast<size_t>(h)][0]) {
-    if (contours[static_cast<size_t>(h)].size() >= 3) out.holes.push_back(toRing(contours[static_cast<size_t>(h)]));
+  for (int h = hierarchy[static_cast<size_t>(largest)][2]; h >= 0;
+       h = hierarchy[static_cast<size_t>(h)][0]) {
+    if (contours[static_cast<size_t>(h)].size() >= 3)
+      out.holes.push_back(toRing(contours[static_cast<size_t>(h)]));
   }
   return out.outer.size() >= 3;
 }
@@ -841,7 +901,9 @@ int vertexCount(const core::Polygon& p) {
 
 }  // namespace
 
-void RegularizationParams::validate() const { core::checkDeclaredRanges(*this); }
+void RegularizationParams::validate() const {
+  core::checkDeclaredRanges(*this);
+}
 
 RegularizationMode regularizationMode(const std::string& name) {
   if (name == "none") return RegularizationMode::None;
@@ -849,55 +911,66 @@ RegularizationMode regularizationMode(const std::string& name) {
   if (name == "right-angles-and-diagonals") return RegularizationMode::RightAnglesAndDiagonals;
   if (name == "any-angle") return RegularizationMode::AnyAngle;
   throw Error(ErrorCode::InvalidParameter,
-              "regularize = '" + name + "' is not one of right-angles|right-angles-and-diagonals|any-angle|none");
+              "regularize = '" + name +
+                  "' is not one of right-angles|right-angles-and-diagonals|any-angle|none");
 }
 
 std::string toString(RegularizationStatus status) {
   switch (status) {
-    case RegularizationStatus::Regularized: return "regularized";
-    case RegularizationStatus::KeptRaw: return "kept-raw";
-    case RegularizationStatus::Off: break;
+    case RegularizationStatus::Regularized:
+      return "regularized";
+    case RegularizationStatus::KeptRaw:
+      return "kept-raw";
+    case RegularizationStatus::Off:
+      break;
   }
   return "off";
 }
 
-double dominantOrientation(const core::Polygon& outline, const cv::Mat& image, double imageEdgeWeight,
-                           double epsilon) {
+double dominantOrientation(const core::Polygon& outline, const cv::Mat& image,
+                           double imageEdgeWeight, double epsilon) {
   std::vector<Vote> shape, edges;
   double shapeTotal = 0, edgeTotal = 0;
   outlineVotes(outline.outer, epsilon, shape, shapeTotal);
   for (const auto& h : outline.holes) outlineVotes(h, epsilon, shape, shapeTotal);
-  if (!image.empty() && imageEdgeWeight > 0 && image.channels() == 1) imageVotes(outline, image, edges, edgeTotal);
+  if (!image.empty() && imageEdgeWeight > 0 && image.channels() == 1)
+    imageVotes(outline, image, edges, edgeTotal);
   // Both sources normalised to a total weight of 1 (then the image's scaled by its weight).
   std::vector<Vote> votes;
   for (const auto& v : shape) votes.push_back({v.angle, v.weight / std::max(shapeTotal, 1e-12)});
-  for (const auto& v : edges) votes.push_back({v.angle, imageEdgeWeight * v.weight / std::max(edgeTotal, 1e-12)});
+  for (const auto& v : edges)
+    votes.push_back({v.angle, imageEdgeWeight * v.weight / std::max(edgeTotal, 1e-12)});
   if (votes.empty()) return 0.0;
   return votePeak(votes);
 }
 
-RegularizationOutcome regularizeOutline(const core::Polygon& outline, const RegularizationParams& params,
-                                        const cv::Mat& image) {
+RegularizationOutcome regularizeOutline(const core::Polygon& outline,
+                                        const RegularizationParams& params, const cv::Mat& image) {
   params.validate();
   const RegularizationMode mode = regularizationMode(params.mode);
   core::Polygon input{cleaned(outline.outer), {}};
   for (const auto& h : outline.holes) input.holes.push_back(cleaned(h));
   if (input.outer.size() < 3 || core::area(core::Polygon{input.outer, {}}) <= 1e-9) {
-    throw Error(ErrorCode::InvalidParameter,
-                "the outline to regularize is not a polygon (fewer than 3 distinct vertices or zero area)");
+    throw Error(
+        ErrorCode::InvalidParameter,
+        "the outline to regularize is not a polygon (fewer than 3 distinct vertices or zero area)");
   }
-  if (!image.empty() && (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U &&
-                                                     image.depth() != CV_16S && image.depth() != CV_32F &&
-                                                     image.depth() != CV_64F))) {
+  if (!image.empty() &&
+      (image.channels() != 1 ||
+       (image.depth() != CV_8U && image.depth() != CV_16U && image.depth() != CV_16S &&
+        image.depth() != CV_32F && image.depth() != CV_64F))) {
     throw Error(ErrorCode::UnsupportedInput,
-                "regularization reads the edges of a single-band 8-bit, 16-bit or floating-point image only");
+                "regularization reads the edges of a single-band 8-bit, 16-bit or floating-point "
+                "image only");
   }
   RegularizationOutcome out;
   out.polygon = outline;
   out.inputVertices = out.outputVertices = vertexCount(outline);
   if (mode == RegularizationMode::None) return out;
 
-  RingContext ctx{mode, dominantOrientation(input, image, params.imageEdgeWeight, std::max(0.5, 0.5 * params.tolerance)),
+  RingContext ctx{mode,
+                  dominantOrientation(input, image, params.imageEdgeWeight,
+                                      std::max(0.5, 0.5 * params.tolerance)),
                   image.size()};
   out.orientationDeg = ctx.theta * 180.0 / kPi;
   auto keep = [&](const std::string& reason) {

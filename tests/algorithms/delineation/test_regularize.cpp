@@ -63,7 +63,8 @@ double worstCorner(const core::Ring& result, const core::Ring& truth) {
 double worstAngleError(const core::Ring& ring, double step = 90.0) {
   double worst = 0;
   for (size_t i = 0; i < ring.size(); ++i) {
-    const cv::Point2d a = ring[(i + ring.size() - 1) % ring.size()], v = ring[i], b = ring[(i + 1) % ring.size()];
+    const cv::Point2d a = ring[(i + ring.size() - 1) % ring.size()], v = ring[i],
+                      b = ring[(i + 1) % ring.size()];
     const cv::Point2d e1 = v - a, e2 = b - v;
     const double turn = std::atan2(e1.x * e2.y - e1.y * e2.x, e1.dot(e2)) * 180.0 / kPi;
     const double err = std::abs(turn - step * std::round(turn / step));
@@ -72,7 +73,9 @@ double worstAngleError(const core::Ring& ring, double step = 90.0) {
   return worst;
 }
 
-core::Ring rectangle(double x0, double y0, double x1, double y1) { return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}; }
+core::Ring rectangle(double x0, double y0, double x1, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+}
 
 }  // namespace
 
@@ -112,7 +115,9 @@ TEST(Regularize, CutsOffAThinFingerBeforeRegularizing) {
   // a facade band): farther than the tolerance from the building, thinner than min-width.
   core::Ring ring = ragged(rectangle(60, 40, 160, 100), 8, 0.6, 12);
   // The west side runs north (y decreasing): the finger goes in before its first sample above y 76.
-  const auto west = std::find_if(ring.begin(), ring.end(), [](const cv::Point2d& p) { return p.x < 61 && p.y < 76 && p.y > 50; });
+  const auto west = std::find_if(ring.begin(), ring.end(), [](const cv::Point2d& p) {
+    return p.x < 61 && p.y < 76 && p.y > 50;
+  });
   ASSERT_NE(west, ring.end());
   ring.insert(west, {{60.4, 75}, {20, 75}, {20, 73}, {60.4, 73}});
   const RegularizationOutcome r = regularizeOutline({ring, {}}, RegularizationParams{});
@@ -127,7 +132,8 @@ TEST(Regularize, AnLShapeKeepsItsSixCorners) {
     SCOPED_TRACE(deg);
     core::Ring truth = rotated(l, {30, 35}, deg);
     for (auto& p : truth) p += cv::Point2d(40, 40);
-    const RegularizationOutcome r = regularizeOutline({ragged(truth, 5, 1.0, 11), {}}, RegularizationParams{});
+    const RegularizationOutcome r =
+        regularizeOutline({ragged(truth, 5, 1.0, 11), {}}, RegularizationParams{});
     ASSERT_EQ(r.status, RegularizationStatus::Regularized) << r.reason;
     EXPECT_EQ(r.polygon.outer.size(), 6u);
     EXPECT_LT(worstAngleError(r.polygon.outer), 1e-6);
@@ -223,7 +229,8 @@ TEST(Regularize, ImageEdgesSetTheOrientationOfAnAmbiguousOutline) {
   cv::Mat image(200, 200, CV_8U, cv::Scalar(40));
   const core::Ring square = rotated(rectangle(60, 60, 140, 140), {100, 100}, 20);
   std::vector<cv::Point> pts;
-  for (const auto& p : square) pts.emplace_back(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
+  for (const auto& p : square)
+    pts.emplace_back(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
   cv::fillConvexPoly(image, pts, cv::Scalar(200), cv::LINE_AA);
   const core::Polygon input{ragged(square, 10, 2.0, 6), {}};
   // The drawn edges run at the angle of the rounded corners (19.8°).
@@ -254,11 +261,17 @@ TEST(Regularize, BadInputsGiveClearErrors) {
   };
   const core::Polygon good{rectangle(0, 0, 20, 20), {}};
   RegularizationParams params;
-  EXPECT_EQ(code([&] { regularizeOutline(core::Polygon{{{0, 0}, {5, 5}}, {}}, params); }),
+  EXPECT_EQ(code([&] {
+              regularizeOutline(core::Polygon{{{0, 0}, {5, 5}}, {}}, params);
+            }),
             core::ErrorCode::InvalidParameter);
-  EXPECT_EQ(code([&] { regularizeOutline(core::Polygon{{{0, 0}, {5, 5}, {10, 10}}, {}}, params); }),
+  EXPECT_EQ(code([&] {
+              regularizeOutline(core::Polygon{{{0, 0}, {5, 5}, {10, 10}}, {}}, params);
+            }),
             core::ErrorCode::InvalidParameter);
-  EXPECT_EQ(code([&] { regularizeOutline(core::Polygon{{{0, 0}, {5, std::nan("")}, {10, 0}}, {}}, params); }),
+  EXPECT_EQ(code([&] {
+              regularizeOutline(core::Polygon{{{0, 0}, {5, std::nan("")}, {10, 0}}, {}}, params);
+            }),
             core::ErrorCode::InvalidParameter);
   params.mode = "square";
   EXPECT_EQ(code([&] { regularizeOutline(good, params); }), core::ErrorCode::InvalidParameter);
@@ -267,12 +280,14 @@ TEST(Regularize, BadInputsGiveClearErrors) {
   EXPECT_EQ(code([&] { regularizeOutline(good, params); }), core::ErrorCode::InvalidParameter);
   params = {};
   const cv::Mat colour(30, 30, CV_8UC3);
-  EXPECT_EQ(code([&] { regularizeOutline(good, params, colour); }), core::ErrorCode::UnsupportedInput);
+  EXPECT_EQ(code([&] { regularizeOutline(good, params, colour); }),
+            core::ErrorCode::UnsupportedInput);
   EXPECT_THROW(regularizationMode("diagonal"), core::Error);
 }
 
 TEST(Regularize, TakesAFewMillisecondsAtMost) {
-  const core::Polygon input{ragged(rotated(rectangle(0, 0, 200, 120), {100, 60}, 33), 2, 1.5, 8), {}};
+  const core::Polygon input{ragged(rotated(rectangle(0, 0, 200, 120), {100, 60}, 33), 2, 1.5, 8),
+                            {}};
   for (auto& p : const_cast<core::Ring&>(input.outer)) p += cv::Point2d(150, 150);
   const cv::Mat image(500, 500, CV_8U, cv::Scalar(100));
   const auto t0 = cv::getTickCount();

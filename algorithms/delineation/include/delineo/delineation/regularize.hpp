@@ -16,12 +16,12 @@ namespace delineo::delineation {
 struct RegularizationParams {
   // right-angles | right-angles-and-diagonals | any-angle | none
   std::string mode = "right-angles";
-  double tolerance = 3.0;       // px: farthest any point of the result may lie from the input outline
-  double minEdge = 4.0;         // px: edges shorter than this are merged away when the tolerance allows
-  double minWidth = 4.0;        // px: spikes, fingers and slits narrower than this are cut off first
-  double maxAreaChange = 8.0;   // %: largest change of the enclosed area
-  double energyMargin = 0.25;   // F per px of outline: how much worse the energy may get (delineate)
-  double imageEdgeWeight = 1.0; // weight of the image edges along the outline in the orientation
+  double tolerance = 3.0;  // px: farthest any point of the result may lie from the input outline
+  double minEdge = 4.0;    // px: edges shorter than this are merged away when the tolerance allows
+  double minWidth = 4.0;   // px: spikes, fingers and slits narrower than this are cut off first
+  double maxAreaChange = 8.0;  // %: largest change of the enclosed area
+  double energyMargin = 0.25;  // F per px of outline: how much worse the energy may get (delineate)
+  double imageEdgeWeight = 1.0;  // weight of the image edges along the outline in the orientation
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"regularize", "Regularize", "",
@@ -38,20 +38,25 @@ struct RegularizationParams {
                       "allows",
                       0, 100},
       minEdge);
-    v(core::ParamInfo{"regularize-min-width", "Regularize min width", "px",
-                      "Spikes, fingers and slits narrower than this are cut off before regularizing "
-                      "(the tolerance applies to the outline without them; 0 = off)",
-                      0, 50},
-      minWidth);
-    v(core::ParamInfo{"regularize-max-area-change", "Regularize area change", "%",
-                      "The raw outline is kept when regularizing changes its area by more than this",
-                      0, 100},
-      maxAreaChange);
-    v(core::ParamInfo{"regularize-energy-margin", "Regularize energy margin", "per px",
-                      "The raw outline is kept when regularizing raises the active polygon's energy "
-                      "by more than this per pixel of outline length",
-                      0, 1000},
-      energyMargin);
+    v(
+        core::ParamInfo{
+            "regularize-min-width", "Regularize min width", "px",
+            "Spikes, fingers and slits narrower than this are cut off before regularizing "
+            "(the tolerance applies to the outline without them; 0 = off)",
+            0, 50},
+        minWidth);
+    v(
+        core::ParamInfo{
+            "regularize-max-area-change", "Regularize area change", "%",
+            "The raw outline is kept when regularizing changes its area by more than this", 0, 100},
+        maxAreaChange);
+    v(
+        core::ParamInfo{
+            "regularize-energy-margin", "Regularize energy margin", "per px",
+            "The raw outline is kept when regularizing raises the active polygon's energy "
+            "by more than this per pixel of outline length",
+            0, 1000},
+        energyMargin);
     v(core::ParamInfo{"regularize-image-edges", "Regularize image edges", "",
                       "Weight of the image edges along the outline against the outline's own edges "
                       "when finding the building's orientation (0 = outline only)",
@@ -76,7 +81,7 @@ std::string toString(RegularizationStatus status);
 struct RegularizationOutcome {
   core::Polygon polygon;  // the regularized outline, or the input when kept
   RegularizationStatus status = RegularizationStatus::Off;
-  std::string reason;     // why the input was kept (empty when regularized or off)
+  std::string reason;         // why the input was kept (empty when regularized or off)
   double orientationDeg = 0;  // dominant orientation, degrees in [0, 90)
   double deviation = 0;       // px: farthest point of the result from the input outline
   double areaRatio = 1;       // area(result) / area(input)
@@ -89,8 +94,8 @@ struct RegularizationOutcome {
 // `epsilon` px), plus `imageEdgeWeight` times the gradient-weighted histogram of the image edges
 // within 2 px of the outline (`image`: single-channel, in the outline's coordinates; empty =
 // outline only).
-double dominantOrientation(const core::Polygon& outline, const cv::Mat& image, double imageEdgeWeight,
-                           double epsilon = 1.5);
+double dominantOrientation(const core::Polygon& outline, const cv::Mat& image,
+                           double imageEdgeWeight, double epsilon = 1.5);
 
 // Regularizes every ring of `outline` (left-image pixels) and gates the result: every ring
 // simple, holes inside the outer ring and apart, no point farther than `tolerance` from the
@@ -101,7 +106,8 @@ double dominantOrientation(const core::Polygon& outline, const cv::Mat& image, d
 // running along the image border stay on it. Throws core::Error(InvalidParameter) for bad
 // parameters or an outline that is not a polygon (fewer than 3 vertices, non-finite
 // coordinates, zero area).
-RegularizationOutcome regularizeOutline(const core::Polygon& outline, const RegularizationParams& params,
+RegularizationOutcome regularizeOutline(const core::Polygon& outline,
+                                        const RegularizationParams& params,
                                         const cv::Mat& image = {});
 
 }  // namespace delineo::delineation
