@@ -132,16 +132,18 @@ double maxDeviation(const core::Ring& result, const EdgeGrid& input, double stop
 }
 
 // Mean distance between two outlines, both ways (input vertices to the result, result samples to
-// the input): the tie-break between candidates with as many vertices.
-double meanDistance(const core::Ring& result, const core::Ring& input) {
+// the input, capped at `limit`): the tie-break between candidates with as many vertices.
+double meanDistance(const core::Ring& result, const EdgeGrid& input, double limit) {
   double sum = 0;
   int n = 0;
-  for (const auto& p : input) sum += ringDistance(p, result), ++n;
+  for (const auto& p : input.ring()) sum += ringDistance(p, result), ++n;
   for (size_t i = 0; i < result.size(); ++i) {
     const cv::Point2d a = result[i], b = result[(i + 1) % result.size()];
     const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a) / 2.0)));
-    for (int s = 0; s < steps; ++s)
-      sum += ringDistance(a + (b - a) * (static_cast<double>(s) / steps), input), ++n;
+    for (int s = 0; s < steps; ++s) {
+      sum += std::min(limit, input.distance(a + (b - a) * (static_cast<double>(s) / steps), limit));
+      ++n;
+    }
   }
   return n ? sum / n : 0.0;
 }
@@ -697,7 +699,7 @@ RingCandidate regularizeRingAt(const core::Ring& input, const EdgeGrid& grid, do
         "deviation " + formatPx(c.deviation) + " px > " + formatPx(params.tolerance) + " px";
     return c;
   }
-  c.mean = meanDistance(c.ring, input);
+  c.mean = meanDistance(c.ring, grid, params.tolerance + 1.0);
   return c;
 }
 
