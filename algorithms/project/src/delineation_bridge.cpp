@@ -66,4 +66,21 @@ EnergyOutcome evaluateBuildingOutline(const Project& project, const Building& bu
   return outcome;
 }
 
+RegularizationOutcome regularizeBuilding(const Project& project, const Building& building,
+                                         const StereoPair& pair, const core::Polygon& outline,
+                                         core::Progress* progress) {
+  const delineation::DelineationRequest request = requestFor(project, building, pair);
+  const auto params = parameters<delineation::DelineationParams>(project, "delineation");
+  const delineation::RegularizationOutcome r = delineation::regularizeBuildingOutline(
+      pair.left, pair.right, request, params, outline, progress);
+  RegularizationOutcome outcome;
+  outcome.outline = r.polygon;
+  outcome.regularization = delineation::toString(r.status);
+  outcome.regularizationNote = r.reason;
+  outcome.verticesBefore = r.inputVertices;
+  outcome.verticesAfter = r.outputVertices;
+  outcome.energyChange = r.energyChange;
+  return outcome;
+}
+
 }  // namespace delineo::project

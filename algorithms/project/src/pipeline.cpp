@@ -195,6 +195,17 @@ EnergyOutcome outlineEnergy(const Project& project, const Building& building, co
 #endif
 }
 
+RegularizationOutcome regularizeOutline(const Project& project, const Building& building,
+                                        const StereoPair& pair, const core::Polygon& outline,
+                                        core::Progress* progress) {
+#ifdef DELINEO_HAVE_DELINEATION
+  return regularizeBuilding(project, building, pair, outline, progress);
+#else
+  (void)project, (void)building, (void)pair, (void)outline, (void)progress;
+  throw Error(ErrorCode::ProcessingFailed, "the active polygon is not part of this build");
+#endif
+}
+
 std::vector<core::Feature> buildingFeatures(const Project& project,
                                             const std::vector<BuildingStatus>& statuses) {
   std::vector<core::Feature> features;

@@ -91,6 +91,22 @@ struct EnergyOutcome {
 EnergyOutcome outlineEnergy(const Project& project, const Building& building, const StereoPair& pair,
                             const core::Polygon& outline, core::Progress* progress);
 
+// The delineation's last stage (regularization, with the project's parameters) on `outline` (the
+// building's current outline, an operator's edit): the regularized outline when it passes the
+// gate, energy included (as delineateBuilding() would score it), else `outline` itself with the
+// reason. The per-building "Regularize" action. Throws InvalidParameter without a roof interval
+// or for an outline that is not a polygon; cancel returns `outline` with regularization "off".
+struct RegularizationOutcome {
+  core::Polygon outline;
+  std::string regularization;      // "regularized", "kept-raw" or "off"
+  std::string regularizationNote;  // why the outline was kept (empty otherwise)
+  int verticesBefore = 0, verticesAfter = 0;
+  double energyChange = 0.0;  // F(result) - F(outline) when the energy gate ran
+};
+RegularizationOutcome regularizeOutline(const Project& project, const Building& building,
+                                        const StereoPair& pair, const core::Polygon& outline,
+                                        core::Progress* progress);
+
 // `delineo-cli run`: matching when the disparity is missing (written to
 // `outputDir`/disparity.tif and recorded in the project), then the active polygon for every
 // Pending building (status becomes Automatic, history updated), then export of accepted +
