@@ -731,8 +731,8 @@
         <translation>&amp;Modifier le contour</translation>
     </message>
     <message>
-        <source>Drag vertices or edges of the selected building; every change can be undone</source>
-        <translation>Faites glisser les sommets ou les côtés du bâtiment sélectionné ; chaque modification peut être annulée</translation>
+        <source>Drag a vertex or an edge of the selected building, Ctrl+drag to select vertices, right-click for more; every change can be undone</source>
+        <translation>Faites glisser un sommet ou un côté du bâtiment sélectionné, Ctrl+glisser pour sélectionner des sommets, clic droit pour la suite ; chaque modification peut être annulée</translation>
     </message>
     <message>
         <source>Compute &amp;disparity</source>
@@ -1148,6 +1148,40 @@
     <message>
         <source>Insert vertex here</source>
         <translation>Insérer un sommet ici</translation>
+    </message>
+    <message>
+        <source>The outline would keep fewer than 3 vertices; select fewer vertices.</source>
+        <translation>Le contour garderait moins de 3 sommets ; sélectionnez-en moins.</translation>
+    </message>
+    <message>
+        <source>A hole would keep fewer than 3 vertices; select all of it to delete it, or fewer of its vertices.</source>
+        <translation>Une cour intérieure garderait moins de 3 sommets ; sélectionnez-la en entier pour la supprimer, ou moins de ses sommets.</translation>
+    </message>
+    <message>
+        <source>Deleting these vertices would make the outline cross itself; nothing was deleted.</source>
+        <translation>Supprimer ces sommets ferait se croiser le contour ; rien n’a été supprimé.</translation>
+    </message>
+    <message numerus="yes">
+        <source>Delete %n vertices</source>
+        <translation>
+            <numerusform>Supprimer %n sommet</numerusform>
+            <numerusform>Supprimer %n sommets</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Delete hole</source>
+        <translation>Supprimer la cour intérieure</translation>
+    </message>
+    <message>
+        <source>Delete the selected vertex</source>
+        <translation>Supprimer le sommet sélectionné</translation>
+    </message>
+    <message numerus="yes">
+        <source>Delete %n selected vertices</source>
+        <translation>
+            <numerusform>Supprimer %n sommet sélectionné</numerusform>
+            <numerusform>Supprimer les %n sommets sélectionnés</numerusform>
+        </translation>
     </message>
 </context>
 <context>

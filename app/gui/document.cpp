@@ -34,6 +34,30 @@ cv::Mat toDisplayGrey(const cv::Mat& grey) {
   }
   return out;
 }
+
+// A BGR 8-bit copy of a colour raster (3 or more bands, read in file order R, G, B) for display;
+// empty for a grey one. Deeper integer bands are stretched from their range to 0..255.
+cv::Mat toDisplayColour(const std::string& path) {
+  const io::Raster raster = io::readRaster(path);
+  if (raster.data.channels() < 3) return {};
+  cv::Mat rgb;
+  if (raster.data.channels() == 3) {
+    rgb = raster.data;
+  } else {
+    cv::Mat bands[CV_CN_MAX];
+    cv::split(raster.data, bands);
+    cv::merge(bands, 3, rgb);  // a fourth (alpha, infrared) band is not shown
+  }
+  if (rgb.depth() != CV_8U) {
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(rgb.reshape(1), &lo, &hi);
+    const double scale = hi > lo ? 255.0 / (hi - lo) : 1.0;
+    rgb.convertTo(rgb, CV_8U, scale, -lo * scale);
+  }
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  return bgr;
+}
 }  // namespace
 
 std::unique_ptr<Document> Document::open(const QString& projectPath) {
@@ -67,6 +91,8 @@ void Document::loadRasters() {
   pair_ = project::readStereoPair(project_);
   leftGrey_ = toDisplayGrey(pair_.left);
   rightGrey_ = toDisplayGrey(pair_.right);
+  leftColour_ = toDisplayColour(project_.left);
+  rightColour_ = toDisplayColour(project_.right);
   disparity_ = project::readDisparity(project_, pair_.left.size());
   if (!project_.labels.empty()) {
     io::Raster labels = io::readRaster(project_.labels);
@@ -129,16 +155,23 @@ void Document::removeBuilding(int id) {
 void Document::editRing(int id, int ringIndex, const core::Ring& ring, const QString& description) {
   const Building* current = project_.find(id);
   if (current == nullptr || ring.size() < 3) return;
-  Building after = *current;
-  // A pending building's rough polygon is still the operator's input: edit it in place.
-  core::Polygon& target = after.hasOutline() ? after.outline : after.initial;
+  core::Polygon polygon = current->currentPolygon();
   if (ringIndex == 0) {
-    target.outer = ring;
-  } else if (ringIndex - 1 < static_cast<int>(target.holes.size())) {
-    target.holes[static_cast<size_t>(ringIndex - 1)] = ring;
+    polygon.outer = ring;
+  } else if (ringIndex - 1 < static_cast<int>(polygon.holes.size())) {
+    polygon.holes[static_cast<size_t>(ringIndex - 1)] = ring;
   } else {
     return;
   }
+  setPolygon(id, polygon, description);
+}
+
+void Document::setPolygon(int id, const core::Polygon& polygon, const QString& description) {
+  const Building* current = project_.find(id);
+  if (current == nullptr || polygon.outer.size() < 3) return;
+  Building after = *current;
+  // A pending building's rough polygon is still the operator's input: edit it in place.
+  (after.hasOutline() ? after.outline : after.initial) = polygon;
   if (after.status != BuildingStatus::Pending) after.status = BuildingStatus::Corrected;
   if (after.hasOutline()) after.roofHeight = project::roofHeight(project_, disparity_, after.outline);
   // The energy belongs to the old outline; the window scores the new one in the background.

@@ -38,6 +38,10 @@ class Document : public QObject {
   const project::StereoPair& pair() const { return pair_; }
   const cv::Mat& leftGrey() const { return leftGrey_; }    // CV_8U for display and read-out
   const cv::Mat& rightGrey() const { return rightGrey_; }
+  // What the image views show: CV_8UC3 (BGR) when the file is a colour image, else the grey
+  // image. Matching, the read-out and the edge map use the grey images.
+  const cv::Mat& leftDisplay() const { return leftColour_.empty() ? leftGrey_ : leftColour_; }
+  const cv::Mat& rightDisplay() const { return rightColour_.empty() ? rightGrey_ : rightColour_; }
   const cv::Mat& disparity() const { return disparity_; }  // CV_32F, empty when not computed
   const cv::Mat& dem() const { return dem_; }              // CV_32F metres, file or derived
   const cv::Mat& labels() const { return labels_; }        // CV_8U, may be empty
@@ -48,6 +52,9 @@ class Document : public QObject {
   void removeBuilding(int id);
   // Replaces ring `ringIndex` (0 outer, k hole k-1) of the building's current polygon.
   void editRing(int id, int ringIndex, const core::Ring& ring, const QString& description);
+  // Replaces the building's current polygon (e.g. a hole removed, vertices of several rings
+  // deleted at once).
+  void setPolygon(int id, const core::Polygon& polygon, const QString& description);
   // An active polygon result (status Automatic).
   void setDelineationResult(int id, const project::DelineationOutcome& outcome);
   void setStatus(int id, project::BuildingStatus status);
@@ -115,6 +122,7 @@ class Document : public QObject {
   bool disparityOnDisk_ = true;
   project::StereoPair pair_;
   cv::Mat leftGrey_, rightGrey_, disparity_, dem_, labels_;
+  cv::Mat leftColour_, rightColour_;  // empty for grey sources
   bool demDerived_ = false;
 };
 

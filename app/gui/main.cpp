@@ -12,7 +12,6 @@
 
 #include "delineo/core/allocator.hpp"
 #include "main_window.hpp"
-#include "screenshot_tour.hpp"
 
 namespace {
 // Loads the application's and Qt's own translations for the chosen language ("" = system).
@@ -44,18 +43,14 @@ struct CommandLine {
                           QStringLiteral("file")};
   QCommandLineOption right{QStringLiteral("right"), QCoreApplication::translate("main", "Right image"),
                            QStringLiteral("file")};
-  // Hidden: scripted tour that saves a PNG of each main state (scripts/screenshots.sh).
-  QCommandLineOption screenshots{QStringLiteral("screenshot-dir"), QString(), QStringLiteral("dir")};
 
   CommandLine() {
     parser.setApplicationDescription(QCoreApplication::translate("main", "Building delineation on stereo pairs"));
     parser.addHelpOption();
     parser.addVersionOption();
     parser.addPositionalArgument(QStringLiteral("project"), QCoreApplication::translate("main", "Project file to open"));
-    screenshots.setFlags(QCommandLineOption::HiddenFromHelp);
     parser.addOption(left);
     parser.addOption(right);
-    parser.addOption(screenshots);
   }
 };
 
@@ -97,12 +92,7 @@ int main(int argc, char** argv) {
   parser.process(app);
 
   delineo::gui::MainWindow window;
-  if (parser.isSet(commandLine.screenshots)) {
-    window.setInteractive(false);
-    window.show();
-    return delineo::gui::runScreenshotTour(window, parser.value(commandLine.screenshots)) ? 0 : 1;
-  }
-  window.show();
+  window.showActivated();
   if (parser.isSet(commandLine.left) || parser.isSet(commandLine.right)) {
     if (!parser.isSet(commandLine.left) || !parser.isSet(commandLine.right)) {
       parser.showHelp(2);

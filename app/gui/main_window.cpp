@@ -22,6 +22,7 @@
 #include <QMessageBox>
 #include <QMetaObject>
 #include <QPushButton>
+#include <QScopedValueRollback>
 #include <QSignalBlocker>
 #include <QSpinBox>
 #include <QScrollArea>
@@ -143,6 +144,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   updateActions();
 }
 
+void MainWindow::showActivated() {
+  show();
+  raise();
+  activateWindow();
+}
+
 MainWindow::~MainWindow() {
   // Workers hold copies of their inputs, but their results are delivered to this window:
   // stop them before the views go away.
@@ -199,6 +206,13 @@ void MainWindow::createViews() {
   });
   connect(leftView_, &ImageView::pointPicked, this, &MainWindow::onObjectPicked);
   connect(&leftView_->polygons(), &widgets::PolygonOverlay::editRequested, this, &MainWindow::onEditRequested);
+  // Hole and rubber-band deletions: the overlay has checked the result is a valid polygon.
+  connect(&leftView_->polygons(), &widgets::PolygonOverlay::polygonEditRequested, this,
+          [this](int id, const QList<QPolygonF>& rings, const QString& description) {
+            if (document_) document_->setPolygon(id, widgets::toPolygon(rings), description);
+          });
+  connect(&leftView_->polygons(), &widgets::PolygonOverlay::editRefused, this,
+          [this](const QString& reason) { showMessage(tr("Edit outline"), reason); });
   connect(&leftView_->polygons(), &widgets::PolygonOverlay::selectionChanged, this,
           &MainWindow::onSelectionFromOverlay);
 
@@ -458,7 +472,8 @@ void MainWindow::createActions() {
   tool(QStringLiteral("actionPickObject"), tr("Pick an above-ground &object"), QStringLiteral("O"),
        InteractionMode::PickPoint, tr("Click a building: its above-ground region becomes the initial polygon"));
   tool(QStringLiteral("actionEdit"), tr("&Edit outline"), QStringLiteral("E"), InteractionMode::EditPolygon,
-       tr("Drag vertices or edges of the selected building; every change can be undone"));
+       tr("Drag a vertex or an edge of the selected building, Ctrl+drag to select vertices, "
+          "right-click for more; every change can be undone"));
   connect(leftView_, &ImageView::interactionModeChanged, this, [this](InteractionMode mode) {
     static const std::map<InteractionMode, QString> names = {
         {InteractionMode::Navigate, QStringLiteral("actionNavigate")},
@@ -790,8 +805,8 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
     refreshTitle();
     updateActions();
   });
-  leftView_->setImage(doc->leftGrey());
-  rightView_->setImage(doc->rightGrey());
+  leftView_->setImage(doc->leftDisplay());
+  rightView_->setImage(doc->rightDisplay());
   QAction* showLabels = action(QStringLiteral("actionShowLabels"));
   showLabels->setEnabled(!doc->labels().empty());
   if (!doc->labels().empty()) {
@@ -808,6 +823,7 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   leftView_->polygons().clearEvolvingContour();
   leftView_->polygons().setRoi({});
   energyAsked_.clear();
+  rangeSource_.clear();
   loadFormsFromDocument();
   loadRangeFromDocument();
   refreshHeightModelNotice();
@@ -964,6 +980,9 @@ void MainWindow::refreshRasters() {
 }
 
 void MainWindow::refreshOverlays() {
+  // Pushing polygons is no choice of the operator's: a view that does not draw the selected
+  // building (the right view before its roof disparity is known) must not deselect it.
+  const QScopedValueRollback<bool> pushing(updatingSelection_, true);
   if (!document_) {
     leftView_->polygons().clearPolygons();
     return;
@@ -1124,10 +1143,15 @@ QWidget* MainWindow::createRangeEditor() {
   layout->addWidget(rangeMin_, 0, 1);
   layout->addWidget(new QLabel(tr("Maximum")), 0, 2);
   layout->addWidget(rangeMax_, 0, 3);
+  auto* estimate = new QPushButton(tr("Estimate from the images"));
+  estimate->setObjectName(QStringLiteral("estimateRange"));
+  estimate->setToolTip(tr("Read the range from feature matches between the two images"));
+  connect(estimate, &QPushButton::clicked, this, [this] { startRangeEstimate(false); });
+  layout->addWidget(estimate, 1, 0, 1, 4);
   rangeNote_ = new QLabel;
   rangeNote_->setObjectName(QStringLiteral("rangeNote"));
   rangeNote_->setWordWrap(true);
-  layout->addWidget(rangeNote_, 1, 0, 1, 4);
+  layout->addWidget(rangeNote_, 2, 0, 1, 4);
   auto commit = [this] {
     if (!document_ || updatingForms_) return;
     const int lo = rangeMin_->value(), hi = rangeMax_->value();
@@ -1136,6 +1160,7 @@ QWidget* MainWindow::createRangeEditor() {
       loadRangeFromDocument();
       return;
     }
+    rangeSource_.clear();
     document_->setDisparityRange(project::DisparityInterval{lo, hi}, tr("Disparity range %1..%2 px").arg(lo).arg(hi));
   };
   connect(rangeMin_, &QSpinBox::valueChanged, this, commit);
@@ -1150,9 +1175,10 @@ void MainWindow::loadRangeFromDocument() {
   rangeMin_->setValue(range ? range->low : 0);
   rangeMax_->setValue(range ? range->high : 0);
   updatingForms_ = false;
-  rangeNote_->setText(range ? tr("Every computation (matching, the active polygon) searches this range; "
-                                 "compute the disparity again after changing it.")
-                            : tr("Not set yet."));
+  const QString use = tr("Every computation (matching, the active polygon) searches this range; compute the "
+                         "disparity again after changing it.");
+  rangeNote_->setText(!range ? tr("Not set yet: estimated from the images when the disparity is computed.")
+                             : rangeSource_.isEmpty() ? use : rangeSource_ + QLatin1Char(' ') + use);
 }
 
 void MainWindow::refreshHeightModelNotice() {
@@ -1488,8 +1514,36 @@ void MainWindow::loadFormsFromDocument() {
 // ------------------------------------------------------------------------------------------
 // jobs
 
+widgets::JobId MainWindow::startRangeEstimate(bool thenMatch) {
+  if (!document_ || !project::matchingAvailable()) return 0;
+  const project::Project projectCopy = document_->project();
+  const project::StereoPair pair = document_->pair();
+  QPointer<Document> doc(document_.get());
+  rangeNote_->setText(tr("Estimating the range from feature matches…"));
+  return jobs_->run<project::RangeOutcome>(
+      tr("Disparity range"),
+      [projectCopy, pair](core::Progress& p) { return project::estimateDisparityRange(projectCopy, pair, &p); },
+      [this, doc, thenMatch](project::RangeOutcome outcome) {
+        if (!doc || doc != document_.get() || outcome.status != core::RunStatus::Completed) return;
+        doc->setDisparityRange(outcome.range, tr("Disparity range %1..%2 px, estimated from %3 feature matches")
+                                                  .arg(outcome.range.low)
+                                                  .arg(outcome.range.high)
+                                                  .arg(outcome.matches));
+        rangeSource_ = tr("Estimated from %n feature match(es) between the two images.", nullptr, outcome.matches);
+        loadRangeFromDocument();
+        statusBar()->showMessage(
+            tr("Disparity range %1..%2 px (from %3 feature matches).").arg(outcome.range.low).arg(outcome.range.high).arg(outcome.matches),
+            8000);
+        emit rangeEstimated();
+        if (thenMatch) startMatching();
+      },
+      QStringLiteral("range"));
+}
+
 widgets::JobId MainWindow::startMatching() {
   if (!document_ || !project::matchingAvailable()) return 0;
+  // The range comes first: estimated from the images when the project has none.
+  if (!document_->project().disparityRange) return startRangeEstimate(true);
   const project::Project projectCopy = document_->project();
   const project::StereoPair pair = document_->pair();
   QPointer<Document> doc(document_.get());

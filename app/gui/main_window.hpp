@@ -47,6 +47,9 @@ class MainWindow : public QMainWindow {
  public:
   explicit MainWindow(QWidget* parent = nullptr);
   ~MainWindow() override;
+  // Shows the window and asks for the keyboard focus: without it (a window started from a
+  // terminal, some window managers) no menu shortcut works until the operator clicks into it.
+  void showActivated();
 
   // ---- documents ----
   // Each returns false (with a message shown, the current document unchanged) on failure.
@@ -65,8 +68,12 @@ class MainWindow : public QMainWindow {
   // ---- actions on the selected building / the pair (also bound to menus) ----
   int selectedBuilding() const { return selectedId_; }
   void selectBuilding(int id);
-  // Starts dense matching (key "matching"); returns the job id or 0.
+  // Starts dense matching (key "matching"), after estimating the disparity range when the
+  // project has none; returns the job id or 0.
   widgets::JobId startMatching();
+  // Estimates the pair's disparity range from feature matches (key "range") and stores it;
+  // `thenMatch` starts the matching with it.
+  widgets::JobId startRangeEstimate(bool thenMatch);
   // Starts the active polygon on the building (key "delineate-<id>": a new run on the same
   // building cancels the previous one); returns the job id or 0.
   widgets::JobId startDelineation(int id);
@@ -130,6 +137,7 @@ class MainWindow : public QMainWindow {
   void delineationFinished(int id);
   void matchingFinished();
   void energyUpdated(int id);
+  void rangeEstimated();
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -208,6 +216,7 @@ class MainWindow : public QMainWindow {
   QSpinBox* rangeMin_ = nullptr;
   QSpinBox* rangeMax_ = nullptr;
   QLabel* rangeNote_ = nullptr;
+  QString rangeSource_;  // how the current range was obtained, when estimated in this session
   QWidget* heightModelNotice_ = nullptr;
   QLabel* view3DNotice_ = nullptr;
   // Outlines whose energy was asked for, so that one that cannot be scored is not asked again.

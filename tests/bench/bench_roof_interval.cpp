@@ -1,9 +1,13 @@
 // Roof interval and ground level proposal on hand-labelled real roofs (tests/bench/data/
 // real_roofs.json). For each roof and each operator rectangle (the outline's box grown by 8, 15
-// and 30 px, clipped to the image) it prints the roof's main peak (mode of the matcher's
+// and 30 px, or by the margins given with --grow, clipped to the image; with --outline, the
+// labelled outline itself instead, as a delineated polygon would be, printed as grow -1) it
+// prints the roof's main peak (mode of the matcher's
 // disparities inside the outline shrunk by 3 px), the proposed interval and whether it holds the
 // peak, and the ground level against the roof's ground reference; "before" columns show the
-// functions the GUI used until now (polygon percentiles, median of an 8 px ring).
+// functions the GUI used until now (polygon percentiles, median of an 8 px ring). Roofs marked
+// "heldOut" are counted apart: they were not used to choose the method or its defaults (except
+// t51_low_wing for the roof peak's entry test, see tests/bench/data/README.md).
 // Skips cleanly (exit 0) when the data folder is missing. Disparity maps are cached.
 #include <algorithm>
 #include <cmath>
@@ -100,6 +104,38 @@ cv::Mat readGroundTruth(const std::string& path, double scale) {
   return gt;
 }
 
+// Counts of one set of roofs (the tuning set, or the held-out set marked "heldOut").
+struct Tally {
+  int runs = 0, oldHits = 0, newHits = 0, oldGroundOk = 0, newGroundOk = 0;
+  double oldErrSum = 0.0, newErrSum = 0.0, oldErrMax = 0.0, newErrMax = 0.0;
+  void add(bool oldIn, bool newIn, double oldErr, double newErr) {
+    ++runs;
+    oldHits += oldIn, newHits += newIn;
+    oldGroundOk += std::abs(oldErr) <= 2.0, newGroundOk += std::abs(newErr) <= 2.0;
+    oldErrSum += std::abs(oldErr), newErrSum += std::abs(newErr);
+    oldErrMax = std::max(oldErrMax, std::abs(oldErr)), newErrMax = std::max(newErrMax, std::abs(newErr));
+  }
+  void print(const char* name) const {
+    if (runs == 0) return;
+    std::printf("%s, %d runs: interval holds the main peak before %d, after %d; ground within 2 px before %d, after %d; "
+                "mean |ground error| before %.1f px, after %.1f px; max after %.1f px\n",
+                name, runs, oldHits, newHits, oldGroundOk, newGroundOk, oldErrSum / runs, newErrSum / runs, newErrMax);
+  }
+};
+
+// "8,15,30" -> {8, 15, 30}; empty when the list holds anything but non-negative integers.
+std::vector<int> growsOf(const std::string& list) {
+  std::vector<int> out;
+  for (size_t start = 0; start <= list.size();) {
+    const size_t end = std::min(list.find(',', start), list.size());
+    const std::string item = list.substr(start, end - start);
+    if (item.empty() || item.find_first_not_of("0123456789") != std::string::npos || item.size() > 6) return {};
+    out.push_back(std::stoi(item));
+    start = end + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -107,6 +143,7 @@ int main(int argc, char** argv) {
   std::string dataRoot = "/work/shared/data";
   std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
   std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  std::vector<int> grows = {8, 15, 30};
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
       dataRoot = argv[++i];
@@ -114,8 +151,13 @@ int main(int argc, char** argv) {
       labels = argv[++i];
     } else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) {
       cache = argv[++i];
+    } else if (!std::strcmp(argv[i], "--grow") && i + 1 < argc && !growsOf(argv[i + 1]).empty()) {
+      grows = growsOf(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--outline")) {
+      grows = {-1};
     } else {
-      std::fprintf(stderr, "usage: bench_roof_interval [--data DIR] [--labels real_roofs.json] [--cache DIR]\n");
+      std::fprintf(stderr, "usage: bench_roof_interval [--data DIR] [--labels real_roofs.json] [--cache DIR] "
+                           "[--grow 8,15,30 | --outline]\n");
       return 2;
     }
   }
@@ -129,11 +171,14 @@ int main(int argc, char** argv) {
   const nlohmann::json data = nlohmann::json::parse(in);
   std::printf("%-18s %4s %5s %6s | %-9s %3s %6s %5s | %-9s %3s %6s %5s %5s\n", "roof", "grow", "peak", "ground",
               "before", "in", "ground", "err", "after", "in", "ground", "err", "peak*");
-  int runs = 0, oldHits = 0, newHits = 0, oldGroundOk = 0, newGroundOk = 0;
-  double oldErrSum = 0.0, newErrSum = 0.0;
+  Tally sets[2];  // tuning set, held-out set
   std::map<std::string, cv::Mat> maps;
+  bool heldOutShown = false;
   for (const auto& roof : data.at("roofs")) {
     const std::string pairName = roof.at("pair");
+    const bool heldOut = roof.value("heldOut", false);
+    if (heldOut && !heldOutShown) std::printf("-- held out (see tests/bench/data/README.md) --\n");
+    heldOutShown = heldOutShown || heldOut;
     const auto& pair = data.at("pairs").at(pairName);
     const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
     if (!fs::exists(left)) {
@@ -157,12 +202,13 @@ int main(int argc, char** argv) {
     }
     const int peak = mainPeak(map, outline);
     const cv::Rect2d box = core::boundingBox(outline.outer);
-    for (int grow : {8, 15, 30}) {
+    for (int grow : grows) {
       const double x0 = std::max(0.0, box.x - grow), y0 = std::max(0.0, box.y - grow);
       const double x1 = std::min<double>(map.cols, box.x + box.width + grow);
       const double y1 = std::min<double>(map.rows, box.y + box.height + grow);
       core::Polygon rect;
       rect.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+      if (grow < 0) rect = outline;  // the labelled outline itself, as a delineated polygon
       const auto [ol, oh] = oldInterval(map, rect);
       const double og = oldGround(map, rect);
       const auto p = delineation::proposeRoofInterval(map, rect, params);
@@ -171,18 +217,15 @@ int main(int argc, char** argv) {
       std::printf("%-18s %4d %5d %6.1f | [%3d,%3d] %3s %6.1f %+5.1f | [%3d,%3d] %3s %6.1f %+5.1f %5.1f\n",
                   roof.at("name").get<std::string>().c_str(), grow, peak, groundRef, ol, oh, oldIn ? "yes" : "NO", og,
                   oe, p.low, p.high, newIn ? "yes" : "NO", p.groundLevel, ne, p.peak);
-      ++runs;
-      oldHits += oldIn, newHits += newIn;
-      oldGroundOk += std::abs(oe) <= 2.0, newGroundOk += std::abs(ne) <= 2.0;
-      oldErrSum += std::abs(oe), newErrSum += std::abs(ne);
+      sets[heldOut ? 1 : 0].add(oldIn, newIn, oe, ne);
     }
   }
-  if (runs == 0) {
+  if (sets[0].runs + sets[1].runs == 0) {
     std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
     return 0;
   }
-  std::printf("\n%d runs: interval holds the main peak before %d, after %d; ground within 2 px before %d, after %d; "
-              "mean |ground error| before %.1f px, after %.1f px\n",
-              runs, oldHits, newHits, oldGroundOk, newGroundOk, oldErrSum / runs, newErrSum / runs);
+  std::printf("\n");
+  sets[0].print("tuning set");
+  sets[1].print("held-out set");
   return 0;
 }

@@ -82,11 +82,17 @@ void ImageView::setImage(const cv::Mat& image, const RasterStyle& style) {
   tilesConverted_ = 0;
   if (!overlayPyramid_.empty() && overlayPyramid_.front().size() != image.size()) clearOverlay();
   setRasterStyle(style);
-  if (previous != image.size()) {
-    fitToWindow();
-  } else {
+  if (previous == image.size()) {
     update();
+    return;
   }
+  for (const QPointer<ImageView>& partner : links_) {
+    if (partner && partner->imageSize() == image.size()) {
+      setView(partner->viewCenter(), partner->zoom());
+      return;
+    }
+  }
+  fitToWindow();
 }
 
 void ImageView::setRasterStyle(const RasterStyle& style) {
@@ -113,6 +119,7 @@ void ImageView::setRasterStyle(const RasterStyle& style) {
 
 void ImageView::clearImage() {
   pyramid_.clear();
+  fitted_ = false;
   invalidateTiles(Layer::Base);
   clearOverlay();
   update();
@@ -325,6 +332,8 @@ void ImageView::zoomAround(double factor, QPointF widgetAnchor) {
 }
 
 void ImageView::setView(QPointF center, double zoom) {
+  // Any view asked for other than a fit ends the fitted state, even when it changes nothing.
+  fitted_ = fitting_;
   const QPointF oldCenter = center_;
   const double oldZoom = zoom_;
   center_ = center;
@@ -349,7 +358,10 @@ void ImageView::fitToWindow() {
   if (size.empty()) return;
   const double fit = std::min(static_cast<double>(std::max(width(), 1)) / size.width,
                               static_cast<double>(std::max(height(), 1)) / size.height);
+  fitting_ = true;
   setView(QPointF(size.width / 2.0, size.height / 2.0), fit);
+  fitting_ = false;
+  fitted_ = true;  // also when the view was already fitted (no change)
 }
 
 // --- painting --------------------------------------------------------------------------------
@@ -392,6 +404,12 @@ void ImageView::paintEvent(QPaintEvent*) {
 }
 
 void ImageView::resizeEvent(QResizeEvent*) {
+  // A fitted view follows the widget's size: an image opened before the window has its final
+  // layout still fills the view once it has.
+  if (fitted_) {
+    fitToWindow();
+    return;
+  }
   const QPointF oldCenter = center_;
   const double oldZoom = zoom_;
   clampView();
@@ -405,11 +423,16 @@ void ImageView::setInteractionMode(InteractionMode mode) {
   mode_ = mode;
   rectDragging_ = false;
   pickPolygon_.clear();
-  setCursor(mode == InteractionMode::Navigate ? Qt::OpenHandCursor
-            : mode == InteractionMode::EditPolygon ? Qt::ArrowCursor
-                                                   : Qt::CrossCursor);
+  polygons_->clearVertexSelection();
+  restoreModeCursor();
   update();
   emit interactionModeChanged(mode);
+}
+
+void ImageView::restoreModeCursor() {
+  setCursor(mode_ == InteractionMode::Navigate      ? Qt::OpenHandCursor
+            : mode_ == InteractionMode::EditPolygon ? Qt::ArrowCursor
+                                                    : Qt::CrossCursor);
 }
 
 void ImageView::beginPan(QPointF widgetPos) {
@@ -479,12 +502,12 @@ void ImageView::mouseReleaseEvent(QMouseEvent* event) {
   if (panning_ && (event->button() == Qt::MiddleButton || event->button() == Qt::RightButton ||
                    event->button() == Qt::LeftButton)) {
     panning_ = false;
-    setCursor(mode_ == InteractionMode::Navigate ? Qt::OpenHandCursor
-              : mode_ == InteractionMode::EditPolygon ? Qt::ArrowCursor
-                                                      : Qt::CrossCursor);
-    // A click without movement on a polygon selects it (Navigate and EditPolygon modes).
+    restoreModeCursor();
+    // A click without movement on a polygon selects it (Navigate and EditPolygon modes); in
+    // EditPolygon it also drops the vertex selection.
     if (event->button() == Qt::LeftButton && !pressMoved_ && !spaceHeld_) {
       const int id = polygons_->polygonAt(event->position());
+      if (mode_ == InteractionMode::EditPolygon) polygons_->clearVertexSelection();
       if (id >= 0 || mode_ == InteractionMode::Navigate) polygons_->setSelectedId(id);
     }
     return;
@@ -582,6 +605,28 @@ void ImageView::contextMenuEvent(QContextMenuEvent* event) {
   event->ignore();
 }
 
+bool ImageView::wantsKey(const QKeyEvent& event) const {
+  if (mode_ == InteractionMode::EditPolygon && polygons_->wantsKey(event)) return true;
+  switch (event.key()) {
+    case Qt::Key_Escape:
+      return rectDragging_ || !pickPolygon_.isEmpty();
+    case Qt::Key_Backspace:
+      return mode_ == InteractionMode::PickPolygon && !pickPolygon_.isEmpty();
+    default:
+      return false;
+  }
+}
+
+bool ImageView::event(QEvent* event) {
+  // Shortcuts are matched before the focused widget sees the key; accepting the override gives
+  // the key to keyPressEvent instead (Delete on a hovered vertex must not remove the building).
+  if (event->type() == QEvent::ShortcutOverride && wantsKey(*static_cast<QKeyEvent*>(event))) {
+    event->accept();
+    return true;
+  }
+  return QWidget::event(event);
+}
+
 void ImageView::leaveEvent(QEvent*) {
   hoverValid_ = false;
   update();
@@ -595,12 +640,15 @@ void linkViews(ImageView* a, ImageView* b) {
   auto busy = std::make_shared<bool>(false);
   auto forward = [busy](ImageView* target) {
     return [busy, target](QPointF center, double zoom) {
-      if (*busy) return;
+      // A target already there is left alone (a fitted view stays fitted).
+      if (*busy || sameView(target->viewCenter(), target->zoom(), center, zoom)) return;
       *busy = true;
       target->setView(center, zoom);
       *busy = false;
     };
   };
+  a->links_.emplace_back(b);
+  b->links_.emplace_back(a);
   QObject::connect(a, &ImageView::viewChanged, b, forward(b));
   QObject::connect(b, &ImageView::viewChanged, a, forward(a));
 }

@@ -58,6 +58,34 @@ bool intersectLines(QPointF p, QPointF d, QPointF q, QPointF e, QPointF* out) {
 
 QPointF perpendicular(QPointF v) { return {-v.y(), v.x()}; }
 
+// True when an edge of ring `a` meets an edge of ring `b` (two rings of one polygon must not).
+bool ringsMeet(const QPolygonF& a, const QPolygonF& b) {
+  for (int i = 0; i < a.size(); ++i) {
+    const cv::Point2d p1(a[i].x(), a[i].y());
+    const cv::Point2d p2(a[(i + 1) % a.size()].x(), a[(i + 1) % a.size()].y());
+    for (int j = 0; j < b.size(); ++j) {
+      const cv::Point2d p3(b[j].x(), b[j].y());
+      const cv::Point2d p4(b[(j + 1) % b.size()].x(), b[(j + 1) % b.size()].y());
+      if (core::segmentsIntersect(p1, p2, p3, p4)) return true;
+    }
+  }
+  return false;
+}
+
+// A valid polygon: every ring simple, no two rings meeting, every hole inside the outer ring.
+bool validRings(const QList<QPolygonF>& rings) {
+  for (const QPolygonF& ring : rings) {
+    if (!core::isSimple(toRing(ring))) return false;
+  }
+  for (int r = 1; r < rings.size(); ++r) {
+    if (!rings[0].containsPoint(rings[r].first(), Qt::OddEvenFill)) return false;
+    for (int k = 0; k < r; ++k) {
+      if (ringsMeet(rings[r], rings[k])) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 QPolygonF toQPolygon(const core::Ring& ring) {
@@ -76,6 +104,14 @@ core::Ring toRing(const QPolygonF& polygon) {
   return out;
 }
 
+core::Polygon toPolygon(const QList<QPolygonF>& rings) {
+  core::Polygon out;
+  if (rings.isEmpty()) return out;
+  out.outer = toRing(rings.first());
+  for (qsizetype k = 1; k < rings.size(); ++k) out.holes.push_back(toRing(rings[k]));
+  return out;
+}
+
 QColor statusColour(PolygonStatus status) {
   switch (status) {
     case PolygonStatus::Candidate: return QColor(0, 200, 255);    // cyan
@@ -90,10 +126,16 @@ QColor statusColour(PolygonStatus status) {
 PolygonOverlay::PolygonOverlay(ImageView* view) : QObject(view), view_(view) {}
 
 void PolygonOverlay::setPolygons(std::vector<OverlayPolygon> polygons) {
+  const OverlayPolygon* before = selectedPolygon();
+  const QList<QPolygonF> ringsBefore = before != nullptr ? ringsOf(*before) : QList<QPolygonF>();
   polygons_ = std::move(polygons);
   drag_.reset();
   hover_.reset();
-  if (selectedId_ >= 0 && selectedPolygon() == nullptr) {
+  band_.reset();
+  const OverlayPolygon* after = selectedPolygon();
+  // Vertex indices only mean something on the same geometry.
+  if (after == nullptr || ringsOf(*after) != ringsBefore) selectedVertices_.clear();
+  if (selectedId_ >= 0 && after == nullptr) {
     selectedId_ = -1;
     emit selectionChanged(-1);
   }
@@ -107,6 +149,8 @@ void PolygonOverlay::setSelectedId(int id) {
   selectedId_ = id;
   drag_.reset();
   hover_.reset();
+  band_.reset();
+  selectedVertices_.clear();
   emit selectionChanged(id);
   emit changed();
 }
@@ -145,6 +189,12 @@ QPolygonF PolygonOverlay::ringOf(const OverlayPolygon& polygon, int ringIndex) c
   if (ringIndex == 0) return toQPolygon(polygon.polygon.outer);
   const size_t hole = static_cast<size_t>(ringIndex - 1);
   return hole < polygon.polygon.holes.size() ? toQPolygon(polygon.polygon.holes[hole]) : QPolygonF();
+}
+
+QList<QPolygonF> PolygonOverlay::ringsOf(const OverlayPolygon& polygon) const {
+  QList<QPolygonF> rings{toQPolygon(polygon.polygon.outer)};
+  for (const core::Ring& hole : polygon.polygon.holes) rings << toQPolygon(hole);
+  return rings;
 }
 
 // --- snapping --------------------------------------------------------------------------------
@@ -276,34 +326,43 @@ int PolygonOverlay::polygonAt(QPointF widgetPos) const {
 bool PolygonOverlay::mousePress(QMouseEvent* event) {
   if (event->button() != Qt::LeftButton) return false;
   const OverlayPolygon* selected = selectedPolygon();
+  if (selected == nullptr) return false;
+  const QPointF imagePos = view_->widgetToImage(event->position());
+  if (event->modifiers() & Qt::ControlModifier) {
+    // Ctrl: a rubber band selects vertices (a Ctrl+click toggles the vertex under the cursor).
+    band_ = QRectF(imagePos, imagePos);
+    emit changed();
+    return true;
+  }
   const std::optional<Hit> hit = hitTest(event->position());
-  if (selected == nullptr || !hit) return false;
-  if (hit->vertex >= 0) {
-    const QPolygonF ring = ringOf(*selected, hit->ring);
-    drag_ = Drag{Drag::Kind::Vertex, hit->ring, hit->vertex, hit->imagePos, ring, ring};
-    hover_ = hit;
-    emit changed();
-    return true;
-  }
-  if (hit->edge >= 0 && (event->modifiers() & Qt::ShiftModifier)) {
-    const QPolygonF ring = ringOf(*selected, hit->ring);
-    drag_ = Drag{Drag::Kind::Edge, hit->ring, hit->edge, hit->imagePos, ring, ring};
-    hover_ = hit;
-    emit changed();
-    return true;
-  }
-  return false;
+  if (!hit) return false;
+  // A vertex moves alone; an edge (highlighted under the cursor) moves with both its vertices.
+  const QPolygonF ring = ringOf(*selected, hit->ring);
+  const Drag::Kind kind = hit->vertex >= 0 ? Drag::Kind::Vertex : Drag::Kind::Edge;
+  drag_ =
+      Drag{kind, hit->ring, hit->vertex >= 0 ? hit->vertex : hit->edge, hit->imagePos, ring, ring};
+  hover_ = hit;
+  emit changed();
+  return true;
 }
 
 bool PolygonOverlay::mouseMove(QMouseEvent* event) {
   const QPointF imagePos = view_->widgetToImage(event->position());
+  if (band_) {
+    band_->setBottomRight(imagePos);
+    emit changed();
+    return true;
+  }
   if (!drag_) {
     const std::optional<Hit> hit = hitTest(event->position());
     const bool hoverChanged = hit.has_value() != hover_.has_value() ||
                               (hit && (hit->vertex != hover_->vertex || hit->edge != hover_->edge ||
                                        hit->ring != hover_->ring));
-    if (hit || !drag_) hover_ = hit;
-    if (hoverChanged) emit changed();
+    hover_ = hit;
+    if (hoverChanged) {
+      updateHoverCursor();
+      emit changed();
+    }
     return false;
   }
   Drag& d = *drag_;
@@ -334,7 +393,28 @@ bool PolygonOverlay::mouseMove(QMouseEvent* event) {
 }
 
 bool PolygonOverlay::mouseRelease(QMouseEvent* event) {
-  if (!drag_ || event->button() != Qt::LeftButton) return false;
+  if (event->button() != Qt::LeftButton) return false;
+  if (band_) {
+    band_->setBottomRight(view_->widgetToImage(event->position()));
+    const QRectF band = band_->normalized();
+    band_.reset();
+    const double widgetSize = std::max(band.width(), band.height()) * view_->zoom();
+    if (widgetSize < 3.0) {
+      // A Ctrl+click: toggle the vertex under the cursor (or clear the selection).
+      const std::optional<Hit> hit = hitTest(event->position());
+      if (hit && hit->vertex >= 0) {
+        const std::pair<int, int> key{hit->ring, hit->vertex};
+        if (!selectedVertices_.erase(key)) selectedVertices_.insert(key);
+      } else {
+        selectedVertices_.clear();
+      }
+      emit changed();
+    } else {
+      selectVerticesIn(band);
+    }
+    return true;
+  }
+  if (!drag_) return false;
   mouseMove(event);  // the release position is the final one
   const Drag d = *drag_;
   drag_.reset();
@@ -346,20 +426,32 @@ bool PolygonOverlay::mouseRelease(QMouseEvent* event) {
   return true;
 }
 
+void PolygonOverlay::updateHoverCursor() {
+  // Over a vertex or an edge of the edited polygon a drag moves it, elsewhere it pans.
+  if (view_->interactionMode() != InteractionMode::EditPolygon) return;
+  view_->setCursor(hover_ ? Qt::SizeAllCursor : Qt::ArrowCursor);
+}
+
 bool PolygonOverlay::mouseDoubleClick(QMouseEvent* event) {
   if (event->button() != Qt::LeftButton) return false;
-  const OverlayPolygon* selected = selectedPolygon();
   const std::optional<Hit> hit = hitTest(event->position());
-  if (selected == nullptr || !hit || hit->edge < 0) return false;
+  if (selectedPolygon() == nullptr || !hit || hit->edge < 0) return false;
   drag_.reset();
-  QPolygonF ring = ringOf(*selected, hit->ring);
-  const int n = static_cast<int>(ring.size());
-  double t = 0.5;
-  segmentDistance(hit->imagePos, ring[hit->edge], ring[(hit->edge + 1) % n], &t);
-  const QPointF inserted = ring[hit->edge] + (ring[(hit->edge + 1) % n] - ring[hit->edge]) * t;
-  ring.insert(hit->edge + 1, inserted);
-  emit editRequested(selectedId_, hit->ring, ring, tr("Insert vertex"));
+  insertVertex(*hit);
   return true;
+}
+
+void PolygonOverlay::insertVertex(const Hit& hit) {
+  const OverlayPolygon* selected = selectedPolygon();
+  if (selected == nullptr || hit.edge < 0) return;
+  QPolygonF ring = ringOf(*selected, hit.ring);
+  const int n = static_cast<int>(ring.size());
+  const QPointF a = ring[hit.edge];
+  const QPointF b = ring[(hit.edge + 1) % n];
+  double t = 0.5;
+  segmentDistance(hit.imagePos, a, b, &t);
+  ring.insert(hit.edge + 1, a + (b - a) * t);
+  emit editRequested(selectedId_, hit.ring, ring, tr("Insert vertex"));
 }
 
 void PolygonOverlay::deleteVertex(int ringIndex, int vertex) {
@@ -372,40 +464,149 @@ void PolygonOverlay::deleteVertex(int ringIndex, int vertex) {
   emit editRequested(selectedId_, ringIndex, ring, tr("Delete vertex"));
 }
 
+int PolygonOverlay::selectVerticesIn(const QRectF& imageRect) {
+  selectedVertices_.clear();
+  if (const OverlayPolygon* selected = selectedPolygon()) {
+    const QList<QPolygonF> rings = ringsOf(*selected);
+    for (int r = 0; r < rings.size(); ++r) {
+      for (int i = 0; i < rings[r].size(); ++i) {
+        if (imageRect.contains(rings[r][i])) selectedVertices_.insert({r, i});
+      }
+    }
+  }
+  emit changed();
+  return static_cast<int>(selectedVertices_.size());
+}
+
+void PolygonOverlay::clearVertexSelection() {
+  if (selectedVertices_.empty() && !band_) return;
+  selectedVertices_.clear();
+  band_.reset();
+  emit changed();
+}
+
+QRectF PolygonOverlay::rubberBand() const {
+  return band_ ? band_->normalized() : QRectF();
+}
+
+bool PolygonOverlay::deleteSelectedVertices() {
+  const OverlayPolygon* selected = selectedPolygon();
+  if (selected == nullptr || selectedVertices_.empty()) return false;
+  const QList<QPolygonF> before = ringsOf(*selected);
+  QList<QPolygonF> after;
+  for (int r = 0; r < before.size(); ++r) {
+    QPolygonF ring;
+    for (int i = 0; i < before[r].size(); ++i) {
+      if (!selectedVertices_.count({r, i})) ring << before[r][i];
+    }
+    if (r > 0 && ring.isEmpty()) continue;  // a hole selected whole goes with its vertices
+    if (ring.size() < 3) {
+      emit editRefused(
+          r == 0 ? tr("The outline would keep fewer than 3 vertices; select fewer vertices.")
+                 : tr("A hole would keep fewer than 3 vertices; select all of it to delete it, "
+                      "or fewer of its vertices."));
+      return false;
+    }
+    after << ring;
+  }
+  if (!validRings(after)) {
+    emit editRefused(
+        tr("Deleting these vertices would make the outline cross itself; nothing was deleted."));
+    return false;
+  }
+  const int count = static_cast<int>(selectedVertices_.size());
+  selectedVertices_.clear();
+  hover_.reset();
+  emit changed();
+  emit polygonEditRequested(
+      selectedId_, after,
+      count == 1 ? tr("Delete vertex") : tr("Delete %n vertices", nullptr, count));
+  return true;
+}
+
+bool PolygonOverlay::deleteHole(int ringIndex) {
+  const OverlayPolygon* selected = selectedPolygon();
+  if (selected == nullptr || ringIndex < 1 ||
+      ringIndex > static_cast<int>(selected->polygon.holes.size())) {
+    return false;
+  }
+  QList<QPolygonF> rings = ringsOf(*selected);
+  rings.removeAt(ringIndex);
+  selectedVertices_.clear();
+  hover_.reset();
+  emit polygonEditRequested(selectedId_, rings, tr("Delete hole"));
+  return true;
+}
+
+bool PolygonOverlay::wantsKey(const QKeyEvent& event) const {
+  switch (event.key()) {
+    case Qt::Key_Escape:
+      return drag_.has_value() || band_.has_value() || !selectedVertices_.empty();
+    case Qt::Key_Delete:
+    case Qt::Key_Backspace:
+      return !drag_ && selectedPolygon() != nullptr &&
+             (!selectedVertices_.empty() || (hover_ && hover_->vertex >= 0));
+    default:
+      return false;
+  }
+}
+
 bool PolygonOverlay::keyPress(QKeyEvent* event) {
-  if (event->key() == Qt::Key_Escape && drag_) {
-    drag_.reset();
+  if (event->key() == Qt::Key_Escape && (drag_ || band_ || !selectedVertices_.empty())) {
+    // One gesture back: a drag, else the rubber band, else the selection.
+    if (drag_)
+      drag_.reset();
+    else if (band_)
+      band_.reset();
+    else
+      selectedVertices_.clear();
     emit changed();
     return true;
   }
-  if ((event->key() == Qt::Key_Delete || event->key() == Qt::Key_Backspace) && !drag_ && hover_ &&
-      hover_->vertex >= 0) {
-    deleteVertex(hover_->ring, hover_->vertex);
-    return true;
+  if ((event->key() == Qt::Key_Delete || event->key() == Qt::Key_Backspace) && !drag_) {
+    if (!selectedVertices_.empty()) {
+      deleteSelectedVertices();
+      return true;
+    }
+    if (hover_ && hover_->vertex >= 0) {
+      deleteVertex(hover_->ring, hover_->vertex);
+      return true;
+    }
   }
   return false;
 }
 
-bool PolygonOverlay::contextMenu(QContextMenuEvent* event) {
+bool PolygonOverlay::fillContextMenu(QMenu& menu, QPointF widgetPos) {
   const OverlayPolygon* selected = selectedPolygon();
-  const std::optional<Hit> hit = hitTest(event->pos());
+  const std::optional<Hit> hit = hitTest(widgetPos);
   if (selected == nullptr || !hit) return false;
-  QMenu menu(view_);
-  if (hit->vertex >= 0) {
+  const Hit at = *hit;
+  if (at.vertex >= 0) {
     QAction* del = menu.addAction(tr("Delete vertex"));
-    del->setEnabled(ringOf(*selected, hit->ring).size() > 3);
-    if (menu.exec(event->globalPos()) == del) deleteVertex(hit->ring, hit->vertex);
+    del->setEnabled(ringOf(*selected, at.ring).size() > 3);
+    connect(del, &QAction::triggered, this, [this, at] { deleteVertex(at.ring, at.vertex); });
   } else {
-    QAction* insert = menu.addAction(tr("Insert vertex here"));
-    if (menu.exec(event->globalPos()) == insert) {
-      QPolygonF ring = ringOf(*selected, hit->ring);
-      const int n = static_cast<int>(ring.size());
-      double t = 0.5;
-      segmentDistance(hit->imagePos, ring[hit->edge], ring[(hit->edge + 1) % n], &t);
-      ring.insert(hit->edge + 1, ring[hit->edge] + (ring[(hit->edge + 1) % n] - ring[hit->edge]) * t);
-      emit editRequested(selectedId_, hit->ring, ring, tr("Insert vertex"));
-    }
+    connect(menu.addAction(tr("Insert vertex here")), &QAction::triggered, this,
+            [this, at] { insertVertex(at); });
   }
+  if (!selectedVertices_.empty()) {
+    const int count = static_cast<int>(selectedVertices_.size());
+    const QString text = count == 1 ? tr("Delete the selected vertex")
+                                    : tr("Delete %n selected vertices", nullptr, count);
+    connect(menu.addAction(text), &QAction::triggered, this, [this] { deleteSelectedVertices(); });
+  }
+  if (at.ring >= 1) {
+    menu.addSeparator();
+    connect(menu.addAction(tr("Delete hole")), &QAction::triggered, this,
+            [this, at] { deleteHole(at.ring); });
+  }
+  return true;
+}
+
+bool PolygonOverlay::contextMenu(QContextMenuEvent* event) {
+  QMenu menu(view_);
+  if (!fillContextMenu(menu, event->pos())) return false;
+  menu.exec(event->globalPos());
   return true;
 }
 
@@ -458,9 +659,13 @@ void PolygonOverlay::paint(QPainter& painter) const {
         for (int i = 0; i < ring.size(); ++i) {
           const bool hot = (hover_ && hover_->ring == r && hover_->vertex == i) ||
                            (drag_ && drag_->kind == Drag::Kind::Vertex && drag_->ring == r && drag_->index == i);
+          // Selected vertices (rubber band) are larger and red, so a deletion shows what it takes.
+          const bool picked = selectedVertices_.count({r, i}) > 0;
           painter.setPen(QPen(Qt::black, 1.0));
-          painter.setBrush(hot ? QColor(255, 255, 0) : QColor(255, 255, 255));
-          const double s = hot ? 4.5 : 3.5;
+          painter.setBrush(hot      ? QColor(255, 255, 0)
+                           : picked ? QColor(255, 40, 40)
+                                    : QColor(255, 255, 255));
+          const double s = picked ? 5.0 : hot ? 4.5 : 3.5;
           painter.drawRect(QRectF(ring[i] - QPointF(s, s), ring[i] + QPointF(s, s)));
         }
         const bool edgeHot = (hover_ && hover_->ring == r && hover_->edge >= 0) ||
@@ -472,6 +677,14 @@ void PolygonOverlay::paint(QPainter& painter) const {
         }
       }
     }
+  }
+
+  if (band_) {
+    const QRectF band = band_->normalized();
+    painter.setBrush(QColor(255, 40, 40, 30));
+    painter.setPen(QPen(QColor(255, 40, 40), 1.5, Qt::DashLine));
+    painter.drawRect(
+        QRectF(view_->imageToWidget(band.topLeft()), view_->imageToWidget(band.bottomRight())));
   }
 
   if (evolving_.size() >= 2) {

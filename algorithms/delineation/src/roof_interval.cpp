@@ -150,14 +150,185 @@ double groundLevelOf(const std::vector<float>& band, const RoofIntervalParams& p
   return median(near);
 }
 
+// A band pixel: ROI coordinates and disparity.
+struct GroundSample {
+  float x, y, d;
+};
+
+std::vector<GroundSample> bandSamples(const cv::Mat& disparity, const cv::Rect& roi, const cv::Mat& mask) {
+  std::vector<GroundSample> out;
+  for (int y = 0; y < roi.height; ++y) {
+    const float* d = disparity.ptr<float>(roi.y + y) + roi.x;
+    const uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      if (m[x] != 0 && std::isfinite(d[x])) out.push_back({static_cast<float>(x), static_cast<float>(y), d[x]});
+    }
+  }
+  return out;
+}
+
+// Plane d = a + b (x - cx) + c (y - cy) through `samples` by least squares; false when degenerate.
+struct Plane {
+  double a = 0.0, b = 0.0, c = 0.0, cx = 0.0, cy = 0.0;
+  double at(double x, double y) const { return a + b * (x - cx) + c * (y - cy); }
+};
+
+bool fitPlane(const std::vector<GroundSample>& samples, const std::vector<char>& use, Plane& plane) {
+  double n = 0.0, sx = 0.0, sy = 0.0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (use[i]) n += 1.0, sx += samples[i].x, sy += samples[i].y;
+  }
+  if (n < 3.0) return false;
+  Plane p;
+  p.cx = sx / n, p.cy = sy / n;
+  cv::Matx33d normal = cv::Matx33d::zeros();
+  cv::Vec3d rhs(0.0, 0.0, 0.0);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (!use[i]) continue;
+    const cv::Vec3d row(1.0, samples[i].x - p.cx, samples[i].y - p.cy);
+    normal += row * row.t();
+    rhs += row * static_cast<double>(samples[i].d);
+  }
+  cv::Vec3d solution;
+  if (!cv::solve(normal, rhs, solution, cv::DECOMP_CHOLESKY)) return false;
+  p.a = solution[0], p.b = solution[1], p.c = solution[2];
+  plane = p;
+  return true;
+}
+
+// The ground next to the polygon: a plane fitted to the band's pixels near the ground level
+// (refitted to the pixels near the plane, so that a sloping ground is followed beyond the
+// level's window), averaged along the polygon's outer ring where band ground lies within
+// `groundReach` (elsewhere the plane would be extrapolated, e.g. along a side lined by other
+// roofs). Falls back to `level` when there is too little ground to fit.
+double groundNextTo(const Neighbourhood& n, const std::vector<GroundSample>& band, double level,
+                    const RoofIntervalParams& params) {
+  if (params.groundReach <= 0.0 || !std::isfinite(level)) return level;
+  std::vector<char> near(band.size());
+  for (size_t i = 0; i < band.size(); ++i) near[i] = std::abs(band[i].d - level) <= params.groundWindow;
+  Plane plane;
+  constexpr int kRefits = 5;  // more refits let the window creep up onto cars and low vegetation
+  for (int k = 0; k < kRefits; ++k) {
+    if (!fitPlane(band, near, plane)) return level;
+    for (size_t i = 0; i < band.size(); ++i) {
+      near[i] = std::abs(band[i].d - plane.at(band[i].x, band[i].y)) <= params.groundWindow;
+    }
+  }
+  cv::Mat ground(n.roi.size(), CV_8U, cv::Scalar(255));  // 0 on the plane's ground pixels
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (size_t i = 0; i < band.size(); ++i) {
+    if (!near[i]) continue;
+    ground.at<uchar>(static_cast<int>(band[i].y), static_cast<int>(band[i].x)) = 0;
+    lo = std::min(lo, band[i].d), hi = std::max(hi, band[i].d);
+  }
+  if (!(lo <= hi)) return level;
+  cv::Mat reach;
+  cv::distanceTransform(ground, reach, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  constexpr float kRing = 4.0f;  // px, width of the outer ring the plane is read on
+  double sum = 0.0;
+  int count = 0;
+  for (int y = 0; y < n.roi.height; ++y) {
+    const float* o = n.outerDistance.ptr<float>(y);
+    const float* r = reach.ptr<float>(y);
+    for (int x = 0; x < n.roi.width; ++x) {
+      if (o[x] > 0.0f && o[x] <= kRing && r[x] <= params.groundReach) sum += plane.at(x, y), ++count;
+    }
+  }
+  if (count == 0) return level;
+  // Never beyond the disparities the plane was fitted to.
+  return std::clamp(sum / count, static_cast<double>(lo), static_cast<double>(hi));
+}
+
+double groundLevelAround(const cv::Mat& disparity, const Neighbourhood& n, const RoofIntervalParams& params,
+                         int* samplesCount) {
+  const cv::Mat bandMask = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
+  const std::vector<GroundSample> band = bandSamples(disparity, n.roi, bandMask);
+  if (samplesCount) *samplesCount = static_cast<int>(band.size());
+  std::vector<float> values(band.size());
+  for (size_t i = 0; i < band.size(); ++i) values[i] = band[i].d;
+  return groundNextTo(n, band, groundLevelOf(values, params), params);
+}
+
+// How many of the core's pixels within `halfWindow` of `level` belong to regions that enter the
+// polygon from outside, as a neighbour's roof crossing a rough outline does: 8-connected pixels
+// within that window, over the polygon and a band around it, that reach `reach` px outside the
+// polygon. Courtyards (holes) are not outside.
+int enteringCount(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, double level,
+                  double halfWindow, double reach) {
+  cv::Mat atLevel;
+  cv::inRange(disparity(n.roi), level - halfWindow, level + halfWindow, atLevel);  // NaN is out of range
+  atLevel &= n.outerDistance <= static_cast<float>(reach + 1.0);
+  cv::Mat labels;
+  const int count = cv::connectedComponents(atLevel, labels, 8, CV_32S);
+  std::vector<char> reachesOut(static_cast<size_t>(count), 0);
+  const cv::Mat farOut = atLevel & (n.outerDistance >= static_cast<float>(reach));
+  for (int y = 0; y < farOut.rows; ++y) {
+    const uchar* f = farOut.ptr<uchar>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < farOut.cols; ++x) {
+      if (f[x] != 0) reachesOut[static_cast<size_t>(l[x])] = 1;
+    }
+  }
+  int entering = 0;
+  for (int y = 0; y < atLevel.rows; ++y) {
+    const uchar* a = atLevel.ptr<uchar>(y);
+    const uchar* c = core.ptr<uchar>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < atLevel.cols; ++x) {
+      if (a[x] != 0 && c[x] != 0) entering += reachesOut[static_cast<size_t>(l[x])];
+    }
+  }
+  return entering;
+}
+
+// The roof level (bin): the most populated level above the floor, its pixels in regions that
+// enter the polygon from outside not counted. Candidates are the most populated level and the
+// other peaks of the mass holding at least a fifth of its mass; when every candidate keeps less
+// than that fifth (a polygon drawn inside its roof), the most populated level.
+size_t roofLevel(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, const Histogram& h,
+                 const std::vector<double>& mass, double floorLevel, int windowBins,
+                 const RoofIntervalParams& params) {
+  size_t first = mass.size();
+  for (size_t i = 0; i < mass.size(); ++i) {
+    if (h.centre(i) >= floorLevel && (first == mass.size() || mass[i] > mass[first])) first = i;
+  }
+  if (first == mass.size() || mass[first] <= 0.0) {
+    return static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  }
+  if (params.entryReach <= 0.0) return first;
+  const double bar = 0.2 * mass[first];
+  const auto near = [windowBins](size_t a, size_t b) {
+    return std::abs(static_cast<long>(a) - static_cast<long>(b)) <= windowBins;
+  };
+  std::vector<size_t> candidates = {first};  // then the other peaks, most populated first
+  for (size_t i = 0; i < mass.size(); ++i) {
+    const bool isMax = (i == 0 || mass[i] >= mass[i - 1]) && (i + 1 == mass.size() || mass[i] >= mass[i + 1]);
+    if (isMax && !near(i, first) && h.centre(i) >= floorLevel && mass[i] >= bar) candidates.push_back(i);
+  }
+  std::stable_sort(candidates.begin() + 1, candidates.end(), [&](size_t a, size_t b) { return mass[a] > mass[b]; });
+  const double halfWindow = (windowBins + 0.5) * h.width;  // the pixels counted in a level's mass
+  constexpr size_t kMaxChecks = 6;  // entry counts at most (each labels the polygon's neighbourhood)
+  std::vector<size_t> checked;
+  size_t best = first;
+  double bestKept = -1.0;
+  for (size_t i : candidates) {
+    if (mass[i] <= bestKept || checked.size() == kMaxChecks) break;
+    // A peak next to a checked one (a plateau of the mass) lies in the same regions.
+    if (std::any_of(checked.begin(), checked.end(), [&](size_t c) { return near(i, c); })) continue;
+    checked.push_back(i);
+    const double kept = mass[i] - enteringCount(disparity, n, core, h.centre(i), halfWindow, params.entryReach);
+    if (kept > bestKept) best = i, bestKept = kept;
+  }
+  return bestKept >= bar ? best : first;
+}
+
 }  // namespace
 
 double estimateGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon, const RoofIntervalParams& params) {
   params.validate();
   const Neighbourhood n = neighbourhood(disparity, polygon, params.groundMargin);
   if (n.inside.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const cv::Mat band = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
-  return groundLevelOf(samples(disparity, n.roi, band), params);
+  return groundLevelAround(disparity, n, params, nullptr);
 }
 
 RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon,
@@ -166,17 +337,15 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
   RoofIntervalProposal out;
   const Neighbourhood n = neighbourhood(disparity, polygon, params.groundMargin);
   if (n.inside.empty()) return out;
-  const cv::Mat band = (n.outerDistance > 1.0f) & (n.outerDistance <= static_cast<float>(params.groundMargin));
-  const std::vector<float> ground = samples(disparity, n.roi, band);
-  out.groundSamples = static_cast<int>(ground.size());
-  out.groundLevel = groundLevelOf(ground, params);
+  out.groundLevel = groundLevelAround(disparity, n, params, &out.groundSamples);
 
   // The polygon's core: away from its border, where a rough outline holds ground, walls and
   // parapets. A small polygon keeps at least half of its inradius.
   const cv::Rect2d box = core::boundingBox(polygon.outer);
   const double shrink = std::min(params.coreShrink, 0.25 * std::min(box.width, box.height));
-  std::vector<float> roof = samples(disparity, n.roi, n.depth > static_cast<float>(shrink));
-  if (roof.size() < 10) roof = samples(disparity, n.roi, n.inside);
+  cv::Mat core = n.depth > static_cast<float>(shrink);
+  std::vector<float> roof = samples(disparity, n.roi, core);
+  if (roof.size() < 10) core = n.inside, roof = samples(disparity, n.roi, core);
   out.roofSamples = static_cast<int>(roof.size());
   if (roof.size() < 10) return out;
 
@@ -190,14 +359,8 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
                                 ? out.groundLevel + params.minRoofHeight
                                 : -std::numeric_limits<double>::infinity();
   // The most populated level above the ground (mass within ±1 px), then its highest bin.
-  size_t best = h.counts.size();
-  for (size_t i = 0; i < h.counts.size(); ++i) {
-    if (h.centre(i) >= floorLevel && (best == h.counts.size() || mass[i] > mass[best])) best = i;
-  }
-  if (best == h.counts.size() || mass[best] <= 0.0) {
-    best = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
-  }
   const int reach = std::max(1, static_cast<int>(std::lround(1.0 / params.binWidth)));
+  const size_t best = roofLevel(disparity, n, core, h, mass, floorLevel, reach, params);
   size_t peak = best;
   for (size_t i = best > static_cast<size_t>(reach) ? best - static_cast<size_t>(reach) : 0;
        i <= std::min(h.counts.size() - 1, best + static_cast<size_t>(reach)); ++i) {

@@ -10,6 +10,7 @@
 #include "delineo/io/vector.hpp"
 
 #ifdef DELINEO_HAVE_STEREO
+#include "delineo/stereo/disparity_range.hpp"
 #include "delineo/stereo/match.hpp"
 #endif
 #ifdef DELINEO_HAVE_SIM
@@ -80,6 +81,21 @@ cv::Mat readDisparity(const Project& project, cv::Size size) {
                 project.disparity);
   }
   return raster.data;
+}
+
+RangeOutcome estimateDisparityRange(const Project& project, const StereoPair& pair, core::Progress* progress) {
+#ifdef DELINEO_HAVE_STEREO
+  const auto params = parameters<stereo::RangeEstimateParams>(project, "range");
+  const stereo::RangeEstimate estimate = stereo::estimateDisparityRange(pair.left, pair.right, params, progress);
+  RangeOutcome outcome;
+  outcome.status = estimate.status;
+  outcome.range = DisparityInterval{estimate.dmin, estimate.dmax};
+  outcome.matches = estimate.matches;
+  return outcome;
+#else
+  (void)project, (void)pair, (void)progress;
+  throw Error(ErrorCode::ProcessingFailed, "dense matching is not part of this build");
+#endif
 }
 
 MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, const cv::Mat& right,
@@ -249,8 +265,18 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
   const std::vector<int> pending = project.pendingBuildings();
   const double matchShare = project.disparity.empty() ? (pending.empty() ? 1.0 : 0.5) : 0.0;
   cv::Mat disparity;
+  if (project.disparity.empty() && !project.disparityRange) {
+    core::Progress::Range range(progress, 0.0, 0.1 * matchShare);
+    const RangeOutcome estimated = estimateDisparityRange(project, pair, &range);
+    if (estimated.status == core::RunStatus::Canceled) {
+      summary.status = core::RunStatus::Canceled;
+      return summary;
+    }
+    project.disparityRange = estimated.range;
+    summary.rangeEstimated = estimated;
+  }
   if (project.disparity.empty()) {
-    core::Progress::Range range(progress, 0.0, matchShare);
+    core::Progress::Range range(progress, 0.1 * matchShare, matchShare);
     range.setStage(core::StageId::DenseMatching);
     MatchingOutcome matched = computeDisparity(project, pair.left, pair.right, &range);
     if (matched.status == core::RunStatus::Canceled) {

@@ -1,6 +1,7 @@
 // delineo-cli delineate: building outlines by the statistical active polygon
 // (docs/delineation.md). One call runs a batch: every polygon of --init is one building, and its
 // roof_disparity_min/max and ground_disparity properties override the flags for it.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -12,6 +13,7 @@
 #include "delineo/delineation/delineate.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
+#include "range_support.hpp"
 
 namespace {
 using namespace delineo;
@@ -39,6 +41,15 @@ std::optional<double> numberAttribute(const core::Feature& f, const std::string&
   return std::nullopt;
 }
 
+// The estimated search range widened to hold the building's intervals: the operator's (or the
+// feature's) intervals are known, the estimate is a statistic of the whole pair.
+DisparityInterval hull(DisparityInterval range, const DisparityInterval& roof,
+                       const std::optional<DisparityInterval>& ground) {
+  range = {std::min(range.min, roof.min), std::max(range.max, roof.max)};
+  if (ground) range = {std::min(range.min, ground->min), std::max(range.max, ground->max)};
+  return range;
+}
+
 std::string statusName(core::RunStatus s) {
   return s == core::RunStatus::Completed ? "completed" : "canceled";
 }
@@ -57,11 +68,14 @@ int run(const std::vector<std::string>& args) {
       .value("ground-disparity", "A:B",
              "ground disparity interval (a feature's ground_disparity overrides it); estimated "
              "around each init when absent")
-      .value("disparity-range", "A:B", "full disparity search range, when known")
+      .value("disparity-range", "A:B",
+             "full disparity search range; estimated from the pair when absent (widened to "
+             "hold the roof and ground intervals)")
       .value("exclude", "FILE",
              "mask of the left image's size, non-zero where a pixel is known not to be roof "
              "(vegetation, a neighbour's roof); kept outside every outline")
       .required("out", "FILE", "output polygons (GeoJSON/GeoPackage) with energies and status")
+      .flag("quiet", "no progress and no range estimate on stderr")
       .params(delineation::DelineationParams{});
   if (!opts.parse(args)) return cli::kExitOk;
   if (opts.has("init") == opts.has("roi")) {
@@ -71,6 +85,8 @@ int run(const std::vector<std::string>& args) {
   opts.apply(params);
 
   auto& progress = cli::commandProgress();
+  const bool quiet = opts.has("quiet");
+  progress.setQuiet(quiet);
   progress.setStage("reading");
   io::GeoReference geo;
   const cv::Mat left = io::readGreyFloat(opts.get("left"), &geo);
@@ -98,6 +114,20 @@ int run(const std::vector<std::string>& args) {
   if (opts.has("roof-disparity")) roofFlag = intervalFlag(opts, "roof-disparity");
   if (opts.has("ground-disparity")) groundFlag = intervalFlag(opts, "ground-disparity");
   if (opts.has("disparity-range")) searchFlag = intervalFlag(opts, "disparity-range");
+  core::Progress::Range buildingsProgress(&progress, searchFlag ? 0.0 : 0.05, 1.0);
+  std::optional<DisparityInterval> estimated;
+  if (!searchFlag) {
+    core::Progress::Range rangeProgress(&progress, 0.0, 0.05);
+    try {
+      const auto e = cli::estimateRangeForCommand(left, right, "give --disparity-range", quiet,
+                                                  &rangeProgress);
+      estimated = DisparityInterval{e.dmin, e.dmax};
+    } catch (const core::Error& e) {
+      // Each building then searches around its own intervals, as without an estimate.
+      std::fprintf(stderr, "warning: %s; searching around each building's intervals only\n",
+                   e.what());
+    }
+  }
 
   std::vector<core::Feature> out;
   int failed = 0;
@@ -110,7 +140,7 @@ int run(const std::vector<std::string>& args) {
     const auto id = numberAttribute(init, "id");
     result.attributes["id"] = static_cast<long long>(id ? *id : static_cast<double>(i + 1));
     progress.setStage("building " + std::to_string(i + 1) + "/" + std::to_string(count));
-    core::Progress::Range range(&progress, double(i) / count, double(i + 1) / count);
+    core::Progress::Range range(&buildingsProgress, double(i) / count, double(i + 1) / count);
     try {
       delineation::DelineationRequest req;
       req.init = init.polygon;
@@ -134,6 +164,7 @@ int run(const std::vector<std::string>& args) {
         req.ground = groundFlag;
       }
       req.searchRange = searchFlag;
+      if (estimated) req.searchRange = hull(*estimated, req.roof, req.ground);
       req.excludeMask = exclude;
       const auto r = delineation::delineate(left, right, req, params, {}, &range);
       result.polygon = r.polygon;

@@ -8,6 +8,7 @@
 #include "delineo/core/error.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
+#include "range_support.hpp"
 
 namespace {
 using namespace delineo;
@@ -15,13 +16,14 @@ using namespace delineo;
 int run(const std::vector<std::string>& args) {
   cli::Options opts("match",
                     "Dense disparity of an epipolar pair (left = reference, x_right = x_left - d).\n"
-                    "Usage: delineo-cli match --left L --right R --dmin A --dmax B --out D.tif "
-                    "[options]");
+                    "Usage: delineo-cli match --left L --right R [--dmin A --dmax B] --out D.tif "
+                    "[options]\nWithout --dmin/--dmax the range is estimated from feature "
+                    "matches (docs/disparity-range.md).");
   opts.required("left", "FILE", "left (reference) image")
       .required("right", "FILE", "right image, same size, epipolar with the left")
       .required("out", "FILE", "output disparity GeoTIFF (float32, NaN = rejected)")
-      .value("dmin", "PX", "smallest disparity searched (x_right = x_left - d)")
-      .value("dmax", "PX", "largest disparity searched")
+      .value("dmin", "PX", "smallest disparity searched, x_right = x_left - d; estimated from the pair when absent")
+      .value("dmax", "PX", "largest disparity searched; estimated from the pair when absent")
       .value("score", "FILE", "optional output of the correlation score (NCC of the match)", "")
       .flag("quiet", "no progress on stderr");
   opts.params(stereo::MatchParams{});
@@ -34,13 +36,13 @@ int run(const std::vector<std::string>& args) {
     }
   }
   if (!opts.parse(normalised)) return cli::kExitOk;
-  if (!opts.has("dmin") || !opts.has("dmax")) {
-    throw cli::UsageError("--dmin and --dmax are required (the disparity search range)");
-  }
   stereo::MatchParams params;
   opts.apply(params);
-  params.dmin = opts.getInt("dmin");
-  params.dmax = opts.getInt("dmax");
+  const bool rangeGiven = opts.has("dmin") && opts.has("dmax");
+  // Without both ends the range is validated once estimated: a lone --dmin above the default
+  // dmax is no error.
+  params.dmin = opts.has("dmin") ? opts.getInt("dmin") : -100000;
+  params.dmax = opts.has("dmax") ? opts.getInt("dmax") : 100000;
   params.validate();
 
   auto& progress = cli::commandProgress();
@@ -57,7 +59,17 @@ int run(const std::vector<std::string>& args) {
                           std::to_string(right.cols) + "x" + std::to_string(right.rows),
                       opts.get("right"));
   }
-  const stereo::MatchResult result = stereo::matchStereo(left, right, params, &progress);
+  core::Progress::Range matchProgress(&progress, rangeGiven ? 0.0 : 0.05, 1.0);
+  if (!rangeGiven) {
+    // A flag given alone overrides its end of the estimate.
+    core::Progress::Range rangeProgress(&progress, 0.0, 0.05);
+    const stereo::RangeEstimate estimate = cli::estimateRangeForCommand(
+        left, right, "give --dmin and --dmax", quiet, &rangeProgress);
+    if (!opts.has("dmin")) params.dmin = estimate.dmin;
+    if (!opts.has("dmax")) params.dmax = estimate.dmax;
+    params.validate();
+  }
+  const stereo::MatchResult result = stereo::matchStereo(left, right, params, &matchProgress);
   cli::throwIfCanceled(progress);
   if (result.status == core::RunStatus::Canceled) throw cli::Canceled();
   progress.finish();
@@ -66,8 +78,10 @@ int run(const std::vector<std::string>& args) {
   if (!opts.get("score").empty()) io::writeFloatGeoTiff(opts.get("score"), result.score, geo);
   if (quiet) return cli::kExitOk;
   const int valid = cv::countNonZero(result.disparity == result.disparity);
-  std::fprintf(stderr, "match: %s, %d level(s), %.1f %% of pixels matched, written to %s\n",
-               params.method.c_str(), result.levelsUsed,
+  std::fprintf(stderr,
+               "match: %s, disparities %d..%d, %d level(s), %.1f %% of pixels matched, written "
+               "to %s\n",
+               params.method.c_str(), params.dmin, params.dmax, result.levelsUsed,
                100.0 * valid / static_cast<double>(result.disparity.total()),
                opts.get("out").c_str());
   return cli::kExitOk;

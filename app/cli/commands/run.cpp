@@ -48,6 +48,11 @@ int run(const std::vector<std::string>& args) {
   cli::throwIfCanceled(progress);
   if (summary.status == core::RunStatus::Canceled) throw cli::Canceled();
   progress.finish();
+  if (summary.rangeEstimated) {
+    std::fprintf(stderr, "run: disparity range estimated from %d matches: [%d, %d] px\n",
+                 summary.rangeEstimated->matches, summary.rangeEstimated->range.low,
+                 summary.rangeEstimated->range.high);
+  }
   for (const auto& message : summary.messages) std::fprintf(stderr, "run: %s\n", message.c_str());
   if (!opts.has("no-save")) project::saveProject(proj, projectPath);
   std::fprintf(stderr, "run: %s; %d building(s) delineated, %d skipped%s%s\n",

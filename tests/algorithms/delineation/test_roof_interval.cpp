@@ -87,6 +87,63 @@ TEST(RoofInterval, SlopedRoofGetsAnIntervalAsWideAsItsSpread) {
   EXPECT_GE(p.high, 48);
 }
 
+// A low wing (31 px, 240 x 40 px) in the shadow of a taller block (80 px, its parapet 82.5 px)
+// along its north side: the matcher keeps every pixel of the sunlit block but only half of the
+// wing's, as in Toulouse.
+cv::Mat wingInTheShadowOfABlockScene() {
+  cv::Mat map(320, 440, CV_32F, cv::Scalar(6.0f));
+  map(cv::Rect(0, 0, 440, 140)).setTo(80.0f);
+  map(cv::Rect(0, 136, 440, 4)).setTo(82.5f);
+  const cv::Rect wing(100, 140, 240, 40);
+  map(wing).setTo(31.0f);
+  addNoise(map);
+  cv::Mat draw(wing.size(), CV_32F);
+  cv::RNG rng(11);
+  rng.fill(draw, cv::RNG::UNIFORM, 0.0, 1.0);
+  map(wing).setTo(std::numeric_limits<float>::quiet_NaN(), draw > 0.5);
+  return map;
+}
+
+TEST(RoofInterval, ANeighboursTallerBlockFillingAThirdOfTheRectangleDoesNotTakeThePeak) {
+  const cv::Mat map = wingInTheShadowOfABlockScene();
+  // The operator's rectangle is centred on the wing, 30-35 px larger on each side, and its north
+  // third lies on the block: the block's matched pixels outnumber the wing's.
+  const auto p = proposeRoofInterval(map, rectangle(70, 105, 370, 215));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.peak, 31.0, 0.5);
+  EXPECT_LE(p.low, 31);
+  EXPECT_GE(p.high, 31);
+  EXPECT_LT(p.high, 60);
+  EXPECT_NEAR(p.groundLevel, 6.0, 0.5);
+  RoofIntervalParams noEntryTest;
+  noEntryTest.entryReach = 0.0;
+  EXPECT_NEAR(proposeRoofInterval(map, rectangle(70, 105, 370, 215), noEntryTest).peak, 80.0, 1.0);
+}
+
+TEST(RoofInterval, ADelineatedRingRoofKeepsItsRingNotTheLowerPartAtItsCentre) {
+  // A raised ring (80 px) around a lower inner roof (72 px) at the polygon's centre, as the
+  // delineated outline of Toulouse's raised block: weighting pixels by their distance to the
+  // border would give the inner roof.
+  cv::Mat map(360, 400, CV_32F, cv::Scalar(6.0f));
+  map(cv::Rect(100, 100, 200, 160)).setTo(80.0f);
+  map(cv::Rect(140, 140, 120, 80)).setTo(72.0f);
+  addNoise(map);
+  const auto p = proposeRoofInterval(map, rectangle(100, 100, 300, 260));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.peak, 80.0, 0.5);
+}
+
+TEST(RoofInterval, APolygonDrawnInsideItsRoofKeepsTheRoofNotASmallStructureOnIt) {
+  // Every level of the polygon enters it from outside except a plant room (46 px, 30 x 30 px).
+  cv::Mat map(300, 400, CV_32F, cv::Scalar(6.0f));
+  map(cv::Rect(50, 50, 300, 200)).setTo(40.0f);
+  map(cv::Rect(185, 135, 30, 30)).setTo(46.0f);
+  addNoise(map);
+  const auto p = proposeRoofInterval(map, rectangle(100, 100, 300, 200));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.peak, 40.0, 0.5);
+}
+
 TEST(GroundLevel, IsTheLowestWellPopulatedLevelNotTheMostFrequentOne) {
   cv::Mat map(300, 300, CV_32F, cv::Scalar(20.0f));  // neighbouring roofs all around
   map(cv::Rect(0, 200, 300, 100)).setTo(6.0f);       // a street along the south side
@@ -94,6 +151,30 @@ TEST(GroundLevel, IsTheLowestWellPopulatedLevelNotTheMostFrequentOne) {
   addNoise(map);
   const double g = estimateGroundLevel(map, rectangle(100, 100, 200, 180));
   EXPECT_NEAR(g, 6.0, 0.5);
+}
+
+// Ground sloping by 0.08 px per px along x (as across the Dublin tile), a tower at 90 px.
+cv::Mat slopedGroundScene() {
+  cv::Mat map(400, 700, CV_32F);
+  for (int y = 0; y < map.rows; ++y) {
+    for (int x = 0; x < map.cols; ++x) map.at<float>(y, x) = 10.0f + 0.08f * static_cast<float>(x);
+  }
+  map(cv::Rect(400, 170, 60, 60)).setTo(90.0f);
+  addNoise(map);
+  return map;
+}
+
+TEST(GroundLevel, OnASlopingGroundIsTheGroundNextToTheBuilding) {
+  const cv::Mat map = slopedGroundScene();
+  // The ground along the tower's sides averages 10 + 0.08 * 430 = 44.4 px; the 120 px band
+  // around a rough rectangle spans 33..58 px. From rectangles 8 and 30 px larger than the tower.
+  EXPECT_NEAR(estimateGroundLevel(map, rectangle(392, 162, 468, 238)), 44.4, 0.5);
+  EXPECT_NEAR(estimateGroundLevel(map, rectangle(370, 140, 490, 260)), 44.4, 0.5);
+  const auto p = proposeRoofInterval(map, rectangle(392, 162, 468, 238));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.groundLevel, 44.4, 0.5);
+  EXPECT_LE(p.low, 90);
+  EXPECT_GE(p.high, 90);
 }
 
 TEST(GroundLevel, NaNWhenTheNeighbourhoodHasNoMatchedPixel) {

@@ -70,6 +70,38 @@ if has match && [ -s "$scene/left.tif" ]; then
     && check match_size_mismatch 3 "short.tif" -- "$cli" match --left "$scene/left.tif" --right "$work/short.tif" --dmin 0 --dmax 16 --out "$work/d.tif"
   gdal_create -q -of GTiff -outsize 320 240 -bands 2 -ot Byte "$work/twoband.tif" >/dev/null 2>&1 \
     && check match_two_bands 3 "twoband.tif" -- "$cli" match --left "$work/twoband.tif" --right "$scene/right.tif" --dmin 0 --dmax 16 --out "$work/d.tif"
+
+  # Without --dmin/--dmax the range is estimated; it must hold the scene's true range.
+  check match_estimated 0 "disparity range estimated from" -- "$cli" match --left "$scene/left.tif" --right "$scene/right.tif" --method sgbm --out "$work/d_est.tif"
+  est=$(grep -o 'estimated from [0-9]* matches: \[-\?[0-9]*, -\?[0-9]*\]' "$work/match_estimated.err" | grep -o '\[.*\]' | tr -d '[],')
+  true_min=$(grep -o '"disparity_min": *-\?[0-9]*' "$scene/scene.json" | grep -o -- '-\?[0-9]*$')
+  true_max=$(grep -o '"disparity_max": *-\?[0-9]*' "$scene/scene.json" | grep -o -- '-\?[0-9]*$')
+  read -r est_min est_max <<<"$est"
+  if [ -n "$est_min" ] && [ -n "$true_min" ] && [ "$est_min" -le "$true_min" ] && [ "$est_max" -ge "$true_max" ]; then
+    passed=$((passed + 1))
+  else
+    echo "FAIL estimated range [$est_min, $est_max] does not hold the scene's $true_min:$true_max"; failures=$((failures + 1))
+  fi
+  if [ -s "$work/d_est.tif" ]; then passed=$((passed + 1)); else echo "FAIL match_estimated wrote no map"; failures=$((failures + 1)); fi
+  # A flag given alone overrides its end of the estimate.
+  check match_dmin_only 0 "disparities 0..$est_max," -- "$cli" match --left "$scene/left.tif" --right "$scene/right.tif" --dmin 0 --method sgbm --out "$work/d_min.tif"
+  check match_quiet_estimate 0 "" -- "$cli" match --left "$scene/left.tif" --right "$scene/right.tif" --method sgbm --quiet --out "$work/d_q.tif"
+  if [ -s "$work/match_quiet_estimate.err" ]; then echo "FAIL match --quiet printed on stderr"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
+  # --help lists no made-up default range.
+  if "$cli" match --help | grep -E -- '--dmi[n]|--dma[x]' | grep -q "default"; then
+    echo "FAIL match --help shows a default for --dmin/--dmax"; failures=$((failures + 1)); else passed=$((passed + 1)); fi
+  # A blank pair: no range can be estimated, the error says so and which flags to give.
+  gdal_create -q -of GTiff -outsize 320 240 -bands 1 -ot Byte -burn 128 "$work/blank.tif" >/dev/null 2>&1 \
+    && check match_blank_pair 4 "blank" -- "$cli" match --left "$work/blank.tif" --right "$work/blank.tif" --out "$work/d.tif" \
+    && if grep -q -- "--dmin" "$work/match_blank_pair.err"; then passed=$((passed + 1)); else echo "FAIL blank-pair error does not name --dmin"; failures=$((failures + 1)); fi
+fi
+
+if has range && [ -s "$scene/left.tif" ]; then
+  check range 0 "" -- "$cli" range --left "$scene/left.tif" --right "$scene/right.tif" --json "$work/range.json"
+  if grep -q -- "^--dmin ${est_min:-x} --dmax ${est_max:-x}\$" "$work/range.out" && grep -q '"dmin"' "$work/range.json"; then
+    passed=$((passed + 1)); else echo "FAIL range printed '$(cat "$work/range.out")', match estimated [$est_min, $est_max]"; failures=$((failures + 1)); fi
+  [ -s "$work/blank.tif" ] && check range_blank 4 "blank" -- "$cli" range --left "$work/blank.tif" --right "$work/blank.tif"
+  check range_bad_param 3 "percentile" -- "$cli" range --left "$scene/left.tif" --right "$scene/right.tif" --low-percentile 50 --high-percentile 50
 fi
 
 if has delineate && [ -s "$scene/footprints_gt.geojson" ] && has rough-init; then

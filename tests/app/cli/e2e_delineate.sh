@@ -31,6 +31,7 @@ TRUTHS=$(count "$S/footprints_gt.geojson" '"type": "Feature"')
 expect_rc delineate 0 "$CLI" delineate --left "$S/left.tif" --right "$S/right.tif" \
   --init "$WORK/init.geojson" --out "$WORK/out.geojson"
 OUT=$WORK/out.geojson
+expect_in "$WORK/delineate.err" "disparity range estimated from [0-9]+ matches" "delineate without --disparity-range estimates it"
 [[ $(count "$OUT" '"type": "Feature"') == "$TRUTHS" ]] || fail "one output polygon per init expected"
 for key in id status energy vertices e_roof e_ground e_occlusion iterations; do
   [[ $(count "$OUT" "\"$key\": ") == "$TRUTHS" ]] || fail "attribute $key missing on some outputs"
@@ -40,9 +41,10 @@ expect_in "$OUT" '"vertices": [0-9]+' "vertex count is an integer"
 expect_rc eval 0 "$CLI" eval-footprints --pred "$OUT" --truth "$S/footprints_gt.geojson" \
   --json "$WORK/eval.json"
 IOU=$(mean_iou "$WORK/eval.json")
-# Measured 0.977 on this scene (0.943 before the aggregated costs and the coarser region
-# outlines, 0.873 before the spike fixes and the region stage); the floor leaves a margin for
-# changes of the simulator's textures or of the optimiser that are not regressions.
+# Measured 0.979 on this scene with the estimated search range (0.943 before the aggregated
+# costs and the coarser region outlines, 0.873 before the spike fixes and the region stage);
+# the floor leaves a margin for changes of the simulator's textures or of the optimiser that
+# are not regressions.
 above "$IOU" 0.88 || fail "mean IoU $IOU is not above the floor 0.88"
 expect_in "$WORK/eval.json" "\"matched\": $TRUTHS," "every building matched"
 

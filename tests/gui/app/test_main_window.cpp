@@ -2,11 +2,14 @@
 // latency measurement), pick a building with the mouse, set the roof interval, run the active
 // polygon, drag a vertex, undo, redo, accept, save, reload, export; plus bad inputs, autosave
 // recovery and the French translation.
+#include <QAbstractSpinBox>
 #include <QAction>
 #include <QCheckBox>
 #include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QFile>
+#include <QLabel>
+#include <QMenu>
 #include <QScrollArea>
 #include <QSettings>
 #include <QSignalSpy>
@@ -23,6 +26,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <thread>
 
 #include <opencv2/imgproc.hpp>
@@ -109,6 +113,49 @@ class MainWindowTest : public QObject {
     const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
     if (!dir.isEmpty()) window_->grab().save(dir + QLatin1Char('/') + shot);
     return tabs;
+  }
+
+  // Each pair the edit tests below open: a bright roof [100, 180) x [60, 120) on a noisy
+  // ground, the right image shifted by 12 px. `colour` writes it as an RGB image (a reddish roof).
+  bool openSyntheticPair(const QString& name, bool colour) {
+    cv::Mat grey(200, 260, CV_8U);
+    cv::RNG rng(11);
+    rng.fill(grey, cv::RNG::NORMAL, 90, 5);
+    grey(cv::Rect(100, 60, 80, 60)) += cv::Scalar(60);
+    cv::Mat left = grey;
+    if (colour) {
+      cv::Mat rgb[3] = {grey.clone(), grey * 0.6, grey * 0.4};  // file band order: R, G, B
+      cv::merge(rgb, 3, left);
+    }
+    cv::Mat right = cv::Mat::zeros(left.size(), left.type());
+    left(cv::Rect(12, 0, left.cols - 12, left.rows))
+        .copyTo(right(cv::Rect(0, 0, left.cols - 12, left.rows)));
+    const QString l = dir_.filePath(name + QStringLiteral("_left.tif"));
+    const QString r = dir_.filePath(name + QStringLiteral("_right.tif"));
+    io::writeGeoTiff(l.toStdString(), left);
+    io::writeGeoTiff(r.toStdString(), right);
+    return window_->openPair(l, r);
+  }
+
+  // Picks a pending building on the open pair, selects it and enters Edit outline mode, the
+  // window active (another test's window may have taken the focus) and the left view focused.
+  int editBuilding(const core::Polygon& polygon) {
+    window_->activateWindow();
+    if (!QTest::qWaitForWindowActive(window_.get())) return -1;
+    const int id = window_->document()->addBuilding(polygon);
+    window_->selectBuilding(id);
+    window_->action(QStringLiteral("actionEdit"))->trigger();
+    window_->action(QStringLiteral("actionSnapRightAngles"))->setChecked(false);
+    window_->action(QStringLiteral("actionSnapEdges"))->setChecked(false);
+    window_->leftView()->setView(QPointF(140, 90), 4.0);
+    window_->leftView()->setFocus();
+    return id;
+  }
+
+  void restoreEditDefaults() {
+    window_->action(QStringLiteral("actionSnapRightAngles"))->setChecked(true);
+    window_->action(QStringLiteral("actionSnapEdges"))->setChecked(true);
+    window_->action(QStringLiteral("actionNavigate"))->trigger();
   }
 
  private slots:
@@ -209,11 +256,11 @@ class MainWindowTest : public QObject {
     const auto before = *doc->project().find(buildingId_)->roofInterval;
     widgets::DisparityHistogramWidget* histogram = window_->histogram();
     histogram->setFocus();
-    QTest::keyClick(histogram, Qt::Key_Right, Qt::ShiftModifier);  // upper bound + 1
+    QTest::keyClick(histogram, Qt::Key_Left, Qt::ShiftModifier);  // upper bound - 1
     auto after = *doc->project().find(buildingId_)->roofInterval;
-    QCOMPARE(after.high, before.high + 1);
+    QCOMPARE(after.high, before.high - 1);
     QCOMPARE(after.low, before.low);
-    QTest::keyClick(histogram, Qt::Key_Left, Qt::ShiftModifier);  // back
+    QTest::keyClick(histogram, Qt::Key_Right, Qt::ShiftModifier);  // back
     QCOMPARE(doc->project().find(buildingId_)->roofInterval->high, before.high);
     // Interval steps merge into one undo entry.
     QVERIFY(doc->undoStack()->undoText().contains(QStringLiteral("Roof interval")));
@@ -663,6 +710,215 @@ class MainWindowTest : public QObject {
     QTabWidget* tabs = showOnMatchingTab(box, QStringLiteral("matching-tab-one-surface.png"));
     QVERIFY(tabs);
     tabs->setCurrentIndex(0);
+  }
+
+  void colourPairIsShownInColourAndMatchedInGrey() {
+    QVERIFY(openSyntheticPair(QStringLiteral("colour"), true));
+    gui::Document* doc = window_->document();
+    QCOMPARE(doc->leftGrey().type(), CV_8UC1);
+    QCOMPARE(doc->pair().left.channels(), 1);
+    QCOMPARE(doc->leftDisplay().type(), CV_8UC3);
+    QCOMPARE(doc->rightDisplay().type(), CV_8UC3);
+    QCOMPARE(window_->leftView()->image().type(), CV_8UC3);
+    QCOMPARE(window_->rightView()->image().type(), CV_8UC3);
+    // The roof is reddish on screen: red > green > blue (OpenCV's BGR order handled).
+    widgets::ImageView* view = window_->leftView();
+    view->setView(QPointF(140, 90), 2.0);
+    const QImage shot = view->grab().toImage().convertToFormat(QImage::Format_RGB32);
+    const QColor roof(shot.pixel(view->imageToWidget(QPointF(140.5, 90.5)).toPoint()));
+    QVERIFY2(roof.red() > roof.green() + 30 && roof.green() > roof.blue() + 15,
+             qPrintable(roof.name()));
+    // The read-out gives the grey value matching works on.
+    QTest::mouseMove(view, view->imageToWidget(QPointF(140.5, 90.5)).toPoint());
+    QTRY_VERIFY(window_->readout()->text().contains(
+        QStringLiteral("grey %1").arg(doc->leftGrey().at<uchar>(90, 140))));
+    // A grey pair is shown grey (the grey image itself).
+    QVERIFY(openSyntheticPair(QStringLiteral("grey"), false));
+    QCOMPARE(window_->leftView()->image().type(), CV_8UC1);
+    QCOMPARE(window_->document()->leftDisplay().data, window_->document()->leftGrey().data);
+  }
+
+  void imageFillsTheViewWhenItOpens() {
+    // As delineo starts: the window is shown and the pair opened before the first layout.
+    const project::Project sample = project::loadProject(projectPath_.toStdString());
+    const QString left = QString::fromStdString(sample.left);
+    const QString right = QString::fromStdString(sample.right);
+    auto fills = [](widgets::ImageView* view) {
+      const cv::Size size = view->imageSize();
+      const QRectF shown(view->imageToWidget(QPointF(0, 0)),
+                         view->imageToWidget(QPointF(size.width, size.height)));
+      return std::abs(shown.width() - view->width()) < 1.0 ||
+             std::abs(shown.height() - view->height()) < 1.0;
+    };
+    for (const bool asProject : {false, true}) {
+      MainWindow fresh;
+      fresh.setInteractive(false);
+      fresh.resize(1300, 850);
+      fresh.showActivated();
+      QVERIFY(asProject ? fresh.openProject(projectPath_) : fresh.openPair(left, right));
+      QVERIFY(QTest::qWaitForWindowExposed(&fresh));
+      QTRY_VERIFY_WITH_TIMEOUT(fresh.jobs()->activeCount() == 0, 20000);
+      widgets::ImageView* view = fresh.leftView();
+      QVERIFY(view->width() > 300);
+      QVERIFY2(fills(view), qPrintable(QStringLiteral("zoom %1 in a %2x%3 view")
+                                           .arg(view->zoom())
+                                           .arg(view->width())
+                                           .arg(view->height())));
+      QVERIFY(view->isFitted());
+      // A disparity arriving later (its dock's view gets its first image) leaves it fitted.
+      if (asProject && project::matchingAvailable()) {
+        const widgets::JobId job = fresh.startMatching();
+        QTRY_VERIFY_WITH_TIMEOUT(!fresh.jobs()->isActive(job), 60000);
+        QVERIFY(fresh.disparityView()->hasImage());
+        QVERIFY(fills(view));
+      }
+      // Until the operator zooms: then a resize keeps the operator's view.
+      view->zoomAround(2.0, QPointF(view->width() / 2.0, view->height() / 2.0));
+      const double zoom = view->zoom();
+      fresh.resize(1200, 800);
+      QTRY_COMPARE(view->zoom(), zoom);
+    }
+  }
+
+  void deletesAHoleAsOneUndoableStep() {
+    QVERIFY(openSyntheticPair(QStringLiteral("hole"), false));
+    gui::Document* doc = window_->document();
+    core::Polygon courtyard;
+    courtyard.outer = {{100, 60}, {180, 60}, {180, 120}, {100, 120}};
+    courtyard.holes = {{{130, 80}, {150, 80}, {150, 100}, {130, 100}}};
+    const int id = editBuilding(courtyard);
+    QVERIFY(id > 0);
+    QUndoStack* undo = doc->undoStack();
+    const int steps = undo->count();
+    // The hole's context menu, as a right-click on its ring opens it.
+    widgets::ImageView* view = window_->leftView();
+    QMenu menu;
+    QVERIFY(view->polygons().fillContextMenu(menu, view->imageToWidget(QPointF(140, 80))));
+    QAction* deleteHole = nullptr;
+    for (QAction* a : menu.actions()) {
+      if (a->text() == QStringLiteral("Delete hole")) deleteHole = a;
+    }
+    QVERIFY(deleteHole);
+    deleteHole->trigger();
+    QVERIFY(doc->project().find(id)->currentPolygon().holes.empty());
+    QVERIFY(doc->project().find(id)->currentPolygon().outer == courtyard.outer);
+    QVERIFY(view->polygons().selectedPolygon()->polygon.holes.empty());
+    QCOMPARE(undo->count(), steps + 1);
+    QCOMPARE(undo->undoText(), QStringLiteral("Delete hole"));
+    QTest::keyClick(view, Qt::Key_Z, Qt::ControlModifier);
+    QCOMPARE(doc->project().find(id)->currentPolygon().holes.size(), size_t(1));
+    QVERIFY(doc->project().find(id)->currentPolygon().holes[0] == courtyard.holes[0]);
+    QCOMPARE(view->polygons().selectedPolygon()->polygon.holes.size(), size_t(1));
+    QTest::keyClick(view, Qt::Key_Y, Qt::ControlModifier);
+    QVERIFY(doc->project().find(id)->currentPolygon().holes.empty());
+    restoreEditDefaults();
+  }
+
+  void rubberBandDeletesVerticesAsOneUndoableStep() {
+    QVERIFY(openSyntheticPair(QStringLiteral("band"), false));
+    gui::Document* doc = window_->document();
+    core::Polygon rough;
+    rough.outer = {{100, 60}, {120, 58}, {140, 62}, {180, 60}, {180, 120}, {100, 120}};
+    const int id = editBuilding(rough);
+    QVERIFY(id > 0);
+    widgets::ImageView* view = window_->leftView();
+    auto at = [&](double x, double y) { return view->imageToWidget(QPointF(x, y)).toPoint(); };
+    QTest::mousePress(view, Qt::LeftButton, Qt::ControlModifier, at(112, 50));
+    QTest::mouseMove(view, at(130, 60));
+    QTest::mouseMove(view, at(150, 66));
+    QTest::mouseRelease(view, Qt::LeftButton, Qt::ControlModifier, at(150, 66));
+    QCOMPARE(view->polygons().selectedVertices().size(), size_t(2));
+    QUndoStack* undo = doc->undoStack();
+    const int steps = undo->count();
+    // Delete is also the window's "Remove building" shortcut: the view claims it here.
+    QTest::keyClick(view, Qt::Key_Delete);
+    QVERIFY(doc->project().find(id) != nullptr);
+    const core::Ring expected{{100, 60}, {180, 60}, {180, 120}, {100, 120}};
+    QVERIFY(doc->project().find(id)->currentPolygon().outer == expected);
+    QCOMPARE(undo->count(), steps + 1);
+    QCOMPARE(undo->undoText(), QStringLiteral("Delete 2 vertices"));
+    undo->undo();
+    QVERIFY(doc->project().find(id)->currentPolygon().outer == rough.outer);
+    undo->redo();
+    // A deletion that would leave 2 vertices is refused with a message; nothing changes.
+    QSignalSpy messages(window_.get(), &MainWindow::messageShown);
+    view->polygons().selectVerticesIn(QRectF(90, 50, 100, 20));
+    QTest::keyClick(view, Qt::Key_Backspace);
+    QCOMPARE(messages.count(), 1);
+    QVERIFY(window_->lastMessage().contains(QStringLiteral("fewer than 3")));
+    QVERIFY(doc->project().find(id)->currentPolygon().outer == expected);
+    QCOMPARE(undo->count(), steps + 1);
+    restoreEditDefaults();
+  }
+
+  void deleteOnAHoveredVertexDeletesTheVertexNotTheBuilding() {
+    QVERIFY(openSyntheticPair(QStringLiteral("hover"), false));
+    gui::Document* doc = window_->document();
+    core::Polygon rough;
+    rough.outer = {{100, 60}, {140, 58}, {180, 60}, {180, 120}, {100, 120}};
+    const int id = editBuilding(rough);
+    QVERIFY(id > 0);
+    widgets::ImageView* view = window_->leftView();
+    QTest::mouseMove(view, view->imageToWidget(QPointF(140, 58)).toPoint());
+    QTest::keyClick(view, Qt::Key_Delete);
+    QVERIFY2(doc->project().find(id) != nullptr, "the building was removed");
+    QCOMPARE(doc->project().find(id)->currentPolygon().outer.size(), size_t(4));
+    // Away from any vertex, Delete is the window's again: it removes the selected building.
+    QTest::mouseMove(view, view->imageToWidget(QPointF(20, 20)).toPoint());
+    QTest::keyClick(view, Qt::Key_Delete);
+    QVERIFY(doc->project().find(id) == nullptr);
+    restoreEditDefaults();
+  }
+
+  void everyMenuShortcutWorksWhateverWidgetHasFocus() {
+    // A window of its own, started as delineo starts it: its actions are cut from their effects
+    // (dialogs, quitting, jobs) so that only "the shortcut reached the action" is measured.
+    MainWindow window;
+    window.setInteractive(false);
+    window.resize(1300, 850);
+    window.showActivated();
+    QVERIFY(QTest::qWaitForWindowActive(&window));
+    QVERIFY(window.openProject(projectPath_));
+    QTRY_VERIFY_WITH_TIMEOUT(window.jobs()->activeCount() == 0, 20000);
+    struct Shortcut {
+      QAction* action;
+      QKeySequence keys;
+    };
+    std::vector<Shortcut> shortcuts;
+    std::map<QAction*, int> fired;
+    for (QAction* a : window.findChildren<QAction*>(QString(), Qt::FindDirectChildrenOnly)) {
+      if (a->shortcuts().isEmpty()) continue;
+      QObject::disconnect(a, &QAction::triggered, nullptr, nullptr);
+      connect(a, &QAction::triggered, &window, [&fired, a] { ++fired[a]; });
+      for (const QKeySequence& k : a->shortcuts()) shortcuts.push_back({a, k});
+    }
+    QVERIFY(shortcuts.size() >= 20);
+    // A text field keeps what it types and edits with (letters, Delete, Ctrl+Z, Ctrl+E = end of
+    // line on X11...): there, the commands of the File and Processing menus must still work.
+    const QList<QKeySequence> commands{QKeySequence::New,         QKeySequence::Open,
+                                       QKeySequence::Save,        QKeySequence::SaveAs,
+                                       QKeySequence::Quit,        QKeySequence(tr("Ctrl+M")),
+                                       QKeySequence(tr("Ctrl+R"))};
+    auto* field = window.delineationForm()->findChild<QAbstractSpinBox*>();
+    QVERIFY(field);
+    window.showDock(QStringLiteral("rightDock"));
+    const std::vector<QWidget*> targets{window.leftView(), window.rightView(), window.histogram(),
+                                        window.buildingsTable(), field};
+    QStringList missed;
+    for (QWidget* target : targets) {
+      target->setFocus(Qt::OtherFocusReason);
+      QTRY_VERIFY2(target->hasFocus(), qPrintable(target->objectName()));
+      for (const Shortcut& s : shortcuts) {
+        if (target == field && !commands.contains(s.keys)) continue;
+        s.action->setEnabled(true);
+        const int before = fired[s.action];
+        QTest::keySequence(target, s.keys);
+        if (fired[s.action] != before + 1) {
+          missed << QStringLiteral("%1 in %2").arg(s.keys.toString(), target->objectName());
+        }
+      }
+    }
+    QVERIFY2(missed.isEmpty(), qPrintable(missed.join(QStringLiteral(", "))));
   }
 
   void cleanupTestCase() { window_.reset(); }

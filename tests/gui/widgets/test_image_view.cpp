@@ -202,3 +202,71 @@ TEST(ImageView, FloatRasterWithColourMapAndOverlay) {
   EXPECT_NE(tinted.rgb(), plain.rgb());
   delineo::widgets::test::saveScreenshot(view, QStringLiteral("image_view_float_overlay"));
 }
+
+TEST(ImageView, ColourImagesAreShownInTheirColours) {
+  // OpenCV order: blue, green, red. Four quadrants: red, green, blue, yellow.
+  cv::Mat bgr(100, 100, CV_8UC3);
+  bgr(cv::Rect(0, 0, 50, 50)).setTo(cv::Scalar(0, 0, 255));
+  bgr(cv::Rect(50, 0, 50, 50)).setTo(cv::Scalar(0, 255, 0));
+  bgr(cv::Rect(0, 50, 50, 50)).setTo(cv::Scalar(255, 0, 0));
+  bgr(cv::Rect(50, 50, 50, 50)).setTo(cv::Scalar(0, 255, 255));
+  ImageView view;
+  view.resize(200, 200);
+  view.setImage(bgr);
+  EXPECT_EQ(view.image().type(), CV_8UC3);
+  view.setView(QPointF(50, 50), 2.0);  // image (x, y) ↔ widget (2x, 2y)
+  const QImage shot = view.grab().toImage().convertToFormat(QImage::Format_RGB32);
+  EXPECT_EQ(QColor(shot.pixel(50, 50)), QColor(255, 0, 0));
+  EXPECT_EQ(QColor(shot.pixel(150, 50)), QColor(0, 255, 0));
+  EXPECT_EQ(QColor(shot.pixel(50, 150)), QColor(0, 0, 255));
+  EXPECT_EQ(QColor(shot.pixel(150, 150)), QColor(255, 255, 0));
+  // Reduced levels keep the colours too.
+  view.setView(QPointF(50, 50), 0.5);
+  const QImage small = view.grab().toImage().convertToFormat(QImage::Format_RGB32);
+  const QPointF red = view.imageToWidget(QPointF(20, 20));
+  EXPECT_EQ(QColor(small.pixel(red.toPoint())), QColor(255, 0, 0));
+  delineo::widgets::test::saveScreenshot(view, QStringLiteral("image_view_colour"));
+}
+
+TEST(ImageView, AFittedViewStaysFittedThroughResizesUntilMoved) {
+  // An image set while the widget is still small (a window not laid out yet) fills the widget
+  // once it has its final size.
+  ImageView view;
+  view.resize(100, 30);
+  view.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&view));
+  view.setImage(patternImage(1024, 1024));
+  EXPECT_TRUE(view.isFitted());
+  view.resize(900, 700);
+  EXPECT_TRUE(view.isFitted());
+  EXPECT_DOUBLE_EQ(view.zoom(), 700.0 / 1024.0);
+  EXPECT_EQ(view.viewCenter(), QPointF(512, 512));
+  // The whole image is shown and touches two sides of the widget.
+  const QRectF shown(view.imageToWidget(QPointF(0, 0)), view.imageToWidget(QPointF(1024, 1024)));
+  EXPECT_NEAR(shown.top(), 0.0, 1e-9);
+  EXPECT_NEAR(shown.bottom(), 700.0, 1e-9);
+  // Once the operator zooms, a resize keeps the operator's view.
+  wheel(&view, QPointF(300, 300), 120);
+  EXPECT_FALSE(view.isFitted());
+  const double zoomed = view.zoom();
+  view.resize(800, 600);
+  EXPECT_DOUBLE_EQ(view.zoom(), zoomed);
+}
+
+TEST(ImageView, ALinkedViewTakesItsPartnersViewForItsFirstImage) {
+  // The visible view is fitted; a hidden dock's view (other size) gets an image of the same
+  // size: it follows the visible one instead of fitting itself and dragging the visible one.
+  ImageView visible;
+  ImageView hidden;
+  visible.resize(900, 700);
+  hidden.resize(160, 120);
+  delineo::widgets::linkViews(&visible, &hidden);
+  visible.setImage(patternImage(1024, 1024));
+  ASSERT_TRUE(visible.isFitted());
+  const double fitted = visible.zoom();
+  hidden.setImage(patternImage(1024, 1024));
+  EXPECT_DOUBLE_EQ(visible.zoom(), fitted);
+  EXPECT_TRUE(visible.isFitted());
+  EXPECT_DOUBLE_EQ(hidden.zoom(), fitted);
+  EXPECT_EQ(hidden.viewCenter(), visible.viewCenter());
+}

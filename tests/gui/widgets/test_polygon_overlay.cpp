@@ -1,3 +1,6 @@
+#include <QApplication>
+#include <QKeyEvent>
+#include <QMenu>
 #include <QSignalSpy>
 #include <QTest>
 #include <gtest/gtest.h>
@@ -136,7 +139,7 @@ TEST_F(EditFixture, DeleteKeyRemovesTheHoveredVertex) {
   EXPECT_FALSE(edited.contains(QPointF(150, 150)));
 }
 
-TEST_F(EditFixture, ShiftDragMovesAWholeEdgeAlongItsNormal) {
+TEST_F(EditFixture, ShiftDragMovesAWholeEdgeAlongItsNormalToo) {
   view.polygons().setSnapToRightAngles(true);
   QSignalSpy spy(&view.polygons(), &PolygonOverlay::editRequested);
   QTest::mousePress(&view, Qt::LeftButton, Qt::ShiftModifier, w(100, 50));
@@ -167,4 +170,152 @@ TEST_F(EditFixture, DrawsPolygonsEvolvingContourAndRoi) {
   EXPECT_GT(edge.blue(), 150);
   EXPECT_NE(QColor(shot.pixel(w(50, 50))).rgb(), QColor(90, 90, 90).rgb());
   test::saveScreenshot(view, QStringLiteral("polygon_overlay"));
+}
+
+TEST_F(EditFixture, PlainDragOnTheHighlightedEdgeMovesTheEdge) {
+  QSignalSpy spy(&view.polygons(), &PolygonOverlay::editRequested);
+  QSignalSpy panned(&view, &ImageView::viewChanged);
+  QTest::mouseMove(&view, w(100, 150));
+  QTest::mousePress(&view, Qt::LeftButton, {}, w(100, 150));
+  QTest::mouseMove(&view, w(100, 155));
+  QTest::mouseMove(&view, w(100, 160));
+  QTest::mouseRelease(&view, Qt::LeftButton, {}, w(100, 160));
+  EXPECT_EQ(panned.count(), 0);  // the view did not move
+  ASSERT_EQ(spy.count(), 1);
+  const QList<QVariant> args = spy.takeLast();
+  const QPolygonF edited = args.at(2).value<QPolygonF>();
+  EXPECT_EQ(edited[0], QPointF(50, 50));
+  EXPECT_EQ(edited[2], QPointF(150, 160));
+  EXPECT_EQ(edited[3], QPointF(50, 160));
+  EXPECT_EQ(args.at(3).toString(), QStringLiteral("Move edge"));
+  // Empty canvas still pans.
+  QTest::mousePress(&view, Qt::LeftButton, {}, w(20, 20));
+  QTest::mouseMove(&view, w(25, 20));
+  QTest::mouseMove(&view, w(30, 20));
+  QTest::mouseRelease(&view, Qt::LeftButton, {}, w(30, 20));
+  EXPECT_GE(panned.count(), 1);
+  EXPECT_EQ(spy.count(), 0);
+}
+
+TEST_F(EditFixture, ContextMenuOfAHoleDeletesTheHole) {
+  QSignalSpy spy(&view.polygons(), &PolygonOverlay::polygonEditRequested);
+  // Right-click on the hole's edge: the menu has "Delete hole".
+  QMenu menu;
+  ASSERT_TRUE(view.polygons().fillContextMenu(menu, w(90, 80)));
+  QAction* deleteHole = nullptr;
+  for (QAction* a : menu.actions()) {
+    if (a->text() == QStringLiteral("Delete hole")) deleteHole = a;
+  }
+  ASSERT_NE(deleteHole, nullptr);
+  // The outer ring's menu has no such entry.
+  QMenu outerMenu;
+  ASSERT_TRUE(view.polygons().fillContextMenu(outerMenu, w(100, 50)));
+  for (QAction* a : outerMenu.actions()) EXPECT_NE(a->text(), QStringLiteral("Delete hole"));
+  deleteHole->trigger();
+  ASSERT_EQ(spy.count(), 1);
+  const QList<QVariant> args = spy.takeLast();
+  EXPECT_EQ(args.at(0).toInt(), 7);
+  const auto rings = args.at(1).value<QList<QPolygonF>>();
+  ASSERT_EQ(rings.size(), 1);  // the outer ring only
+  EXPECT_EQ(rings[0].size(), 4);
+  EXPECT_EQ(args.at(2).toString(), QStringLiteral("Delete hole"));
+  const delineo::core::Polygon polygon = toPolygon(rings);
+  EXPECT_TRUE(polygon.holes.empty());
+  EXPECT_EQ(polygon.outer.size(), size_t(4));
+}
+
+TEST_F(EditFixture, CtrlDragSelectsVerticesAndDeleteRemovesThemAsOneEdit) {
+  // A square with two extra vertices on its top edge.
+  OverlayPolygon p;
+  p.id = 3;
+  p.polygon.outer = {{50, 50}, {80, 48}, {120, 52}, {150, 50}, {150, 150}, {50, 150}};
+  view.polygons().setPolygons({p});
+  view.polygons().setSelectedId(3);
+  QSignalSpy spy(&view.polygons(), &PolygonOverlay::polygonEditRequested);
+  QSignalSpy panned(&view, &ImageView::viewChanged);
+  QTest::mousePress(&view, Qt::LeftButton, Qt::ControlModifier, w(70, 35));
+  QTest::mouseMove(&view, w(100, 50));
+  EXPECT_FALSE(view.polygons().rubberBand().isNull());
+  QTest::mouseMove(&view, w(130, 60));
+  QTest::mouseRelease(&view, Qt::LeftButton, Qt::ControlModifier, w(130, 60));
+  EXPECT_EQ(panned.count(), 0);
+  EXPECT_TRUE(view.polygons().rubberBand().isNull());
+  const std::set<std::pair<int, int>> expected{{0, 1}, {0, 2}};
+  EXPECT_EQ(view.polygons().selectedVertices(), expected);
+  // The selection is drawn: the selected handles are red.
+  const QImage shot = view.grab().toImage().convertToFormat(QImage::Format_RGB32);
+  const QColor handle(shot.pixel(w(80, 48)));
+  EXPECT_GT(handle.red(), 200);
+  EXPECT_LT(handle.green(), 80);
+  test::saveScreenshot(view, QStringLiteral("polygon_overlay_vertex_selection"));
+  // Delete claims the key before any window shortcut, then removes both vertices at once.
+  QKeyEvent override(QEvent::ShortcutOverride, Qt::Key_Delete, Qt::NoModifier);
+  QApplication::sendEvent(&view, &override);
+  EXPECT_TRUE(override.isAccepted());
+  QTest::keyClick(&view, Qt::Key_Delete);
+  ASSERT_EQ(spy.count(), 1);
+  const QList<QVariant> args = spy.takeLast();
+  const auto rings = args.at(1).value<QList<QPolygonF>>();
+  ASSERT_EQ(rings.size(), 1);
+  EXPECT_EQ(rings[0],
+            QPolygonF({QPointF(50, 50), QPointF(150, 50), QPointF(150, 150), QPointF(50, 150)}));
+  EXPECT_EQ(args.at(2).toString(), QStringLiteral("Delete 2 vertices"));
+  EXPECT_TRUE(view.polygons().selectedVertices().empty());
+}
+
+TEST_F(EditFixture, VertexDeletionThatBreaksThePolygonIsRefused) {
+  QSignalSpy edits(&view.polygons(), &PolygonOverlay::polygonEditRequested);
+  QSignalSpy refused(&view.polygons(), &PolygonOverlay::editRefused);
+  // Two vertices of the 4-vertex outer ring: 2 would be left.
+  EXPECT_EQ(view.polygons().selectVerticesIn(QRectF(40, 40, 120, 20)), 2);
+  EXPECT_FALSE(view.polygons().deleteSelectedVertices());
+  EXPECT_EQ(edits.count(), 0);
+  ASSERT_EQ(refused.count(), 1);
+  EXPECT_TRUE(refused.takeLast().at(0).toString().contains(QStringLiteral("fewer than 3")));
+  EXPECT_EQ(view.polygons().selectedVertices().size(), size_t(2));  // kept, to adjust it
+  // A corner whose removal makes the new edge cut through a notch.
+  OverlayPolygon p;
+  p.id = 4;
+  p.polygon.outer = {{50, 50},  {150, 50}, {150, 150}, {110, 150},
+                     {110, 70}, {90, 70},  {90, 150},  {50, 150}};
+  view.polygons().setPolygons({p});
+  view.polygons().setSelectedId(4);
+  EXPECT_EQ(view.polygons().selectVerticesIn(QRectF(140, 40, 20, 20)), 1);
+  EXPECT_FALSE(view.polygons().deleteSelectedVertices());
+  ASSERT_EQ(refused.count(), 1);
+  EXPECT_TRUE(refused.takeLast().at(0).toString().contains(QStringLiteral("cross itself")));
+  EXPECT_EQ(edits.count(), 0);
+  // A hole selected whole goes with its vertices, in the same single edit.
+  view.polygons().setPolygons({});
+  OverlayPolygon q;
+  q.id = 5;
+  q.polygon.outer = {{50, 50}, {150, 50}, {150, 150}, {50, 150}};
+  q.polygon.holes = {{{80, 80}, {100, 80}, {100, 100}, {80, 100}}};
+  view.polygons().setPolygons({q});
+  view.polygons().setSelectedId(5);
+  EXPECT_EQ(view.polygons().selectVerticesIn(QRectF(75, 75, 30, 30)), 4);
+  EXPECT_TRUE(view.polygons().deleteSelectedVertices());
+  ASSERT_EQ(edits.count(), 1);
+  EXPECT_EQ(edits.takeLast().at(1).value<QList<QPolygonF>>().size(), 1);
+}
+
+TEST_F(EditFixture, EscapeAndAClickClearTheVertexSelection) {
+  view.polygons().selectVerticesIn(QRectF(40, 40, 20, 20));
+  ASSERT_EQ(view.polygons().selectedVertices().size(), size_t(1));
+  QKeyEvent override(QEvent::ShortcutOverride, Qt::Key_Escape, Qt::NoModifier);
+  QApplication::sendEvent(&view, &override);
+  EXPECT_TRUE(override.isAccepted());
+  QTest::keyClick(&view, Qt::Key_Escape);
+  EXPECT_TRUE(view.polygons().selectedVertices().empty());
+  // Nothing to cancel or delete: the keys are left to the window's shortcuts.
+  QKeyEvent idle(QEvent::ShortcutOverride, Qt::Key_Escape, Qt::NoModifier);
+  QApplication::sendEvent(&view, &idle);
+  EXPECT_FALSE(idle.isAccepted());
+  QKeyEvent del(QEvent::ShortcutOverride, Qt::Key_Delete, Qt::NoModifier);
+  QApplication::sendEvent(&view, &del);
+  EXPECT_FALSE(del.isAccepted());
+  view.polygons().selectVerticesIn(QRectF(40, 40, 20, 20));
+  QTest::mouseClick(&view, Qt::LeftButton, {}, w(20, 20));
+  EXPECT_TRUE(view.polygons().selectedVertices().empty());
+  EXPECT_EQ(view.polygons().selectedId(), 7);  // the polygon stays selected
 }

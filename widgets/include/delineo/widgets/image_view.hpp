@@ -11,6 +11,7 @@
 #include <QElapsedTimer>
 #include <QImage>
 #include <QPointF>
+#include <QPointer>
 #include <QPolygonF>
 #include <QRectF>
 #include <QWidget>
@@ -53,10 +54,12 @@ class ImageView : public QWidget {
   ~ImageView() override;
 
   // --- layers ---
-  // Shows `image` (CV_8UC1, CV_16UC1, CV_32FC1, CV_64FC1 or CV_8UC3 in BGR order). The data is
-  // shared with the caller (cv::Mat reference count), not copied. Keeps the current view when
-  // the size is unchanged, otherwise fits the image to the window.
+  // Shows `image` (CV_8UC1, CV_16UC1, CV_32FC1, CV_64FC1 or CV_8UC3 in BGR order, as OpenCV
+  // reads colour). The data is shared with the caller (cv::Mat reference count), not copied.
+  // Keeps the current view when the size is unchanged, otherwise fits the image to the window.
   void setImage(const cv::Mat& image, const RasterStyle& style = {});
+  // The full-resolution raster shown (CV_64FC1 input is held as CV_32FC1); empty when none.
+  cv::Mat image() const { return pyramid_.empty() ? cv::Mat() : pyramid_.front(); }
   void setRasterStyle(const RasterStyle& style);
   RasterStyle rasterStyle() const { return style_; }
   // The display range actually used (resolved automatic limits).
@@ -86,7 +89,11 @@ class ImageView : public QWidget {
   void setZoom(double zoom);                            // keeps the centre
   void zoomAround(double factor, QPointF widgetAnchor);  // keeps the image point under the anchor
   void setView(QPointF center, double zoom);            // emits viewChanged once, if changed
+  // Shows the whole image, centred, as large as the widget allows. The view then stays fitted
+  // through resizes (a window still being laid out, a dock resized) until the view is moved or
+  // zoomed some other way.
   void fitToWindow();
+  bool isFitted() const { return fitted_; }
   double minimumZoom() const;  // the whole image fits in a quarter of the widget
   static constexpr double kMaximumZoom = 64.0;
 
@@ -131,8 +138,10 @@ class ImageView : public QWidget {
   void keyReleaseEvent(QKeyEvent* event) override;
   void contextMenuEvent(QContextMenuEvent* event) override;
   void leaveEvent(QEvent* event) override;
+  bool event(QEvent* event) override;
 
  private:
+  friend void linkViews(ImageView* a, ImageView* b);
   enum class Layer : uint8_t { Base = 0, Overlay = 1 };
   struct TileKey {
     Layer layer;
@@ -157,6 +166,10 @@ class ImageView : public QWidget {
   void invalidateTiles(Layer layer);
   void clampView();
   void beginPan(QPointF widgetPos);
+  void restoreModeCursor();
+  // True when the view has a use for this key now (a gesture to cancel, a vertex to delete), so
+  // it takes precedence over a window shortcut on the same key.
+  bool wantsKey(const QKeyEvent& event) const;
 
   std::vector<cv::Mat> pyramid_;
   std::vector<cv::Mat> overlayPyramid_;
@@ -174,8 +187,11 @@ class ImageView : public QWidget {
 
   QPointF center_{0, 0};
   double zoom_ = 1.0;
+  bool fitted_ = false;   // the last view change was a fit: refit on resize
+  bool fitting_ = false;  // inside fitToWindow()
   InteractionMode mode_ = InteractionMode::Navigate;
   std::unique_ptr<PolygonOverlay> polygons_;
+  std::vector<QPointer<ImageView>> links_;  // views showing the same place (linkViews)
 
   // gesture state
   bool panning_ = false;
@@ -192,7 +208,9 @@ class ImageView : public QWidget {
 };
 
 // Keeps the centres and zooms of two views equal in both directions, without feedback loops.
-// The link lasts as long as both views exist.
+// The link lasts as long as both views exist. A linked view given its first image (or one of a
+// new size) takes the view of a partner showing an image of that size instead of fitting its
+// own widget, so a hidden dock's view never moves the visible one.
 void linkViews(ImageView* a, ImageView* b);
 
 }  // namespace delineo::widgets

@@ -3,15 +3,19 @@
 // of the selected one, the "evolving contour" of a running active polygon and the ROI rectangle.
 //
 // The overlay never changes the model: every finished editing gesture is reported through
-// editRequested() with the complete new ring, so the application can wrap it in a QUndoCommand
-// and push the updated polygons back with setPolygons(). While a gesture is in progress a live
-// preview is drawn instead of the stored ring.
+// editRequested() with the complete new ring (or polygonEditRequested() with all the rings when
+// a gesture changes several rings or removes one), so the application can wrap it in a
+// QUndoCommand and push the updated polygons back with setPolygons(). While a gesture is in
+// progress a live preview is drawn instead of the stored ring.
 #include <QColor>
+#include <QList>
 #include <QObject>
 #include <QPolygonF>
 #include <QRectF>
 #include <QString>
 #include <optional>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -22,6 +26,7 @@ class QPainter;
 class QMouseEvent;
 class QKeyEvent;
 class QContextMenuEvent;
+class QMenu;
 
 namespace delineo::widgets {
 
@@ -30,6 +35,8 @@ class ImageView;
 // Conversions between the core geometry and Qt (same pixel frame: x right, y down).
 QPolygonF toQPolygon(const core::Ring& ring);
 core::Ring toRing(const QPolygonF& polygon);
+// rings[0] = outer, the others holes (as polygonEditRequested() reports them).
+core::Polygon toPolygon(const QList<QPolygonF>& rings);
 
 enum class PolygonStatus {
   Candidate,  // produced by the algorithm, not yet reviewed
@@ -94,6 +101,31 @@ class PolygonOverlay : public QObject {
   // True while a drag gesture is in progress (the preview is drawn).
   bool isDragging() const { return drag_.has_value(); }
 
+  // --- vertex selection of the selected polygon (Ctrl+drag a rubber band in EditPolygon) ---
+  // Vertices as (ring, index): ring 0 = outer, k = hole k-1. Cleared when the selected polygon
+  // changes (another selection, or an edit of its geometry).
+  const std::set<std::pair<int, int>>& selectedVertices() const { return selectedVertices_; }
+  // Replaces the selection by the vertices inside `imageRect` (image pixels); returns their count.
+  int selectVerticesIn(const QRectF& imageRect);
+  void clearVertexSelection();
+  // Removes the selected vertices as one polygonEditRequested(). A hole whose vertices are all
+  // selected goes with them. Refused (editRefused(), nothing emitted, selection kept) when a
+  // ring would keep fewer than 3 vertices or the polygon would cross itself.
+  bool deleteSelectedVertices();
+  // Removes hole `ringIndex` (>= 1) of the selected polygon as one polygonEditRequested().
+  bool deleteHole(int ringIndex);
+  // The rubber band being dragged, in image pixels (null when none).
+  QRectF rubberBand() const;
+
+  // Adds the editing entries for the widget position (a vertex, an edge, a hole's ring, the
+  // vertex selection) to `menu`; their actions apply the edit when triggered. False when
+  // nothing applies there.
+  bool fillContextMenu(QMenu& menu, QPointF widgetPos);
+  // True when the overlay would use this key now (Delete/Backspace with a vertex to delete,
+  // Escape with a gesture or a selection to cancel): the view then claims it before the
+  // window's shortcuts.
+  bool wantsKey(const QKeyEvent& event) const;
+
   // --- used by ImageView ---
   void paint(QPainter& painter) const;
   // Returns true when the event was consumed (edit gestures on the selected polygon).
@@ -110,6 +142,11 @@ class PolygonOverlay : public QObject {
   // A finished gesture on polygon `id`: `newRing` replaces ring `ringIndex` (0 = outer,
   // k = hole k-1). `description` is a translated sentence for the undo stack.
   void editRequested(int id, int ringIndex, const QPolygonF& newRing, const QString& description);
+  // A finished gesture that changes the ring list of polygon `id`: `rings` is the complete new
+  // polygon (rings[0] outer, the others holes).
+  void polygonEditRequested(int id, const QList<QPolygonF>& rings, const QString& description);
+  // A gesture that was not applied, with a translated sentence saying why.
+  void editRefused(const QString& reason);
   void selectionChanged(int id);
   // Emitted by the view while the overlay content changes (repaint request).
   void changed();
@@ -132,7 +169,10 @@ class PolygonOverlay : public QObject {
   QPolygonF ringOf(const OverlayPolygon& polygon, int ringIndex) const;
   std::optional<Hit> hitTest(QPointF widgetPos) const;
   void deleteVertex(int ring, int vertex);
+  void insertVertex(const Hit& hit);
+  QList<QPolygonF> ringsOf(const OverlayPolygon& polygon) const;
   QPointF snapToEdge(QPointF pos, bool* snapped) const;
+  void updateHoverCursor();
 
   ImageView* view_;
   std::vector<OverlayPolygon> polygons_;
@@ -147,7 +187,8 @@ class PolygonOverlay : public QObject {
   double edgeSnapRadius_ = 3.0;
   std::optional<Drag> drag_;
   std::optional<Hit> hover_;
-  std::optional<Hit> contextHit_;
+  std::set<std::pair<int, int>> selectedVertices_;
+  std::optional<QRectF> band_;  // rubber band in image pixels (start corner, current corner)
 };
 
 }  // namespace delineo::widgets

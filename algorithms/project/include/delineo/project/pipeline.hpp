@@ -34,6 +34,16 @@ StereoPair readStereoPair(const Project& project);
 // names none. Throws like io::readRaster, and MismatchedInputs when its size differs from `size`.
 cv::Mat readDisparity(const Project& project, cv::Size size);
 
+// The pair's disparity search range estimated from sparse feature matches
+// (stereo::estimateDisparityRange with the project's "range" parameters). Throws
+// ProcessingFailed when the images give too few matches (the range must then be given by hand).
+struct RangeOutcome {
+  DisparityInterval range;
+  int matches = 0;  // feature matches the range was read from
+  core::RunStatus status = core::RunStatus::Completed;
+};
+RangeOutcome estimateDisparityRange(const Project& project, const StereoPair& pair, core::Progress* progress);
+
 // Dense matching with the project's "matching" parameters; dmin/dmax come from the project's
 // disparity range (InvalidParameter when it has none). Canceled → empty disparity and status
 // Canceled.
@@ -107,12 +117,14 @@ RegularizationOutcome regularizeOutline(const Project& project, const Building& 
                                         const StereoPair& pair, const core::Polygon& outline,
                                         core::Progress* progress);
 
-// `delineo-cli run`: matching when the disparity is missing (written to
+// `delineo-cli run`: the disparity range estimated when the project has none, matching when
+// the disparity is missing (written to
 // `outputDir`/disparity.tif and recorded in the project), then the active polygon for every
 // Pending building (status becomes Automatic, history updated), then export of accepted +
 // automatic + corrected outlines to `outputDir`/buildings.geojson. `outputDir` is the resolved
 // folder (outputDirectory()). The caller saves the project.
 struct RunSummary {
+  std::optional<RangeOutcome> rangeEstimated;  // set when the range was estimated
   bool matched = false;
   int delineated = 0;
   int skipped = 0;  // pending buildings whose active polygon failed (reason in `messages`)

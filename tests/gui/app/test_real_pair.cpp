@@ -1,0 +1,307 @@
+// The operator's whole job on a real aerial pair (Toulouse 0051 from the shared data folder,
+// skipped when it is absent), driven through the real main window with mouse and keys: open the
+// pair (the range is estimated, the disparity computed), pick the big roof with a rectangle (the
+// active polygon runs at once, its live contour stays on the building), accept, set the height
+// model, look at the DEM and the 3D view, save, export; then a second building. Checks the range
+// against the roof, the outline against a hand-drawn one (tests/bench/data/real_roofs.json),
+// that nothing is written beside the images, and counts the operator's actions.
+//
+// DELINEO_DATA_DIR overrides the data folder; DELINEO_SCREENSHOT_DIR keeps a screenshot of each
+// step (the user guide's images: scripts/screenshots.sh).
+#include <QAction>
+#include <QComboBox>
+#include <QDir>
+#include <QDirIterator>
+#include <QDockWidget>
+#include <QDoubleSpinBox>
+#include <QFile>
+#include <QPushButton>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QStandardPaths>
+#include <QTemporaryDir>
+#include <QTest>
+#include <QTimer>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/eval/polygon_measures.hpp"
+#include "delineo/io/vector.hpp"
+#include "delineo/project/pipeline.hpp"
+#include "delineo/widgets/disparity_histogram.hpp"
+#include "delineo/widgets/image_view.hpp"
+#include "delineo/widgets/polygon_overlay.hpp"
+#include "delineo/widgets/terrain3d_view.hpp"
+#include "document.hpp"
+#include "main_window.hpp"
+#include "project_settings_dialog.hpp"
+
+using namespace delineo;
+using gui::MainWindow;
+
+namespace {
+
+QString dataDirectory() {
+  const QString fromEnv = qEnvironmentVariable("DELINEO_DATA_DIR");
+  return fromEnv.isEmpty() ? QStringLiteral(DELINEO_DEFAULT_DATA_DIR) : fromEnv;
+}
+
+// A hand-drawn roof outline of the labelled set.
+core::Polygon handOutline(const std::string& name) {
+  std::ifstream in(DELINEO_REAL_ROOFS);
+  const nlohmann::json labelled = nlohmann::json::parse(in);
+  core::Polygon outline;
+  for (const auto& roof : labelled["roofs"]) {
+    if (roof["name"] != name) continue;
+    for (const auto& v : roof["outline"]) outline.outer.emplace_back(v[0].get<double>(), v[1].get<double>());
+  }
+  return outline;
+}
+
+// Median of the finite disparities inside the outline shrunk by `inset` px (the roof's level).
+double roofLevel(const cv::Mat& disparity, const core::Polygon& outline, int inset) {
+  cv::Mat mask = core::rasterize(outline, disparity.size());
+  cv::erode(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, {2 * inset + 1, 2 * inset + 1}));
+  std::vector<float> values;
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) {
+      const float d = disparity.at<float>(y, x);
+      if (mask.at<uchar>(y, x) != 0 && std::isfinite(d)) values.push_back(d);
+    }
+  }
+  if (values.empty()) return std::nan("");
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
+QStringList filesUnder(const QString& dir) {
+  QStringList files;
+  QDirIterator it(dir, QDir::Files | QDir::Hidden, QDirIterator::Subdirectories);
+  while (it.hasNext()) files << it.next();
+  files.sort();
+  return files;
+}
+
+}  // namespace
+
+class RealPairTest : public QObject {
+  Q_OBJECT
+ private:
+  QTemporaryDir dir_;
+  QString imagesDir_, projectPath_;
+  QStringList imagesBefore_;
+  std::unique_ptr<MainWindow> window_;
+  int actions_ = 0;  // operator actions after opening the pair
+  int bigRoof_ = -1;
+
+  void shot(const QString& name) {
+    const QString out = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
+    if (out.isEmpty()) return;
+    QTest::qWait(300);  // docks laid out, tiles rendered
+    QDir().mkpath(out);
+    QVERIFY(window_->grab().save(QDir(out).filePath(name + QStringLiteral(".png"))));
+  }
+
+  // Shows `region` (image pixels) whole in the left view; framing is navigation, not an action.
+  void frame(const QRectF& region) {
+    widgets::ImageView* view = window_->leftView();
+    const double zoom = 0.85 * std::min(view->width() / region.width(), view->height() / region.height());
+    view->setView(region.center(), zoom);
+  }
+
+  // The operator's pick: the rectangle tool (B), then a drag around the building.
+  void pickWithRectangle(const QRectF& rect) {
+    widgets::ImageView* view = window_->leftView();
+    QTest::keyClick(view, Qt::Key_B);
+    QCOMPARE(view->interactionMode(), widgets::InteractionMode::PickRectangle);
+    const QPoint from = view->imageToWidget(rect.topLeft()).toPoint();
+    const QPoint to = view->imageToWidget(rect.bottomRight()).toPoint();
+    QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, from);
+    QTest::mouseMove(view, (from + to) / 2);
+    QTest::mouseMove(view, to);
+    QTest::mouseRelease(view, Qt::LeftButton, Qt::NoModifier, to);
+    ++actions_;
+  }
+
+  // Waits for the building's active polygon while checking every live contour drawn meanwhile
+  // against `region` (the picked rectangle grown by the search margin).
+  void waitForOutline(int id, const QRectF& region, int* contoursSeen) {
+    QSignalSpy finished(window_.get(), &MainWindow::delineationFinished);
+    double worst = 0;
+    QTimer probe;
+    connect(&probe, &QTimer::timeout, [&] {
+      const QPolygonF live = window_->leftView()->polygons().evolvingContour();
+      if (live.isEmpty()) return;
+      ++*contoursSeen;
+      for (const QPointF& p : live) {
+        const double dx = std::max({region.left() - p.x(), p.x() - region.right(), 0.0});
+        const double dy = std::max({region.top() - p.y(), p.y() - region.bottom(), 0.0});
+        worst = std::max(worst, std::hypot(dx, dy));
+      }
+    });
+    probe.start(15);
+    QTRY_VERIFY_WITH_TIMEOUT(!finished.isEmpty(), 300000);
+    probe.stop();
+    QCOMPARE(finished.first().at(0).toInt(), id);
+    QVERIFY2(worst == 0.0, qPrintable(QStringLiteral("a live contour vertex was %1 px off the picked region").arg(worst)));
+  }
+
+ private slots:
+  void initTestCase() {
+    const QString data = dataDirectory();
+    const QString left = data + QStringLiteral("/aerial-toulouse/31_15083_31_15084_0051_left.png");
+    const QString right = data + QStringLiteral("/aerial-toulouse/31_15083_31_15084_0051_right.png");
+    if (!QFile::exists(left) || !QFile::exists(right)) QSKIP("the real Toulouse pair is not here (../shared/data)");
+    QStandardPaths::setTestModeEnabled(true);
+    QCoreApplication::setOrganizationName(QStringLiteral("DelineoRealPairTest"));
+    QSettings().clear();  // defaults: automatic range and matching, delineate on pick
+    QVERIFY(dir_.isValid());
+    // The operator's copy of the pair in a folder of its own, to see what gets written there.
+    imagesDir_ = dir_.filePath(QStringLiteral("images"));
+    QVERIFY(QDir().mkpath(imagesDir_));
+    QVERIFY(QFile::copy(left, imagesDir_ + QStringLiteral("/left.png")));
+    QVERIFY(QFile::copy(right, imagesDir_ + QStringLiteral("/right.png")));
+    imagesBefore_ = filesUnder(imagesDir_);
+    projectPath_ = dir_.filePath(QStringLiteral("project/toulouse-0051.delineo.json"));
+    window_ = std::make_unique<MainWindow>();
+    window_->setInteractive(false);
+    window_->resize(1500, 950);
+    window_->showActivated();
+    QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
+  }
+
+  void opensThePairWithARangeThatHoldsTheRoofs() {
+    QSignalSpy matched(window_.get(), &MainWindow::matchingFinished);
+    QVERIFY(window_->openPair(imagesDir_ + QStringLiteral("/left.png"), imagesDir_ + QStringLiteral("/right.png")));
+    QTRY_VERIFY_WITH_TIMEOUT(!matched.isEmpty(), 300000);
+    const gui::Document* doc = window_->document();
+    const auto range = doc->project().disparityRange;
+    QVERIFY(range.has_value());
+    const double roof = roofLevel(doc->disparity(), handOutline("t51_right_big"), 8);
+    qInfo("estimated range %d..%d px; the big roof at %.1f px", range->low, range->high, roof);
+    QVERIFY2(roof > range->low + 1 && roof < range->high - 1, "the big roof lies outside the estimated range");
+    QVERIFY(doc->leftDisplay().channels() == 3);  // shown in colour
+    shot(QStringLiteral("01-pair-opened"));
+  }
+
+  void delineatesTheBigRoofWithOnePick() {
+    const core::Polygon hand = handOutline("t51_right_big");
+    QVERIFY(hand.outer.size() >= 4);
+    const cv::Rect2d box = core::boundingBox(hand.outer);
+    // An operator's rough rectangle: 15 px around the roof, inside the image.
+    const QRectF pick = QRectF(box.x - 15, box.y - 15, box.width + 30, box.height + 30) & QRectF(0, 0, 1024, 1024);
+    frame(pick.adjusted(-40, -40, 40, 40));
+    pickWithRectangle(pick);
+    bigRoof_ = window_->selectedBuilding();
+    QVERIFY(bigRoof_ > 0);
+    shot(QStringLiteral("02-building-picked"));
+    int contours = 0;
+    waitForOutline(bigRoof_, pick.adjusted(-40, -40, 40, 40), &contours);
+    QVERIFY(contours > 0);
+    const project::Building* b = window_->document()->project().find(bigRoof_);
+    QVERIFY(b->hasOutline());
+    const double iou = eval::intersectionOverUnion(b->outline, hand);
+    qInfo("big roof: IoU %.3f against the hand outline, %zu vertices, %d live contours seen", iou,
+          b->outline.outer.size(), contours);
+    QVERIFY2(iou >= 0.9, qPrintable(QStringLiteral("IoU %1").arg(iou)));
+    shot(QStringLiteral("03-delineated"));
+  }
+
+  void acceptsAndShowsHeightsIn2DAnd3D() {
+    QTest::keyClick(window_->leftView(), Qt::Key_A);
+    ++actions_;
+    gui::Document* doc = window_->document();
+    QVERIFY(doc->project().find(bigRoof_)->status == project::BuildingStatus::Accepted);
+    QVERIFY(!window_->heightModelNotice()->isHidden());
+    // The pair's height model, set once per project: ground from the disparity map, 0.25 m of
+    // height per pixel of disparity (a 5 cm image with a base of a fifth of the flying height).
+    window_->setProjectSettingsHandler([](gui::ProjectSettingsDialog& dialog) {
+      auto* fromMap = dialog.findChild<QPushButton*>(QStringLiteral("groundFromMap"));
+      if (fromMap == nullptr) return false;
+      fromMap->click();
+      dialog.findChild<QDoubleSpinBox*>(QStringLiteral("metresPerPixel"))->setValue(0.25);
+      dialog.findChild<QDoubleSpinBox*>(QStringLiteral("gsd"))->setValue(0.05);
+      return true;
+    });
+    window_->openProjectSettings();
+    QVERIFY(doc->project().height.known());
+    QVERIFY(std::abs(doc->project().height.groundDisparity - 8.0) < 2.5);
+    const double height = doc->project().find(bigRoof_)->roofHeight;
+    qInfo("big roof: %.1f m above the ground", height);
+    QVERIFY(height > 10.0 && height < 25.0);
+    QVERIFY(window_->heightModelNotice()->isHidden());
+    QVERIFY(!doc->dem().empty());
+    window_->showDock(QStringLiteral("demDock"));
+    window_->findChild<QComboBox*>(QStringLiteral("demMode"))->setCurrentIndex(1);
+    QVERIFY(window_->demView()->hasImage());
+    shot(QStringLiteral("05-accepted-dem"));
+    window_->showDock(QStringLiteral("view3DDock"));
+    if (qEnvironmentVariableIsEmpty("DISPLAY")) return;  // the 3D view needs an X server
+    QTRY_VERIFY_WITH_TIMEOUT(window_->view3D() != nullptr, 10000);
+    QVERIFY(window_->view3D()->displayedGridSize().width > 0);
+    shot(QStringLiteral("06-3d-view"));
+  }
+
+  void savesAndExportsIntoTheProjectFolderOnly() {
+    QVERIFY(window_->saveAs(projectPath_));
+    ++actions_;
+    const QString exported = window_->document()->outputDirectory() + QStringLiteral("/buildings.geojson");
+    QCOMPARE(window_->exportAccepted(exported), 1);
+    ++actions_;
+    QCOMPARE(QFileInfo(exported).absolutePath(), dir_.filePath(QStringLiteral("project/output")));
+    QVERIFY(QFile::exists(dir_.filePath(QStringLiteral("project/output/disparity.tif"))));
+    QCOMPARE(filesUnder(imagesDir_), imagesBefore_);
+    qInfo("big roof: %d operator actions after opening the pair", actions_);
+    QVERIFY(actions_ <= 4);
+  }
+
+  void delineatesASecondBuilding() {
+    const core::Polygon hand = handOutline("t51_middle_main");
+    QVERIFY(hand.outer.size() >= 4);
+    const cv::Rect2d box = core::boundingBox(hand.outer);
+    actions_ = 0;
+    // The operator clicks back into the main window after the 3D view; the window manager then
+    // gives it the keyboard again (Xvfb has none, so the test does it).
+    window_->activateWindow();
+    QTRY_VERIFY(window_->isActiveWindow());
+    const QRectF pick(box.x - 15, box.y - 15, box.width + 30, box.height + 30);
+    frame(pick.adjusted(-40, -40, 40, 40));
+    pickWithRectangle(pick);
+    const int id = window_->selectedBuilding();
+    int contours = 0;
+    waitForOutline(id, pick.adjusted(-40, -40, 40, 40), &contours);
+    const project::Building* b = window_->document()->project().find(id);
+    qInfo("middle building: IoU %.3f, %zu vertices with the proposed interval %d..%d px",
+          eval::intersectionOverUnion(b->outline, hand), b->outline.outer.size(), b->roofInterval->low,
+          b->roofInterval->high);
+    shot(QStringLiteral("04-second-building"));
+    // Its lower inner part (about 72 px) is part of the building: the operator drags the band's
+    // lower handle down to it, and the active polygon runs again.
+    widgets::DisparityHistogramWidget* histogram = window_->histogram();
+    const QPoint handle(static_cast<int>(histogram->xOfDisparity(histogram->lowerBound() - 0.5)), histogram->height() / 2);
+    const QPoint target(static_cast<int>(histogram->xOfDisparity(69.5)), histogram->height() / 2);
+    QTest::mousePress(histogram, Qt::LeftButton, Qt::NoModifier, handle);
+    QTest::mouseMove(histogram, (handle + target) / 2);
+    QTest::mouseMove(histogram, target);
+    QTest::mouseRelease(histogram, Qt::LeftButton, Qt::NoModifier, target);
+    ++actions_;
+    qInfo("middle building: interval dragged to %d..%d px", histogram->lowerBound(), histogram->upperBound());
+    waitForOutline(id, pick.adjusted(-40, -40, 40, 40), &contours);
+    b = window_->document()->project().find(id);
+    const double iou = eval::intersectionOverUnion(b->outline, hand);
+    qInfo("middle building: IoU %.3f, %zu vertices", iou, b->outline.outer.size());
+    shot(QStringLiteral("04-interval-widened"));
+    QTest::keyClick(window_->leftView(), Qt::Key_A);
+    ++actions_;
+    QVERIFY(window_->document()->project().find(id)->status == project::BuildingStatus::Accepted);
+    qInfo("middle building: %d operator actions", actions_);
+    QVERIFY(iou >= 0.85);
+  }
+
+  void cleanupTestCase() { window_.reset(); }
+};
+
+QTEST_MAIN(RealPairTest)
+#include "test_real_pair.moc"
