@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <random>
 #include <vector>
 
@@ -286,15 +287,21 @@ TEST(Regularize, BadInputsGiveClearErrors) {
 }
 
 TEST(Regularize, TakesAFewMillisecondsAtMost) {
-  const core::Polygon input{ragged(rotated(rectangle(0, 0, 200, 120), {100, 60}, 33), 2, 1.5, 8),
-                            {}};
-  for (auto& p : const_cast<core::Ring&>(input.outer)) p += cv::Point2d(150, 150);
+  core::Polygon input{ragged(rotated(rectangle(0, 0, 200, 120), {100, 60}, 33), 2, 1.5, 8), {}};
+  for (auto& p : input.outer) p += cv::Point2d(150, 150);
   const cv::Mat image(500, 500, CV_8U, cv::Scalar(100));
-  const auto t0 = cv::getTickCount();
+  // CPU time of this thread: the machine may be shared (wall time measured 10-41 ms under load).
+  auto cpuMs = [] {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+  };
+  const double t0 = cpuMs();
   const RegularizationOutcome r = regularizeOutline(input, RegularizationParams{}, image);
-  const double ms = 1000.0 * static_cast<double>(cv::getTickCount() - t0) / cv::getTickFrequency();
+  const double ms = cpuMs() - t0;
   EXPECT_EQ(r.status, RegularizationStatus::Regularized) << r.reason;
-  EXPECT_LT(ms, 50.0);  // the target is 5 ms; loose for debug and sanitizer builds
+  EXPECT_LT(ms, 50.0) << ms;  // the target is 5 ms; loose for debug and sanitizer builds
+  std::printf("regularization of a 320-vertex outline: %.2f ms CPU\n", ms);
 }
 
 TEST(Regularize, EditingHelpersKeepTheAngles) {
