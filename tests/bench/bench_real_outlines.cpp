@@ -151,7 +151,13 @@ int main(int argc, char** argv) {
   std::printf("%-18s %-9s | %-13s | %-13s | %-13s | %-11s %s\n", "roof", "interval", "naive IoU/v",
               "raw IoU/v", "regular. IoU/v", "reg ms", "regularization");
   std::map<std::string, cv::Mat> maps, lefts, rights;
-  std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV, regMs;
+  // Per set: the tuning roofs and the held-out ones (marked "heldOut", labelled afterwards).
+  struct Set {
+    std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV;
+    int regularized = 0;
+  };
+  std::map<std::string, Set> sets;
+  std::vector<double> regMs;
   std::map<double, std::vector<double>> tolIou, tolVertices;
   int runs = 0;
   for (const auto& roof : data.at("roofs")) {
@@ -237,9 +243,11 @@ int main(int argc, char** argv) {
           std::printf("\n");
         }
       }
-      naiveIou.push_back(ni), rawIou.push_back(ri), regIou.push_back(gi);
-      naiveV.push_back(vertices(naive)), rawV.push_back(vertices(r.rawPolygon)),
-          regV.push_back(r.vertexCount);
+      Set& set = sets[roof.value("heldOut", false) ? "held-out" : "tuning"];
+      set.naiveIou.push_back(ni), set.rawIou.push_back(ri), set.regIou.push_back(gi);
+      set.naiveV.push_back(vertices(naive)), set.rawV.push_back(vertices(r.rawPolygon)),
+          set.regV.push_back(r.vertexCount);
+      set.regularized += r.regularization.status == delineation::RegularizationStatus::Regularized;
       regMs.push_back(ms);
       ++runs;
       if (!dumpDir.empty()) {
@@ -266,13 +274,14 @@ int main(int argc, char** argv) {
     for (double x : v) s += x;
     return v.empty() ? std::nan("") : s / static_cast<double>(v.size());
   };
-  std::printf(
-      "\n%d roofs (rectangle = labelled box + %d px): mean IoU naive %.3f, raw %.3f, regularized "
-      "%.3f; "
-      "median vertices naive %.0f, raw %.0f, regularized %.0f; regularization median %.2f ms, max "
-      "%.2f ms\n",
-      runs, grow, mean(naiveIou), mean(rawIou), mean(regIou), median(naiveV), median(rawV),
-      median(regV), median(regMs), *std::max_element(regMs.begin(), regMs.end()));
+  for (const auto& [name, set] : sets) {
+    std::printf("\n%s, %zu roofs (rectangle = labelled box + %d px): mean IoU naive %.3f, raw %.3f, "
+                "regularized %.3f; median vertices naive %.0f, raw %.0f, regularized %.0f; %d regularized",
+                name.c_str(), set.rawIou.size(), grow, mean(set.naiveIou), mean(set.rawIou),
+                mean(set.regIou), median(set.naiveV), median(set.rawV), median(set.regV), set.regularized);
+  }
+  std::printf("\nregularization time median %.2f ms, max %.2f ms\n", median(regMs),
+              *std::max_element(regMs.begin(), regMs.end()));
   for (const auto& [t, v] : tolIou) {
     std::printf("  tolerance %4.1f px: mean IoU %.3f, median vertices %.0f\n", t, mean(v),
                 median(tolVertices[t]));
