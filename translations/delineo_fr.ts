@@ -299,6 +299,34 @@
         <translation>Coût de bande selon l’appariement</translation>
     </message>
     <message>
+        <source>Regularize</source>
+        <translation>Régulariser</translation>
+    </message>
+    <message>
+        <source>Regularize tolerance</source>
+        <translation>Tolérance de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize min edge</source>
+        <translation>Côté minimal de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize min width</source>
+        <translation>Largeur minimale de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize area change</source>
+        <translation>Variation de surface de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize energy margin</source>
+        <translation>Marge d’énergie de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize image edges</source>
+        <translation>Contours de l’image pour la régularisation</translation>
+    </message>
+    <message>
         <source>Square windows on one surface</source>
         <translation>Fenêtres carrées sur une même surface</translation>
     </message>

@@ -119,7 +119,7 @@ core::Polygon jittered(const core::Polygon& p, std::mt19937& rng, double amount)
 // (white: the roof interval matches better).
 void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& right, const cv::Rect& roi,
                  const DelineationRequest& req, const core::Polygon& truth, const core::Polygon& result,
-                 const stereo::CostParams& costParams) {
+                 const core::Polygon& raw, const stereo::CostParams& costParams) {
   const int k = 3;
   cv::Mat crop;
   cv::normalize(left(roi), crop, 0, 255, cv::NORM_MINMAX, CV_8U);
@@ -164,6 +164,7 @@ void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& ri
     if (img->empty()) continue;
     draw(*img, truth, {0, 200, 0});
     draw(*img, req.init, {255, 80, 0});
+    draw(*img, raw, {0, 200, 255});
     draw(*img, result, {0, 0, 255});
   }
   cv::Mat both = crop;
@@ -308,6 +309,37 @@ void printDiag(const DiagTable& t, const char* indent, bool detailed) {
   }
 }
 
+// Regularization stage: the raw outline's scores beside the regularized ones.
+struct RegStats {
+  std::vector<double> rawIou, rawCorner, rawRatio, regRatio, energyPerPx;
+  std::map<std::string, int> status, reasons;
+};
+
+int vertexCount(const core::Polygon& p) {
+  size_t n = p.outer.size();
+  for (const auto& h : p.holes) n += h.size();
+  return static_cast<int>(n);
+}
+
+double outlineLength(const core::Polygon& p) {
+  auto ring = [](const core::Ring& r) {
+    double s = 0;
+    for (size_t i = 0; i < r.size(); ++i) s += cv::norm(r[(i + 1) % r.size()] - r[i]);
+    return s;
+  };
+  double s = ring(p.outer);
+  for (const auto& h : p.holes) s += ring(h);
+  return s;
+}
+
+// The first words of a reason (numbers dropped): "energy", "deviation", "round outline", ...
+std::string reasonKind(const std::string& reason) {
+  const size_t cut = reason.find_first_of("0123456789+(");
+  std::string k = reason.substr(0, cut);
+  while (!k.empty() && k.back() == ' ') k.pop_back();
+  return k;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -369,7 +401,8 @@ int main(int argc, char** argv) {
   std::map<std::string, std::vector<double>> ious, corners, hausdorffs;
   // Per-group IoU and corner RMS for the breakdown, keyed by "init|group".
   std::map<std::string, std::vector<double>> groupIous, groupCorners;
-  std::vector<double> times;
+  std::vector<double> times, regTimes;
+  std::map<std::string, RegStats> regStats;  // by init
   int sideOk = 0, sideTotal = 0, failures = 0;
   double fastMs = 0, referenceMs = 0;
   long long fastEvaluations = 0, referenceEvaluations = 0;
@@ -399,6 +432,60 @@ int main(int argc, char** argv) {
           const auto r = delineate(left, right, req, params);
           const auto t1 = Clock::now();
           const Scores sc = score(r.polygon, fp.polygon, left.size());
+          std::string regLine;
+          {
+            // The same run before its last stage (regularization), and that stage alone timed.
+            const Scores raw = score(r.rawPolygon, fp.polygon, left.size());
+            const auto t2 = Clock::now();
+            const RegularizationOutcome again = regularizeOutline(r.rawPolygon, params.regularization, left);
+            regTimes.push_back(ms(t2, Clock::now()));
+            (void)again;
+            const std::string shape = text(fp, "shape");
+            const double corners0 = vertexCount(fp.polygon), rawVerts = vertexCount(r.rawPolygon);
+            RegStats& st = regStats[initName];
+            st.rawIou.push_back(raw.iou);
+            st.rawCorner.push_back(raw.corner);
+            st.status[toString(r.regularization.status)]++;
+            if (r.regularization.status == RegularizationStatus::KeptRaw) st.reasons[reasonKind(r.regularization.reason)]++;
+            if (shape != "angled") {
+              st.rawRatio.push_back(rawVerts / corners0);
+              st.regRatio.push_back(r.vertexCount / corners0);
+            }
+            const double length = outlineLength(r.rawPolygon);
+            if (r.regularization.status != RegularizationStatus::Off && r.regularization.energyChange != 0) {
+              st.energyPerPx.push_back(r.regularization.energyChange / length);
+            }
+            regLine = cv::format("      regularization %s%s%s: IoU raw %.3f, vertices raw %.0f, corner RMS raw %.2f; dF %+.1f (%+.3f/px), "
+                        "deviation %.2f px, orientation %.1f deg\n",
+                        toString(r.regularization.status).c_str(), r.regularization.reason.empty() ? "" : " - ",
+                        r.regularization.reason.c_str(), raw.iou, rawVerts, raw.corner, r.regularization.energyChange,
+                        r.regularization.energyChange / length, r.regularization.deviation, r.regularization.orientationDeg);
+          }
+          std::string regLineCopy = regLine;
+          if (const char* path = std::getenv("BENCH_DUMP_OUTLINES")) {
+            // One JSON line per run: the true and the raw outline, to compare other regularizers.
+            auto rings = [](const core::Polygon& p) {
+              nlohmann::json out = nlohmann::json::array();
+              for (const core::Ring* outer : {&p.outer}) {
+                nlohmann::json ring = nlohmann::json::array();
+                for (const auto& v : *outer) ring.push_back({v.x, v.y});
+                out.push_back(ring);
+              }
+              for (const auto& h : p.holes) {
+                nlohmann::json ring = nlohmann::json::array();
+                for (const auto& v : h) ring.push_back({v.x, v.y});
+                out.push_back(ring);
+              }
+              return out;
+            };
+            const nlohmann::json line{{"scene", sceneParams.seed}, {"id", id}, {"shape", text(fp, "shape")},
+                                      {"init", initName}, {"truth", rings(fp.polygon)}, {"raw", rings(r.rawPolygon)},
+                                      {"regularized", rings(r.polygon)}};
+            if (FILE* f = std::fopen(path, "a")) {
+              std::fprintf(f, "%s\n", line.dump().c_str());
+              std::fclose(f);
+            }
+          }
           ious[initName].push_back(sc.iou);
           corners[initName].push_back(sc.corner);
           hausdorffs[initName].push_back(sc.hausdorff);
@@ -417,10 +504,11 @@ int main(int argc, char** argv) {
           std::printf("%-5d %-3d %-9s %-6s %-5s %7.3f %7.2f %7.2f %7.2f %7.2f %8.1f %5d %5zu\n", sceneParams.seed,
                       id, text(fp, "shape").c_str(), text(fp, "roof_type").c_str(), initName, sc.iou, sc.p1,
                       sc.polis, sc.hausdorff, sc.corner, ms(t0, t1), r.vertexCount, r.polygon.holes.size());
+          std::fputs(regLineCopy.c_str(), stdout);
           if (!dumpDir.empty()) {
             dumpPicture(dumpDir + "/s" + std::to_string(sceneParams.seed) + "_b" + std::to_string(id) + "_" +
                             initName + ".png",
-                        left, right, r.roi, req, fp.polygon, r.polygon,
+                        left, right, r.roi, req, fp.polygon, r.polygon, r.rawPolygon,
                         stereo::CostParams{params.costWindow, 1.0, params.costBrightness});
           }
           if (diag || std::getenv("BENCH_VERBOSE")) {
@@ -531,6 +619,28 @@ int main(int argc, char** argv) {
     const size_t bar = key.find('|');
     std::printf("    %-6s %-26s %.3f  %.3f  %.2f px  %zu\n", key.substr(0, bar).c_str(), key.substr(bar + 1).c_str(),
                 mean(v), median(v), median(groupCorners[key]), v.size());
+  }
+  std::printf("  regularization (%s; raw = the same runs before it):\n", params.regularization.mode.c_str());
+  for (const auto& [name, st] : regStats) {
+    std::printf("    init %-6s mean IoU raw %.3f -> %.3f (%+.4f)  median corner RMS raw %.2f -> %.2f px  "
+                "median vertices / true corners (rectilinear, %zu) raw %.2f -> %.2f\n",
+                name.c_str(), mean(st.rawIou), mean(ious[name]), mean(ious[name]) - mean(st.rawIou), median(st.rawCorner),
+                median(corners[name]), st.regRatio.size(), median(st.rawRatio), median(st.regRatio));
+    std::printf("      status:");
+    for (const auto& [k, n] : st.status) std::printf(" %s %d", k.c_str(), n);
+    std::printf("; kept raw because:");
+    for (const auto& [k, n] : st.reasons) std::printf(" %s %d", k.c_str(), n);
+    std::vector<double> e = st.energyPerPx;
+    std::sort(e.begin(), e.end());
+    if (!e.empty()) {
+      std::printf("; dF per px of outline: median %+.3f, 90 %% %+.3f, max %+.3f", median(e),
+                  e[static_cast<size_t>(0.9 * (e.size() - 1))], e.back());
+    }
+    std::printf("\n");
+  }
+  if (!regTimes.empty()) {
+    std::printf("  regularization time per building: median %.2f ms, max %.2f ms (outline only, without the energy gate)\n",
+                median(regTimes), *std::max_element(regTimes.begin(), regTimes.end()));
   }
   std::printf("  median time per building %.1f ms (cost service + optimisation, one core)\n", median(times));
   std::printf("  occlusion side from the data agrees with the geometry: %d / %d\n", sideOk, sideTotal);

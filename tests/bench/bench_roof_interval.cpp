@@ -29,17 +29,14 @@
 #include "delineo/delineation/roof_interval.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
+#include "real_roofs.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
+using bench::disparityFor;
+using bench::ringOf;
 
 namespace {
-
-core::Polygon ringOf(const nlohmann::json& points) {
-  core::Polygon p;
-  for (const auto& v : points) p.outer.emplace_back(v.at(0).get<double>(), v.at(1).get<double>());
-  return p;
-}
 
 std::vector<float> valuesIn(const cv::Mat& map, const cv::Mat& mask) {
   std::vector<float> out;
@@ -105,24 +102,6 @@ cv::Mat readGroundTruth(const std::string& path, double scale) {
   gt /= scale;
   gt.setTo(std::nanf(""), gt <= 0.0f);
   return gt;
-}
-
-cv::Mat disparityFor(const std::string& name, const std::string& left, const std::string& right, int dmin,
-                     int dmax, const fs::path& cache) {
-  const fs::path cached = cache / (name + "_" + std::to_string(dmin) + "_" + std::to_string(dmax) + ".tif");
-  if (fs::exists(cached)) {
-    io::ReadOptions options;
-    options.type = io::PixelType::Float32;
-    return io::readRaster(cached.string(), options).data;
-  }
-  stereo::MatchParams params;
-  params.dmin = dmin;
-  params.dmax = dmax;
-  std::fprintf(stderr, "matching %s (%d..%d px)...\n", name.c_str(), dmin, dmax);
-  const cv::Mat disparity = stereo::matchStereo(io::readGreyFloat(left), io::readGreyFloat(right), params).disparity;
-  fs::create_directories(cache);
-  io::writeFloatGeoTiff(cached.string(), disparity);
-  return disparity;
 }
 
 // Counts of one set of roofs (the tuning set, or the held-out set marked "heldOut").

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <tuple>
 
@@ -544,6 +545,50 @@ IntPolygon toRoiPolygon(const core::Polygon& outline, cv::Rect roi) {
   return out;
 }
 
+double outlineLength(const core::Polygon& p) {
+  auto ringLength = [](const core::Ring& r) {
+    double s = 0;
+    for (size_t i = 0; i < r.size(); ++i) s += cv::norm(r[(i + 1) % r.size()] - r[i]);
+    return s;
+  };
+  double s = ringLength(p.outer);
+  for (const auto& h : p.holes) s += ringLength(h);
+  return s;
+}
+
+EnergyWeights weightsOf(const DelineationParams& params) {
+  return {params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle, params.minGap};
+}
+
+// The energy gate of the regularization stage: a regularized outline whose F(C) (vertices on the
+// pixel grid) exceeds the raw one's by more than the margin per px of the raw outline's length
+// is refused, and the raw outline kept. Returns the terms of the outline kept.
+EnergyTerms gateByEnergy(RegularizationOutcome& reg, const core::Polygon& raw, const EnergyTerms& rawTerms,
+                         const PreparedEnergy& prepared, const DelineationParams& params) {
+  if (reg.status != RegularizationStatus::Regularized) return rawTerms;
+  const IntPolygon local = toRoiPolygon(reg.polygon, prepared.roi);
+  if (!isValidPolygon(local)) {
+    reg.status = RegularizationStatus::KeptRaw;
+    reg.reason = "not a valid polygon on the pixel grid";
+    reg.polygon = raw;
+    reg.outputVertices = reg.inputVertices;
+    return rawTerms;
+  }
+  const EnergyTerms terms = referenceEnergy(prepared.images, weightsOf(params), local);
+  reg.energyChange = terms.total() - rawTerms.total();
+  const double allowed = params.regularization.energyMargin * outlineLength(raw);
+  if (reg.energyChange > allowed) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "energy +%.1f > %.1f allowed", reg.energyChange, allowed);
+    reg.status = RegularizationStatus::KeptRaw;
+    reg.reason = buf;
+    reg.polygon = raw;
+    reg.outputVertices = reg.inputVertices;
+    return rawTerms;
+  }
+  return terms;
+}
+
 }  // namespace
 
 OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
@@ -563,10 +608,32 @@ OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const D
                 "(a ring with fewer than 3 distinct corners, crossing itself or another ring)");
   }
   const PreparedEnergy prepared = prepareEnergy(*costs, left, right, request, params);
-  const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle,
-                              params.minGap};
-  result.terms = referenceEnergy(prepared.images, weights, polygon);
+  result.terms = referenceEnergy(prepared.images, weightsOf(params), polygon);
   return result;
+}
+
+RegularizationOutcome regularizeBuildingOutline(const cv::Mat& left, const cv::Mat& right,
+                                                const DelineationRequest& request, const DelineationParams& params,
+                                                const core::Polygon& outline, core::Progress* progress) {
+  RegularizationOutcome reg = regularizeOutline(outline, params.regularization, left);
+  if (reg.status != RegularizationStatus::Regularized) return reg;
+  const cv::Rect roi = regionOfInterest(left, right, request, params);
+  const auto costs = costsOver(left, right, roi, request, params, progress);
+  if (!costs || core::isCanceled(progress)) {
+    reg.status = RegularizationStatus::Off;
+    reg.polygon = outline;
+    reg.outputVertices = reg.inputVertices;
+    return reg;
+  }
+  const IntPolygon raw = toRoiPolygon(outline, roi);
+  if (!isValidPolygon(raw)) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the outline is not a valid polygon on the pixel grid of its region of interest "
+                "(a ring with fewer than 3 distinct corners, crossing itself or another ring)");
+  }
+  const PreparedEnergy prepared = prepareEnergy(*costs, left, right, request, params);
+  gateByEnergy(reg, outline, referenceEnergy(prepared.images, weightsOf(params), raw), prepared, params);
+  return reg;
 }
 
 DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
@@ -603,10 +670,18 @@ DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
   const ActivePolygonResult r = optimiseActivePolygon(
       prepared.images, prepared.init, params, forward, progress ? &optimiseProgress : nullptr);
   result.polygon = toPolygon(r.polygon, cv::Point2d(offset));
+  result.rawPolygon = result.polygon;
   result.terms = r.terms;
   result.iterations = r.iterations;
-  result.vertexCount = r.polygon.vertexCount();
   result.status = r.status;
+  result.regularization.polygon = result.polygon;
+  if (r.status == core::RunStatus::Completed) {
+    result.regularization = regularizeOutline(result.rawPolygon, params.regularization, left);
+    result.terms = gateByEnergy(result.regularization, result.rawPolygon, r.terms, prepared, params);
+    result.polygon = result.regularization.polygon;
+  }
+  result.vertexCount = static_cast<int>(result.polygon.outer.size());
+  for (const auto& h : result.polygon.holes) result.vertexCount += static_cast<int>(h.size());
   if (progress && r.status == core::RunStatus::Completed) progress->report(1.0);
   return result;
 }

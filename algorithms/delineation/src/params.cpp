@@ -6,6 +6,7 @@ namespace delineo::delineation {
 
 void DelineationParams::validate() const {
   core::checkDeclaredRanges(*this);
+  regularization.validate();
   if (refinedSpacing > initialSpacing) {
     throw core::Error(core::ErrorCode::InvalidParameter,
                       "refined-spacing (" + std::to_string(refinedSpacing) +

@@ -46,6 +46,9 @@ DelineationOutcome runActivePolygon(const Project& project, const Building& buil
   outcome.energy = result.terms.total();
   outcome.terms = result.terms.term;
   outcome.iterations = result.iterations;
+  outcome.rawOutline = result.rawPolygon;
+  outcome.regularization = delineation::toString(result.regularization.status);
+  outcome.regularizationNote = result.regularization.reason;
   return outcome;
 }
 
@@ -60,6 +63,23 @@ EnergyOutcome evaluateBuildingOutline(const Project& project, const Building& bu
   outcome.status = energy.status;
   outcome.energy = energy.terms.total();
   outcome.terms = energy.terms.term;
+  return outcome;
+}
+
+RegularizationOutcome regularizeBuilding(const Project& project, const Building& building,
+                                         const StereoPair& pair, const core::Polygon& outline,
+                                         core::Progress* progress) {
+  const delineation::DelineationRequest request = requestFor(project, building, pair);
+  const auto params = parameters<delineation::DelineationParams>(project, "delineation");
+  const delineation::RegularizationOutcome r = delineation::regularizeBuildingOutline(
+      pair.left, pair.right, request, params, outline, progress);
+  RegularizationOutcome outcome;
+  outcome.outline = r.polygon;
+  outcome.regularization = delineation::toString(r.status);
+  outcome.regularizationNote = r.reason;
+  outcome.verticesBefore = r.inputVertices;
+  outcome.verticesAfter = r.outputVertices;
+  outcome.energyChange = r.energyChange;
   return outcome;
 }
 

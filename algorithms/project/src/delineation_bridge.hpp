@@ -12,4 +12,8 @@ EnergyOutcome evaluateBuildingOutline(const Project& project, const Building& bu
                                       const StereoPair& pair, const core::Polygon& outline,
                                       core::Progress* progress);
 
+RegularizationOutcome regularizeBuilding(const Project& project, const Building& building,
+                                         const StereoPair& pair, const core::Polygon& outline,
+                                         core::Progress* progress);
+
 }  // namespace delineo::project

@@ -211,6 +211,17 @@ EnergyOutcome outlineEnergy(const Project& project, const Building& building, co
 #endif
 }
 
+RegularizationOutcome regularizeOutline(const Project& project, const Building& building,
+                                        const StereoPair& pair, const core::Polygon& outline,
+                                        core::Progress* progress) {
+#ifdef DELINEO_HAVE_DELINEATION
+  return regularizeBuilding(project, building, pair, outline, progress);
+#else
+  (void)project, (void)building, (void)pair, (void)outline, (void)progress;
+  throw Error(ErrorCode::ProcessingFailed, "the active polygon is not part of this build");
+#endif
+}
+
 std::vector<core::Feature> buildingFeatures(const Project& project,
                                             const std::vector<BuildingStatus>& statuses) {
   std::vector<core::Feature> features;
@@ -299,7 +310,10 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
       b.energyTerms = outcome.terms;
       b.roofHeight = roofHeight(project, disparity, b.outline);
       b.status = BuildingStatus::Automatic;
-      b.addHistory("delineated", "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices");
+      std::string detail = "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices";
+      if (!outcome.regularization.empty()) detail += ", " + outcome.regularization;
+      if (!outcome.regularizationNote.empty()) detail += " (" + outcome.regularizationNote + ")";
+      b.addHistory("delineated", detail);
       ++summary.delineated;
     } catch (const Error& e) {
       if (!core::isInputError(e.code()) || e.code() == ErrorCode::InvalidParameter) {

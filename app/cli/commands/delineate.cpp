@@ -175,6 +175,11 @@ int run(const std::vector<std::string>& args) {
       for (int k = 0; k < 6; ++k) result.attributes[names[k]] = r.terms.term[k];
       result.attributes["iterations"] = static_cast<long long>(r.iterations);
       result.attributes["vertices"] = static_cast<long long>(r.vertexCount);
+      result.attributes["regularization"] = delineation::toString(r.regularization.status);
+      if (!r.regularization.reason.empty()) result.attributes["regularization_note"] = r.regularization.reason;
+      long long rawVertices = static_cast<long long>(r.rawPolygon.outer.size());
+      for (const auto& hole : r.rawPolygon.holes) rawVertices += static_cast<long long>(hole.size());
+      result.attributes["raw_vertices"] = rawVertices;
       result.attributes["roof_disparity_min"] = static_cast<long long>(r.roof.min);
       result.attributes["roof_disparity_max"] = static_cast<long long>(r.roof.max);
       result.attributes["ground_disparity_min"] = static_cast<long long>(r.ground.min);

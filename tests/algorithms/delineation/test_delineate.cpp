@@ -449,3 +449,51 @@ TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
     EXPECT_GT(iou(result.polygon, c.pair.truth, c.pair.left.size()), 0.9) << "band-best-cost " << best;
   }
 }
+
+TEST(Delineate, RegularizesTheOutlineAsItsLastStage) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
+  ASSERT_EQ(r.status, core::RunStatus::Completed);
+  EXPECT_EQ(r.regularization.status, RegularizationStatus::Regularized) << r.regularization.reason;
+  EXPECT_EQ(r.vertexCount, 4);
+  EXPECT_EQ(r.polygon.outer.size(), 4u);
+  EXPECT_GE(r.rawPolygon.outer.size(), 4u);
+  EXPECT_GE(iou(r.polygon, pair.truth, pair.left.size()), iou(r.rawPolygon, pair.truth, pair.left.size()) - 0.01);
+  EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.9);
+  // `none` keeps the active polygon's own outline.
+  DelineationParams none;
+  none.regularization.mode = "none";
+  const auto raw = delineate(pair.left, pair.right, req, none);
+  EXPECT_EQ(raw.regularization.status, RegularizationStatus::Off);
+  EXPECT_EQ(raw.polygon.outer, raw.rawPolygon.outer);
+  EXPECT_EQ(raw.rawPolygon.outer, r.rawPolygon.outer);
+}
+
+TEST(Delineate, TheEnergyGateKeepsAnOutlineWhoseRegularizationLeavesTheRoofEdge) {
+  const cv::Rect roof(50, 40, 60, 50);
+  const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  // The true outline except a 3 px bulge over the middle 30 px of the east side: its jogs are
+  // shorter than min-edge, and regularizing merges the side into one line about 2 px out, off
+  // the image edge over its whole length.
+  core::Polygon outline;
+  outline.outer = {{50, 40}, {110, 40}, {110, 50}, {113, 50}, {113, 80}, {110, 80}, {110, 90}, {50, 90}};
+  DelineationParams strict;
+  strict.regularization.energyMargin = 0;
+  const RegularizationOutcome kept = regularizeBuildingOutline(pair.left, pair.right, req, strict, outline);
+  EXPECT_EQ(kept.status, RegularizationStatus::KeptRaw);
+  EXPECT_EQ(kept.reason.rfind("energy", 0), 0u) << kept.reason;
+  EXPECT_GT(kept.energyChange, 0.0);
+  EXPECT_EQ(kept.polygon.outer, outline.outer);
+  const RegularizationOutcome taken = regularizeBuildingOutline(pair.left, pair.right, req, DelineationParams{}, outline);
+  EXPECT_EQ(taken.status, RegularizationStatus::Regularized) << taken.reason;
+  EXPECT_EQ(taken.polygon.outer.size(), 4u);
+}

@@ -102,6 +102,26 @@ TEST(Pipeline, AnEditedOutlineIsScoredLikeTheActivePolygonScoresItsOwn) {
   EXPECT_GT(worse.energy, outcome.energy + 0.01 * std::abs(outcome.energy));
 }
 
+TEST(Pipeline, RegularizingTheRawOutlineGivesWhatTheDelineationGave) {
+  SceneProject s = makeSceneProject();
+  const auto outcome = project::delineateBuilding(s.project, s.building, s.pair, nullptr);
+  ASSERT_EQ(outcome.status, core::RunStatus::Completed);
+  ASSERT_FALSE(outcome.rawOutline.outer.empty());
+  const auto again =
+      project::regularizeOutline(s.project, s.building, s.pair, outcome.rawOutline, nullptr);
+  EXPECT_EQ(again.regularization, outcome.regularization);
+  EXPECT_EQ(again.outline.outer, outcome.outline.outer);
+  size_t rawVertices = outcome.rawOutline.outer.size();
+  for (const auto& hole : outcome.rawOutline.holes) rawVertices += hole.size();
+  EXPECT_EQ(again.verticesBefore, static_cast<int>(rawVertices));
+  // With regularization off the outline comes back as it is.
+  s.project.parameters["delineation"] = nlohmann::json{{"regularize", "none"}};
+  const auto off =
+      project::regularizeOutline(s.project, s.building, s.pair, outcome.rawOutline, nullptr);
+  EXPECT_EQ(off.regularization, "off");
+  EXPECT_EQ(off.outline.outer, outcome.rawOutline.outer);
+}
+
 TEST(Pipeline, TheProjectsRangeIsTheRangeTheMatcherSearches) {
   SceneProject s = makeSceneProject();
   // Share of the roof pixels (true disparity above 16 px) matched within 1 px of the truth.

@@ -48,6 +48,18 @@ IOU=$(mean_iou "$WORK/eval.json")
 above "$IOU" 0.88 || fail "mean IoU $IOU is not above the floor 0.88"
 expect_in "$WORK/eval.json" "\"matched\": $TRUTHS," "every building matched"
 
+# 1b. Regularization (the last stage, on by default): every output says what it did; `none`
+#     keeps the raw outline; an unknown mode is refused.
+for key in regularization raw_vertices; do
+  [[ $(count "$OUT" "\"$key\": ") == "$TRUTHS" ]] || fail "attribute $key missing on some outputs"
+done
+[[ $(count "$OUT" '"regularization": "regularized"') -ge 1 ]] || fail "no outline was regularized"
+expect_rc raw 0 "$CLI" delineate --left "$S/left.tif" --right "$S/right.tif" \
+  --init "$WORK/init.geojson" --regularize none --out "$WORK/raw.geojson"
+[[ $(count "$WORK/raw.geojson" '"regularization": "off"') == "$TRUTHS" ]] || fail "--regularize none should say off"
+expect_rc bad_mode 3 "$CLI" delineate --left "$S/left.tif" --right "$S/right.tif" \
+  --init "$WORK/init.geojson" --regularize squares --out "$WORK/bad.geojson"
+
 # 2. Feature properties override the flags: wrong flag intervals must not change the result.
 expect_rc override 0 "$CLI" delineate --left "$S/left.tif" --right "$S/right.tif" \
   --init "$WORK/init.geojson" --roof-disparity 1:2 --ground-disparity 30:31 \

@@ -10,6 +10,7 @@
 #include "delineo/core/progress.hpp"
 #include "delineo/delineation/active_polygon.hpp"
 #include "delineo/delineation/params.hpp"
+#include "delineo/delineation/regularize.hpp"
 
 namespace delineo::stereo {
 class CorrelationCostService;
@@ -64,10 +65,13 @@ std::pair<DisparityInterval, DisparityInterval> costIntervals(const DisparityInt
                                                               bool balance);
 
 struct DelineationResult {
-  core::Polygon polygon;  // left-image coordinates
-  EnergyTerms terms;
+  core::Polygon polygon;  // left-image coordinates: the regularized outline when it passed the gate
+  EnergyTerms terms;      // of `polygon` (vertices rounded to the pixel grid when regularized)
   int iterations = 0;
-  int vertexCount = 0;
+  int vertexCount = 0;    // of `polygon`
+  core::Polygon rawPolygon;  // the active polygon's own outline, before regularization
+  // The last stage: regularized, kept raw (and why) or off. Its polygon is `polygon`.
+  RegularizationOutcome regularization;
   core::RunStatus status = core::RunStatus::Completed;
   cv::Rect roi;
   DisparityInterval roof, ground;
@@ -103,5 +107,15 @@ struct OutlineEnergy {
 OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
                               const DelineationParams& params, const core::Polygon& outline,
                               core::Progress* progress = nullptr);
+
+// The regularization stage of delineate() on any outline of the building of `request` (an
+// operator's edit, a box-fitting outline): regularizeOutline() with params.regularization, then
+// the energy gate: the regularized outline's F(C), on the same costs as delineate() would use,
+// may exceed the input's by at most regularize-energy-margin per px of the input's length, else
+// the input is kept (status KeptRaw, reason "energy ..."). Throws like evaluateOutline(); cancel
+// returns the input with status Off.
+RegularizationOutcome regularizeBuildingOutline(const cv::Mat& left, const cv::Mat& right,
+                                                const DelineationRequest& request, const DelineationParams& params,
+                                                const core::Polygon& outline, core::Progress* progress = nullptr);
 
 }  // namespace delineo::delineation

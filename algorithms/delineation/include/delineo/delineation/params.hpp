@@ -1,6 +1,7 @@
 #pragma once
 // Parameters of the statistical active polygon (docs/delineation.md explains each choice).
 #include "delineo/core/params.hpp"
+#include "delineo/delineation/regularize.hpp"
 
 namespace delineo::delineation {
 
@@ -38,6 +39,7 @@ struct DelineationParams {
   double intermediateMargin = 0.1; // Crit units: in-between match this much better: not roof (0 = off)
   int intermediateGuard = 1;       // disparities kept off each interval when looking between them
   bool bandBestCost = false;       // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost, the paper)
+  RegularizationParams regularization;  // the outline's last stage (its keys start with regularize)
   template <class V>
   void visit(V&& v) {
     v(core::ParamInfo{"occlusion", "Occlusion", "%",
@@ -188,6 +190,7 @@ struct DelineationParams {
                       "c_roof and c_ground there, so that the band is never cheaper than the pixel's "
                       "best explanation as roof or ground (false = NoMatchCost everywhere, the paper)"},
       bandBestCost);
+    regularization.visit(v);
   }
   void validate() const;
 };

@@ -75,11 +75,14 @@ double roofHeight(const Project& project, const cv::Mat& disparity, const core::
 // The active polygon for one building. `onContour` (may be empty) receives intermediate
 // contours in left-image pixels from the worker thread.
 struct DelineationOutcome {
-  core::Polygon outline;
+  core::Polygon outline;  // regularized when its last stage passed the gate
   double energy = 0.0;
   EnergyTerms terms{};  // the energy's terms, summing to `energy`
   int iterations = 0;
   core::RunStatus status = core::RunStatus::Completed;
+  core::Polygon rawOutline;       // the active polygon's outline before regularization
+  std::string regularization;     // "regularized", "kept-raw" or "off"
+  std::string regularizationNote; // why the raw outline was kept (empty otherwise)
 };
 using ContourListener = std::function<void(const core::Polygon&)>;
 DelineationOutcome delineateBuilding(const Project& project, const Building& building,
@@ -97,6 +100,22 @@ struct EnergyOutcome {
 };
 EnergyOutcome outlineEnergy(const Project& project, const Building& building, const StereoPair& pair,
                             const core::Polygon& outline, core::Progress* progress);
+
+// The delineation's last stage (regularization, with the project's parameters) on `outline` (the
+// building's current outline, an operator's edit): the regularized outline when it passes the
+// gate, energy included (as delineateBuilding() would score it), else `outline` itself with the
+// reason. The per-building "Regularize" action. Throws InvalidParameter without a roof interval
+// or for an outline that is not a polygon; cancel returns `outline` with regularization "off".
+struct RegularizationOutcome {
+  core::Polygon outline;
+  std::string regularization;      // "regularized", "kept-raw" or "off"
+  std::string regularizationNote;  // why the outline was kept (empty otherwise)
+  int verticesBefore = 0, verticesAfter = 0;
+  double energyChange = 0.0;  // F(result) - F(outline) when the energy gate ran
+};
+RegularizationOutcome regularizeOutline(const Project& project, const Building& building,
+                                        const StereoPair& pair, const core::Polygon& outline,
+                                        core::Progress* progress);
 
 // `delineo-cli run`: the disparity range estimated when the project has none, matching when
 // the disparity is missing (written to

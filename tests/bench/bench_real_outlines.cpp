@@ -1,0 +1,290 @@
+// Outlines on the hand-labelled real roofs (tests/bench/data/real_roofs.json): from a rough
+// rectangle (the labelled outline's box grown by 30 px, clipped to the image) and the proposed
+// roof interval, the active polygon's outline before and after its last stage (regularization),
+// and a naive baseline: the matcher's disparities inside the rectangle thresholded at the roof
+// interval, closed then opened 7x7, largest component, polygonised (1 px). Prints IoU against the
+// labelled outline and vertex counts; `--dump DIR` draws them over the left image (labelled
+// green, rectangle blue, naive cyan, raw yellow, regularized red). Skips cleanly (exit 0) when the
+// data folder is missing. Disparity maps are cached as in bench_roof_interval.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/allocator.hpp"
+#include "delineo/core/error.hpp"
+#include "delineo/core/geometry.hpp"
+#include "delineo/delineation/delineate.hpp"
+#include "delineo/delineation/roof_interval.hpp"
+#include "delineo/io/raster.hpp"
+#include "real_roofs.hpp"
+
+namespace fs = std::filesystem;
+using namespace delineo;
+
+namespace {
+
+double iou(const core::Polygon& a, const core::Polygon& b, cv::Size size) {
+  const cv::Mat ma = core::rasterize(a, size), mb = core::rasterize(b, size);
+  return static_cast<double>(cv::countNonZero(ma & mb)) / std::max(1, cv::countNonZero(ma | mb));
+}
+
+int vertices(const core::Polygon& p) {
+  size_t n = p.outer.size();
+  for (const auto& h : p.holes) n += h.size();
+  return static_cast<int>(n);
+}
+
+// The naive recipe: roof-interval pixels of the matcher's map inside the rectangle, closed and
+// opened 7x7, the largest component's outline simplified at 1 px. Empty when nothing is left.
+core::Polygon naiveOutline(const cv::Mat& disparity, const core::Polygon& rect, int low, int high) {
+  const cv::Mat inside = core::rasterize(rect, disparity.size());
+  cv::Mat mask = (disparity >= low - 0.5f) & (disparity <= high + 0.5f) & inside;
+  const cv::Mat k = cv::getStructuringElement(cv::MORPH_RECT, {7, 7});
+  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, k);
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, k);
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  if (contours.empty()) return {};
+  const auto largest = std::max_element(
+      contours.begin(), contours.end(),
+      [](const auto& a, const auto& b) { return cv::contourArea(a) < cv::contourArea(b); });
+  std::vector<cv::Point> simplified;
+  cv::approxPolyDP(*largest, simplified, 1.0, true);
+  core::Polygon p;
+  for (const auto& v : simplified)
+    p.outer.emplace_back(v.x + 0.5, v.y + 0.5);  // pixel centres → corners
+  return p;
+}
+
+void dump(const std::string& path, const cv::Mat& left, const cv::Rect& box,
+          const std::vector<std::pair<core::Polygon, cv::Scalar>>& outlines) {
+  const cv::Rect crop = cv::Rect(box.x - 10, box.y - 10, box.width + 20, box.height + 20) &
+                        cv::Rect(0, 0, left.cols, left.rows);
+  const int k = std::max(1, std::min(4, 900 / std::max(crop.width, crop.height)));
+  cv::Mat img;
+  cv::normalize(left(crop), img, 0, 255, cv::NORM_MINMAX, CV_8U);
+  cv::resize(img, img, {}, k, k, cv::INTER_NEAREST);
+  cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
+  for (const auto& [p, colour] : outlines) {
+    auto ring = [&](const core::Ring& r) {
+      std::vector<cv::Point> pts;
+      for (const auto& v : r)
+        pts.emplace_back(static_cast<int>(std::lround((v.x - crop.x) * k)),
+                         static_cast<int>(std::lround((v.y - crop.y) * k)));
+      cv::polylines(img, pts, true, colour, 1);
+      for (const auto& q : pts) cv::circle(img, q, 2, colour, cv::FILLED);
+    };
+    if (p.outer.size() >= 3) ring(p.outer);
+    for (const auto& h : p.holes) ring(h);
+  }
+  cv::imwrite(path, img);
+}
+
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  core::tuneAllocatorForLargeImages();
+  std::string dataRoot = "/work/shared/data";
+  std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
+  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  std::string dumpDir;
+  int grow = 30;
+  std::vector<double> tolerances;  // --tolerances A,B,...: the raw outline regularized at each too
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
+      dataRoot = argv[++i];
+    } else if (!std::strcmp(argv[i], "--labels") && i + 1 < argc) {
+      labels = argv[++i];
+    } else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) {
+      cache = argv[++i];
+    } else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) {
+      dumpDir = argv[++i];
+    } else if (!std::strcmp(argv[i], "--grow") && i + 1 < argc) {
+      grow = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--tolerances") && i + 1 < argc) {
+      for (const char* p = argv[++i]; *p;) {
+        char* end = nullptr;
+        tolerances.push_back(std::strtod(p, &end));
+        p = *end == ',' ? end + 1 : end;
+      }
+    } else {
+      std::fprintf(
+          stderr,
+          "usage: bench_real_outlines [--data DIR] [--labels real_roofs.json] [--cache DIR] "
+          "[--grow PX] [--tolerances A,B,...] [--dump DIR]\n");
+      return 2;
+    }
+  }
+  if (!fs::is_directory(dataRoot)) {
+    std::printf("skipped: no data folder %s\n", dataRoot.c_str());
+    return 0;
+  }
+  delineation::DelineationParams params;
+  if (const char* json = std::getenv("BENCH_PARAMS"))
+    core::fromJson(params, nlohmann::json::parse(json));
+  std::ifstream in(labels);
+  const nlohmann::json data = nlohmann::json::parse(in);
+  std::printf("%-18s %-9s | %-13s | %-13s | %-13s | %-11s %s\n", "roof", "interval", "naive IoU/v",
+              "raw IoU/v", "regular. IoU/v", "reg ms", "regularization");
+  std::map<std::string, cv::Mat> maps, lefts, rights;
+  // Per set: the tuning roofs and the held-out ones (marked "heldOut", labelled afterwards).
+  struct Set {
+    std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV;
+    int regularized = 0;
+  };
+  std::map<std::string, Set> sets;
+  std::vector<double> regMs;
+  std::map<double, std::vector<double>> tolIou, tolVertices;
+  int runs = 0;
+  for (const auto& roof : data.at("roofs")) {
+    const std::string name = roof.at("name"), pairName = roof.at("pair");
+    if (const char* only = std::getenv("BENCH_ONLY"); only && name != only) continue;
+    const auto& pair = data.at("pairs").at(pairName);
+    const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
+    const std::string right = (fs::path(dataRoot) / pair.at("right").get<std::string>()).string();
+    if (!fs::exists(left) || !fs::exists(right)) {
+      std::printf("skipped %s: %s missing\n", name.c_str(), left.c_str());
+      continue;
+    }
+    const int dmin = pair.at("disparity_range").at(0), dmax = pair.at("disparity_range").at(1);
+    if (!maps.count(pairName)) {
+      maps[pairName] = bench::disparityFor(pairName, left, right, dmin, dmax, cache);
+      lefts[pairName] = io::readGreyFloat(left);
+      rights[pairName] = io::readGreyFloat(right);
+    }
+    const cv::Mat& map = maps[pairName];
+    const core::Polygon truth = bench::ringOf(roof.at("outline"));
+    const cv::Rect2d box = core::boundingBox(truth.outer);
+    const double x0 = std::max(0.0, box.x - grow), y0 = std::max(0.0, box.y - grow);
+    const double x1 = std::min<double>(map.cols, box.x + box.width + grow);
+    const double y1 = std::min<double>(map.rows, box.y + box.height + grow);
+    core::Polygon rect;
+    rect.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    const auto proposal =
+        delineation::proposeRoofInterval(map, rect, delineation::RoofIntervalParams{});
+    if (!proposal.found) {
+      std::printf("%-18s no roof interval proposed\n", name.c_str());
+      continue;
+    }
+    const core::Polygon naive = naiveOutline(map, rect, proposal.low, proposal.high);
+    delineation::DelineationRequest request;
+    request.init = rect;
+    request.roof = {proposal.low, proposal.high};
+    request.searchRange = delineation::DisparityInterval{dmin, dmax};
+    try {
+      const auto r = delineation::delineate(lefts[pairName], rights[pairName], request, params);
+      // The stage alone, CPU time of this thread, best of 3 (the machine may be shared).
+      double ms = 1e300;
+      for (int rep = 0; rep < 3; ++rep) {
+        const double t0 = cpuMs();
+        (void)delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
+        ms = std::min(ms, cpuMs() - t0);
+      }
+      const cv::Size size = map.size();
+      const double ni = naive.outer.empty() ? 0.0 : iou(naive, truth, size);
+      const double ri = iou(r.rawPolygon, truth, size), gi = iou(r.polygon, truth, size);
+      std::printf(
+          "%-18s [%3d,%3d] | %6.3f %5d | %6.3f %5d | %6.3f %5d | %6.2f ms %s%s%s (dF %+.1f, %.1f "
+          "deg)\n",
+          name.c_str(), proposal.low, proposal.high, ni, vertices(naive), ri,
+          vertices(r.rawPolygon), gi, r.vertexCount, ms,
+          delineation::toString(r.regularization.status).c_str(),
+          r.regularization.reason.empty() ? "" : ": ", r.regularization.reason.c_str(),
+          r.regularization.energyChange, r.regularization.orientationDeg);
+      for (double t : tolerances) {
+        // The same raw outline through the public entry point (outline + energy gate) at tolerance
+        // t.
+        delineation::DelineationParams other = params;
+        other.regularization.tolerance = t;
+        const auto g = delineation::regularizeBuildingOutline(lefts[pairName], rights[pairName],
+                                                              request, other, r.rawPolygon);
+        std::printf("    tolerance %4.1f px: IoU %.3f, %3d vertices, %s%s%s\n", t,
+                    iou(g.polygon, truth, size), g.outputVertices,
+                    delineation::toString(g.status).c_str(), g.reason.empty() ? "" : ": ",
+                    g.reason.c_str());
+        tolIou[t].push_back(iou(g.polygon, truth, size));
+        tolVertices[t].push_back(g.outputVertices);
+      }
+      if (std::getenv("BENCH_VERBOSE")) {
+        const auto g =
+            delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
+        for (const auto& [label, poly] :
+             {std::pair{"raw", r.rawPolygon}, std::pair{"regularized", g.polygon}}) {
+          std::printf("    %s:", label);
+          for (const auto& v : poly.outer) std::printf(" (%.1f,%.1f)", v.x, v.y);
+          for (const auto& h : poly.holes) {
+            std::printf(" hole");
+            for (const auto& v : h) std::printf(" (%.1f,%.1f)", v.x, v.y);
+          }
+          std::printf("\n");
+        }
+      }
+      Set& set = sets[roof.value("heldOut", false) ? "held-out" : "tuning"];
+      set.naiveIou.push_back(ni), set.rawIou.push_back(ri), set.regIou.push_back(gi);
+      set.naiveV.push_back(vertices(naive)), set.rawV.push_back(vertices(r.rawPolygon)),
+          set.regV.push_back(r.vertexCount);
+      set.regularized += r.regularization.status == delineation::RegularizationStatus::Regularized;
+      regMs.push_back(ms);
+      ++runs;
+      if (!dumpDir.empty()) {
+        fs::create_directories(dumpDir);
+        dump((fs::path(dumpDir) / (name + ".png")).string(), lefts[pairName],
+             cv::Rect(static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(x1 - x0),
+                      static_cast<int>(y1 - y0)),
+             {{rect, {255, 80, 0}},
+              {truth, {0, 200, 0}},
+              {naive, {255, 255, 0}},
+              {r.rawPolygon, {0, 220, 255}},
+              {r.polygon, {0, 0, 255}}});
+      }
+    } catch (const core::Error& e) {
+      std::printf("%-18s failed: %s\n", name.c_str(), e.what());
+    }
+  }
+  if (runs == 0) {
+    std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
+    return 0;
+  }
+  auto mean = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return v.empty() ? std::nan("") : s / static_cast<double>(v.size());
+  };
+  for (const auto& [name, set] : sets) {
+    std::printf("\n%s, %zu roofs (rectangle = labelled box + %d px): mean IoU naive %.3f, raw %.3f, "
+                "regularized %.3f; median vertices naive %.0f, raw %.0f, regularized %.0f; %d regularized",
+                name.c_str(), set.rawIou.size(), grow, mean(set.naiveIou), mean(set.rawIou),
+                mean(set.regIou), median(set.naiveV), median(set.rawV), median(set.regV), set.regularized);
+  }
+  std::printf("\nregularization time median %.2f ms, max %.2f ms\n", median(regMs),
+              *std::max_element(regMs.begin(), regMs.end()));
+  for (const auto& [t, v] : tolIou) {
+    std::printf("  tolerance %4.1f px: mean IoU %.3f, median vertices %.0f\n", t, mean(v),
+                median(tolVertices[t]));
+  }
+  return 0;
+}
