@@ -139,14 +139,6 @@
         <translation>Méthode</translation>
     </message>
     <message>
-        <source>Minimum disparity</source>
-        <translation>Disparité minimale</translation>
-    </message>
-    <message>
-        <source>Maximum disparity</source>
-        <translation>Disparité maximale</translation>
-    </message>
-    <message>
         <source>Pyramid levels</source>
         <translation>Niveaux de pyramide</translation>
     </message>
@@ -299,34 +291,6 @@
         <translation>Coût de bande selon l’appariement</translation>
     </message>
     <message>
-        <source>Regularize</source>
-        <translation>Régulariser</translation>
-    </message>
-    <message>
-        <source>Regularize tolerance</source>
-        <translation>Tolérance de la régularisation</translation>
-    </message>
-    <message>
-        <source>Regularize min edge</source>
-        <translation>Côté minimal de la régularisation</translation>
-    </message>
-    <message>
-        <source>Regularize min width</source>
-        <translation>Largeur minimale de la régularisation</translation>
-    </message>
-    <message>
-        <source>Regularize area change</source>
-        <translation>Variation de surface de la régularisation</translation>
-    </message>
-    <message>
-        <source>Regularize energy margin</source>
-        <translation>Marge d’énergie de la régularisation</translation>
-    </message>
-    <message>
-        <source>Regularize image edges</source>
-        <translation>Contours de l’image pour la régularisation</translation>
-    </message>
-    <message>
         <source>Square windows on one surface</source>
         <translation>Fenêtres carrées sur une même surface</translation>
     </message>
@@ -361,6 +325,42 @@
     <message>
         <source>Roof plane area</source>
         <translation>Surface minimale d’un plan de toit</translation>
+    </message>
+    <message>
+        <source>Coarse-check score</source>
+        <translation>Score du contrôle au niveau grossier</translation>
+    </message>
+    <message>
+        <source>Ordering check</source>
+        <translation>Contrôle de l’ordre</translation>
+    </message>
+    <message>
+        <source>Regularize</source>
+        <translation>Régulariser</translation>
+    </message>
+    <message>
+        <source>Regularize tolerance</source>
+        <translation>Tolérance de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize min edge</source>
+        <translation>Côté minimal de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize min width</source>
+        <translation>Largeur minimale de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize area change</source>
+        <translation>Variation de surface de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize energy margin</source>
+        <translation>Marge d’énergie de la régularisation</translation>
+    </message>
+    <message>
+        <source>Regularize image edges</source>
+        <translation>Contours de l’image pour la régularisation</translation>
     </message>
 </context>
 <context>
@@ -1215,6 +1215,34 @@
     <message>
         <source>Disparity range %1..%2 px (from %3 feature matches).</source>
         <translation>Intervalle de disparité %1..%2 px (sur %3 appariements de points d’intérêt).</translation>
+    </message>
+    <message>
+        <source>Re&amp;gularize outline</source>
+        <translation>Ré&amp;gulariser le contour</translation>
+    </message>
+    <message>
+        <source>Square the selected outline: right angles, few vertices, within the tolerance of it</source>
+        <translation>Équerrer le contour sélectionné : angles droits, peu de sommets, sans s’en écarter de plus que la tolérance</translation>
+    </message>
+    <message>
+        <source>Regularize outline</source>
+        <translation>Régulariser le contour</translation>
+    </message>
+    <message>
+        <source>Regularize building %1</source>
+        <translation>Régulariser le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Regularize building %1 (%2 → %3 vertices)</source>
+        <translation>Régulariser le bâtiment %1 (%2 → %3 sommets)</translation>
+    </message>
+    <message>
+        <source>Building %1 regularized: %2 → %3 vertices.</source>
+        <translation>Bâtiment %1 régularisé : %2 → %3 sommets.</translation>
+    </message>
+    <message>
+        <source>The outline of building %1 was kept as it is: %2</source>
+        <translation>Le contour du bâtiment %1 a été gardé tel quel : %2</translation>
     </message>
 </context>
 <context>

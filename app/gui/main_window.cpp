@@ -488,6 +488,10 @@ void MainWindow::createActions() {
           &QAction::triggered, this, &MainWindow::startMatching);
   connect(make(QStringLiteral("actionDelineate"), tr("Run the active &polygon"), QKeySequence(tr("Ctrl+R"))),
           &QAction::triggered, this, [this] { startDelineation(selectedId_); });
+  connect(make(QStringLiteral("actionRegularize"), tr("Re&gularize outline")), &QAction::triggered, this,
+          [this] { startRegularization(selectedId_); });
+  action(QStringLiteral("actionRegularize"))
+      ->setStatusTip(tr("Square the selected outline: right angles, few vertices, within the tolerance of it"));
   auto* onPick = make(QStringLiteral("actionDelineateOnPick"), tr("Delineate on &pick"));
   onPick->setCheckable(true);
   onPick->setChecked(QSettings().value(QStringLiteral("delineateOnPick"), true).toBool());
@@ -589,6 +593,7 @@ void MainWindow::createMenus() {
   building->addSeparator();
   building->addAction(action(QStringLiteral("actionDelineate")));
   building->addAction(action(QStringLiteral("actionDelineateOnPick")));
+  building->addAction(action(QStringLiteral("actionRegularize")));
   building->addAction(action(QStringLiteral("actionAccept")));
   building->addAction(action(QStringLiteral("actionReject")));
   building->addAction(action(QStringLiteral("actionReopen")));
@@ -1241,6 +1246,49 @@ widgets::JobId MainWindow::startEnergyUpdate(int id) {
       QStringLiteral("energy-%1").arg(id));
 }
 
+widgets::JobId MainWindow::startRegularization(int id) {
+  if (!document_ || !project::delineationAvailable()) return 0;
+  const Building* b = document_->project().find(id);
+  if (b == nullptr || !b->hasOutline()) return 0;
+  if (!b->roofInterval) {
+    showMessage(tr("Regularize outline"), tr("Choose the roof disparity interval on the histogram first."));
+    return 0;
+  }
+  const project::Project projectCopy = document_->project();
+  const Building building = *b;
+  const project::StereoPair pair = document_->pair();
+  QPointer<Document> doc(document_.get());
+  return jobs_->run<project::RegularizationOutcome>(
+      tr("Regularize building %1").arg(id),
+      [projectCopy, building, pair](core::Progress& p) {
+        return project::regularizeOutline(projectCopy, building, pair, building.outline, &p);
+      },
+      [this, doc, id, before = building.outline](project::RegularizationOutcome outcome) {
+        if (!doc || doc != document_.get()) return;
+        const Building* now = doc->project().find(id);
+        // The outline changed meanwhile (an edit, an undo): this result is about another one.
+        if (now == nullptr || !(now->outline.outer == before.outer && now->outline.holes == before.holes)) return;
+        if (outcome.regularization == "regularized") {
+          doc->setPolygon(id, outcome.outline,
+                          tr("Regularize building %1 (%2 → %3 vertices)")
+                              .arg(id)
+                              .arg(outcome.verticesBefore)
+                              .arg(outcome.verticesAfter));
+          statusBar()->showMessage(tr("Building %1 regularized: %2 → %3 vertices.")
+                                       .arg(id)
+                                       .arg(outcome.verticesBefore)
+                                       .arg(outcome.verticesAfter),
+                                   8000);
+        } else if (outcome.regularization == "kept-raw") {
+          showMessage(tr("Regularize outline"), tr("The outline of building %1 was kept as it is: %2")
+                                                    .arg(id)
+                                                    .arg(QString::fromStdString(outcome.regularizationNote)));
+        }
+        emit regularizationFinished(id);
+      },
+      QStringLiteral("regularize-%1").arg(id));
+}
+
 void MainWindow::rememberFolder(const QString& path) {
   QSettings().setValue(QStringLiteral("lastProjectFolder"), QFileInfo(path).absolutePath());
 }
@@ -1305,6 +1353,8 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionExport"))->setEnabled(hasDoc);
   action(QStringLiteral("actionMatch"))->setEnabled(hasDoc && project::matchingAvailable());
   action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr && project::delineationAvailable());
+  action(QStringLiteral("actionRegularize"))
+      ->setEnabled(b != nullptr && b->hasOutline() && project::delineationAvailable());
   action(QStringLiteral("actionAccept"))->setEnabled(b != nullptr && b->hasOutline() && b->status != BuildingStatus::Accepted);
   action(QStringLiteral("actionReject"))->setEnabled(b != nullptr && b->status != BuildingStatus::Rejected);
   action(QStringLiteral("actionReopen"))->setEnabled(

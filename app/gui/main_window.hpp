@@ -85,6 +85,9 @@ class MainWindow : public QMainWindow {
   // Scores the building's current outline (after a manual edit) in the background; returns the
   // job id or 0 when there is nothing to score.
   widgets::JobId startEnergyUpdate(int id);
+  // Squares the building's outline in the background (the delineation's last stage, energy gate
+  // included) and applies it as one undoable edit, or says why it was kept; returns the job id.
+  widgets::JobId startRegularization(int id);
 
   // ---- accessors for tests and the screenshot tour ----
   widgets::ImageView* leftView() const { return leftView_; }
@@ -138,6 +141,7 @@ class MainWindow : public QMainWindow {
   void matchingFinished();
   void energyUpdated(int id);
   void rangeEstimated();
+  void regularizationFinished(int id);
 
  protected:
   void closeEvent(QCloseEvent* event) override;

@@ -51,8 +51,6 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Band best cost"),
     // stereo::MatchParams
     QT_TRANSLATE_NOOP("Parameters", "Method"),
-    QT_TRANSLATE_NOOP("Parameters", "Minimum disparity"),
-    QT_TRANSLATE_NOOP("Parameters", "Maximum disparity"),
     QT_TRANSLATE_NOOP("Parameters", "Pyramid levels"),
     QT_TRANSLATE_NOOP("Parameters", "Template size"),
     QT_TRANSLATE_NOOP("Parameters", "Validation tolerance"),
@@ -73,6 +71,8 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Edge gap closing"),
     QT_TRANSLATE_NOOP("Parameters", "Steepest slanted facet"),
     QT_TRANSLATE_NOOP("Parameters", "Threads"),
+    QT_TRANSLATE_NOOP("Parameters", "Coarse-check score"),
+    QT_TRANSLATE_NOOP("Parameters", "Ordering check"),
     QT_TRANSLATE_NOOP("Parameters", "Square windows on one surface"),
     QT_TRANSLATE_NOOP("Parameters", "Cut windows at depth steps"),
     QT_TRANSLATE_NOOP("Parameters", "Step-cut levels"),
@@ -82,5 +82,12 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Smoothing tolerance"),
     QT_TRANSLATE_NOOP("Parameters", "Roof planes"),
     QT_TRANSLATE_NOOP("Parameters", "Roof plane area"),
+    QT_TRANSLATE_NOOP("Parameters", "Regularize"),
+    QT_TRANSLATE_NOOP("Parameters", "Regularize tolerance"),
+    QT_TRANSLATE_NOOP("Parameters", "Regularize min edge"),
+    QT_TRANSLATE_NOOP("Parameters", "Regularize min width"),
+    QT_TRANSLATE_NOOP("Parameters", "Regularize area change"),
+    QT_TRANSLATE_NOOP("Parameters", "Regularize energy margin"),
+    QT_TRANSLATE_NOOP("Parameters", "Regularize image edges"),
 };
 }  // namespace

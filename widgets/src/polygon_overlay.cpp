@@ -1,5 +1,7 @@
 #include "delineo/widgets/polygon_overlay.hpp"
 
+#include "delineo/core/error.hpp"
+
 #include <QContextMenuEvent>
 #include <QKeyEvent>
 #include <QMenu>
@@ -368,7 +370,10 @@ bool PolygonOverlay::mouseMove(QMouseEvent* event) {
   Drag& d = *drag_;
   const int n = static_cast<int>(d.original.size());
   d.preview = d.original;
-  if (d.kind == Drag::Kind::Vertex) {
+  if (event->modifiers() & Qt::ShiftModifier) {
+    // Shift keeps every edge's direction: the neighbours slide along the edges beyond them.
+    d.preview = keepingAngles(d, imagePos);
+  } else if (d.kind == Drag::Kind::Vertex) {
     d.preview[d.index] = snapVertex(d.original, d.index, imagePos);
   } else {
     const int j = (d.index + 1) % n;
@@ -390,6 +395,26 @@ bool PolygonOverlay::mouseMove(QMouseEvent* event) {
   }
   emit changed();
   return true;
+}
+
+QPolygonF PolygonOverlay::keepingAngles(const Drag& d, QPointF imagePos) const {
+  const core::Ring ring = toRing(d.original);
+  try {
+    if (d.kind == Drag::Kind::Vertex) {
+      if (ring.size() < 4) return d.original;  // a triangle has no angle-keeping move
+      return toQPolygon(core::moveCornerKeepingAngles(ring, d.index, {imagePos.x(), imagePos.y()}));
+    }
+    const int j = (d.index + 1) % static_cast<int>(d.original.size());
+    const QPointF along = d.original[j] - d.original[d.index];
+    const double length = std::hypot(along.x(), along.y());
+    if (length < 1e-9) return d.original;
+    // Offset along the edge's left normal (y down), as moveEdgeKeepingAngles takes it.
+    const QPointF delta = imagePos - d.pressImagePos;
+    const double offset = (delta.x() * along.y() - delta.y() * along.x()) / length;
+    return toQPolygon(core::moveEdgeKeepingAngles(ring, d.index, offset));
+  } catch (const core::Error&) {
+    return d.original;
+  }
 }
 
 bool PolygonOverlay::mouseRelease(QMouseEvent* event) {

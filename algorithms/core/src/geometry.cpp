@@ -1,5 +1,9 @@
 #include "delineo/core/geometry.hpp"
 
+#include <string>
+
+#include "delineo/core/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -105,6 +109,59 @@ cv::Mat rasterize(const Polygon& polygon, cv::Size size) {
     }
   }
   return mask;
+}
+
+
+namespace {
+
+double crossProduct(cv::Point2d a, cv::Point2d b) { return a.x * b.y - a.y * b.x; }
+
+bool lineIntersection(cv::Point2d a, cv::Point2d u, cv::Point2d b, cv::Point2d v,
+                      cv::Point2d& out) {
+  const double det = crossProduct(u, v);
+  if (std::abs(det) < 1e-12 * std::max(1.0, cv::norm(u) * cv::norm(v))) return false;
+  out = a + u * (crossProduct(b - a, v) / det);
+  return true;
+}
+
+void requireRing(const Ring& ring, int index, size_t minVertices) {
+  if (ring.size() < minVertices || index < 0 || static_cast<size_t>(index) >= ring.size()) {
+    throw Error(ErrorCode::InvalidParameter, "cannot move vertex or edge " + std::to_string(index) +
+                                                 " of a ring of " + std::to_string(ring.size()) +
+                                                 " vertices (at least " +
+                                                 std::to_string(minVertices) + " needed)");
+  }
+}
+
+}  // namespace
+
+Ring moveCornerKeepingAngles(const Ring& ring, int index, cv::Point2d to) {
+  requireRing(ring, index, 4);
+  const size_t n = ring.size(), i = static_cast<size_t>(index);
+  const size_t ip = (i + n - 1) % n, ipp = (i + n - 2) % n, in = (i + 1) % n, inn = (i + 2) % n;
+  Ring out = ring;
+  out[i] = to;
+  // The previous vertex stays on the edge arriving at it and on the line through `to` with the
+  // direction of its edge to the moved vertex; likewise the next one.
+  cv::Point2d p, q;
+  if (lineIntersection(ring[ipp], ring[ip] - ring[ipp], to, ring[i] - ring[ip], p)) out[ip] = p;
+  if (lineIntersection(ring[inn], ring[in] - ring[inn], to, ring[in] - ring[i], q)) out[in] = q;
+  return out;
+}
+
+Ring moveEdgeKeepingAngles(const Ring& ring, int index, double offset) {
+  requireRing(ring, index, 3);
+  const size_t n = ring.size(), i = static_cast<size_t>(index);
+  const size_t ip = (i + n - 1) % n, in = (i + 1) % n, inn = (i + 2) % n;
+  const cv::Point2d e = ring[in] - ring[i];
+  const double len = cv::norm(e);
+  if (len < 1e-12) return ring;
+  const cv::Point2d shift = cv::Point2d(e.y, -e.x) * (offset / len);  // left of e with y down
+  Ring out = ring;
+  cv::Point2d a, b;
+  if (lineIntersection(ring[ip], ring[i] - ring[ip], ring[i] + shift, e, a)) out[i] = a;
+  if (lineIntersection(ring[inn], ring[in] - ring[inn], ring[i] + shift, e, b)) out[in] = b;
+  return out;
 }
 
 }  // namespace delineo::core

@@ -307,7 +307,7 @@ TEST(Regularize, TakesAFewMillisecondsAtMost) {
 TEST(Regularize, EditingHelpersKeepTheAngles) {
   const core::Ring box = rotated(rectangle(0, 0, 60, 40), {30, 20}, 25);
   // Dragging a corner: a rectangle stays a rectangle, the opposite corner stays.
-  const core::Ring moved = moveCornerKeepingAngles(box, 2, box[2] + cv::Point2d(7, -3));
+  const core::Ring moved = core::moveCornerKeepingAngles(box, 2, box[2] + cv::Point2d(7, -3));
   ASSERT_EQ(moved.size(), 4u);
   EXPECT_LT(worstAngleError(moved), 1e-9);
   EXPECT_LT(cv::norm(moved[0] - box[0]), 1e-9);
@@ -315,11 +315,11 @@ TEST(Regularize, EditingHelpersKeepTheAngles) {
   // An L's inner edge (running west at y 30) moved 5 px to its left, i.e. south into the notch:
   // still six right angles, 30 x 5 px more area.
   const core::Ring l{{0, 0}, {60, 0}, {60, 30}, {30, 30}, {30, 70}, {0, 70}};
-  const core::Ring pushed = moveEdgeKeepingAngles(l, 2, 5.0);
+  const core::Ring pushed = core::moveEdgeKeepingAngles(l, 2, 5.0);
   EXPECT_LT(worstAngleError(pushed), 1e-9);
   EXPECT_NEAR(std::abs(core::signedArea(pushed)) - std::abs(core::signedArea(l)), 5.0 * 30.0, 1e-9);
   EXPECT_DOUBLE_EQ(pushed[2].y, 35.0);
   EXPECT_DOUBLE_EQ(pushed[3].y, 35.0);
-  EXPECT_THROW(moveCornerKeepingAngles({{0, 0}, {1, 0}, {0, 1}}, 0, {2, 2}), core::Error);
-  EXPECT_THROW(moveEdgeKeepingAngles(l, 6, 1.0), core::Error);
+  EXPECT_THROW(core::moveCornerKeepingAngles({{0, 0}, {1, 0}, {0, 1}}, 0, {2, 2}), core::Error);
+  EXPECT_THROW(core::moveEdgeKeepingAngles(l, 6, 1.0), core::Error);
 }

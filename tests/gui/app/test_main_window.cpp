@@ -396,6 +396,36 @@ class MainWindowTest : public QObject {
     window_->action(QStringLiteral("actionSnapEdges"))->setChecked(true);
   }
 
+  void regularizesAnEditedOutlineAsOneStep() {
+    if (!project::delineationAvailable()) QSKIP("no active polygon in this build");
+    gui::Document* doc = window_->document();
+    window_->selectBuilding(buildingId_);
+    // A hand-drawn outline of the building that zigzags by a pixel along its sides.
+    const cv::Rect truth = largestBuilding(doc->labels());
+    core::Ring jagged;
+    const double x0 = truth.x, y0 = truth.y, x1 = truth.br().x, y1 = truth.br().y;
+    for (int k = 0; k < 6; ++k) jagged.emplace_back(x0 + (x1 - x0) * k / 6.0, y0 + (k % 2));
+    for (int k = 0; k < 6; ++k) jagged.emplace_back(x1 - (k % 2), y0 + (y1 - y0) * k / 6.0);
+    for (int k = 0; k < 6; ++k) jagged.emplace_back(x1 - (x1 - x0) * k / 6.0, y1 - (k % 2));
+    for (int k = 0; k < 6; ++k) jagged.emplace_back(x0 + (k % 2), y1 - (y1 - y0) * k / 6.0);
+    doc->editRing(buildingId_, 0, jagged, QStringLiteral("Draw outline"));
+    QUndoStack* undo = doc->undoStack();
+    const int steps = undo->count();
+    QSignalSpy done(window_.get(), &MainWindow::regularizationFinished);
+    QAction* regularize = window_->action(QStringLiteral("actionRegularize"));
+    QVERIFY(regularize->isEnabled());
+    regularize->trigger();
+    QTRY_COMPARE_WITH_TIMEOUT(done.count(), 1, 60000);
+    const core::Ring squared = doc->project().find(buildingId_)->outline.outer;
+    QVERIFY2(squared.size() <= 6, qPrintable(QString::number(squared.size())));
+    QCOMPARE(undo->count(), steps + 1);
+    QVERIFY(undo->undoText().startsWith(QStringLiteral("Regularize building")));
+    undo->undo();
+    QVERIFY(doc->project().find(buildingId_)->outline.outer == jagged);
+    undo->redo();
+    QVERIFY(doc->project().find(buildingId_)->outline.outer == squared);
+  }
+
   void acceptsSavesReloadsAndExports() {
     gui::Document* doc = window_->document();
     window_->selectBuilding(buildingId_);

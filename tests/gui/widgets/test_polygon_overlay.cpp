@@ -154,6 +154,24 @@ TEST_F(EditFixture, ShiftDragMovesAWholeEdgeAlongItsNormalToo) {
   EXPECT_EQ(args.at(3).toString(), QStringLiteral("Move edge"));
 }
 
+TEST_F(EditFixture, ShiftDragOfAVertexKeepsEveryEdgesDirection) {
+  QSignalSpy spy(&view.polygons(), &PolygonOverlay::editRequested);
+  QTest::mousePress(&view, Qt::LeftButton, Qt::ShiftModifier, w(150, 50));
+  // A move event with Shift held (QTest's mouseMove carries no modifiers).
+  QMouseEvent move(QEvent::MouseMove, w(160, 45), view.mapToGlobal(w(160, 45)), Qt::NoButton, Qt::LeftButton,
+                   Qt::ShiftModifier);
+  QApplication::sendEvent(&view, &move);
+  QTest::mouseRelease(&view, Qt::LeftButton, Qt::ShiftModifier, w(160, 45));
+  ASSERT_EQ(spy.count(), 1);
+  const QPolygonF edited = lastRing(spy);
+  // The corner went where it was dragged and its neighbours slid along the edges beyond them:
+  // still a rectangle.
+  EXPECT_EQ(edited[1], QPointF(160, 45));
+  EXPECT_EQ(edited[0], QPointF(50, 45));
+  EXPECT_EQ(edited[2], QPointF(160, 150));
+  EXPECT_EQ(edited[3], QPointF(50, 150));
+}
+
 TEST_F(EditFixture, ClickingAnotherPolygonSelectsIt) {
   QSignalSpy spy(&view.polygons(), &PolygonOverlay::selectionChanged);
   QTest::mouseClick(&view, Qt::LeftButton, {}, w(175, 175));

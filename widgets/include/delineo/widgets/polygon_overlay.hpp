@@ -172,6 +172,8 @@ class PolygonOverlay : public QObject {
   void insertVertex(const Hit& hit);
   QList<QPolygonF> ringsOf(const OverlayPolygon& polygon) const;
   QPointF snapToEdge(QPointF pos, bool* snapped) const;
+  // The dragged ring with every edge keeping its direction (Shift held).
+  QPolygonF keepingAngles(const Drag& drag, QPointF imagePos) const;
   void updateHoverCursor();
 
   ImageView* view_;

@@ -40,4 +40,15 @@ bool isSimple(const Ring& ring);
 // centre is inside.
 cv::Mat rasterize(const Polygon& polygon, cv::Size size);
 
+// Editing an outline without changing its angles (the vertex editor's "keep the angles" drag,
+// e.g. on a regularized outline). Both return the changed ring; every edge keeps its direction,
+// so right angles stay right.
+// Moves vertex `index` to `to`; its two neighbours slide along the edges beyond them. Throws
+// Error(InvalidParameter) for fewer than 4 vertices or an index out of range.
+Ring moveCornerKeepingAngles(const Ring& ring, int index, cv::Point2d to);
+// Moves edge `index` (vertex index to index + 1) by `offset` px along its normal (positive: to
+// the left of its direction in image coordinates, x right and y down); its end vertices slide
+// along the neighbouring edges. Throws like moveCornerKeepingAngles (at least 3 vertices).
+Ring moveEdgeKeepingAngles(const Ring& ring, int index, double offset);
+
 }  // namespace delineo::core

@@ -110,15 +110,4 @@ RegularizationOutcome regularizeOutline(const core::Polygon& outline,
                                         const RegularizationParams& params,
                                         const cv::Mat& image = {});
 
-// Editing a regularized outline without losing its angles (the vertex editor's "keep right
-// angles" drag). Both return the changed ring; every edge keeps its direction, so right angles
-// stay right.
-// Moves vertex `index` to `to`; its two neighbours slide along the edges beyond them. Throws
-// core::Error(InvalidParameter) for fewer than 4 vertices or an index out of range.
-core::Ring moveCornerKeepingAngles(const core::Ring& ring, int index, cv::Point2d to);
-// Moves edge `index` (vertex index to index + 1) by `offset` px along its normal (positive: to
-// the left of its direction in image coordinates, x right and y down); its end vertices slide
-// along the neighbouring edges. Throws like moveCornerKeepingAngles (at least 3 vertices).
-core::Ring moveEdgeKeepingAngles(const core::Ring& ring, int index, double offset);
-
 }  // namespace delineo::delineation
