@@ -55,9 +55,6 @@ LabelledView plainRegions(const cv::Mat& grey, const cv::Mat& mask, int minArea)
     r.label = i;
     r.box = {stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP),
              stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT)};
-    // A region cut by the left or right border is cut at another place of the surface in the
-    // other view (the views are shifted along the rows): its shape does not tell its shift.
-    if (r.box.x == 0 || r.box.br().x == grey.cols) continue;
     r.cx = centroids.at<double>(i, 0);
     r.cy = centroids.at<double>(i, 1);
     r.grey = cv::mean(grey(r.box), view.labels(r.box) == i)[0];
@@ -168,7 +165,10 @@ std::vector<RegionSample> matchPlainRegions(const cv::Mat& leftGrey, const cv::M
           p.dx = dx;
         }
       }
-      if (p.overlap < settings.minOverlap) continue;
+      // The overlap must peak inside the shifts tried: at their end the true shift may lie
+      // beyond (a region cut by the image border or leaking into a neighbour in one view only
+      // has its centroid moved).
+      if (p.overlap < settings.minOverlap || std::abs(p.dx - guess) == search) continue;
       good.push_back(p);
       bestLeft[i].add(p.overlap);
       bestRight[j].add(p.overlap);
