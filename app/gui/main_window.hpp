@@ -153,6 +153,8 @@ class MainWindow : public QMainWindow {
   void createMenus();
   void restoreSettings();
   void installDocument(std::unique_ptr<Document> document);
+  void connectDocument(Document* doc);
+  bool relocateMissingImages(project::Project& loaded, const QString& path);
   bool maybeSave();
   void showMessage(const QString& title, const QString& text);
   bool askYesNo(const QString& title, const QString& text, bool defaultAnswer);
