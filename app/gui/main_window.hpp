@@ -150,7 +150,14 @@ class MainWindow : public QMainWindow {
   void createViews();
   void createDocks();
   void createActions();
+  void createFileActions();
+  void createToolActions();
+  void createBuildingActions();
+  void createEditActions();
+  void createViewActions();
   void createMenus();
+  void createLanguageMenu();
+  void createToolBar();
   void restoreSettings();
   void installDocument(std::unique_ptr<Document> document);
   void connectDocument(Document* doc);

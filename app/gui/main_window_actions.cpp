@@ -1,0 +1,359 @@
+// MainWindow's actions, menus and toolbar, and which actions are enabled.
+#include <QAction>
+#include <QActionGroup>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QMenu>
+#include <QMenuBar>
+#include <QSettings>
+#include <QToolBar>
+#include <QUndoStack>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "delineo/project/pipeline.hpp"
+#include "delineo/widgets/image_view.hpp"
+#include "delineo/widgets/polygon_overlay.hpp"
+#include "document.hpp"
+#include "main_window.hpp"
+
+namespace delineo::gui {
+
+using project::Building;
+using project::BuildingStatus;
+using widgets::ImageView;
+using widgets::InteractionMode;
+
+namespace {
+
+// A named action of `window`: its shortcut works wherever the focus is in the window.
+QAction* makeAction(QWidget* window, const QString& name, const QString& text, const QKeySequence& key = {}) {
+  auto* a = new QAction(text, window);
+  a->setObjectName(name);
+  if (!key.isEmpty()) a->setShortcut(key);
+  window->addAction(a);
+  return a;
+}
+
+}  // namespace
+
+// Every action is a child of the window named "action…" (action() finds it), with its shortcut
+// active whatever widget has the focus; the menus and the toolbar only show them.
+void MainWindow::createActions() {
+  createFileActions();
+  createToolActions();
+  createBuildingActions();
+  createEditActions();
+  createViewActions();
+}
+
+void MainWindow::createFileActions() {
+  connect(makeAction(this, QStringLiteral("actionOpen"), tr("&Open project…"), QKeySequence::Open),
+          &QAction::triggered, this, [this] {
+            if (!maybeSave()) return;
+            const QString start =
+                document_ ? document_->dialogFolder()
+                          : QSettings().value(QStringLiteral("lastProjectFolder")).toString();
+            const QString path = QFileDialog::getOpenFileName(this, tr("Open project"), start,
+                                                              tr("Delineo projects (*.json)"));
+            if (!path.isEmpty()) openProject(path);
+          });
+  connect(makeAction(this, QStringLiteral("actionNewFromPair"),
+                     tr("&New project from a stereo pair…"), QKeySequence::New),
+          &QAction::triggered, this, [this] {
+            if (!maybeSave()) return;
+            const QString filter = tr("Images (*.tif *.tiff *.png *.jpg)");
+            const QString left = QFileDialog::getOpenFileName(
+                this, tr("Left image (reference)"),
+                QSettings().value(QStringLiteral("lastImageFolder")).toString(), filter);
+            if (left.isEmpty()) return;
+            const QString right = QFileDialog::getOpenFileName(this, tr("Right image"),
+                                                               QFileInfo(left).path(), filter);
+            QSettings().setValue(QStringLiteral("lastImageFolder"), QFileInfo(left).absolutePath());
+            if (!right.isEmpty()) openPair(left, right);
+          });
+  connect(makeAction(this, QStringLiteral("actionOpenSample"), tr("Open the &sample project")),
+          &QAction::triggered, this, [this] {
+            if (maybeSave()) openSample();
+          });
+  connect(makeAction(this, QStringLiteral("actionSave"), tr("&Save"), QKeySequence::Save),
+          &QAction::triggered, this, &MainWindow::save);
+  connect(makeAction(this, QStringLiteral("actionSaveAs"), tr("Save &as…"), QKeySequence::SaveAs),
+          &QAction::triggered, this, [this] {
+            const QString path = QFileDialog::getSaveFileName(
+                this, tr("Save project"), document_ ? document_->dialogFolder() : QString(),
+                tr("Delineo projects (*.json)"));
+            if (!path.isEmpty()) saveAs(path);
+          });
+  connect(makeAction(this, QStringLiteral("actionProjectSettings"), tr("Project se&ttings…")),
+          &QAction::triggered, this, &MainWindow::openProjectSettings);
+  connect(makeAction(this, QStringLiteral("actionExport"), tr("&Export accepted buildings…"),
+                     QKeySequence(tr("Ctrl+E"))),
+          &QAction::triggered, this, [this] {
+            QString start = document_ ? document_->outputDirectory() : QString();
+            if (start.isEmpty() && document_) start = document_->dialogFolder();
+            const QString path = QFileDialog::getSaveFileName(
+                this, tr("Export accepted buildings"), start + QStringLiteral("/buildings.geojson"),
+                tr("GeoJSON (*.geojson);;GeoPackage (*.gpkg)"));
+            if (!path.isEmpty()) exportAccepted(path);
+          });
+  connect(makeAction(this, QStringLiteral("actionQuit"), tr("&Quit"), QKeySequence::Quit),
+          &QAction::triggered, this, &QWidget::close);
+}
+
+// The left view's interaction modes, one checked at a time.
+void MainWindow::createToolActions() {
+  toolGroup_ = new QActionGroup(this);
+  auto tool = [&](const QString& name, const QString& text, const QString& key, InteractionMode mode, const QString& tip) {
+    QAction* a = makeAction(this, name, text, QKeySequence(key));
+    a->setCheckable(true);
+    a->setToolTip(tip);
+    a->setStatusTip(tip);
+    toolGroup_->addAction(a);
+    connect(a, &QAction::triggered, this, [this, mode] { leftView_->setInteractionMode(mode); });
+    return a;
+  };
+  tool(QStringLiteral("actionNavigate"), tr("&Navigate"), QStringLiteral("N"), InteractionMode::Navigate,
+       tr("Pan with the mouse, zoom with the wheel, click a building to select it"))->setChecked(true);
+  tool(QStringLiteral("actionPickRectangle"), tr("Pick with a &rectangle"), QStringLiteral("B"),
+       InteractionMode::PickRectangle, tr("Drag a rectangle around a building"));
+  tool(QStringLiteral("actionPickPolygon"), tr("Pick with a &polygon"), QStringLiteral("P"),
+       InteractionMode::PickPolygon, tr("Click the corners of a rough polygon; double-click to close"));
+  tool(QStringLiteral("actionPickObject"), tr("Pick an above-ground &object"), QStringLiteral("O"),
+       InteractionMode::PickPoint, tr("Click a building: its above-ground region becomes the initial polygon"));
+  tool(QStringLiteral("actionEdit"), tr("&Edit outline"), QStringLiteral("E"), InteractionMode::EditPolygon,
+       tr("Drag a vertex or an edge of the selected building, Ctrl+drag to select vertices, "
+          "right-click for more; every change can be undone"));
+  connect(leftView_, &ImageView::interactionModeChanged, this, [this](InteractionMode mode) {
+    static const std::map<InteractionMode, QString> names = {
+        {InteractionMode::Navigate, QStringLiteral("actionNavigate")},
+        {InteractionMode::PickRectangle, QStringLiteral("actionPickRectangle")},
+        {InteractionMode::PickPolygon, QStringLiteral("actionPickPolygon")},
+        {InteractionMode::PickPoint, QStringLiteral("actionPickObject")},
+        {InteractionMode::EditPolygon, QStringLiteral("actionEdit")}};
+    if (QAction* a = action(names.at(mode))) a->setChecked(true);
+  });
+}
+
+// Processing and the selected building's commands.
+void MainWindow::createBuildingActions() {
+  connect(makeAction(this, QStringLiteral("actionMatch"), tr("Compute &disparity"),
+                     QKeySequence(tr("Ctrl+M"))),
+          &QAction::triggered, this, &MainWindow::startMatching);
+  connect(makeAction(this, QStringLiteral("actionDelineate"), tr("Run the active &polygon"),
+                     QKeySequence(tr("Ctrl+R"))),
+          &QAction::triggered, this, [this] { startDelineation(selectedId_); });
+  connect(makeAction(this, QStringLiteral("actionRegularize"), tr("Re&gularize outline")),
+          &QAction::triggered, this, [this] { startRegularization(selectedId_); });
+  action(QStringLiteral("actionRegularize"))
+      ->setStatusTip(tr(
+          "Square the selected outline: right angles, few vertices, within the tolerance of it"));
+  auto* onPick =
+      makeAction(this, QStringLiteral("actionDelineateOnPick"), tr("Delineate on &pick"));
+  onPick->setCheckable(true);
+  onPick->setChecked(QSettings().value(QStringLiteral("delineateOnPick"), true).toBool());
+  onPick->setStatusTip(
+      tr("Run the active polygon as soon as a building is picked, and again when its roof interval "
+         "changes"));
+  connect(onPick, &QAction::toggled, this,
+          [](bool on) { QSettings().setValue(QStringLiteral("delineateOnPick"), on); });
+  connect(makeAction(this, QStringLiteral("actionAccept"), tr("&Accept building"),
+                     QKeySequence(QStringLiteral("A"))),
+          &QAction::triggered, this, &MainWindow::acceptSelected);
+  connect(makeAction(this, QStringLiteral("actionReject"), tr("Re&ject building"),
+                     QKeySequence(QStringLiteral("X"))),
+          &QAction::triggered, this, &MainWindow::rejectSelected);
+  connect(makeAction(this, QStringLiteral("actionReopen"), tr("Re&open building")),
+          &QAction::triggered, this, [this] {
+            if (document_ && selectedId_ > 0) {
+              const Building* b = document_->project().find(selectedId_);
+              if (b)
+                document_->setStatus(selectedId_, b->hasOutline() ? BuildingStatus::Corrected
+                                                                  : BuildingStatus::Pending);
+            }
+          });
+  connect(makeAction(this, QStringLiteral("actionRemove"), tr("Re&move building"),
+                     QKeySequence::Delete),
+          &QAction::triggered, this, [this] {
+            if (document_ && selectedId_ > 0) {
+              const int id = selectedId_;
+              selectBuilding(-1);
+              document_->removeBuilding(id);
+            }
+          });
+  connect(makeAction(this, QStringLiteral("actionCancelJobs"), tr("&Cancel running jobs"),
+                     QKeySequence(Qt::Key_Escape)),
+          &QAction::triggered, jobs_, &widgets::JobRunner::cancelAll);
+}
+
+// Undo, redo and the snapping of edited outlines.
+void MainWindow::createEditActions() {
+  auto* undo = makeAction(this, QStringLiteral("actionUndo"), tr("&Undo"));
+  undo->setShortcuts({QKeySequence::Undo});
+  auto* redo = makeAction(this, QStringLiteral("actionRedo"), tr("&Redo"));
+  redo->setShortcuts({QKeySequence(tr("Ctrl+Y")), QKeySequence(tr("Ctrl+Shift+Z"))});
+  connect(undo, &QAction::triggered, this, [this] {
+    if (document_) document_->undoStack()->undo();
+  });
+  connect(redo, &QAction::triggered, this, [this] {
+    if (document_) document_->undoStack()->redo();
+  });
+
+  // Snapping while editing outlines: right angles to the neighbouring edges, and the image's
+  // own edges (an edge map of the left image computed when a project opens).
+  auto* snapAngles =
+      makeAction(this, QStringLiteral("actionSnapRightAngles"), tr("Snap to right &angles"));
+  snapAngles->setCheckable(true);
+  snapAngles->setChecked(QSettings().value(QStringLiteral("edit/snapRightAngles"), true).toBool());
+  snapAngles->setStatusTip(tr("While dragging, corners within 6° of a right angle become square"));
+  leftView_->polygons().setSnapToRightAngles(snapAngles->isChecked());
+  connect(snapAngles, &QAction::toggled, this, [this](bool on) {
+    leftView_->polygons().setSnapToRightAngles(on);
+    QSettings().setValue(QStringLiteral("edit/snapRightAngles"), on);
+  });
+  auto* snapEdges = makeAction(this, QStringLiteral("actionSnapEdges"), tr("Snap to image &edges"));
+  snapEdges->setCheckable(true);
+  snapEdges->setChecked(QSettings().value(QStringLiteral("edit/snapEdges"), true).toBool());
+  snapEdges->setStatusTip(
+      tr("While dragging, a vertex within 3 px of an edge of the left image lands on it"));
+  leftView_->polygons().setSnapToEdges(snapEdges->isChecked());
+  leftView_->polygons().setEdgeSnapRadius(3.0);
+  connect(snapEdges, &QAction::toggled, this, [this](bool on) {
+    leftView_->polygons().setSnapToEdges(on);
+    QSettings().setValue(QStringLiteral("edit/snapEdges"), on);
+  });
+}
+
+void MainWindow::createViewActions() {
+  // A label raster is reference material (ground truth of a simulated scene, a classification):
+  // an operator's project usually has none, and when it has one the outlines should be judged on
+  // the image first. So the overlay is off until asked for, and the choice is remembered.
+  auto* labels = makeAction(this, QStringLiteral("actionShowLabels"), tr("Show &labels"),
+                            QKeySequence(QStringLiteral("L")));
+  labels->setCheckable(true);
+  labels->setChecked(QSettings().value(QStringLiteral("view/showLabels"), false).toBool());
+  labels->setEnabled(false);
+  labels->setStatusTip(tr("Overlay the project's label raster (only when the project has one)"));
+  connect(labels, &QAction::toggled, this, [this](bool on) {
+    leftView_->setOverlayVisible(on);
+    QSettings().setValue(QStringLiteral("view/showLabels"), on);
+  });
+}
+
+void MainWindow::createMenus() {
+  QMenu* file = menuBar()->addMenu(tr("&File"));
+  file->addAction(action(QStringLiteral("actionNewFromPair")));
+  file->addAction(action(QStringLiteral("actionOpen")));
+  file->addAction(action(QStringLiteral("actionOpenSample")));
+  recentMenu_ = file->addMenu(tr("Open &recent"));
+  recentMenu_->setObjectName(QStringLiteral("recentMenu"));
+  file->addSeparator();
+  file->addAction(action(QStringLiteral("actionSave")));
+  file->addAction(action(QStringLiteral("actionSaveAs")));
+  file->addAction(action(QStringLiteral("actionExport")));
+  file->addAction(action(QStringLiteral("actionProjectSettings")));
+  file->addSeparator();
+  file->addAction(action(QStringLiteral("actionQuit")));
+
+  QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+  edit->addAction(action(QStringLiteral("actionUndo")));
+  edit->addAction(action(QStringLiteral("actionRedo")));
+  edit->addSeparator();
+  edit->addAction(action(QStringLiteral("actionSnapRightAngles")));
+  edit->addAction(action(QStringLiteral("actionSnapEdges")));
+
+  QMenu* building = menuBar()->addMenu(tr("&Building"));
+  for (const char* name : {"actionNavigate", "actionPickRectangle", "actionPickPolygon", "actionPickObject", "actionEdit"}) {
+    building->addAction(action(QString::fromLatin1(name)));
+  }
+  building->addSeparator();
+  building->addAction(action(QStringLiteral("actionDelineate")));
+  building->addAction(action(QStringLiteral("actionDelineateOnPick")));
+  building->addAction(action(QStringLiteral("actionRegularize")));
+  building->addAction(action(QStringLiteral("actionAccept")));
+  building->addAction(action(QStringLiteral("actionReject")));
+  building->addAction(action(QStringLiteral("actionReopen")));
+  building->addAction(action(QStringLiteral("actionRemove")));
+
+  QMenu* process = menuBar()->addMenu(tr("&Processing"));
+  process->addAction(action(QStringLiteral("actionMatch")));
+  process->addAction(action(QStringLiteral("actionDelineate")));
+  process->addAction(action(QStringLiteral("actionCancelJobs")));
+
+  QMenu* view = menuBar()->addMenu(tr("&View"));
+  view->addAction(action(QStringLiteral("actionShowLabels")));
+  view->addSeparator();
+  for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
+
+  createLanguageMenu();
+  createToolBar();
+  rebuildRecentMenu();
+}
+
+// Settings > Language: the choice applies at the next start.
+void MainWindow::createLanguageMenu() {
+  QMenu* settingsMenu = menuBar()->addMenu(tr("&Settings"));
+  QMenu* language = settingsMenu->addMenu(tr("&Language"));
+  auto* languages = new QActionGroup(this);
+  const QString current = QSettings().value(QStringLiteral("language")).toString();
+  for (const auto& [code, name] : std::vector<std::pair<QString, QString>>{
+           {QString(), tr("System default")}, {QStringLiteral("en"), QStringLiteral("English")},
+           {QStringLiteral("fr"), QStringLiteral("Français")}}) {
+    QAction* a = language->addAction(name);
+    a->setObjectName(QStringLiteral("actionLanguage_") + (code.isEmpty() ? QStringLiteral("system") : code));
+    a->setCheckable(true);
+    a->setChecked(code == current);
+    languages->addAction(a);
+    connect(a, &QAction::triggered, this, [this, code = code] { setLanguage(code); });
+  }
+}
+
+void MainWindow::createToolBar() {
+  auto* toolbar = addToolBar(tr("Tools"));
+  toolbar->setObjectName(QStringLiteral("toolsToolbar"));
+  for (const char* name : {"actionOpen", "actionSave", "actionUndo", "actionRedo", "actionNavigate",
+                           "actionPickRectangle", "actionPickPolygon", "actionPickObject", "actionEdit",
+                           "actionMatch", "actionDelineate", "actionAccept", "actionReject"}) {
+    toolbar->addAction(action(QString::fromLatin1(name)));
+  }
+}
+
+void MainWindow::updateActions() {
+  const bool hasDoc = document_ != nullptr;
+  const Building* b = hasDoc && selectedId_ > 0 ? document_->project().find(selectedId_) : nullptr;
+  action(QStringLiteral("actionSave"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionSaveAs"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionExport"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionMatch"))->setEnabled(hasDoc && project::matchingAvailable());
+  action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr && project::delineationAvailable());
+  action(QStringLiteral("actionRegularize"))
+      ->setEnabled(b != nullptr && b->hasOutline() && project::delineationAvailable());
+  action(QStringLiteral("actionAccept"))->setEnabled(b != nullptr && b->hasOutline() && b->status != BuildingStatus::Accepted);
+  action(QStringLiteral("actionReject"))->setEnabled(b != nullptr && b->status != BuildingStatus::Rejected);
+  action(QStringLiteral("actionReopen"))->setEnabled(
+      b != nullptr && (b->status == BuildingStatus::Accepted || b->status == BuildingStatus::Rejected));
+  action(QStringLiteral("actionRemove"))->setEnabled(b != nullptr);
+  action(QStringLiteral("actionCancelJobs"))->setEnabled(jobs_->activeCount() > 0);
+  QUndoStack* stack = hasDoc ? document_->undoStack() : nullptr;
+  QAction* undo = action(QStringLiteral("actionUndo"));
+  QAction* redo = action(QStringLiteral("actionRedo"));
+  undo->setEnabled(stack && stack->canUndo());
+  redo->setEnabled(stack && stack->canRedo());
+  undo->setText(stack && stack->canUndo() ? tr("&Undo %1").arg(stack->undoText()) : tr("&Undo"));
+  redo->setText(stack && stack->canRedo() ? tr("&Redo %1").arg(stack->redoText()) : tr("&Redo"));
+  // The toolbar keeps a short label (with the command's name the buttons after it moved into the
+  // overflow menu); the tooltip and the Edit menu name the command.
+  undo->setIconText(tr("Undo"));
+  redo->setIconText(tr("Redo"));
+  undo->setToolTip(QString(undo->text()).remove(QLatin1Char('&')));
+  redo->setToolTip(QString(redo->text()).remove(QLatin1Char('&')));
+}
+
+void MainWindow::setLanguage(const QString& code) {
+  QSettings().setValue(QStringLiteral("language"), code);
+  showMessage(tr("Language"), tr("The language will change the next time Delineo starts."));
+}
+
+}  // namespace delineo::gui
