@@ -225,15 +225,8 @@ void MainWindow::createViews() {
 
 void MainWindow::createDocks() {
   setDockOptions(QMainWindow::AnimatedDocks | QMainWindow::AllowTabbedDocks | QMainWindow::AllowNestedDocks);
-  auto makeDock = [this](const QString& name, const QString& title, QWidget* content, Qt::DockWidgetArea area) {
-    auto* dock = new QDockWidget(title, this);
-    dock->setObjectName(name);
-    dock->setWidget(content);
-    addDockWidget(area, dock);
-    return dock;
-  };
 
-  auto* rightDock = makeDock(QStringLiteral("rightDock"), tr("Right image"), rightView_, Qt::RightDockWidgetArea);
+  auto* rightDock = addDock(QStringLiteral("rightDock"), tr("Right image"), rightView_, Qt::RightDockWidgetArea);
 
   auto* disparityPage = new QWidget;
   auto* disparityLayout = new QHBoxLayout(disparityPage);
@@ -244,7 +237,7 @@ void MainWindow::createDocks() {
   disparityLegend_->setUnit(tr("px"));
   disparityLayout->addWidget(disparityView_, 1);
   disparityLayout->addWidget(disparityLegend_);
-  auto* disparityDock = makeDock(QStringLiteral("disparityDock"), tr("Disparity"), disparityPage, Qt::RightDockWidgetArea);
+  auto* disparityDock = addDock(QStringLiteral("disparityDock"), tr("Disparity"), disparityPage, Qt::RightDockWidgetArea);
 
   auto* demPage = new QWidget;
   auto* demLayout = new QGridLayout(demPage);
@@ -273,7 +266,7 @@ void MainWindow::createDocks() {
   demLayout->addWidget(demView_, 2, 0);
   demLayout->addWidget(demLegend_, 2, 1);
   connect(demMode_, &QComboBox::currentIndexChanged, this, [this] { refreshRasters(); });
-  auto* demDock = makeDock(QStringLiteral("demDock"), tr("DEM"), demPage, Qt::RightDockWidgetArea);
+  auto* demDock = addDock(QStringLiteral("demDock"), tr("DEM"), demPage, Qt::RightDockWidgetArea);
 
   view3DHost_ = new QWidget;
   auto* host3D = new QVBoxLayout(view3DHost_);
@@ -313,7 +306,7 @@ void MainWindow::createDocks() {
   view3DPlaceholder_->setAlignment(Qt::AlignCenter);
   view3DPlaceholder_->setWordWrap(true);
   host3D->addWidget(view3DPlaceholder_);
-  auto* view3DDock = makeDock(QStringLiteral("view3DDock"), tr("3D view"), view3DHost_, Qt::RightDockWidgetArea);
+  auto* view3DDock = addDock(QStringLiteral("view3DDock"), tr("3D view"), view3DHost_, Qt::RightDockWidgetArea);
   connect(view3DDock, &QDockWidget::visibilityChanged, this, [this](bool visible) {
     if (visible) ensure3DView();
   });
@@ -341,67 +334,18 @@ void MainWindow::createDocks() {
     if (row >= 0) buildingsTable_->selectRow(row);
     updatingSelection_ = false;
   });
-  makeDock(QStringLiteral("buildingsDock"), tr("Buildings"), buildingsTable_, Qt::LeftDockWidgetArea);
+  addDock(QStringLiteral("buildingsDock"), tr("Buildings"), buildingsTable_, Qt::LeftDockWidgetArea);
 
-  auto* paramsPage = new QWidget;
-  auto* paramsLayout = new QVBoxLayout(paramsPage);
-  auto* intervalTitle = new QLabel(tr("<b>Roof disparity interval</b> (drag on the histogram of the ROI; the line marks the ground)"));
-  intervalTitle->setWordWrap(true);
-  paramsLayout->addWidget(intervalTitle);
-  histogram_ = new widgets::DisparityHistogramWidget;
-  histogram_->setObjectName(QStringLiteral("histogram"));
-  histogram_->setToolTip(tr("Disparities inside the region of interest of the selected building. "
-                            "Drag the band or its handles to choose the roof interval [px]."));
-  paramsLayout->addWidget(histogram_);
-  intervalLabel_ = new QLabel;
-  intervalLabel_->setObjectName(QStringLiteral("intervalLabel"));
-  paramsLayout->addWidget(intervalLabel_);
-  connect(histogram_, &widgets::DisparityHistogramWidget::intervalChanged, this, [this](int a, int b) {
-    intervalLabel_->setText(tr("Roof: %1 .. %2 px").arg(a).arg(b));
-  });
-  connect(histogram_, &widgets::DisparityHistogramWidget::intervalEditingFinished, this, [this](int a, int b) {
-    if (!document_ || selectedId_ <= 0) return;
-    document_->setRoofInterval(selectedId_, {a, b});
-    // A new interval for an outline nobody has edited yet: the active polygon runs again with it.
-    const Building* building = document_->project().find(selectedId_);
-    if (building != nullptr && action(QStringLiteral("actionDelineateOnPick"))->isChecked() &&
-        (building->status == BuildingStatus::Pending || building->status == BuildingStatus::Automatic)) {
-      startDelineation(selectedId_);
-    }
-  });
-  auto* tabs = new QTabWidget;
-  delineationForm_ = new widgets::ParameterForm;
-  delineationForm_->setObjectName(QStringLiteral("delineationForm"));
-  matchingForm_ = new widgets::ParameterForm;
-  matchingForm_->setObjectName(QStringLiteral("matchingForm"));
-#ifdef DELINEO_HAVE_DELINEATION
-  delineationForm_->setParams(delineation::DelineationParams{});
-#endif
-#ifdef DELINEO_HAVE_STEREO
-  matchingForm_->setParams(stereo::MatchParams{});
-#endif
-  for (auto* form : {delineationForm_, matchingForm_}) {
-    connect(form, &widgets::ParameterForm::changed, this, [this, form] {
-      if (!updatingForms_) readFormIntoDocument(form);
-    });
-  }
-  auto* delineationScroll = new QScrollArea;
-  delineationScroll->setWidget(delineationForm_);
-  delineationScroll->setWidgetResizable(true);
-  auto* matchingPage = new QWidget;
-  auto* matchingLayout = new QVBoxLayout(matchingPage);
-  matchingLayout->setContentsMargins(0, 0, 0, 0);
-  matchingLayout->addWidget(createRangeEditor());
-  matchingLayout->addWidget(matchingForm_);
-  matchingLayout->addStretch(1);
-  auto* matchingScroll = new QScrollArea;
-  matchingScroll->setWidget(matchingPage);
-  matchingScroll->setWidgetResizable(true);
-  tabs->addTab(delineationScroll, tr("Active polygon"));
-  tabs->addTab(matchingScroll, tr("Matching"));
-  paramsLayout->addWidget(tabs, 1);
-  auto* paramsDock = makeDock(QStringLiteral("parametersDock"), tr("Parameters"), paramsPage, Qt::LeftDockWidgetArea);
-  Q_UNUSED(paramsDock);
+  createParametersDock();
+}
+
+QDockWidget* MainWindow::addDock(const QString& objectName, const QString& title, QWidget* content,
+                                  Qt::DockWidgetArea area) {
+  auto* dock = new QDockWidget(title, this);
+  dock->setObjectName(objectName);
+  dock->setWidget(content);
+  addDockWidget(area, dock);
+  return dock;
 }
 
 void MainWindow::restoreSettings() {
@@ -555,134 +499,6 @@ void MainWindow::syncRightView() {
   linkingRight_ = true;
   rightView_->setView(leftView_->viewCenter() - QPointF(rightShift_, 0.0), leftView_->zoom());
   linkingRight_ = false;
-}
-
-void MainWindow::refreshHistogram() {
-  histogram_->setValues({});
-  histogram_->clearGroundLevel();
-  intervalLabel_->clear();
-  leftView_->polygons().setRoi({});
-  if (!document_ || selectedId_ <= 0) return;
-  const Building* b = document_->project().find(selectedId_);
-  if (b == nullptr) return;
-  const cv::Rect2d box = core::boundingBox(b->initial.outer);
-  int margin = 24;
-#ifdef DELINEO_HAVE_DELINEATION
-  margin = project::parameters<delineation::DelineationParams>(document_->project(), "delineation").roiMargin;
-#endif
-  QRectF roi(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin);
-  roi &= QRectF(0, 0, document_->leftGrey().cols, document_->leftGrey().rows);
-  leftView_->polygons().setRoi(roi);
-  const cv::Mat& disparity = document_->disparity();
-  if (disparity.empty()) {
-    intervalLabel_->setText(tr("Compute the disparity to see the histogram."));
-    return;
-  }
-  const cv::Rect r(static_cast<int>(roi.left()), static_cast<int>(roi.top()), static_cast<int>(roi.width()),
-                   static_cast<int>(roi.height()));
-  const cv::Mat roiDisparities = disparity(r & cv::Rect(0, 0, disparity.cols, disparity.rows));
-  histogram_->setDisparities(roiDisparities);
-  if (auto ground = project::suggestGroundLevel(disparity, b->initial)) histogram_->setGroundLevel(*ground);
-  std::optional<project::DisparityInterval> interval = b->roofInterval;
-  if (!interval) interval = project::suggestRoofInterval(disparity, b->initial);
-  QString text;
-  if (interval) {
-    histogram_->setInterval(interval->low, interval->high);
-    text = tr("Roof: %1 .. %2 px").arg(interval->low).arg(interval->high);
-  }
-  const QString warning = rangeEndWarning(roiDisparities);
-  if (!warning.isEmpty()) {
-    text += QStringLiteral("<br><span style=\"color:#b00000\">%1</span>").arg(warning.toHtmlEscaped());
-    statusBar()->showMessage(warning, 15000);
-  }
-  intervalLabel_->setText(text);
-}
-
-QString MainWindow::rangeEndWarning(const cv::Mat& roiDisparities) const {
-  const auto& range = document_->project().disparityRange;
-  if (!range || roiDisparities.empty()) return {};
-  // Matches piled up against an end of the searched range stand for disparities beyond it
-  // (the matcher cannot return what it did not search).
-  int finite = 0, atEnd = 0;
-  for (int y = 0; y < roiDisparities.rows; ++y) {
-    const float* row = roiDisparities.ptr<float>(y);
-    for (int x = 0; x < roiDisparities.cols; ++x) {
-      if (!std::isfinite(row[x])) continue;
-      ++finite;
-      if (row[x] >= static_cast<float>(range->high) - 1.0f || row[x] <= static_cast<float>(range->low) + 1.0f) ++atEnd;
-    }
-  }
-  const double total = static_cast<double>(roiDisparities.total());
-  if (finite > 0 && atEnd >= std::max(20.0, 0.02 * finite)) {
-    return tr("%1 % of the disparities here lie at an end of the matched range (%2..%3 px): the roof may lie "
-              "beyond it. Widen the range on the Matching tab and compute the disparity again.")
-        .arg(100.0 * atEnd / finite, 0, 'f', 0)
-        .arg(range->low)
-        .arg(range->high);
-  }
-  if (finite < 0.5 * total) {
-    return tr("Most of this region has no disparity: the roof may lie outside the matched range (%1..%2 px).")
-        .arg(range->low)
-        .arg(range->high);
-  }
-  return {};
-}
-
-QWidget* MainWindow::createRangeEditor() {
-  auto* box = new QGroupBox(tr("Disparity search range of the pair"));
-  box->setObjectName(QStringLiteral("rangeEditor"));
-  auto* layout = new QGridLayout(box);
-  rangeMin_ = new QSpinBox;
-  rangeMin_->setObjectName(QStringLiteral("rangeMin"));
-  rangeMax_ = new QSpinBox;
-  rangeMax_->setObjectName(QStringLiteral("rangeMax"));
-  for (QSpinBox* spin : {rangeMin_, rangeMax_}) {
-    spin->setRange(-100000, 100000);
-    spin->setSuffix(tr(" px"));
-    spin->setKeyboardTracking(false);
-  }
-  rangeMin_->setToolTip(tr("Smallest disparity searched (x_right = x_left − d)"));
-  rangeMax_->setToolTip(tr("Largest disparity searched; the roofs' disparities must lie below it"));
-  layout->addWidget(new QLabel(tr("Minimum")), 0, 0);
-  layout->addWidget(rangeMin_, 0, 1);
-  layout->addWidget(new QLabel(tr("Maximum")), 0, 2);
-  layout->addWidget(rangeMax_, 0, 3);
-  auto* estimate = new QPushButton(tr("Estimate from the images"));
-  estimate->setObjectName(QStringLiteral("estimateRange"));
-  estimate->setToolTip(tr("Read the range from feature matches between the two images"));
-  connect(estimate, &QPushButton::clicked, this, [this] { startRangeEstimate(false); });
-  layout->addWidget(estimate, 1, 0, 1, 4);
-  rangeNote_ = new QLabel;
-  rangeNote_->setObjectName(QStringLiteral("rangeNote"));
-  rangeNote_->setWordWrap(true);
-  layout->addWidget(rangeNote_, 2, 0, 1, 4);
-  auto commit = [this] {
-    if (!document_ || updatingForms_) return;
-    const int lo = rangeMin_->value(), hi = rangeMax_->value();
-    if (lo > hi) {
-      showMessage(tr("Disparity range"), tr("The minimum disparity must not exceed the maximum."));
-      loadRangeFromDocument();
-      return;
-    }
-    rangeSource_.clear();
-    document_->setDisparityRange(project::DisparityInterval{lo, hi}, tr("Disparity range %1..%2 px").arg(lo).arg(hi));
-  };
-  connect(rangeMin_, &QSpinBox::valueChanged, this, commit);
-  connect(rangeMax_, &QSpinBox::valueChanged, this, commit);
-  return box;
-}
-
-void MainWindow::loadRangeFromDocument() {
-  if (!document_) return;
-  updatingForms_ = true;
-  const auto& range = document_->project().disparityRange;
-  rangeMin_->setValue(range ? range->low : 0);
-  rangeMax_->setValue(range ? range->high : 0);
-  updatingForms_ = false;
-  const QString use = tr("Every computation (matching, the active polygon) searches this range; compute the "
-                         "disparity again after changing it.");
-  rangeNote_->setText(!range ? tr("Not set yet: estimated from the images when the disparity is computed.")
-                             : rangeSource_.isEmpty() ? use : rangeSource_ + QLatin1Char(' ') + use);
 }
 
 void MainWindow::refreshHeightModelNotice() {
@@ -890,45 +706,6 @@ void MainWindow::rejectSelected() {
 
 // ------------------------------------------------------------------------------------------
 // parameters
-
-void MainWindow::readFormIntoDocument(const widgets::ParameterForm* form) {
-  Q_UNUSED(form);  // (in a build without both algorithms)
-  if (!document_) return;
-  // Only the edited form's group is written: one edit, one undo entry. Writing a group reloads
-  // both forms from the project, and the other form shows its stored group already (each edit
-  // is written at once), so nothing of it is lost. (Writing both groups made two undo entries
-  // when the stored one lacked a field, and, written in the wrong order, lost the edit.)
-#ifdef DELINEO_HAVE_DELINEATION
-  if (form == delineationForm_) {
-    auto params = project::parameters<delineation::DelineationParams>(document_->project(), "delineation");
-    delineationForm_->readInto(params);
-    document_->setParameters("delineation", core::toJson(params));
-  }
-#endif
-#ifdef DELINEO_HAVE_STEREO
-  if (form == matchingForm_) {
-    auto params = project::parameters<stereo::MatchParams>(document_->project(), "matching");
-    matchingForm_->readInto(params);
-    document_->setParameters("matching", core::toJson(params));
-  }
-#endif
-}
-
-void MainWindow::loadFormsFromDocument() {
-  if (!document_) return;
-  updatingForms_ = true;
-  try {
-#ifdef DELINEO_HAVE_DELINEATION
-    delineationForm_->setValues(project::parameters<delineation::DelineationParams>(document_->project(), "delineation"));
-#endif
-#ifdef DELINEO_HAVE_STEREO
-    matchingForm_->setValues(project::parameters<stereo::MatchParams>(document_->project(), "matching"));
-#endif
-  } catch (const core::Error& e) {
-    showMessage(tr("Parameters"), errorMessage(e));
-  }
-  updatingForms_ = false;
-}
 
 // ------------------------------------------------------------------------------------------
 // jobs

@@ -26,6 +26,7 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QStackedWidget;
+class QTabWidget;
 class QSpinBox;
 
 namespace delineo::widgets {
@@ -149,6 +150,10 @@ class MainWindow : public QMainWindow {
  private:
   void createViews();
   void createDocks();
+  void createParametersDock();
+  QTabWidget* createParameterTabs();
+  QDockWidget* addDock(const QString& objectName, const QString& title, QWidget* content,
+                       Qt::DockWidgetArea area);
   void createActions();
   void createFileActions();
   void createToolActions();
