@@ -150,6 +150,10 @@ class MainWindow : public QMainWindow {
  private:
   void createViews();
   void createDocks();
+  QDockWidget* createDisparityDock();
+  QDockWidget* createDemDock();
+  QDockWidget* create3DDock();
+  void createBuildingsDock();
   void createParametersDock();
   QTabWidget* createParameterTabs();
   QDockWidget* addDock(const QString& objectName, const QString& title, QWidget* content,
