@@ -234,57 +234,6 @@ void MainWindow::refresh3D() {
 // ------------------------------------------------------------------------------------------
 // buildings
 
-void MainWindow::selectBuilding(int id) {
-  if (document_ && id > 0 && document_->project().find(id) == nullptr) id = -1;
-  const bool changed = id != selectedId_;
-  selectedId_ = id;
-  updatingSelection_ = true;
-  for (ImageView* v : {leftView_, rightView_, disparityView_, demView_}) v->polygons().setSelectedId(id);
-  rightShift_ = roofDisparity(id).value_or(document_ ? document_->project().height.groundDisparity : 0.0);
-  const int row = buildingsModel_->rowOf(id);
-  if (row >= 0) buildingsTable_->selectRow(row);
-  else buildingsTable_->clearSelection();
-  updatingSelection_ = false;
-  if (id > 0) {
-    const cv::Rect2d box = core::boundingBox(document_->project().find(id)->currentPolygon().outer);
-    leftView_->setViewCenter(QPointF(box.x + box.width / 2, box.y + box.height / 2));
-  }
-  syncRightView();
-  if (changed) frame3D();
-  refreshHistogram();
-  updateActions();
-  if (changed) emit selectedBuildingChanged(id);
-}
-
-void MainWindow::onSelectionFromOverlay(int id) {
-  if (updatingSelection_ || id == selectedId_) return;
-  selectBuilding(id);
-}
-
-void MainWindow::onSelectionFromTable() {
-  if (updatingSelection_) return;
-  const auto rows = buildingsTable_->selectionModel()->selectedRows();
-  const int id = rows.isEmpty() ? -1 : buildingsModel_->idAt(rows.first().row());
-  if (id != selectedId_) selectBuilding(id);
-}
-
-void MainWindow::onPicked(const core::Polygon& polygon) {
-  if (!document_) return;
-  if (polygon.outer.size() < 3 || core::area(polygon) < 16.0 || !core::isSimple(polygon.outer)) {
-    showMessage(tr("Pick a building"), tr("The picked shape is too small or crosses itself; draw it again."));
-    return;
-  }
-  const int id = document_->addBuilding(polygon);
-  selectBuilding(id);
-  leftView_->setInteractionMode(InteractionMode::Navigate);
-  // The pick is the request: the active polygon starts at once with the proposed interval (or
-  // as soon as the disparity is there).
-  if (action(QStringLiteral("actionDelineateOnPick"))->isChecked()) {
-    if (document_->disparity().empty()) awaitingDisparity_ = id;
-    else startDelineation(id);
-  }
-}
-
 void MainWindow::onObjectPicked(QPointF imagePos) {
   if (!document_) return;
   const cv::Mat& dem = document_->dem();
@@ -324,28 +273,6 @@ void MainWindow::onObjectPicked(QPointF imagePos) {
   core::Polygon p;
   for (const auto& q : simplified) p.outer.emplace_back(q.x + 0.5, q.y + 0.5);
   onPicked(p);
-}
-
-void MainWindow::onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description) {
-  if (!document_) return;
-  const core::Ring newRing = widgets::toRing(ring);
-  if (!core::isSimple(newRing)) {
-    showMessage(tr("Edit outline"), tr("That change would make the outline cross itself; it was not applied."));
-    refreshOverlays();
-    return;
-  }
-  document_->editRing(id, ringIndex, newRing, description);
-}
-
-void MainWindow::acceptSelected() {
-  if (!document_ || selectedId_ <= 0) return;
-  const Building* b = document_->project().find(selectedId_);
-  if (b == nullptr || !b->hasOutline()) return;
-  document_->setStatus(selectedId_, BuildingStatus::Accepted);
-}
-
-void MainWindow::rejectSelected() {
-  if (document_ && selectedId_ > 0) document_->setStatus(selectedId_, BuildingStatus::Rejected);
 }
 
 // ------------------------------------------------------------------------------------------

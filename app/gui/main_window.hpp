@@ -189,6 +189,8 @@ class MainWindow : public QMainWindow {
   void onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description);
   void onSelectionFromOverlay(int id);
   void onSelectionFromTable();
+  void reopenSelected();
+  void removeSelected();
   void addRecent(const QString& path);
   void rebuildRecentMenu();
   void setLanguage(const QString& code);

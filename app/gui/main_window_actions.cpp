@@ -166,23 +166,10 @@ void MainWindow::createBuildingActions() {
                      QKeySequence(QStringLiteral("X"))),
           &QAction::triggered, this, &MainWindow::rejectSelected);
   connect(makeAction(this, QStringLiteral("actionReopen"), tr("Re&open building")),
-          &QAction::triggered, this, [this] {
-            if (document_ && selectedId_ > 0) {
-              const Building* b = document_->project().find(selectedId_);
-              if (b)
-                document_->setStatus(selectedId_, b->hasOutline() ? BuildingStatus::Corrected
-                                                                  : BuildingStatus::Pending);
-            }
-          });
+          &QAction::triggered, this, &MainWindow::reopenSelected);
   connect(makeAction(this, QStringLiteral("actionRemove"), tr("Re&move building"),
                      QKeySequence::Delete),
-          &QAction::triggered, this, [this] {
-            if (document_ && selectedId_ > 0) {
-              const int id = selectedId_;
-              selectBuilding(-1);
-              document_->removeBuilding(id);
-            }
-          });
+          &QAction::triggered, this, &MainWindow::removeSelected);
   connect(makeAction(this, QStringLiteral("actionCancelJobs"), tr("&Cancel running jobs"),
                      QKeySequence(Qt::Key_Escape)),
           &QAction::triggered, jobs_, &widgets::JobRunner::cancelAll);
