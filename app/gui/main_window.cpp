@@ -1,73 +1,35 @@
+// MainWindow itself: construction, the window's settings, messages and title; also the 3D view's
+// content and the pick of an above-ground object. The rest of the class is in main_window_*.cpp,
+// one file per part (listed in main_window.hpp).
 #include "main_window.hpp"
 
 #include <QAction>
-#include <QActionGroup>
-#include <QApplication>
 #include <QCloseEvent>
 #include <QComboBox>
-#include <QDir>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
-#include <QFileDialog>
-#include <QFileInfo>
-#include <QFormLayout>
-#include <QGridLayout>
-#include <QGroupBox>
-#include <QHBoxLayout>
-#include <QGuiApplication>
-#include <QHeaderView>
-#include <QLabel>
-#include <QMenu>
-#include <QMenuBar>
 #include <QMessageBox>
-#include <QMetaObject>
-#include <QPushButton>
-#include <QScopedValueRollback>
-#include <QSignalBlocker>
-#include <QSpinBox>
-#include <QScrollArea>
 #include <QSettings>
-#include <QStandardPaths>
+#include <QSignalBlocker>
 #include <QStatusBar>
-#include <QTabWidget>
-#include <QTableView>
-#include <QToolBar>
-#include <QUndoStack>
-#include <QVBoxLayout>
+#include <algorithm>
 #include <cmath>
-#include <map>
-#include <mutex>
-#include <utility>
+#include <optional>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
-#include "buildings_model.hpp"
 #include "delineo/core/error.hpp"
-#include "delineo/project/edge_map.hpp"
-#include "delineo/project/pipeline.hpp"
-#include "delineo/widgets/colour_maps.hpp"
-#include "delineo/widgets/disparity_histogram.hpp"
 #include "delineo/widgets/image_view.hpp"
-#include "delineo/widgets/parameter_form.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "delineo/widgets/terrain3d_view.hpp"
 #include "document.hpp"
 #include "error_text.hpp"
-#include "project_settings_dialog.hpp"
-
-#ifdef DELINEO_HAVE_DELINEATION
-#include "delineo/delineation/params.hpp"
-#endif
-#ifdef DELINEO_HAVE_STEREO
-#include "delineo/stereo/match.hpp"
-#endif
 
 namespace delineo::gui {
 
 using project::Building;
 using project::BuildingStatus;
-using widgets::ImageView;
-using widgets::InteractionMode;
 
 namespace {
 
@@ -138,9 +100,6 @@ MainWindow::~MainWindow() {
   jobs_->waitForIdle(30000);
 }
 
-// ------------------------------------------------------------------------------------------
-// construction
-
 void MainWindow::restoreSettings() {
   QSettings settings;
   resize(1400, 900);
@@ -182,9 +141,6 @@ bool MainWindow::askYesNo(const QString& title, const QString& text, bool defaul
                                defaultAnswer ? QMessageBox::Yes : QMessageBox::No) == QMessageBox::Yes;
 }
 
-// ------------------------------------------------------------------------------------------
-// documents
-
 void MainWindow::closeEvent(QCloseEvent* event) {
   if (!maybeSave()) {
     event->ignore();
@@ -197,9 +153,6 @@ void MainWindow::closeEvent(QCloseEvent* event) {
   event->accept();
 }
 
-// ------------------------------------------------------------------------------------------
-// refresh
-
 void MainWindow::refreshTitle() {
   QString title = QStringLiteral("Delineo");
   if (document_) title = document_->displayName() + QStringLiteral("[*] — Delineo");
@@ -207,6 +160,10 @@ void MainWindow::refreshTitle() {
   setWindowModified(document_ && document_->isModified());
 }
 
+// ------------------------------------------------------------------------------------------
+// 3D view
+
+// The DEM, its texture and the extruded outlines of the buildings with a roof height.
 void MainWindow::refresh3D() {
   if (view3D_ == nullptr || !document_) return;
   if (document_->dem().empty()) return;
@@ -232,7 +189,7 @@ void MainWindow::refresh3D() {
 }
 
 // ------------------------------------------------------------------------------------------
-// buildings
+// picking an above-ground object
 
 void MainWindow::onObjectPicked(QPointF imagePos) {
   if (!document_) return;
@@ -274,11 +231,5 @@ void MainWindow::onObjectPicked(QPointF imagePos) {
   for (const auto& q : simplified) p.outer.emplace_back(q.x + 0.5, q.y + 0.5);
   onPicked(p);
 }
-
-// ------------------------------------------------------------------------------------------
-// parameters
-
-// ------------------------------------------------------------------------------------------
-// jobs
 
 }  // namespace delineo::gui

@@ -148,16 +148,47 @@ class MainWindow : public QMainWindow {
   void closeEvent(QCloseEvent* event) override;
 
  private:
+  // The private functions, grouped by the file that defines them.
+  // main_window.cpp: the window's settings, messages and title, the 3D view's content, the pick
+  // of an above-ground object.
+  void restoreSettings();
+  void showMessage(const QString& title, const QString& text);
+  bool askYesNo(const QString& title, const QString& text, bool defaultAnswer);
+  void refreshTitle();
+  void refresh3D();
+  void onObjectPicked(QPointF imagePos);
+
+  // main_window_views.cpp: the image views, what they show, the cursor readout.
   void createViews();
+  void refreshRasters();
+  void refreshOverlays();
+  void syncRightView();
+  void updateReadout(QPointF imagePos, bool leftGeometry, const cv::Mat& ownGrey);
+
+  // main_window_docks.cpp: the docks around the left view.
   void createDocks();
   QDockWidget* createDisparityDock();
   QDockWidget* createDemDock();
   QDockWidget* create3DDock();
   void createBuildingsDock();
-  void createParametersDock();
-  QTabWidget* createParameterTabs();
   QDockWidget* addDock(const QString& objectName, const QString& title, QWidget* content,
                        Qt::DockWidgetArea area);
+  void ensure3DView();
+  void frame3D();
+  void refreshHeightModelNotice();
+
+  // main_window_parameters.cpp: the roof interval histogram, the range editor, the forms.
+  void createParametersDock();
+  QTabWidget* createParameterTabs();
+  void refreshHistogram();
+  // The warning shown when the selected building's disparities reach the matched range's end.
+  QString rangeEndWarning(const cv::Mat& roiDisparities) const;
+  QWidget* createRangeEditor();
+  void loadRangeFromDocument();
+  void readFormIntoDocument(const widgets::ParameterForm* form);
+  void loadFormsFromDocument();
+
+  // main_window_actions.cpp: actions, menus, toolbar.
   void createActions();
   void createFileActions();
   void createToolActions();
@@ -167,42 +198,28 @@ class MainWindow : public QMainWindow {
   void createMenus();
   void createLanguageMenu();
   void createToolBar();
-  void restoreSettings();
+  void updateActions();
+  void setLanguage(const QString& code);
+
+  // main_window_project.cpp: opening, saving, exporting, recent projects.
+  bool relocateMissingImages(project::Project& loaded, const QString& path);
   void installDocument(std::unique_ptr<Document> document);
   void connectDocument(Document* doc);
-  bool relocateMissingImages(project::Project& loaded, const QString& path);
   bool maybeSave();
-  void showMessage(const QString& title, const QString& text);
-  bool askYesNo(const QString& title, const QString& text, bool defaultAnswer);
-  void refreshTitle();
-  void refreshRasters();
-  void refreshOverlays();
-  void refreshHistogram();
-  void refresh3D();
-  void startEdgeMap();
-  void frame3D();
-  void syncRightView();
-  void updateActions();
-  void updateReadout(QPointF imagePos, bool leftGeometry, const cv::Mat& ownGrey);
-  void onPicked(const core::Polygon& polygon);
-  void onObjectPicked(QPointF imagePos);
-  void onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description);
-  void onSelectionFromOverlay(int id);
-  void onSelectionFromTable();
-  void reopenSelected();
-  void removeSelected();
   void addRecent(const QString& path);
   void rebuildRecentMenu();
-  void setLanguage(const QString& code);
-  void ensure3DView();
-  void readFormIntoDocument(const widgets::ParameterForm* form);
-  void loadFormsFromDocument();
-  QWidget* createRangeEditor();
-  void loadRangeFromDocument();
-  void refreshHeightModelNotice();
-  // The warning shown when the selected building's disparities reach the matched range's end.
-  QString rangeEndWarning(const cv::Mat& roiDisparities) const;
   void rememberFolder(const QString& path);
+
+  // main_window_buildings.cpp: selection, picks, outline edits, status changes.
+  void onSelectionFromOverlay(int id);
+  void onSelectionFromTable();
+  void onPicked(const core::Polygon& polygon);
+  void onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description);
+  void reopenSelected();
+  void removeSelected();
+
+  // main_window_jobs.cpp: the background jobs (the others are public).
+  void startEdgeMap();
 
   std::unique_ptr<Document> document_;
   widgets::JobRunner* jobs_ = nullptr;
