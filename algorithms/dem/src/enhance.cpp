@@ -145,6 +145,126 @@ cv::Rect paintFootprint(const core::Polygon& polygon, size_t index, cv::Mat& lab
   return cv::boundingRect(mask) + roi.tl();
 }
 
+// Median of the finite values of `values` under non-zero `mask`; NaN when there is none.
+// `count` receives how many values there were.
+double medianUnder(const cv::Mat& values, const cv::Mat& mask, int& count) {
+  std::vector<float> v;
+  for (int y = 0; y < values.rows; ++y) {
+    const float* row = values.ptr<float>(y);
+    const uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < values.cols; ++x) {
+      if (m[x] != 0 && std::isfinite(row[x])) v.push_back(row[x]);
+    }
+  }
+  count = static_cast<int>(v.size());
+  if (v.empty()) return std::nan("");
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// The parts of `mask` at least `size` px thick (a morphological opening by a size x size square).
+cv::Mat thickParts(const cv::Mat& mask, int size) {
+  cv::Mat opened;
+  cv::morphologyEx(mask, opened, cv::MORPH_OPEN, cv::Mat::ones(size, size, CV_8U));
+  return opened;
+}
+
+// Checks footprint `label` against the DEM and corrects its pixels in `labels` where the two
+// disagree over more than params.outlineTolerance px: ground inside the outline (a strip of
+// ground, a courtyard the outline left out) leaves the footprint; roof outside it (a roof part
+// the outline missed, within params.outlineReach px) joins it. Thinner disagreements (the
+// matcher's fattening of a roof, an outline a pixel or two off) follow the outline. Roof and
+// ground are told apart by the midpoint between the roof's median height and the median height
+// of the ground around the footprint; a footprint whose roof does not stand clear of its ground
+// is left as it is. Paints its free roof pixels into `roofAround` (for the outer band) and
+// returns the bounding box of the footprint's pixels afterwards.
+cv::Rect reconcileFootprint(const cv::Mat& dem, cv::Mat& labels, int label, cv::Rect box,
+                            const EnhanceParams& params, FootprintEnhancement& info,
+                            cv::Mat& roofAround) {
+  const int groundReach = 2 * params.wallBand + params.groundWindow;
+  const int grow = std::max(params.outlineReach, params.wallBand + groundReach) + 2;
+  const cv::Rect roi = (box - cv::Point(grow, grow) + cv::Size(2 * grow, 2 * grow)) &
+                       cv::Rect(0, 0, dem.cols, dem.rows);
+  cv::Mat own = labels(roi);
+  const cv::Mat heights = dem(roi);
+  const cv::Mat inside = own == label, free = own == 0;
+  cv::Mat depth, away;
+  cv::distanceTransform(inside, depth, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(~inside, away, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  int roofCount = 0, groundCount = 0;
+  cv::Mat core = inside & (depth > params.wallBand);
+  if (cv::countNonZero(core) == 0) core = inside;
+  info.roofHeight = medianUnder(heights, core, roofCount);
+  const cv::Mat ring = free & (away > params.wallBand) & (away <= params.wallBand + groundReach);
+  info.groundHeight = medianUnder(heights, ring, groundCount);
+  const double step = info.roofHeight - info.groundHeight;
+  constexpr int kMinSamples = 8;
+  if (params.outlineTolerance == 0 || roofCount < kMinSamples || groundCount < kMinSamples ||
+      !(step > 0)) {
+    return box;
+  }
+  // Heights below the midpoint are ground; within half a step of the roof's, roof.
+  const double mid = info.roofHeight - 0.5 * step, top = info.roofHeight + 0.5 * step;
+  const cv::Mat finite = core::numberMask(heights);
+  const cv::Mat groundLike = finite & (heights < mid);
+  const cv::Mat roofLike = finite & (heights >= mid) & (heights < top);
+  const int size = params.outlineTolerance + 1;
+  cv::Mat around = roofAround(roi);
+  around.setTo(255, free & roofLike);
+
+  // Ground inside: thick parts anywhere, and any ground in the wall band that reaches the ground
+  // outside (the matcher fattens roofs outwards, so ground seen inside the outline is ground).
+  cv::Mat removed = thickParts(inside & groundLike, size);
+  {
+    cv::Mat parts;
+    const int m = cv::connectedComponents(groundLike & (free | (inside & (depth <= params.wallBand))),
+                                          parts, 8, CV_32S);
+    std::vector<uchar> outside(static_cast<size_t>(m), 0);
+    for (int y = 0; y < roi.height; ++y) {
+      for (int x = 0; x < roi.width; ++x) {
+        if (free.at<uchar>(y, x) != 0) outside[static_cast<size_t>(parts.at<int>(y, x))] = 1;
+      }
+    }
+    for (int y = 0; y < roi.height; ++y) {
+      for (int x = 0; x < roi.width; ++x) {
+        const int c = parts.at<int>(y, x);
+        if (c > 0 && outside[static_cast<size_t>(c)] != 0 && inside.at<uchar>(y, x) != 0) {
+          removed.at<uchar>(y, x) = 255;
+        }
+      }
+    }
+  }
+  // Roof outside the outline joins when its thick part touches the footprint.
+  const cv::Mat candidates = thickParts(free & roofLike & (away <= params.outlineReach), size);
+  cv::Mat components;
+  const int n = cv::connectedComponents(candidates, components, 8, CV_32S);
+  std::vector<uchar> touches(static_cast<size_t>(n), 0);
+  cv::Mat near;
+  cv::dilate(inside & ~removed, near, cv::Mat::ones(3, 3, CV_8U));
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      const int c = components.at<int>(y, x);
+      if (c > 0 && near.at<uchar>(y, x) != 0) touches[static_cast<size_t>(c)] = 1;
+    }
+  }
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      int& l = own.at<int>(y, x);
+      if (removed.at<uchar>(y, x) != 0) {
+        l = 0;
+        ++info.removedPixels;
+      } else if (touches[static_cast<size_t>(components.at<int>(y, x))] != 0) {
+        l = label;
+        ++info.addedPixels;
+      }
+    }
+  }
+  const cv::Mat after = own == label;
+  if (cv::countNonZero(after) == 0) return box;  // never happens: the roof core is roof-like
+  return cv::boundingRect(after) + roi.tl();
+}
+
 // Median filter of the DEM over the pixels of `mask` (ROI coordinates), written into `out` at
 // those pixels. False when canceled.
 bool filterOver(const cv::Mat& dem, const cv::Mat& mask, int window, cv::Mat& out,
@@ -214,24 +334,33 @@ bool enhanceFootprint(const cv::Mat& dem, const cv::Mat& labels, int label, cv::
 
 // The outer band: pixels outside every footprint within `band` px of one take the median ground
 // height around the nearest ground pixel beyond the band. False when canceled.
-bool flattenOuterBand(const cv::Mat& dem, const cv::Mat& labels, const EnhanceParams& params,
-                      cv::Mat& out, core::Progress* progress) {
+bool flattenOuterBand(const cv::Mat& dem, const cv::Mat& labels, const cv::Mat& roofAround,
+                      const EnhanceParams& params, cv::Mat& out, core::Progress* progress) {
   if (params.wallBand == 0) return true;
   const cv::Mat outside = labels == 0;
   cv::Mat away;
   cv::distanceTransform(outside, away, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  const cv::Mat band = outside & (away <= params.wallBand);
-  const cv::Mat ground = (away > params.wallBand) & core::numberMask(dem);
-  cv::Mat distance;
+  // Roof (as told by reconcileFootprint, empty when the check is off) more than 1 px from any
+  // other pixel outside the footprints is roof an outline missed by a pixel or two, not the
+  // matcher's one-pixel fattening: it keeps its height.
+  cv::Mat fromOther;
+  cv::distanceTransform(roofAround | ~outside, fromOther, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  const cv::Mat missedRoof = roofAround & (fromOther > 1.5);
+  const cv::Mat band = outside & (away <= params.wallBand) & ~missedRoof;
+  const cv::Mat beyond = outside & (away > params.wallBand);
+  const cv::Mat ground = beyond & core::numberMask(dem);
+  cv::Mat distance, open;
   const cv::Mat nearest = nearestSource(ground, distance);
-  // A band pixel farther than this from any ground (a small courtyard, a dense block) keeps its
-  // height rather than borrow a far one.
+  // A band pixel farther than `reach` from anything beyond the band (a small courtyard, a dense
+  // block) keeps its height rather than borrow a far one. No data beyond the band counts as
+  // open ground: next to a wall it is mostly ground hidden in the other view.
+  cv::distanceTransform(~beyond, open, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   const double reach = 2.0 * params.wallBand + params.groundWindow;
   std::vector<float> buffer;
   for (int y = 0; y < dem.rows; ++y) {
     if (y % kRowsPerPoll == 0 && core::isCanceled(progress)) return false;
     for (int x = 0; x < dem.cols; ++x) {
-      if (band.at<uchar>(y, x) == 0 || distance.at<float>(y, x) > reach) continue;
+      if (band.at<uchar>(y, x) == 0 || open.at<float>(y, x) > reach) continue;
       const cv::Vec2i p = nearest.at<cv::Vec2i>(y, x);
       if (p[0] < 0) continue;
       out.at<float>(y, x) = maskedMedian(dem, ground, p[0], p[1], params.groundWindow / 2, buffer);
@@ -342,6 +471,11 @@ EnhanceResult enhanceDem(const cv::Mat& dem, const std::vector<core::Polygon>& f
 
   EnhanceResult result;
   result.footprints.resize(footprints.size());
+  cv::Mat roofAround = cv::Mat::zeros(dem.size(), CV_8U);
+  for (size_t i = 0; i < footprints.size(); ++i) {
+    boxes[i] = reconcileFootprint(dem, labels, static_cast<int>(i) + 1, boxes[i], params,
+                                  result.footprints[i], roofAround);
+  }
   auto canceled = [&] {
     result.status = core::RunStatus::Canceled;
     result.dem = dem;
@@ -368,7 +502,7 @@ EnhanceResult enhanceDem(const cv::Mat& dem, const std::vector<core::Polygon>& f
     part.report(1.0);
   }
   core::Progress::Range ground(progress, 0.9, 1.0);
-  if (!flattenOuterBand(dem, labels, params, result.dem, &ground)) return canceled();
+  if (!flattenOuterBand(dem, labels, roofAround, params, result.dem, &ground)) return canceled();
   core::report(progress, 1.0);
   return result;
 }

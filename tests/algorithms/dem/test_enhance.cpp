@@ -323,3 +323,52 @@ TEST(DemEnhance, ParametersRoundTripThroughJson) {
   EXPECT_EQ(q.wallBand, 5);
   EXPECT_EQ(q.largeWindow, 7);
 }
+
+TEST(DemEnhance, RoofOutsideAnOutlineTooSmallKeepsItsHeight) {
+  // The outline lies 5 px inside a 40 x 40 roof: the 5 px strip around it is roof in the DEM,
+  // thicker than the tolerance, so it joins the footprint instead of being flattened.
+  const cv::Mat dem = rampedBox(80, 20, 20, 60, 60);
+  const auto r = enhanceDem(dem, {square(25, 25, 55, 55)}, EnhanceParams{});
+  for (int x = 20; x < 25; ++x) EXPECT_FLOAT_EQ(r.dem.at<float>(40, x), kRoof) << "x " << x;
+  for (int x = 10; x < 18; ++x) EXPECT_FLOAT_EQ(r.dem.at<float>(40, x), 0.0f) << "x " << x;
+  EXPECT_GT(r.footprints[0].addedPixels, 4 * 30 * 4);
+  EXPECT_NEAR(r.footprints[0].roofHeight, kRoof, 1e-6);
+  // Tolerance 0 takes the outline as given.
+  EnhanceParams asGiven;
+  asGiven.outlineTolerance = 0;
+  EXPECT_EQ(enhanceDem(dem, {square(25, 25, 55, 55)}, asGiven).footprints[0].addedPixels, 0);
+}
+
+TEST(DemEnhance, GroundInsideAnOutlineTooLargeKeepsItsHeight) {
+  // The outline lies 6 px outside the roof: the ground strip inside it stays ground.
+  const cv::Mat dem = rampedBox(90, 25, 25, 65, 65);
+  const auto r = enhanceDem(dem, {square(19, 19, 71, 71)}, EnhanceParams{});
+  for (int x = 19; x < 23; ++x) EXPECT_FLOAT_EQ(r.dem.at<float>(45, x), 0.0f) << "x " << x;
+  for (int x = 25; x < 65; ++x) EXPECT_FLOAT_EQ(r.dem.at<float>(45, x), kRoof) << "x " << x;
+  EXPECT_GT(r.footprints[0].removedPixels, 4 * 46 * 4);
+  EnhanceParams asGiven;
+  asGiven.outlineTolerance = 0;
+  EXPECT_EQ(enhanceDem(dem, {square(19, 19, 71, 71)}, asGiven).footprints[0].removedPixels, 0);
+}
+
+TEST(DemEnhance, AnOutlineOnePixelInsideKeepsTheRoofAndDropsTheRamp) {
+  // The outline 1 px inside the roof: the roof pixel it misses keeps the roof's height (it is
+  // 2 px from the ground in the DEM); the ramp beyond it is flattened.
+  cv::Mat dem(80, 80, CV_32F, cv::Scalar(0.0f));
+  dem(cv::Rect(20, 20, 40, 40)).setTo(kRoof);
+  dem.col(19).rowRange(20, 60).setTo(kRoof);  // the matcher's fattening, 1 px
+  const auto r = enhanceDem(dem, {square(21, 21, 59, 59)}, EnhanceParams{});
+  EXPECT_FLOAT_EQ(r.dem.at<float>(40, 20), kRoof);
+  EXPECT_FLOAT_EQ(r.dem.at<float>(40, 19), 0.0f);
+}
+
+TEST(DemEnhance, FatteningNextToHiddenGroundIsFlattened) {
+  // West of the building the ground is hidden in the other view (no data) from x 4 to 17; the
+  // two ramp pixels at x 18 and 19 are the matcher's fattening and take the ground's height.
+  cv::Mat dem = rampedBox(80, 20, 20, 60, 60);
+  dem(cv::Rect(4, 0, 14, 80)).setTo(kNaN);
+  const auto r = enhanceDem(dem, {square(20, 20, 60, 60)}, EnhanceParams{});
+  EXPECT_FLOAT_EQ(r.dem.at<float>(40, 19), 0.0f);
+  EXPECT_FLOAT_EQ(r.dem.at<float>(40, 18), 0.0f);
+  EXPECT_TRUE(std::isnan(r.dem.at<float>(40, 10)));
+}

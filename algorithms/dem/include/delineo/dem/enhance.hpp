@@ -7,6 +7,7 @@
 // Geometry: the DEM is a height per left-image pixel (CV_32F, metres, NaN = no data); the
 // footprints are in the same left-image pixel coordinates (core/geometry.hpp). No GUI
 // interaction here: the CLI and the GUI call the same function.
+#include <limits>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -25,6 +26,9 @@ struct EnhanceParams {
   int minObjectPixels = 16;      // px, connected roof pixels above the Otsu threshold that make
                                  // an object (paper: 1)
   int groundWindow = 5;          // px, median window over the ground that fills the outer band
+  int outlineTolerance = 2;      // px, outline/DEM disagreements up to this thick follow the
+                                 // outline, thicker ones the DEM (0: the outline as given)
+  int outlineReach = 12;         // px, how far outside its outline a footprint may grow
 
   template <class V>
   void visit(V&& v) {
@@ -53,6 +57,16 @@ struct EnhanceParams {
     v(ParamInfo{"ground-window", "Ground median window", "px",
                 "Odd median window over the ground whose values fill the outer band", 1, 99},
       groundWindow);
+    v(ParamInfo{"outline-tolerance", "Outline tolerance", "px",
+                "Thickness up to which the outline wins where the DEM disagrees with it (ground "
+                "inside, roof outside); thicker disagreements follow the DEM (0: off)",
+                0, 50},
+      outlineTolerance);
+    v(ParamInfo{"outline-reach", "Outline reach", "px",
+                "How far outside its outline a footprint may grow to take in roof the outline "
+                "missed",
+                0, 1000},
+      outlineReach);
   }
   // Throws core::Error(InvalidParameter): a field outside its domain, an even window, or a
   // small window larger than the large one.
@@ -66,6 +80,10 @@ struct FootprintEnhancement {
   int objectPixels = 0;      // largest connected group of roof pixels above the Otsu threshold
   int band = 0;              // px, inner band actually used (narrower on narrow footprints)
   int filledPixels = 0;      // no-data pixels inside the footprint that got a height
+  int addedPixels = 0;       // roof pixels outside the outline taken into the footprint
+  int removedPixels = 0;     // ground pixels inside the outline left out of the footprint
+  double roofHeight = std::numeric_limits<double>::quiet_NaN();    // m, median of the roof
+  double groundHeight = std::numeric_limits<double>::quiet_NaN();  // m, median around it
 };
 
 struct EnhanceResult {
