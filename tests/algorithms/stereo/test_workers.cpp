@@ -76,12 +76,22 @@ TEST(RowOrderedTasks, AHelperRunsDisjointTasksAlongsideAndOverlappingOnesInOrder
     SCOPED_TRACE(helperDelayMs);
     RowLogs logs(someRows());
     std::atomic<int> concurrent{0}, mostConcurrent{0};
+    std::atomic<bool> firstTaskSeen{false};
     detail::RowOrderedTasks tasks(
         logs.rows,
         [&](size_t k) {
           const int now = ++concurrent;
           int seen = mostConcurrent.load();
           while (now > seen && !mostConcurrent.compare_exchange_weak(seen, now)) {
+          }
+          // The first task holds its thread until the other one runs a task beside it (or 2 s
+          // pass): on a loaded machine the helper may otherwise be scheduled only once the
+          // owner is done, which says nothing about the scheduler.
+          if (helperDelayMs == 0 && !firstTaskSeen.exchange(true)) {
+            const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+            while (mostConcurrent.load() < 2 && std::chrono::steady_clock::now() < deadline) {
+              std::this_thread::sleep_for(std::chrono::microseconds(100));
+            }
           }
           logs.task(k);
           --concurrent;
