@@ -159,8 +159,11 @@ cv::Mat buildingSegment(const cv::Mat& aboveGround, const cv::Mat& initMask, dou
     mask &= initMask;
   }
   fillSmallHoles(mask, params.minArea);
-  cv::Mat eroded = mask;
+  // A separate buffer: eroding into a header of `mask` would erode `mask` itself, and the
+  // grow-back below would then be clipped to the eroded mask.
+  cv::Mat eroded;
   if (params.erosionRadius > 0) cv::erode(mask, eroded, disk(params.erosionRadius));
+  else eroded = mask.clone();
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(eroded, labels, stats, centroids, 8, CV_32S);
   std::vector<int> overlap(static_cast<size_t>(n), 0);
@@ -188,8 +191,11 @@ cv::Mat buildingSegment(const cv::Mat& aboveGround, const cv::Mat& initMask, dou
 
 std::vector<cv::Mat> candidateRegions(const cv::Mat& aboveGround, const BoxFitParams& params) {
   cv::Mat mask = aboveGround >= params.minHeight;
-  cv::Mat eroded = mask;
+  // A separate buffer: eroding into a header of `mask` would erode `mask` itself, and the
+  // grow-back below would then be clipped to the eroded mask.
+  cv::Mat eroded;
   if (params.erosionRadius > 0) cv::erode(mask, eroded, disk(params.erosionRadius));
+  else eroded = mask.clone();
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(eroded, labels, stats, centroids, 8, CV_32S);
   std::vector<cv::Mat> regions;
