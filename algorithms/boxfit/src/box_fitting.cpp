@@ -129,7 +129,7 @@ bool fitOne(const cv::Mat& above, const cv::Mat& initMask, double roofHeight, co
   }
   core::setStage(progress, core::StageId::BoxFitOutline);
   t0 = std::chrono::steady_clock::now();
-  core::Polygon outline = mergeBoxes(fitting.boxes, roi.size(), params, &d.mergedArea);
+  core::Polygon outline = mergeBoxes(fitting.boxes, roi.size(), params, d.segment, &d.mergedArea);
   d.outlineMs = msSince(t0);
   if (outline.outer.size() < 3) {
     why = "no box could be grown from the " + std::to_string(seeds.seeds.size()) + " seeds";

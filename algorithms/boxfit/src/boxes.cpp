@@ -135,6 +135,29 @@ struct Fitted {
   bool ok = false;
 };
 
+// The summed cost of a box side at a frame boundary: the capped distance of its pixels to the
+// nearest edge (the paper's energy) plus, weighted by segment-weight, the cap for each pixel
+// where the segment disagrees with the side (a segment pixel just outside it, a non-segment
+// pixel just inside it), counted half each. Edges then place a side within the segment's
+// blurred border, and where the image has no edge (a roof as bright as the street) or edges
+// inside the roof (tiles, ridges) the segment decides.
+class SideCosts {
+ public:
+  SideCosts(const Frame& f, const BoxFitParams& p) : f_(f), weight_(0.5 * p.segmentWeight * p.edgeCap) {}
+  // Vertical sides at boundary x over rows [y0, y1): the box lies right of a left side.
+  double left(int x, int y0, int y1) const { return f_.costVertical(x, y0, y1) + disagree(column(x, y0, y1), column(x - 1, y0, y1), y1 - y0); }
+  double right(int x, int y0, int y1) const { return f_.costVertical(x, y0, y1) + disagree(column(x - 1, y0, y1), column(x, y0, y1), y1 - y0); }
+  double top(int y, int x0, int x1) const { return f_.costHorizontal(y, x0, x1) + disagree(row(y, x0, x1), row(y - 1, x0, x1), x1 - x0); }
+  double bottom(int y, int x0, int x1) const { return f_.costHorizontal(y, x0, x1) + disagree(row(y - 1, x0, x1), row(y, x0, x1), x1 - x0); }
+
+ private:
+  int column(int x, int y0, int y1) const { return x >= 0 && x < f_.side() ? f_.insideColumn(x, y0, y1) : 0; }
+  int row(int y, int x0, int x1) const { return y >= 0 && y < f_.side() ? f_.insideRow(y, x0, x1) : 0; }
+  double disagree(int insideIn, int insideOut, int length) const { return weight_ * ((length - insideIn) + insideOut); }
+  const Frame& f_;
+  double weight_;
+};
+
 // Grows the box from a square around the seed while each new row or column is mostly in the
 // segment, then moves each side onto the best-fitting edge near where it stopped.
 SeedFit fitInFrame(const Frame& f, const Seed& seed, const BoxFitParams& params) {
@@ -157,11 +180,12 @@ SeedFit fitInFrame(const Frame& f, const Seed& seed, const BoxFitParams& params)
     if (b.y1 < wy1 && f.insideRow(b.y1, b.x0, b.x1) >= need * b.width()) ++b.y1, grew = true;
   }
   // Snapping: each side takes, within snap-inward / snap-outward of where the segment stopped it,
-  // the position of lowest mean edge distance (a small pull towards the grown position breaks
-  // ties). Two rounds, since each side's length depends on the others.
+  // the position of lowest cost (a small pull towards the grown position breaks ties). Two
+  // rounds, since each side's length depends on the others.
   const FrameBox grown = b;
   constexpr double kPull = 0.01;  // px of edge distance per px moved
   const int in = params.snapInward, out = params.snapOutward;
+  const SideCosts side(f, params);
   for (int round = 0; round < 2; ++round) {
     auto best = [&](int from, int to, int home, auto cost) {
       int pos = home;
@@ -174,17 +198,17 @@ SeedFit fitInFrame(const Frame& f, const Seed& seed, const BoxFitParams& params)
     };
     const double h = b.height(), w = b.width();
     b.x0 = best(std::max(wx0, grown.x0 - out), std::min(b.x1 - 2, grown.x0 + in), grown.x0,
-                [&](int x) { return f.costVertical(x, b.y0, b.y1) / h; });
+                [&](int x) { return side.left(x, b.y0, b.y1) / h; });
     b.x1 = best(std::max(b.x0 + 2, grown.x1 - in), std::min(wx1, grown.x1 + out), grown.x1,
-                [&](int x) { return f.costVertical(x, b.y0, b.y1) / h; });
+                [&](int x) { return side.right(x, b.y0, b.y1) / h; });
     b.y0 = best(std::max(wy0, grown.y0 - out), std::min(b.y1 - 2, grown.y0 + in), grown.y0,
-                [&](int y) { return f.costHorizontal(y, b.x0, b.x1) / w; });
+                [&](int y) { return side.top(y, b.x0, b.x1) / w; });
     b.y1 = best(std::max(b.y0 + 2, grown.y1 - in), std::min(wy1, grown.y1 + out), grown.y1,
-                [&](int y) { return f.costHorizontal(y, b.x0, b.x1) / w; });
+                [&](int y) { return side.bottom(y, b.x0, b.x1) / w; });
   }
   if (b.width() < 2 || b.height() < 2) return fit;
-  const double sum = f.costVertical(b.x0, b.y0, b.y1) + f.costVertical(b.x1, b.y0, b.y1) +
-                     f.costHorizontal(b.y0, b.x0, b.x1) + f.costHorizontal(b.y1, b.x0, b.x1);
+  const double sum = side.left(b.x0, b.y0, b.y1) + side.right(b.x1, b.y0, b.y1) + side.top(b.y0, b.x0, b.x1) +
+                     side.bottom(b.y1, b.x0, b.x1);
   fit.box = b;
   fit.energy = sum / (2.0 * (b.width() + b.height()));
   fit.ok = true;

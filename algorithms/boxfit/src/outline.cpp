@@ -233,9 +233,47 @@ core::Ring clampTo(core::Ring ring, cv::Size size) {
   return ring;
 }
 
+// Boxes that do not touch (a wing whose corner no box covers) are joined by the pieces of the
+// segment that no box covers and that touch two or more groups of boxes: the outline is one
+// polygon, and the segment says the building is continuous there.
+void bridgeWithSegment(cv::Mat& mask, const cv::Mat& segment) {
+  cv::Mat groups;
+  const int n = cv::connectedComponents(mask, groups, 8, CV_32S);
+  if (n <= 2) return;
+  cv::Mat segmentScaled;
+  cv::resize(segment, segmentScaled, mask.size(), 0, 0, cv::INTER_NEAREST);
+  const cv::Mat uncovered = segmentScaled & ~mask;
+  cv::Mat pieces;
+  const int m = cv::connectedComponents(uncovered, pieces, 8, CV_32S);
+  std::vector<std::vector<int>> touched(static_cast<size_t>(m));
+  for (int y = 0; y < mask.rows; ++y) {
+    const int* p = pieces.ptr<int>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      if (p[x] == 0) continue;
+      auto& list = touched[static_cast<size_t>(p[x])];
+      for (const cv::Point d : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+        const cv::Point q(x + d.x, y + d.y);
+        if (q.x < 0 || q.y < 0 || q.x >= mask.cols || q.y >= mask.rows) continue;
+        const int g = groups.at<int>(q);
+        if (g > 0 && std::find(list.begin(), list.end(), g) == list.end()) list.push_back(g);
+      }
+    }
+  }
+  std::vector<uchar> bridge(static_cast<size_t>(m), 0);
+  for (int i = 1; i < m; ++i) bridge[static_cast<size_t>(i)] = touched[static_cast<size_t>(i)].size() >= 2;
+  for (int y = 0; y < mask.rows; ++y) {
+    const int* p = pieces.ptr<int>(y);
+    uchar* out = mask.ptr<uchar>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      if (bridge[static_cast<size_t>(p[x])]) out[x] = 255;
+    }
+  }
+}
+
 }  // namespace
 
-core::Polygon mergeBoxes(const std::vector<Box>& boxes, cv::Size roiSize, const BoxFitParams& params, int* mergedArea) {
+core::Polygon mergeBoxes(const std::vector<Box>& boxes, cv::Size roiSize, const BoxFitParams& params,
+                         const cv::Mat& segment, int* mergedArea) {
   core::Polygon polygon;
   if (mergedArea) *mergedArea = 0;
   if (boxes.empty()) return polygon;
@@ -245,6 +283,7 @@ core::Polygon mergeBoxes(const std::vector<Box>& boxes, cv::Size roiSize, const 
     for (auto& c : corners) c *= kScale;
     fillConvex(mask, corners);
   }
+  if (!segment.empty()) bridgeWithSegment(mask, segment);
   if (params.closingRadius > 0) {
     const int r = params.closingRadius * kScale;
     cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}),

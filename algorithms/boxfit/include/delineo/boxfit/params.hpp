@@ -12,7 +12,7 @@ struct BoxFitParams {
   // Building segments from the DEM (the paper: local thresholding, erosion, components).
   double minHeight = 2.0;          // m above the local ground for anything to be a building
   int groundWindow = 301;          // px, side of the grey opening that estimates the local ground
-  double thresholdFraction = 0.5;  // the local threshold, as a fraction of the roof's height
+  double thresholdFraction = 0.8;  // the local threshold, as a fraction of the roof's height
   double roofBand = 0.5;           // heights above (1 + this) x roof + min-height: another building
   int erosionRadius = 2;           // px, disk separating touching segments (paper: 2)
   int minArea = 500;               // px, smaller segments are dropped (paper: 500)
@@ -29,6 +29,7 @@ struct BoxFitParams {
   int snapInward = 12;           // px a side may move inward from the segment onto an edge
   int snapOutward = 4;           // px a side may move outward from the segment onto an edge
   double edgeCap = 3.0;          // px, distance to the nearest edge is capped at this
+  double segmentWeight = 1.0;    // weight of the segment's disagreement with a box side (0 = edges only)
   double orientationTolerance = 0.3;  // px of mean edge distance a box may give up to take the
                                       // building's main orientation (0 = each box its own)
   double maxEnergy = 2.0;        // px, whole image: a region whose boxes all fit worse is no building
@@ -118,6 +119,11 @@ struct BoxFitParams {
                 "Distance from a box side to the nearest Canny edge is capped at this in the energy",
                 0.5, 100},
       edgeCap);
+    v(ParamInfo{"segment-weight", "Segment weight", "",
+                "Weight of the DEM segment's disagreement with a box side beside its edge distance "
+                "(0 = the image's edges alone, as in the paper)",
+                0, 100},
+      segmentWeight);
     v(ParamInfo{"orientation-tolerance", "Orientation tolerance", "px",
                 "A box takes the building's main orientation when its energy rises by at most "
                 "this (0 = every box keeps its own)",

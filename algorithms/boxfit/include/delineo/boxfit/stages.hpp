@@ -88,11 +88,14 @@ BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges,
 
 // ---- 4. Outline -----------------------------------------------------------------------------
 
-// The boxes filled (at twice the resolution), closed with a disk of closing-radius px; the
+// The boxes filled (at twice the resolution), groups of boxes that do not touch joined by the
+// pieces of `segment` (CV_8U, ROI size; may be empty) no box covers, closed with a disk of
+// closing-radius px; the
 // largest region's border, with its holes of at least min-hole-area px², cut at its corners and
 // into pieces of at most refine-length px, one least-squares line per piece, collinear
 // neighbours merged, consecutive lines intersected. ROI coordinates. Empty when no box.
 core::Polygon mergeBoxes(const std::vector<Box>& boxes, cv::Size roiSize,
-                         const BoxFitParams& params, int* mergedArea = nullptr);
+                         const BoxFitParams& params, const cv::Mat& segment = {},
+                         int* mergedArea = nullptr);
 
 }  // namespace delineo::boxfit
