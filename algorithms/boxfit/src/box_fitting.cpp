@@ -67,13 +67,14 @@ cv::Rect grown(const cv::Rect& r, int margin, cv::Size size) {
 }
 
 // Heights above the local ground over `roi`, computed on `roi` widened by half the ground window
-// (the opening needs the ground around the building). Empty when no height is finite there.
-cv::Mat aboveGround(const cv::Mat& heights, const cv::Rect& roi, const BoxFitParams& params, double* groundMedian) {
-  const cv::Rect context = grown(roi, params.groundWindow / 2, heights.size());
+// (the opening needs the ground around the building). `window` is the opening's side (px, odd).
+// Empty when no height is finite there.
+cv::Mat aboveGround(const cv::Mat& heights, const cv::Rect& roi, int window, double* groundMedian) {
+  const cv::Rect context = grown(roi, window / 2, heights.size());
   const cv::Mat filled = fillHeightGaps(heights(context));
   // The gap filling leaves NaN only where the whole context is NaN.
   if (cv::countNonZero(core::numberMask(filled)) == 0) return {};
-  const cv::Mat ground = localGround(filled, params.groundWindow);
+  const cv::Mat ground = localGround(filled, window);
   const cv::Rect local(roi.tl() - context.tl(), roi.size());
   cv::Mat above = filled(local) - ground(local);
   if (groundMedian) {
@@ -173,7 +174,10 @@ BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFit
                          cv::Point(static_cast<int>(std::ceil(box.x + box.width)), static_cast<int>(std::ceil(box.y + box.height))));
     const cv::Rect roi = grown(tight, params.roiMargin, size);
     double groundMedian = 0;
-    const cv::Mat above = aboveGround(heights32, roi, params, &groundMedian);
+    // An opening narrower than the building would take its roof for the ground: the window is
+    // at least twice the initial polygon's longer side.
+    const int window = std::max(params.groundWindow, (2 * std::max(tight.width, tight.height)) | 1);
+    const cv::Mat above = aboveGround(heights32, roi, window, &groundMedian);
     if (above.empty()) {
       result.message = "no finite height in the DEM around the initial polygon";
       return result;
@@ -202,7 +206,7 @@ BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFit
   core::setStage(progress, core::StageId::BoxFitSegment);
   const cv::Rect all(0, 0, size.width, size.height);
   double groundMedian = 0;
-  const cv::Mat above = aboveGround(heights32, all, params, &groundMedian);
+  const cv::Mat above = aboveGround(heights32, all, params.groundWindow, &groundMedian);
   if (above.empty()) {
     result.message = "the DEM has no finite height";
     return result;
