@@ -2,10 +2,11 @@
 // Box-fitting (Sirmacek, d'Angelo, Reinartz): a building's outline as the merged union of
 // rectangles. The DEM gives the building segment (local thresholding), its skeleton gives the
 // seeds, each seed grows a box onto the left image's Canny edges over a sweep of orientations
-// (energy: mean distance of the box sides to the nearest edge), the boxes are merged and the
+// (energy: mean distance of the box sides to the nearest edge, plus their disagreement with the
+// segment), the boxes are merged and the
 // merged border is refined into straight lines. docs/boxfit.md explains each stage.
 //
-// No GUI interaction here: the CLI (`delineo-cli boxfit`), `delineo-cli run` and the GUI's job
+// No GUI interaction here: the CLI (`delineo-cli boxfit`) and, later, the GUI's job
 // runner call these functions. Coordinates are left-image pixels (x right, y down, pixel (i, j)
 // covers [i, i+1) x [j, j+1)).
 #include <optional>
@@ -27,7 +28,8 @@ struct Box {
   double length = 0.0;
   double width = 0.0;
   double angleDeg = 0.0;
-  double energy = 0.0;  // px: mean distance of its sides to the nearest edge (capped at edge-cap)
+  double energy = 0.0;  // px: mean cost of its sides (edge distance capped at edge-cap, plus
+                        // segment-weight x edge-cap where the segment disagrees with a side)
   cv::Point2d seed;     // the skeleton seed it grew from
   core::Ring corners() const;  // four corners, counter-clockwise on screen
   double area() const { return length * width; }
