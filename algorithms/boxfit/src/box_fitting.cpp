@@ -115,8 +115,20 @@ bool fitOne(const cv::Mat& above, const cv::Mat& initMask, double roofHeight, co
   core::setStage(progress, core::StageId::BoxFitBoxes);
   t0 = std::chrono::steady_clock::now();
   const cv::Vec4b border(roi.x == 0, roi.y == 0, roi.br().x == imageSize.width, roi.br().y == imageSize.height);
-  core::Progress::Range boxProgress(progress, 0.1, 0.9);
+  core::Progress::Range boxProgress(progress, 0.1, 0.8);
   BoxFitting fitting = fitSeedBoxes(d.segment, edges, seeds.seeds, params, border, progress ? &boxProgress : nullptr);
+  // A second round of boxes for what the first left uncovered.
+  const std::vector<Seed> extra = fitting.status == core::RunStatus::Completed
+                                      ? uncoveredSeeds(d.segment, fitting.boxes, params)
+                                      : std::vector<Seed>{};
+  if (!extra.empty()) {
+    core::Progress::Range extraProgress(progress, 0.8, 0.9);
+    BoxFitting more = fitSeedBoxes(d.segment, edges, extra, params, border, progress ? &extraProgress : nullptr);
+    fitting.status = more.status;
+    fitting.anglesEvaluated += more.anglesEvaluated;
+    fitting.boxes.insert(fitting.boxes.end(), more.boxes.begin(), more.boxes.end());
+    for (const auto& s : extra) d.seeds.emplace_back(s.point.x + 0.5 + roi.x, s.point.y + 0.5 + roi.y);
+  }
   d.boxesMs = msSince(t0);
   d.seedsFitted = static_cast<int>(fitting.boxes.size());
   d.seedsSkipped = fitting.seedsSkipped;

@@ -141,4 +141,35 @@ SkeletonSeeds skeletonSeeds(const cv::Mat& segment, const BoxFitParams& params) 
   return out;
 }
 
+std::vector<Seed> uncoveredSeeds(const cv::Mat& segment, const std::vector<Box>& boxes, const BoxFitParams& params) {
+  cv::Mat covered = cv::Mat::zeros(segment.size(), CV_8U);
+  for (const auto& b : boxes) {
+    std::vector<cv::Point> corners;
+    for (const auto& c : b.corners()) corners.emplace_back(static_cast<int>(std::lround(c.x)), static_cast<int>(std::lround(c.y)));
+    cv::fillConvexPoly(covered, corners, 255);
+  }
+  // Slivers along the boxes' sides are no wing: an opening removes them.
+  cv::Mat residual = segment & ~covered;
+  const int r = std::max(1, params.erosionRadius);
+  cv::morphologyEx(residual, residual, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
+  cv::Mat labels, stats, centroids, depth, segmentDepth;
+  const int n = cv::connectedComponentsWithStats(residual, labels, stats, centroids, 8, CV_32S);
+  if (n <= 1) return {};
+  cv::distanceTransform(residual, depth, cv::DIST_L2, 5);
+  cv::distanceTransform(segment, segmentDepth, cv::DIST_L2, 5);
+  const int minArea = std::max(1, params.minArea / 5);
+  std::vector<Seed> seeds;
+  for (int i = 1; i < n; ++i) {
+    if (stats.at<int>(i, cv::CC_STAT_AREA) < minArea) continue;
+    double deepest = 0;
+    cv::Point at;
+    cv::minMaxLoc(depth, nullptr, &deepest, nullptr, &at, labels == i);
+    if (deepest < 3.0) continue;
+    const double local = segmentDepth.at<float>(at);
+    seeds.push_back({at, deepest, std::max(2.0 * params.pieceLength, params.windowFactor * 2.0 * local)});
+  }
+  return seeds;
+}
+
 }  // namespace delineo::boxfit

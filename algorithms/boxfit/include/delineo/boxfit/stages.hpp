@@ -65,6 +65,13 @@ struct SkeletonSeeds {
 // deepest pixel.
 SkeletonSeeds skeletonSeeds(const cv::Mat& segment, const BoxFitParams& params);
 
+// Seeds for the parts of the segment that the boxes grown from the skeleton leave uncovered (a
+// short wing whose spur was too short to seed, a corner): the residual opened with a disk of
+// erosion-radius px, one seed at the deepest pixel of each piece of at least min-area / 5 px
+// and 3 px deep. `boxes` in ROI coordinates.
+std::vector<Seed> uncoveredSeeds(const cv::Mat& segment, const std::vector<Box>& boxes,
+                                 const BoxFitParams& params);
+
 // ---- 3. Boxes -------------------------------------------------------------------------------
 
 struct BoxFitting {
