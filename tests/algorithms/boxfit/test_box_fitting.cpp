@@ -301,3 +301,20 @@ TEST(BoxFitStages, MergedBoxesOfAnLGiveOneStraightOutline) {
   const core::Polygon truth{{{40, 30}, {160, 30}, {160, 70}, {80, 70}, {80, 160}, {40, 160}}, {}};
   EXPECT_GT(iou(outline, truth, {200, 200}), 0.98);
 }
+
+TEST(BoxFitStages, AWingNoBoxCoversGetsASeedOfItsOwn) {
+  // An L whose boxes cover only the long arm: the short wing left over gets one seed inside it,
+  // slivers along the box's sides none.
+  const core::Polygon truth{{{40, 30}, {170, 30}, {170, 80}, {95, 80}, {95, 120}, {40, 120}}, {}};
+  const cv::Mat segment = core::rasterize(truth, kSize);
+  Box arm;
+  arm.centre = {105, 55}, arm.length = 129, arm.width = 49, arm.angleDeg = 0;
+  const std::vector<Seed> seeds = uncoveredSeeds(segment, {arm}, BoxFitParams{});
+  ASSERT_EQ(seeds.size(), 1u);
+  EXPECT_TRUE(cv::Rect(40, 80, 55, 40).contains(seeds[0].point)) << seeds[0].point;
+  Box all;
+  all.centre = {105, 55}, all.length = 130, all.width = 50;
+  Box wing;
+  wing.centre = {67.5, 100}, wing.length = 55, wing.width = 40;
+  EXPECT_TRUE(uncoveredSeeds(segment, {all, wing}, BoxFitParams{}).empty());
+}
