@@ -42,6 +42,10 @@ std::string Stage::english() const {
     case StageId::PolygonCourtyard: return "courtyard";
     case StageId::DenseMatching: return "matching";
     case StageId::DelineatingBuilding: return "building " + std::to_string(number);
+    case StageId::BoxFitSegment: return "box-fitting: building segment";
+    case StageId::BoxFitBoxes: return "box-fitting: boxes";
+    case StageId::BoxFitOutline: return "box-fitting: outline";
+    case StageId::BoxFittingBuilding: return "box-fitting building " + std::to_string(number);
   }
   return text;
 }

@@ -81,7 +81,7 @@ TEST(Progress, AStageIsAnIdentifierWithItsNumbersWordedInEnglishForTheCli) {
   // Every identifier has its own wording.
   std::set<std::string> words;
   for (int id = static_cast<int>(StageId::PreparingPyramids);
-       id <= static_cast<int>(delineo::core::kLastStageId); ++id) {
+       id <= static_cast<int>(delineo::core::kLastEnglishStageId); ++id) {
     const std::string text = Stage::of(static_cast<StageId>(id), 1, 2).english();
     EXPECT_FALSE(text.empty()) << id;
     EXPECT_TRUE(words.insert(text).second) << text;

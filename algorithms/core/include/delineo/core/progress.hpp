@@ -44,10 +44,19 @@ enum class StageId {
   PolygonCourtyard,
   // Project pipeline (number: the building's id).
   DenseMatching,
-  DelineatingBuilding,  // keep last (kLastStageId)
+  DelineatingBuilding,  // kLastStageId
+  // Box-fitting (number/count: the building of a whole-image run; BoxFittingBuilding: the
+  // project building's id). Not yet worded by the GUI, which shows english() for them until
+  // kLastStageId moves to the last of these.
+  BoxFitSegment,
+  BoxFitBoxes,
+  BoxFitOutline,
+  BoxFittingBuilding,
 };
-// The last identifier: wordings are checked for every id up to it.
+// The last identifier the GUI words (its table is checked against it); the box-fitting stages
+// after it are worded in English only for now.
 constexpr StageId kLastStageId = StageId::DelineatingBuilding;
+constexpr StageId kLastEnglishStageId = StageId::BoxFittingBuilding;
 
 struct Stage {
   StageId id = StageId::Text;

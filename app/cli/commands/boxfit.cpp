@@ -1,0 +1,194 @@
+// delineo-cli boxfit: building outlines by box-fitting (docs/boxfit.md): the building segment
+// from a DEM, boxes grown from its skeleton onto the left image's Canny edges, merged and
+// straightened. One call runs a batch: every polygon of --init is one building; with neither
+// --init nor --roi every building segment of the image is fitted.
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include "cli_support.hpp"
+#include "delineo/boxfit/box_fitting.hpp"
+#include "delineo/core/error.hpp"
+#include "delineo/io/raster.hpp"
+#include "delineo/io/vector.hpp"
+
+namespace {
+using namespace delineo;
+
+std::optional<long long> idAttribute(const core::Feature& f) {
+  const auto it = f.attributes.find("id");
+  if (it == f.attributes.end()) return std::nullopt;
+  if (const auto* i = std::get_if<long long>(&it->second)) return *i;
+  if (const auto* d = std::get_if<double>(&it->second)) return std::llround(*d);
+  return std::nullopt;
+}
+
+double polygonArea(const core::Polygon& p) {
+  double area = std::abs(core::signedArea(p.outer));
+  for (const auto& h : p.holes) area -= std::abs(core::signedArea(h));
+  return area;
+}
+
+// Heights (m) on the image's grid: --dem as it is, or --disparity through the height model.
+cv::Mat readHeights(const cli::Options& opts, cv::Size imageSize, bool quiet) {
+  if (opts.has("dem") == opts.has("disparity")) throw cli::UsageError("give exactly one of --dem and --disparity");
+  const std::string path = opts.has("dem") ? opts.get("dem") : opts.get("disparity");
+  io::ReadOptions options;
+  options.type = io::PixelType::Float32;
+  const cv::Mat raster = io::readRaster(path, options).data;
+  if (raster.channels() != 1) {
+    throw core::Error(core::ErrorCode::UnsupportedInput,
+                      "a DEM or disparity map has one band, this one has " + std::to_string(raster.channels()), path);
+  }
+  if (raster.size() != imageSize) {
+    throw core::Error(core::ErrorCode::MismatchedInputs,
+                      "the raster is " + std::to_string(raster.cols) + "x" + std::to_string(raster.rows) +
+                          " px but the image " + std::to_string(imageSize.width) + "x" +
+                          std::to_string(imageSize.height) + ": it must be on the left image's grid",
+                      path);
+  }
+  if (opts.has("dem")) return raster;
+  const double metresPerPixel = opts.getDouble("metres-per-pixel");
+  if (!(metresPerPixel > 0)) throw cli::UsageError("--metres-per-pixel must be positive");
+  if (!opts.has("metres-per-pixel") && !quiet) {
+    std::fprintf(stderr, "boxfit: no --metres-per-pixel: heights in px of disparity (min-height etc. in px)\n");
+  }
+  return boxfit::heightsFromDisparity(raster, opts.getDouble("ground-disparity"), metresPerPixel);
+}
+
+std::vector<core::Feature> initialPolygons(const cli::Options& opts, const io::GeoReference& geo) {
+  if (opts.has("init") && opts.has("roi")) throw cli::UsageError("give at most one of --init and --roi");
+  if (opts.has("init")) return io::readFeatures(opts.get("init"), geo);
+  if (!opts.has("roi")) return {};
+  const auto v = opts.getList("roi");
+  if (v.size() != 4 || v[2] <= 0 || v[3] <= 0) throw cli::UsageError("--roi expects X,Y,W,H with positive W and H");
+  core::Feature f;
+  f.polygon.outer = {{v[0], v[1]}, {v[0] + v[2], v[1]}, {v[0] + v[2], v[1] + v[3]}, {v[0], v[1] + v[3]}};
+  return {f};
+}
+
+core::Feature outlineFeature(const boxfit::BoxFitBuilding& b, long long id) {
+  core::Feature f;
+  f.polygon = b.outline;
+  f.attributes["id"] = id;
+  f.attributes["method"] = std::string("box-fitting");
+  f.attributes["status"] = std::string("completed");
+  f.attributes["boxes"] = static_cast<long long>(b.boxes.size());
+  f.attributes["area"] = polygonArea(b.outline);
+  f.attributes["vertices"] = static_cast<long long>(b.diagnostics.vertices);
+  f.attributes["energy"] = b.energy;
+  f.attributes["roof_height_m"] = b.diagnostics.roofHeight;
+  return f;
+}
+
+void appendBoxes(const boxfit::BoxFitBuilding& b, long long id, std::vector<core::Feature>& out) {
+  long long k = 0;
+  for (const auto& box : b.boxes) {
+    core::Feature f;
+    f.polygon.outer = box.corners();
+    f.attributes["building_id"] = id;
+    f.attributes["box"] = ++k;
+    f.attributes["angle_deg"] = box.angleDeg;
+    f.attributes["length"] = box.length;
+    f.attributes["width"] = box.width;
+    f.attributes["energy"] = box.energy;
+    out.push_back(std::move(f));
+  }
+}
+
+int run(const std::vector<std::string>& args) {
+  cli::Options opts("boxfit",
+                    "Delineates buildings by box-fitting: the building segment from a DEM on the left "
+                    "image's grid, chains of boxes fitted to the image's edges, merged into one outline.\n"
+                    "Usage: delineo-cli boxfit --dem D --image L [--init F | --roi X,Y,W,H] --out F.geojson "
+                    "[--boxes B.geojson]\nWithout --init and --roi every building segment of the image "
+                    "is fitted.");
+  opts.required("image", "FILE", "left (reference) image")
+      .value("dem", "FILE", "heights in metres on the left image's grid (NaN or nodata = none)")
+      .value("disparity", "FILE", "disparity map of the left image (as `match` writes it), instead of --dem")
+      .value("metres-per-pixel", "M", "with --disparity: metres of height per px of disparity", "1")
+      .value("ground-disparity", "PX", "with --disparity: disparity of zero height", "0")
+      .value("init", "FILE", "initial polygons (GeoJSON/GeoPackage, left-image pixels); may hold many")
+      .value("roi", "X,Y,W,H", "initial rectangle in left-image pixels (instead of --init)")
+      .required("out", "FILE", "output outlines (GeoJSON/GeoPackage) with their attributes")
+      .value("boxes", "FILE", "also write the fitted boxes (one polygon each, with building_id)")
+      .flag("quiet", "no progress on stderr")
+      .params(boxfit::BoxFitParams{});
+  if (!opts.parse(args)) return cli::kExitOk;
+  boxfit::BoxFitParams params;
+  opts.apply(params);
+  auto& progress = cli::commandProgress();
+  const bool quiet = opts.has("quiet");
+  progress.setQuiet(quiet);
+  progress.setStage("reading");
+  io::GeoReference geo;
+  const cv::Mat image = io::readGreyFloat(opts.get("image"), &geo);
+  const cv::Mat heights = readHeights(opts, image.size(), quiet);
+  const std::vector<core::Feature> inits = initialPolygons(opts, geo);
+
+  std::vector<core::Feature> outlines, boxes;
+  int failed = 0;
+  bool canceled = false;
+  if (inits.empty()) {
+    // Whole image: every segment; nothing found is a processing failure.
+    const auto r = boxfit::fitBoxes(heights, image, {}, params, &progress);
+    canceled = r.status == core::RunStatus::Canceled;
+    if (r.buildings.empty() && !canceled) throw core::Error(core::ErrorCode::ProcessingFailed, r.message, opts.get("image"));
+    long long id = 0;
+    for (const auto& b : r.buildings) {
+      outlines.push_back(outlineFeature(b, ++id));
+      appendBoxes(b, id, boxes);
+    }
+  }
+  const size_t count = inits.size();
+  for (size_t i = 0; i < count && !canceled; ++i) {
+    const long long id = idAttribute(inits[i]).value_or(static_cast<long long>(i + 1));
+    progress.setStage("building " + std::to_string(i + 1) + "/" + std::to_string(count));
+    core::Progress::Range range(&progress, double(i) / count, double(i + 1) / count);
+    boxfit::BoxFitRequest request;
+    request.init = inits[i].polygon;
+    request.init.holes.clear();
+    std::string error;
+    try {
+      const auto r = boxfit::fitBoxes(heights, image, request, params, &range);
+      canceled = r.status == core::RunStatus::Canceled;
+      if (!r.buildings.empty()) {
+        outlines.push_back(outlineFeature(r.buildings.front(), id));
+        appendBoxes(r.buildings.front(), id, boxes);
+        continue;
+      }
+      error = canceled ? "canceled" : r.message;
+    } catch (const core::Error& e) {
+      if (count == 1) throw;  // a single building reports its error
+      error = e.detail();
+    }
+    if (canceled) break;
+    if (count == 1) throw core::Error(core::ErrorCode::ProcessingFailed, error, opts.has("init") ? opts.get("init") : "");
+    // One building without an outline does not stop the batch: its init is written, marked.
+    ++failed;
+    core::Feature f;
+    f.polygon = request.init;
+    f.attributes["id"] = id;
+    f.attributes["method"] = std::string("box-fitting");
+    f.attributes["status"] = std::string("failed");
+    f.attributes["error"] = error;
+    outlines.push_back(std::move(f));
+    std::fprintf(stderr, "building %lld: %s\n", id, error.c_str());
+  }
+  io::writeFeatures(opts.get("out"), outlines, geo, "buildings");
+  if (opts.has("boxes")) io::writeFeatures(opts.get("boxes"), boxes, geo, "boxes");
+  progress.report(1.0);
+  progress.finish();
+  if (canceled) throw cli::Canceled();
+  if (!quiet) {
+    std::fprintf(stderr, "boxfit: %zu outline(s), %zu box(es), %d failed, written to %s\n", outlines.size() - failed,
+                 boxes.size(), failed, opts.get("out").c_str());
+  }
+  return failed > 0 ? cli::kExitProcessing : cli::kExitOk;
+}
+
+const bool registered =
+    cli::registerCommand({"boxfit", "building outlines by box-fitting on a DEM and the left image's edges", run});
+}  // namespace
