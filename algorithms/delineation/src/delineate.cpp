@@ -224,6 +224,28 @@ std::pair<DisparityInterval, DisparityInterval> costIntervals(const DisparityInt
   return {r, g};
 }
 
+// Refuses a building with nothing to work on: no image data under its initial polygon, or an
+// exclusion mask covering all of it.
+void requireDataUnder(const cv::Mat& left, const cv::Mat& right, const cv::Mat& excludeMask,
+                      const core::Polygon& init) {
+  const cv::Mat inside = core::rasterize(init, left.size());
+  if (cv::countNonZero((left == left) & inside) == 0) {
+    throw Error(ErrorCode::UnsupportedInput, "the left image has no data under the initial polygon");
+  }
+  // The right view of the building lies on the same rows, shifted by its disparity.
+  const cv::Rect2d box = core::boundingBox(init.outer);
+  const int row0 = std::clamp(static_cast<int>(std::floor(box.y)), 0, right.rows - 1);
+  const int row1 = std::clamp(static_cast<int>(std::ceil(box.y + box.height)), row0 + 1, right.rows);
+  const cv::Mat rows = right.rowRange(row0, row1);
+  if (cv::countNonZero(rows == rows) == 0) {
+    throw Error(ErrorCode::UnsupportedInput, "the right image has no data on the initial polygon's rows");
+  }
+  if (!excludeMask.empty() && cv::countNonZero(inside & (excludeMask == 0)) == 0) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the exclusion mask covers the whole initial polygon: nothing is left to delineate");
+  }
+}
+
 cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
                           const DelineationRequest& request, const DelineationParams& params) {
   params.validate();
@@ -240,7 +262,17 @@ cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
     throw Error(ErrorCode::UnsupportedInput, "delineation needs single-band images");
   }
   requireInterval(request.roof, "roof");
-  if (request.ground) requireInterval(*request.ground, "ground");
+  if (request.ground) {
+    requireInterval(*request.ground, "ground");
+    // x_right = x_left - d: a roof is nearer the cameras than its ground, its disparities larger.
+    if (request.ground->max >= request.roof.min) {
+      throw Error(ErrorCode::InvalidParameter,
+                  "the ground disparity interval " + str(*request.ground) +
+                      (request.ground->min > request.roof.max ? " lies above" : " overlaps") +
+                      " the roof interval " + str(request.roof) +
+                      ": a roof's disparities are larger than its ground's");
+    }
+  }
   if (request.searchRange) {
     requireInterval(*request.searchRange, "search");
     if (!contains(*request.searchRange, request.roof)) {
@@ -277,6 +309,7 @@ cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
                     std::to_string(box.height) + ") is outside the image (" +
                     std::to_string(left.cols) + "x" + std::to_string(left.rows) + ")");
   }
+  requireDataUnder(left, right, request.excludeMask, init);
   const int m = params.roiMargin;
   const cv::Rect grown(static_cast<int>(std::floor(box.x)) - m, static_cast<int>(std::floor(box.y)) - m,
                        static_cast<int>(std::ceil(box.x + box.width)) - static_cast<int>(std::floor(box.x)) + 2 * m,

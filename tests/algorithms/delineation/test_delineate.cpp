@@ -1,3 +1,5 @@
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -370,6 +372,25 @@ TEST(Delineate, RejectsBadInputs) {
   DelineationRequest smallMask = ok;
   smallMask.excludeMask = cv::Mat::zeros(100, 100, CV_8U);
   expectCode(smallMask, core::ErrorCode::MismatchedInputs, pair.right);
+  // A roof is nearer than its ground: a ground interval at or above the roof's is refused.
+  DelineationRequest groundAbove = ok;
+  groundAbove.ground = DisparityInterval{20, 24};
+  expectCode(groundAbove, core::ErrorCode::InvalidParameter, pair.right);
+  DelineationRequest groundOverlap = ok;
+  groundOverlap.ground = DisparityInterval{10, 13};
+  expectCode(groundOverlap, core::ErrorCode::InvalidParameter, pair.right);
+  // Nothing to delineate: no data under the polygon, or all of it excluded.
+  const cv::Mat noData(pair.left.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  try {
+    regionOfInterest(noData, pair.right, ok, params);
+    ADD_FAILURE() << "an all-NaN left image was accepted";
+  } catch (const core::Error& e) {
+    EXPECT_EQ(e.code(), core::ErrorCode::UnsupportedInput) << e.what();
+  }
+  expectCode(ok, core::ErrorCode::UnsupportedInput, noData);
+  DelineationRequest allExcluded = ok;
+  allExcluded.excludeMask = cv::Mat(pair.left.size(), CV_8U, cv::Scalar(255));
+  expectCode(allExcluded, core::ErrorCode::InvalidParameter, pair.right);
   EXPECT_NO_THROW(regionOfInterest(pair.left, pair.right, ok, params));
   // The cost box filter is centred: an even side is rejected.
   DelineationParams even;
