@@ -36,6 +36,8 @@ BuildingStatus statusFromString(const std::string& name) {
   throw Error(ErrorCode::UnreadableFile, "unknown building status '" + name + "'");
 }
 
+bool isOutlineMethod(const std::string& name) { return name == kActivePolygon || name == kBoxFitting; }
+
 std::string currentUtcTime() {
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm utc{};
@@ -70,6 +72,10 @@ std::vector<int> Project::pendingBuildings() const {
   return ids;
 }
 
+const std::string& Project::methodOf(const Building& building) const {
+  return building.method.empty() ? method : building.method;
+}
+
 std::vector<std::string> Project::missingFiles() const {
   std::vector<std::string> missing;
   for (const std::string* p : {&left, &right, &disparity, &dem, &labels, &exclude}) {
@@ -91,8 +97,7 @@ bool sameBuilding(const Building& a, const Building& b) {
   return a.id == b.id && samePolygon(a.initial, b.initial) && samePolygon(a.outline, b.outline) &&
          a.status == b.status && a.roofInterval == b.roofInterval &&
          sameNumber(a.roofHeight, b.roofHeight) && sameNumber(a.energy, b.energy) &&
-         a.energyTerms == b.energyTerms &&
-         a.history == b.history;
+         a.energyTerms == b.energyTerms && a.method == b.method && a.history == b.history;
 }
 
 // ---- paths ---------------------------------------------------------------------------------
@@ -160,6 +165,10 @@ core::Polygon polygonFromJson(const json& in, const std::string& field) {
   return polygon;
 }
 
+std::string methodProblem(const std::string& name) {
+  return "unknown method '" + name + "' (\"" + kActivePolygon + "\" or \"" + kBoxFitting + "\")";
+}
+
 json numberOrNull(double v) { return std::isnan(v) ? json(nullptr) : json(v); }
 
 template <class T>
@@ -180,7 +189,7 @@ bool Project::operator==(const Project& other) const {
         disparity == other.disparity && dem == other.dem && labels == other.labels &&
         exclude == other.exclude && outputDir == other.outputDir &&
         disparityRange == other.disparityRange &&
-        height == other.height && parameters == other.parameters &&
+        height == other.height && method == other.method && parameters == other.parameters &&
         buildings.size() == other.buildings.size())) {
     return false;
   }
@@ -209,6 +218,7 @@ json toJson(const Project& project, const std::string& baseDir) {
   out["heightModel"] = {{"groundDisparity", project.height.groundDisparity},
                         {"metresPerPixel", project.height.metresPerPixel},
                         {"gsd", project.height.gsd}};
+  out["method"] = project.method;
   out["parameters"] = project.parameters.is_null() ? json::object() : project.parameters;
   json buildings = json::array();
   for (const auto& b : project.buildings) {
@@ -225,6 +235,7 @@ json toJson(const Project& project, const std::string& baseDir) {
       for (size_t t = 0; t < kEnergyTermNames.size(); ++t) terms[kEnergyTermNames[t]] = (*b.energyTerms)[t];
       jb["energyTerms"] = std::move(terms);
     }
+    if (!b.method.empty()) jb["method"] = b.method;
     json history = json::array();
     for (const auto& h : b.history) {
       history.push_back({{"action", h.action}, {"time", h.time}, {"detail", h.detail}});
@@ -275,6 +286,9 @@ Project fromJson(const json& in, const std::string& baseDir) {
     p.height.gsd = get<double>(*it, "gsd", 1.0, "heightModel.");
     if (!(p.height.gsd > 0)) badField("heightModel.gsd", "must be positive");
   }
+  // Files written before outlines had a method name none: the active polygon, the only one then.
+  p.method = get<std::string>(in, "method", kActivePolygon, "");
+  if (!isOutlineMethod(p.method)) badField("method", methodProblem(p.method));
   p.parameters = in.value("parameters", json::object());
   if (!p.parameters.is_object()) badField("parameters", "must be an object of groups");
   for (auto it = p.parameters.begin(); it != p.parameters.end(); ++it) {
@@ -326,6 +340,8 @@ Project fromJson(const json& in, const std::string& baseDir) {
       }
       b.energyTerms = terms;
     }
+    b.method = get<std::string>(jb, "method", "", where);
+    if (!b.method.empty() && !isOutlineMethod(b.method)) badField(where + "method", methodProblem(b.method));
     const json history = jb.value("history", json::array());
     if (!history.is_array()) badField(where + "history", "must be an array");
     for (const auto& h : history) {
