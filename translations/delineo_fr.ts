@@ -552,6 +552,18 @@
         <source>Energy F(C) = %1, of which:</source>
         <translation>Énergie F(C) = %1, dont :</translation>
     </message>
+    <message>
+        <source>box-fitting</source>
+        <translation>ajustement de boîtes</translation>
+    </message>
+    <message>
+        <source>active polygon</source>
+        <translation>polygone actif</translation>
+    </message>
+    <message>
+        <source>Method</source>
+        <translation>Méthode</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::Document</name>
@@ -1366,10 +1378,6 @@
     <message>
         <source>box-fitting</source>
         <translation>ajustement de boîtes</translation>
-    </message>
-    <message>
-        <source>active polygon</source>
-        <translation>polygone actif</translation>
     </message>
     <message>
         <source>Enhanced DEM</source>

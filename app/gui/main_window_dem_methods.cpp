@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "buildings_model.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
@@ -225,9 +226,7 @@ void MainWindow::refreshBoxFitProposals() {
   boxFitTable_->setHorizontalHeaderItem(0, currentHeader);
   boxFitTable_->setHorizontalHeaderItem(1, boxFitHeader);
   const core::Polygon& outline = b->currentPolygon();
-  const QString method = !b->hasOutline()                          ? tr("initial polygon")
-                         : project::kBoxFitting == b->method       ? tr("box-fitting")
-                                                                   : tr("active polygon");
+  const QString method = b->hasOutline() ? BuildingsModel::methodText(*b) : tr("initial polygon");
   const project::BoxFitOutcome& fitted = proposal.outcome;
   const QStringList left = {method, number(core::area(outline), 0), QString::number(vertexCount(outline)),
                             number(b->energy, 1), QStringLiteral("–"), QStringLiteral("–")};

@@ -490,6 +490,10 @@ class MainWindowTest : public QObject {
     QVERIFY(undo->undoText().startsWith(QStringLiteral("Box-fitting outline")));
     QCOMPARE(QString::fromStdString(b->method), QStringLiteral("box-fitting"));
     QCOMPARE(st(b->status), st(BuildingStatus::Automatic));
+    const int row = window_->buildingsModel()->rowOf(buildingId_);
+    QCOMPARE(window_->buildingsModel()->data(window_->buildingsModel()->index(row, gui::BuildingsModel::Method),
+                                             Qt::DisplayRole).toString(),
+             QStringLiteral("box-fitting"));
     QVERIFY(b->outline.outer == outline.polygon.outer);
     QCOMPARE(QString::fromStdString(b->history.back().action), QStringLiteral("delineated"));
     QVERIFY(QString::fromStdString(b->history.back().detail).startsWith(QStringLiteral("box-fitting, ")));
