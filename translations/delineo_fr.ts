@@ -457,6 +457,26 @@
         <source>delineating building %1</source>
         <translation>délinéation du bâtiment %1</translation>
     </message>
+    <message>
+        <source>box-fitting: building segment</source>
+        <translation>ajustement de boîtes : segment du bâtiment</translation>
+    </message>
+    <message>
+        <source>box-fitting: boxes</source>
+        <translation>ajustement de boîtes : boîtes</translation>
+    </message>
+    <message>
+        <source>box-fitting: outline</source>
+        <translation>ajustement de boîtes : contour</translation>
+    </message>
+    <message>
+        <source>box-fitting building %1</source>
+        <translation>ajustement de boîtes, bâtiment %1</translation>
+    </message>
+    <message>
+        <source>enhancing the DEM</source>
+        <translation>amélioration du MNE</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::BuildingsModel</name>
@@ -532,6 +552,18 @@
         <source>Energy F(C) = %1, of which:</source>
         <translation>Énergie F(C) = %1, dont :</translation>
     </message>
+    <message>
+        <source>box-fitting</source>
+        <translation>ajustement de boîtes</translation>
+    </message>
+    <message>
+        <source>active polygon</source>
+        <translation>polygone actif</translation>
+    </message>
+    <message>
+        <source>Method</source>
+        <translation>Méthode</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::Document</name>
@@ -586,6 +618,10 @@
     <message>
         <source>Height model</source>
         <translation>Modèle de hauteur</translation>
+    </message>
+    <message>
+        <source>Box-fitting outline for building %1</source>
+        <translation>Contour par ajustement de boîtes du bâtiment %1</translation>
     </message>
 </context>
 <context>
@@ -1243,6 +1279,124 @@
     <message>
         <source>The outline of building %1 was kept as it is: %2</source>
         <translation>Le contour du bâtiment %1 a été gardé tel quel : %2</translation>
+    </message>
+    <message>
+        <source>Bo&amp;x-fitting</source>
+        <translation>Ajustement de &amp;boîtes</translation>
+    </message>
+    <message>
+        <source>Fit boxes to the selected building from its DEM and the left image&apos;s edges, and show their outline beside the building&apos;s outline</source>
+        <translation>Ajuster des boîtes au bâtiment sélectionné d’après son MNE et les contours de l’image gauche, et montrer leur contour à côté de celui du bâtiment</translation>
+    </message>
+    <message>
+        <source>Keep the bo&amp;x-fitting outline</source>
+        <translation>Garder le contour des &amp;boîtes</translation>
+    </message>
+    <message>
+        <source>The box-fitting outline becomes the selected building&apos;s outline (one undoable step)</source>
+        <translation>Le contour de l’ajustement de boîtes devient celui du bâtiment sélectionné (une étape annulable)</translation>
+    </message>
+    <message>
+        <source>Keep the current outline</source>
+        <translation>Garder le contour actuel</translation>
+    </message>
+    <message>
+        <source>Drop the box-fitting outline and keep the building&apos;s outline as it is</source>
+        <translation>Abandonner le contour de l’ajustement de boîtes et garder celui du bâtiment tel quel</translation>
+    </message>
+    <message>
+        <source>En&amp;hanced DEM</source>
+        <translation>MNE a&amp;mélioré</translation>
+    </message>
+    <message>
+        <source>Show the DEM sharpened with the buildings&apos; outlines: vertical walls, filtered roofs</source>
+        <translation>Montrer le MNE affiné par les contours des bâtiments : murs verticaux, toits filtrés</translation>
+    </message>
+    <message>
+        <source>Box-fitting</source>
+        <translation>Ajustement de boîtes</translation>
+    </message>
+    <message>
+        <source>Box-fitting needs heights: compute the disparity and set the height model (File → Project settings).</source>
+        <translation>L’ajustement de boîtes a besoin des hauteurs : calculez la disparité et définissez le modèle de hauteur (Fichier → Réglages du projet).</translation>
+    </message>
+    <message>
+        <source>Box-fitting, building %1</source>
+        <translation>Ajustement de boîtes, bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Box-fitting found no building in building %1&apos;s initial polygon: %2</source>
+        <translation>L’ajustement de boîtes n’a trouvé aucun bâtiment dans le polygone initial du bâtiment %1 : %2</translation>
+    </message>
+    <message numerus="yes">
+        <source>Box-fitting of building %1: %n box(es). Keep either outline under the buildings list.</source>
+        <translation>
+            <numerusform>Ajustement de boîtes du bâtiment %1 : %n boîte. Gardez l’un des deux contours sous la liste des bâtiments.</numerusform>
+            <numerusform>Ajustement de boîtes du bâtiment %1 : %n boîtes. Gardez l’un des deux contours sous la liste des bâtiments.</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Method</source>
+        <translation>Méthode</translation>
+    </message>
+    <message>
+        <source>Area (px²)</source>
+        <translation>Surface (px²)</translation>
+    </message>
+    <message>
+        <source>Vertices</source>
+        <translation>Sommets</translation>
+    </message>
+    <message>
+        <source>Energy F(C)</source>
+        <translation>Énergie F(C)</translation>
+    </message>
+    <message>
+        <source>Box energy (px)</source>
+        <translation>Énergie des boîtes (px)</translation>
+    </message>
+    <message>
+        <source>Boxes</source>
+        <translation>Boîtes</translation>
+    </message>
+    <message>
+        <source>The building&apos;s outline beside the outline box-fitting proposes (violet, dashed; its boxes dotted white). Energy F(C) is the active polygon&apos;s energy of each outline (lower explains the images better); box energy is box-fitting&apos;s own, the mean distance of the boxes&apos; sides to the image&apos;s edges.</source>
+        <translation>Le contour du bâtiment à côté de celui que propose l’ajustement de boîtes (violet, tirets ; ses boîtes en pointillés blancs). L’énergie F(C) est celle du polygone actif pour chaque contour (plus basse, elle explique mieux les images) ; l’énergie des boîtes est celle de l’ajustement, la distance moyenne des côtés des boîtes aux contours de l’image.</translation>
+    </message>
+    <message>
+        <source>Boxes: dotted white.</source>
+        <translation>Boîtes : pointillés blancs.</translation>
+    </message>
+    <message>
+        <source>Building %1</source>
+        <translation>Bâtiment %1</translation>
+    </message>
+    <message>
+        <source>initial polygon</source>
+        <translation>polygone initial</translation>
+    </message>
+    <message>
+        <source>box-fitting</source>
+        <translation>ajustement de boîtes</translation>
+    </message>
+    <message>
+        <source>Enhanced DEM</source>
+        <translation>MNE amélioré</translation>
+    </message>
+    <message>
+        <source>The enhanced DEM needs a DEM: compute the disparity and set the height model (File → Project settings).</source>
+        <translation>Le MNE amélioré a besoin d’un MNE : calculez la disparité et définissez le modèle de hauteur (Fichier → Réglages du projet).</translation>
+    </message>
+    <message>
+        <source>The enhanced DEM sharpens the DEM along the buildings&apos; outlines: delineate a building first.</source>
+        <translation>Le MNE amélioré affine le MNE le long des contours des bâtiments : délimitez d’abord un bâtiment.</translation>
+    </message>
+    <message numerus="yes">
+        <source>Enhanced DEM from %n outline(s).</source>
+        <translation>
+            <numerusform>MNE amélioré à partir de %n contour.</numerusform>
+            <numerusform>MNE amélioré à partir de %n contours.</numerusform>
+        </translation>
     </message>
 </context>
 <context>

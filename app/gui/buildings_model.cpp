@@ -51,11 +51,18 @@ QString BuildingsModel::statusText(BuildingStatus status) {
   return {};
 }
 
+QString BuildingsModel::methodText(const project::Building& building) {
+  if (!building.hasOutline()) return {};
+  if (building.method == project::kBoxFitting) return tr("box-fitting");
+  // Outlines from before methods were recorded came from the active polygon.
+  return tr("active polygon");
+}
+
 QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
   if (!index.isValid() || document_ == nullptr || index.row() >= rowCount()) return {};
   const auto& b = document_->project().buildings[static_cast<size_t>(index.row())];
   if (role == kIdRole) return b.id;
-  if (role == Qt::TextAlignmentRole && index.column() != Status) {
+  if (role == Qt::TextAlignmentRole && index.column() != Status && index.column() != Method) {
     return QVariant::fromValue(Qt::AlignRight | Qt::AlignVCenter);
   }
   if (role == Qt::ForegroundRole && index.column() == Status) {
@@ -81,6 +88,7 @@ QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
       return std::isfinite(b.roofHeight) ? QVariant(QString::number(b.roofHeight, 'f', 1)) : QVariant(QStringLiteral("–"));
     case Energy:
       return std::isfinite(b.energy) ? QVariant(QString::number(b.energy, 'f', 1)) : QVariant(QStringLiteral("–"));
+    case Method: return methodText(b);
     default: return {};
   }
 }
@@ -106,6 +114,7 @@ QVariant BuildingsModel::headerData(int section, Qt::Orientation orientation, in
     case Vertices: return tr("Vertices");
     case RoofHeight: return tr("Roof height (m)");
     case Energy: return tr("Energy");
+    case Method: return tr("Method");
     default: return {};
   }
 }

@@ -1,5 +1,6 @@
 #pragma once
-// Table of the document's buildings: id, status, vertex count, roof height, energy.
+// Table of the document's buildings: id, status, vertex count, roof height, energy, and the
+// method that produced the outline.
 #include <QAbstractTableModel>
 
 #include "delineo/project/project.hpp"
@@ -11,7 +12,7 @@ class Document;
 class BuildingsModel : public QAbstractTableModel {
   Q_OBJECT
  public:
-  enum Column { Id, Status, Vertices, RoofHeight, Energy, ColumnCount };
+  enum Column { Id, Status, Vertices, RoofHeight, Energy, Method, ColumnCount };
   static constexpr int kIdRole = Qt::UserRole + 1;
 
   explicit BuildingsModel(QObject* parent = nullptr);
@@ -25,6 +26,8 @@ class BuildingsModel : public QAbstractTableModel {
   int idAt(int row) const;
   int rowOf(int id) const;  // -1 when absent
   static QString statusText(project::BuildingStatus status);
+  // The method that produced the building's outline, in words; empty while it has none.
+  static QString methodText(const project::Building& building);
   // The energy and its terms, one per line (the energy column's tooltip).
   static QString energyTermsText(const project::Building& building);
 

@@ -190,10 +190,23 @@ void Document::setDelineationResult(int id, const project::DelineationOutcome& o
   after.energy = outcome.energy;
   after.energyTerms = outcome.terms;
   after.status = BuildingStatus::Automatic;
+  after.method = project::kActivePolygon;
   after.roofHeight = project::roofHeight(project_, disparity_, after.outline);
   after.addHistory("delineated", std::to_string(outcome.outline.outer.size()) + " vertices, " +
                                      std::to_string(outcome.iterations) + " sweeps");
   undo_.push(new BuildingCommand(this, id, *current, after, tr("Delineate building %1").arg(id)));
+}
+
+void Document::setBoxFitResult(int id, const project::BoxFitOutcome& outcome,
+                               const std::optional<project::EnergyOutcome>& energy) {
+  const Building* current = project_.find(id);
+  if (current == nullptr || !outcome.hasOutline()) return;
+  Building after = project::withBoxFitOutline(project_, *current, outcome, disparity_);
+  if (energy) {
+    after.energy = energy->energy;
+    after.energyTerms = energy->terms;
+  }
+  undo_.push(new BuildingCommand(this, id, *current, after, tr("Box-fitting outline for building %1").arg(id)));
 }
 
 void Document::setStatus(int id, BuildingStatus status) {

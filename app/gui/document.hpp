@@ -57,6 +57,10 @@ class Document : public QObject {
   void setPolygon(int id, const core::Polygon& polygon, const QString& description);
   // An active polygon result (status Automatic).
   void setDelineationResult(int id, const project::DelineationOutcome& outcome);
+  // A box-fitting result the operator keeps (status Automatic, method "box-fitting"), with the
+  // active polygon's energy of its outline when it was scored.
+  void setBoxFitResult(int id, const project::BoxFitOutcome& outcome,
+                       const std::optional<project::EnergyOutcome>& energy);
   void setStatus(int id, project::BuildingStatus status);
   void setRoofInterval(int id, project::DisparityInterval interval);
   void setParameters(const std::string& group, const nlohmann::json& values);

@@ -73,6 +73,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   createMenus();
   restoreSettings();
   connect(&autosaveTimer_, &QTimer::timeout, this, &MainWindow::autosaveNow);
+  enhanceTimer_.setSingleShot(true);
+  enhanceTimer_.setInterval(300);
+  connect(&enhanceTimer_, &QTimer::timeout, this, [this] { startDemEnhancement(); });
   QSettings settings;
   autosaveTimer_.start(std::max(5, settings.value(QStringLiteral("autosaveSeconds"), 60).toInt()) * 1000);
   connect(jobs_, &widgets::JobRunner::failed, this,
@@ -167,6 +170,7 @@ void MainWindow::refreshTitle() {
 void MainWindow::refresh3D() {
   if (view3D_ == nullptr || !document_) return;
   if (document_->dem().empty()) return;
+  // A new DEM of the project (not the enhanced one shown instead of it) is framed again.
   const bool newDem = view3DDem_.data != document_->dem().data;
   if (newDem) {
     view3DDem_ = document_->dem();
@@ -175,13 +179,14 @@ void MainWindow::refresh3D() {
         widgets::Terrain3DView::suggestedExaggeration(view3DDem_, document_->project().height.gsd));
     view3D_->setVerticalExaggeration(view3DExaggeration_->value());
   }
-  view3D_->setDem(document_->dem(), document_->project().height.gsd);
+  const cv::Mat& dem = shownDem();
+  view3D_->setDem(dem, document_->project().height.gsd);
   // Height colours by default: a grey drape is low-contrast and repeats the 2D view.
   view3D_->setTexture(view3DColour_->currentIndex() == 1 ? document_->leftGrey() : cv::Mat());
   std::vector<widgets::BuildingOutline> outlines;
   for (const Building& b : document_->project().buildings) {
     if (!b.hasOutline() || b.status == BuildingStatus::Rejected || !std::isfinite(b.roofHeight)) continue;
-    const double base = ringMedian(document_->dem(), b.outline, 6).value_or(0.0);
+    const double base = ringMedian(dem, b.outline, 6).value_or(0.0);
     outlines.push_back({b.outline, base, b.roofHeight});
   }
   view3D_->setBuildings(outlines);

@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "delineo/project/pipeline.hpp"
 #include "delineo/project/project.hpp"
 #include "delineo/widgets/job_runner.hpp"
 
@@ -28,6 +29,7 @@ class QDoubleSpinBox;
 class QStackedWidget;
 class QTabWidget;
 class QSpinBox;
+class QTableWidget;
 
 namespace delineo::widgets {
 class ImageView;
@@ -90,6 +92,23 @@ class MainWindow : public QMainWindow {
   // included) and applies it as one undoable edit, or says why it was kept; returns the job id.
   widgets::JobId startRegularization(int id);
 
+  // Box-fitting on the building from its initial polygon and the DEM (key "boxfit-<id>"). Its
+  // outline and boxes are shown beside the building's outline as a proposal, with both outlines'
+  // attributes in the Buildings dock; nothing changes until the operator keeps one. Returns the
+  // job id or 0 (with a message saying why).
+  widgets::JobId startBoxFitting(int id);
+  // The box-fitting proposal of the selected building becomes its outline (one undoable step,
+  // method "box-fitting"); false when there is none.
+  bool keepBoxFitOutline();
+  // Keeps the selected building's outline as it is and drops its box-fitting proposal.
+  void discardBoxFitProposal();
+  bool hasBoxFitProposal(int id) const { return boxFitProposals_.count(id) > 0; }
+  // The DEM the DEM view and the 3D view show: the enhanced one while View > Enhanced DEM is on
+  // and computed, else the project's.
+  const cv::Mat& shownDem() const;
+  // DEM enhancement with the current outlines (key "enhance"); returns the job id or 0.
+  widgets::JobId startDemEnhancement();
+
   // ---- accessors for tests and the screenshot tour ----
   widgets::ImageView* leftView() const { return leftView_; }
   widgets::ImageView* rightView() const { return rightView_; }
@@ -133,6 +152,8 @@ class MainWindow : public QMainWindow {
   QLabel* rangeNote() const { return rangeNote_; }
   QLabel* intervalLabel() const { return intervalLabel_; }
   QWidget* heightModelNotice() const { return heightModelNotice_; }
+  QWidget* boxFitPanel() const { return boxFitPanel_; }
+  QTableWidget* boxFitTable() const { return boxFitTable_; }
 
  signals:
   void documentOpened();
@@ -143,6 +164,8 @@ class MainWindow : public QMainWindow {
   void energyUpdated(int id);
   void rangeEstimated();
   void regularizationFinished(int id);
+  void boxFittingFinished(int id);  // a proposal is shown, or a message says why there is none
+  void demEnhanced();
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -221,6 +244,12 @@ class MainWindow : public QMainWindow {
   // main_window_jobs.cpp: the background jobs (the others are public).
   void startEdgeMap();
 
+  // main_window_dem_methods.cpp: box-fitting beside the active polygon, the enhanced DEM.
+  QWidget* createBoxFitPanel();
+  void refreshBoxFitProposals();
+  void onEnhancedDemToggled(bool on);
+  void scheduleDemEnhancement();
+
   std::unique_ptr<Document> document_;
   widgets::JobRunner* jobs_ = nullptr;
   widgets::ImageView* leftView_ = nullptr;
@@ -265,6 +294,17 @@ class MainWindow : public QMainWindow {
   int awaitingDisparity_ = -1;  // picked while matching ran: delineated when the disparity arrives
   widgets::JobId matchingJob_ = 0;
   cv::Mat edgeMap_;
+  // Box-fitting results shown beside a building's outline until kept or dropped, by building.
+  struct BoxFitProposal {
+    project::BoxFitOutcome outcome;
+    std::optional<project::EnergyOutcome> activeEnergy;  // F(C) of its outline, when computable
+  };
+  std::map<int, BoxFitProposal> boxFitProposals_;
+  QWidget* boxFitPanel_ = nullptr;
+  QTableWidget* boxFitTable_ = nullptr;
+  cv::Mat enhancedDem_;  // the enhanced DEM, empty until computed (or while stale)
+  std::vector<core::Polygon> enhancedFrom_;  // the outlines it was made from
+  QTimer enhanceTimer_;  // outlines changed while the enhanced DEM is shown: compute it again
   double rightShift_ = 0.0;
   bool linkingRight_ = false;
 };

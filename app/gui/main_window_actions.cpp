@@ -8,6 +8,7 @@
 #include <QMenuBar>
 #include <QSettings>
 #include <QToolBar>
+#include <QToolButton>
 #include <QUndoStack>
 #include <map>
 #include <utility>
@@ -150,6 +151,18 @@ void MainWindow::createBuildingActions() {
   action(QStringLiteral("actionRegularize"))
       ->setStatusTip(tr(
           "Square the selected outline: right angles, few vertices, within the tolerance of it"));
+  QAction* boxFit = makeAction(this, QStringLiteral("actionBoxFit"), tr("Bo&x-fitting"));
+  boxFit->setStatusTip(tr("Fit boxes to the selected building from its DEM and the left image's edges, and show "
+                          "their outline beside the building's outline"));
+  connect(boxFit, &QAction::triggered, this, [this] { startBoxFitting(selectedId_); });
+  QAction* keepBoxFit = makeAction(this, QStringLiteral("actionKeepBoxFit"), tr("Keep the bo&x-fitting outline"));
+  keepBoxFit->setStatusTip(tr("The box-fitting outline becomes the selected building's outline (one undoable step)"));
+  connect(keepBoxFit, &QAction::triggered, this, &MainWindow::keepBoxFitOutline);
+  QAction* keepCurrent = makeAction(this, QStringLiteral("actionDiscardBoxFit"), tr("Keep the current outline"));
+  keepCurrent->setStatusTip(tr("Drop the box-fitting outline and keep the building's outline as it is"));
+  connect(keepCurrent, &QAction::triggered, this, &MainWindow::discardBoxFitProposal);
+  findChild<QToolButton*>(QStringLiteral("keepBoxFit"))->setDefaultAction(keepBoxFit);
+  findChild<QToolButton*>(QStringLiteral("keepCurrentOutline"))->setDefaultAction(keepCurrent);
   auto* onPick =
       makeAction(this, QStringLiteral("actionDelineateOnPick"), tr("Delineate on &pick"));
   onPick->setCheckable(true);
@@ -227,6 +240,13 @@ void MainWindow::createViewActions() {
     leftView_->setOverlayVisible(on);
     QSettings().setValue(QStringLiteral("view/showLabels"), on);
   });
+  // The DEM sharpened with the current outlines (walls vertical, roofs median-filtered), in the
+  // DEM view and the 3D view; off shows the DEM as computed.
+  QAction* enhanced = makeAction(this, QStringLiteral("actionEnhancedDem"), tr("En&hanced DEM"));
+  enhanced->setCheckable(true);
+  enhanced->setStatusTip(tr("Show the DEM sharpened with the buildings' outlines: vertical walls, filtered roofs"));
+  connect(enhanced, &QAction::toggled, this, &MainWindow::onEnhancedDemToggled);
+  findChild<QToolButton*>(QStringLiteral("enhancedDemButton"))->setDefaultAction(enhanced);
 }
 
 void MainWindow::createMenus() {
@@ -259,6 +279,9 @@ void MainWindow::createMenus() {
   building->addAction(action(QStringLiteral("actionDelineate")));
   building->addAction(action(QStringLiteral("actionDelineateOnPick")));
   building->addAction(action(QStringLiteral("actionRegularize")));
+  building->addAction(action(QStringLiteral("actionBoxFit")));
+  building->addAction(action(QStringLiteral("actionKeepBoxFit")));
+  building->addAction(action(QStringLiteral("actionDiscardBoxFit")));
   building->addAction(action(QStringLiteral("actionAccept")));
   building->addAction(action(QStringLiteral("actionReject")));
   building->addAction(action(QStringLiteral("actionReopen")));
@@ -267,10 +290,12 @@ void MainWindow::createMenus() {
   QMenu* process = menuBar()->addMenu(tr("&Processing"));
   process->addAction(action(QStringLiteral("actionMatch")));
   process->addAction(action(QStringLiteral("actionDelineate")));
+  process->addAction(action(QStringLiteral("actionBoxFit")));
   process->addAction(action(QStringLiteral("actionCancelJobs")));
 
   QMenu* view = menuBar()->addMenu(tr("&View"));
   view->addAction(action(QStringLiteral("actionShowLabels")));
+  view->addAction(action(QStringLiteral("actionEnhancedDem")));
   view->addSeparator();
   for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
 
@@ -317,6 +342,11 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr && project::delineationAvailable());
   action(QStringLiteral("actionRegularize"))
       ->setEnabled(b != nullptr && b->hasOutline() && project::delineationAvailable());
+  action(QStringLiteral("actionBoxFit"))->setEnabled(b != nullptr && project::boxFittingAvailable());
+  const bool proposal = b != nullptr && hasBoxFitProposal(b->id);
+  action(QStringLiteral("actionKeepBoxFit"))->setEnabled(proposal);
+  action(QStringLiteral("actionDiscardBoxFit"))->setEnabled(proposal);
+  action(QStringLiteral("actionEnhancedDem"))->setEnabled(hasDoc && project::demEnhancementAvailable());
   action(QStringLiteral("actionAccept"))->setEnabled(b != nullptr && b->hasOutline() && b->status != BuildingStatus::Accepted);
   action(QStringLiteral("actionReject"))->setEnabled(b != nullptr && b->status != BuildingStatus::Rejected);
   action(QStringLiteral("actionReopen"))->setEnabled(

@@ -35,6 +35,7 @@ void MainWindow::selectBuilding(int id) {
   syncRightView();
   if (changed) frame3D();
   refreshHistogram();
+  refreshBoxFitProposals();
   updateActions();
   if (changed) emit selectedBuildingChanged(id);
 }

@@ -9,6 +9,7 @@
 #include <QLabel>
 #include <QPushButton>
 #include <QTableView>
+#include <QToolButton>
 #include <QVBoxLayout>
 #include <algorithm>
 
@@ -79,7 +80,14 @@ QDockWidget* MainWindow::createDemDock() {
   noticeLayout->addWidget(noticeText, 1);
   noticeLayout->addWidget(noticeButton);
   heightModelNotice_->hide();
-  demLayout->addWidget(demMode_, 0, 0, 1, 2);
+  // View > Enhanced DEM, also here (its action is set with the actions: createViewActions).
+  auto* enhanced = new QToolButton;
+  enhanced->setObjectName(QStringLiteral("enhancedDemButton"));
+  enhanced->setToolButtonStyle(Qt::ToolButtonTextOnly);
+  auto* demControls = new QHBoxLayout;
+  demControls->addWidget(demMode_, 1);
+  demControls->addWidget(enhanced);
+  demLayout->addLayout(demControls, 0, 0, 1, 2);
   demLayout->addWidget(heightModelNotice_, 1, 0, 1, 2);
   demLayout->addWidget(demView_, 2, 0);
   demLayout->addWidget(demLegend_, 2, 1);
@@ -155,7 +163,12 @@ void MainWindow::createBuildingsDock() {
     if (row >= 0) buildingsTable_->selectRow(row);
     updatingSelection_ = false;
   });
-  addDock(QStringLiteral("buildingsDock"), tr("Buildings"), buildingsTable_, Qt::LeftDockWidgetArea);
+  auto* buildingsPage = new QWidget;
+  auto* buildingsLayout = new QVBoxLayout(buildingsPage);
+  buildingsLayout->setContentsMargins(0, 0, 0, 0);
+  buildingsLayout->addWidget(buildingsTable_, 1);
+  buildingsLayout->addWidget(createBoxFitPanel());
+  addDock(QStringLiteral("buildingsDock"), tr("Buildings"), buildingsPage, Qt::LeftDockWidgetArea);
 }
 
 QDockWidget* MainWindow::addDock(const QString& objectName, const QString& title, QWidget* content,

@@ -7,6 +7,7 @@
 #include <QMenu>
 #include <QMessageBox>
 #include <QSettings>
+#include <QSignalBlocker>
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QUndoStack>
@@ -147,6 +148,15 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   leftView_->polygons().setRoi({});
   energyAsked_.clear();
   rangeSource_.clear();
+  boxFitProposals_.clear();
+  enhanceTimer_.stop();
+  enhancedDem_ = cv::Mat();
+  enhancedFrom_.clear();
+  {
+    const QSignalBlocker block(action(QStringLiteral("actionEnhancedDem")));
+    action(QStringLiteral("actionEnhancedDem"))->setChecked(false);
+  }
+  refreshBoxFitProposals();
   loadFormsFromDocument();
   loadRangeFromDocument();
   refreshHeightModelNotice();
@@ -168,7 +178,10 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
 // What the views do when the document changes.
 void MainWindow::connectDocument(Document* doc) {
   connect(doc, &Document::buildingChanged, this, [this](int id) {
+    if (document_->project().find(id) == nullptr) boxFitProposals_.erase(id);
     refreshOverlays();
+    refreshBoxFitProposals();
+    scheduleDemEnhancement();
     if (id == selectedId_) {
       if (document_->project().find(id) == nullptr) {
         selectBuilding(-1);
@@ -181,6 +194,14 @@ void MainWindow::connectDocument(Document* doc) {
     refresh3D();
     updateActions();
   });
+  // A new DEM (disparity, height model) makes the enhanced one stale: computed again if shown.
+  const auto demChanged = [this] {
+    enhancedDem_ = cv::Mat();
+    enhancedFrom_.clear();
+    scheduleDemEnhancement();
+  };
+  connect(doc, &Document::disparityChanged, this, demChanged);
+  connect(doc, &Document::settingsChanged, this, demChanged);
   connect(doc, &Document::disparityChanged, this, [this] {
     refreshHeightModelNotice();
     refreshRasters();
@@ -198,6 +219,7 @@ void MainWindow::connectDocument(Document* doc) {
     refresh3D();
   });
   connect(doc, &Document::buildingsReset, this, [this] {
+    scheduleDemEnhancement();
     refreshOverlays();
     refresh3D();
   });

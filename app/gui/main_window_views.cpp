@@ -120,7 +120,7 @@ void MainWindow::refreshRasters() {
     disparityView_->setImage(disparity, {widgets::ColourMap::Viridis, lo, hi});
     disparityLegend_->setRange(lo, hi);
   }
-  const cv::Mat& dem = document_->dem();
+  const cv::Mat& dem = shownDem();
   if (dem.empty()) {
     demView_->clearImage();
   } else if (demMode_->currentIndex() == 0) {
@@ -212,7 +212,7 @@ void MainWindow::updateReadout(QPointF p, bool leftGeometry, const cv::Mat& ownG
       const float d = disparity.at<float>(y, x);
       text += std::isfinite(d) ? tr("  disparity %1 px").arg(d, 0, 'f', 2) : tr("  disparity –");
     }
-    const cv::Mat& dem = document_->dem();
+    const cv::Mat& dem = shownDem();
     if (!dem.empty()) {
       const float h = dem.at<float>(y, x);
       text += std::isfinite(h) ? tr("  height %1 m").arg(h, 0, 'f', 2) : tr("  height –");

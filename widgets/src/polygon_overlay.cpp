@@ -171,6 +171,11 @@ void PolygonOverlay::setEvolvingContour(const QPolygonF& contour) {
 
 void PolygonOverlay::clearEvolvingContour() { setEvolvingContour({}); }
 
+void PolygonOverlay::setGuides(std::vector<OverlayGuide> guides) {
+  guides_ = std::move(guides);
+  emit changed();
+}
+
 void PolygonOverlay::setRoi(const QRectF& roi) {
   roi_ = roi;
   emit changed();
@@ -702,6 +707,22 @@ void PolygonOverlay::paint(QPainter& painter) const {
         }
       }
     }
+  }
+
+  for (const OverlayGuide& guide : guides_) {
+    QPainterPath path;
+    path.setFillRule(Qt::OddEvenFill);
+    path.addPolygon(toWidget(toQPolygon(guide.polygon.outer)));
+    path.closeSubpath();
+    for (const core::Ring& hole : guide.polygon.holes) {
+      path.addPolygon(toWidget(toQPolygon(hole)));
+      path.closeSubpath();
+    }
+    painter.setBrush(Qt::NoBrush);
+    painter.setPen(QPen(QColor(0, 0, 0, 160), guide.width + 1.5));
+    painter.drawPath(path);
+    painter.setPen(QPen(guide.colour, guide.width, guide.style));
+    painter.drawPath(path);
   }
 
   if (band_) {

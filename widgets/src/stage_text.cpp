@@ -34,6 +34,11 @@ constexpr const char* kStageWords[] = {
     QT_TRANSLATE_NOOP("Stages", "active polygon: courtyard"),
     QT_TRANSLATE_NOOP("Stages", "dense matching"),
     QT_TRANSLATE_NOOP("Stages", "delineating building %1"),
+    QT_TRANSLATE_NOOP("Stages", "box-fitting: building segment"),
+    QT_TRANSLATE_NOOP("Stages", "box-fitting: boxes"),
+    QT_TRANSLATE_NOOP("Stages", "box-fitting: outline"),
+    QT_TRANSLATE_NOOP("Stages", "box-fitting building %1"),
+    QT_TRANSLATE_NOOP("Stages", "enhancing the DEM"),
 };
 static_assert(std::size(kStageWords) == static_cast<size_t>(core::kLastStageId) + 1,
               "one wording per StageId");

@@ -46,6 +46,7 @@ std::string Stage::english() const {
     case StageId::BoxFitBoxes: return "box-fitting: boxes";
     case StageId::BoxFitOutline: return "box-fitting: outline";
     case StageId::BoxFittingBuilding: return "box-fitting building " + std::to_string(number);
+    case StageId::EnhancingDem: return "enhancing the DEM";
   }
   return text;
 }

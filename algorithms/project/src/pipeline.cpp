@@ -17,6 +17,12 @@
 #ifdef DELINEO_HAVE_SIM
 #include "delineo/sim/scene.hpp"
 #endif
+#ifdef DELINEO_HAVE_BOXFIT
+#include "delineo/boxfit/params.hpp"
+#endif
+#ifdef DELINEO_HAVE_DEM
+#include "delineo/dem/enhance.hpp"
+#endif
 #ifdef DELINEO_HAVE_DELINEATION
 #include "delineation_bridge.hpp"
 #include "delineo/delineation/params.hpp"
@@ -71,6 +77,12 @@ void validateParameters(const Project& project) {
 #endif
 #ifdef DELINEO_HAVE_DELINEATION
   validateGroup<delineation::DelineationParams>(project, "delineation");
+#endif
+#ifdef DELINEO_HAVE_BOXFIT
+  validateGroup<boxfit::BoxFitParams>(project, "boxfit");
+#endif
+#ifdef DELINEO_HAVE_DEM
+  validateGroup<dem::EnhanceParams>(project, "enhance");
 #endif
   (void)project;
 }
@@ -255,6 +267,7 @@ std::vector<core::Feature> buildingFeatures(const Project& project,
     f.polygon = b.currentPolygon();
     f.attributes["id"] = static_cast<long long>(b.id);
     f.attributes["status"] = toString(b.status);
+    if (b.hasOutline()) f.attributes["method"] = b.method.empty() ? std::string(kActivePolygon) : b.method;
     long long vertices = static_cast<long long>(f.polygon.outer.size());
     for (const auto& hole : f.polygon.holes) vertices += static_cast<long long>(hole.size());
     f.attributes["vertices"] = vertices;
@@ -282,6 +295,29 @@ int exportBuildings(const Project& project, const std::string& path,
   io::writeFeatures(path, features, geo);
   return static_cast<int>(features.size());
 }
+
+namespace {
+
+// The active polygon on one pending building of `delineo-cli run`; false when canceled.
+bool delineateOne(const Project& project, Building& b, const StereoPair& pair, const cv::Mat& disparity,
+                  core::Progress* progress) {
+  if (!b.roofInterval) b.roofInterval = suggestRoofInterval(disparity, b.initial);
+  DelineationOutcome outcome = delineateBuilding(project, b, pair, progress);
+  if (outcome.status == core::RunStatus::Canceled) return false;
+  b.outline = outcome.outline;
+  b.energy = outcome.energy;
+  b.energyTerms = outcome.terms;
+  b.roofHeight = roofHeight(project, disparity, b.outline);
+  b.status = BuildingStatus::Automatic;
+  b.method = kActivePolygon;
+  std::string detail = "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices";
+  if (!outcome.regularization.empty()) detail += ", " + outcome.regularization;
+  if (!outcome.regularizationNote.empty()) detail += " (" + outcome.regularizationNote + ")";
+  b.addHistory("delineated", detail);
+  return true;
+}
+
+}  // namespace
 
 RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress) {
   RunSummary summary;
@@ -325,28 +361,36 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
   } else {
     disparity = readDisparity(project, pair.left.size());
   }
+  cv::Mat heights;  // for box-fitting, read when a building asks for it
   for (size_t i = 0; i < pending.size(); ++i) {
     const double begin = matchShare + (1.0 - matchShare) * static_cast<double>(i) / static_cast<double>(pending.size());
     const double end = matchShare + (1.0 - matchShare) * static_cast<double>(i + 1) / static_cast<double>(pending.size());
     core::Progress::Range range(progress, begin, end);
-    range.setStage(core::StageId::DelineatingBuilding, pending[i]);
     Building& b = *project.find(pending[i]);
-    if (!b.roofInterval) b.roofInterval = suggestRoofInterval(disparity, b.initial);
     try {
-      DelineationOutcome outcome = delineateBuilding(project, b, pair, &range);
-      if (outcome.status == core::RunStatus::Canceled) {
-        summary.status = core::RunStatus::Canceled;
-        return summary;
+      const bool boxFitting = project.methodOf(b) == kBoxFitting;
+      if (boxFitting) {
+        range.setStage(core::StageId::BoxFittingBuilding, b.id);
+        if (heights.empty()) heights = projectHeights(project, disparity);
+        if (heights.empty()) {
+          throw Error(ErrorCode::InvalidParameter,
+                      "box-fitting needs heights: the project names no DEM and has no height model");
+        }
+        const BoxFitOutcome outcome = fitBuildingBoxes(project, b, heights, pair.left, &range);
+        if (outcome.status == core::RunStatus::Canceled) {
+          summary.status = core::RunStatus::Canceled;
+          return summary;
+        }
+        if (!outcome.hasOutline()) throw Error(ErrorCode::ProcessingFailed, "box-fitting: " + outcome.message);
+        b = withBoxFitOutline(project, b, outcome, disparity, "delineo-cli run");
+        ++summary.boxFitted;
+      } else {
+        range.setStage(core::StageId::DelineatingBuilding, b.id);
+        if (!delineateOne(project, b, pair, disparity, &range)) {
+          summary.status = core::RunStatus::Canceled;
+          return summary;
+        }
       }
-      b.outline = outcome.outline;
-      b.energy = outcome.energy;
-      b.energyTerms = outcome.terms;
-      b.roofHeight = roofHeight(project, disparity, b.outline);
-      b.status = BuildingStatus::Automatic;
-      std::string detail = "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices";
-      if (!outcome.regularization.empty()) detail += ", " + outcome.regularization;
-      if (!outcome.regularizationNote.empty()) detail += " (" + outcome.regularizationNote + ")";
-      b.addHistory("delineated", detail);
       ++summary.delineated;
     } catch (const Error& e) {
       if (!core::isInputError(e.code()) || e.code() == ErrorCode::InvalidParameter) {

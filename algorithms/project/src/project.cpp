@@ -38,6 +38,8 @@ BuildingStatus statusFromString(const std::string& name) {
   throw Error(ErrorCode::UnreadableFile, "unknown building status '" + name + "'");
 }
 
+bool isOutlineMethod(const std::string& name) { return name == kActivePolygon || name == kBoxFitting; }
+
 std::string currentUtcTime() {
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm utc{};
@@ -72,6 +74,10 @@ std::vector<int> Project::pendingBuildings() const {
   return ids;
 }
 
+const std::string& Project::methodOf(const Building& building) const {
+  return building.method.empty() ? method : building.method;
+}
+
 std::vector<std::string> Project::missingFiles() const {
   std::vector<std::string> missing;
   for (const std::string* p : {&left, &right, &disparity, &dem, &labels, &exclude}) {
@@ -93,8 +99,7 @@ bool sameBuilding(const Building& a, const Building& b) {
   return a.id == b.id && samePolygon(a.initial, b.initial) && samePolygon(a.outline, b.outline) &&
          a.status == b.status && a.roofInterval == b.roofInterval &&
          sameNumber(a.roofHeight, b.roofHeight) && sameNumber(a.energy, b.energy) &&
-         a.energyTerms == b.energyTerms &&
-         a.history == b.history;
+         a.energyTerms == b.energyTerms && a.method == b.method && a.history == b.history;
 }
 
 // ---- paths ---------------------------------------------------------------------------------
@@ -194,6 +199,10 @@ core::Polygon polygonFromJson(const json& in, const std::string& field) {
   return polygon;
 }
 
+std::string methodProblem(const std::string& name) {
+  return "unknown method '" + name + "' (\"" + kActivePolygon + "\" or \"" + kBoxFitting + "\")";
+}
+
 json numberOrNull(double v) { return std::isnan(v) ? json(nullptr) : json(v); }
 
 template <class T>
@@ -214,7 +223,7 @@ bool Project::operator==(const Project& other) const {
         disparity == other.disparity && dem == other.dem && labels == other.labels &&
         exclude == other.exclude && outputDir == other.outputDir &&
         disparityRange == other.disparityRange &&
-        height == other.height && parameters == other.parameters &&
+        height == other.height && method == other.method && parameters == other.parameters &&
         buildings.size() == other.buildings.size())) {
     return false;
   }
@@ -243,6 +252,7 @@ json toJson(const Project& project, const std::string& baseDir) {
   out["heightModel"] = {{"groundDisparity", project.height.groundDisparity},
                         {"metresPerPixel", project.height.metresPerPixel},
                         {"gsd", project.height.gsd}};
+  out["method"] = project.method;
   out["parameters"] = project.parameters.is_null() ? json::object() : project.parameters;
   json buildings = json::array();
   for (const auto& b : project.buildings) {
@@ -259,6 +269,7 @@ json toJson(const Project& project, const std::string& baseDir) {
       for (size_t t = 0; t < kEnergyTermNames.size(); ++t) terms[kEnergyTermNames[t]] = (*b.energyTerms)[t];
       jb["energyTerms"] = std::move(terms);
     }
+    if (!b.method.empty()) jb["method"] = b.method;
     json history = json::array();
     for (const auto& h : b.history) {
       history.push_back({{"action", h.action}, {"time", h.time}, {"detail", h.detail}});
@@ -322,6 +333,9 @@ Project fromJson(const json& in, const std::string& baseDir) {
       badField("heightModel.groundDisparity", "must be within +-" + std::to_string(kMaxDisparity) + " px");
     }
   }
+  // Files written before outlines had a method name none: the active polygon, the only one then.
+  p.method = get<std::string>(in, "method", kActivePolygon, "");
+  if (!isOutlineMethod(p.method)) badField("method", methodProblem(p.method));
   p.parameters = in.value("parameters", json::object());
   if (!p.parameters.is_object()) badField("parameters", "must be an object of groups");
   for (auto it = p.parameters.begin(); it != p.parameters.end(); ++it) {
@@ -374,6 +388,8 @@ Project fromJson(const json& in, const std::string& baseDir) {
       }
       b.energyTerms = terms;
     }
+    b.method = get<std::string>(jb, "method", "", where);
+    if (!b.method.empty() && !isOutlineMethod(b.method)) badField(where + "method", methodProblem(b.method));
     const json history = jb.value("history", json::array());
     if (!history.is_array()) badField(where + "history", "must be an array");
     for (const auto& h : history) {
@@ -382,11 +398,11 @@ Project fromJson(const json& in, const std::string& baseDir) {
                            get<std::string>(h, "time", "", where + "history."),
                            get<std::string>(h, "detail", "", where + "history.")});
     }
-    b.unknownKeys = unknownKeys(jb, {"id", "status", "initial", "outline", "roofInterval", "roofHeight",
+    b.unknownKeys = unknownKeys(jb, {"id", "status", "method", "initial", "outline", "roofInterval", "roofHeight",
                                      "energy", "energyTerms", "history"});
     p.buildings.push_back(std::move(b));
   }
-  p.unknownKeys = unknownKeys(in, {"format", "version", "name", "images", "outputDir", "disparityRange",
+  p.unknownKeys = unknownKeys(in, {"format", "version", "name", "method", "images", "outputDir", "disparityRange",
                                    "heightModel", "parameters", "buildings"});
   if (json imageExtras = unknownKeys(images, {"left", "right", "disparity", "dem", "labels", "exclude"});
       !imageExtras.empty()) {

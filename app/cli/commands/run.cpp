@@ -1,7 +1,7 @@
 // delineo-cli run PROJECT: executes a project's pending steps with the same code as the GUI
-// (delineo::project): dense matching when the project has no disparity yet, the active polygon
-// for every pending building, export of the delineated outlines, then an atomic save of the
-// project. `--sample DIR` first creates (or reuses) the bundled sample project in DIR.
+// (delineo::project): dense matching when the project has no disparity yet, the outline of every
+// pending building with its method (the active polygon, or box-fitting), export of the
+// delineated outlines, then an atomic save of the project. `--sample DIR` first creates (or reuses) the bundled sample project in DIR.
 #include <cstdio>
 
 #include "cli_support.hpp"
@@ -15,8 +15,9 @@ using namespace delineo;
 int run(const std::vector<std::string>& args) {
   cli::Options opts("run",
                     "Executes the pending steps of a project: matching if the disparity is "
-                    "missing, the active polygon for pending buildings, export of the outlines "
-                    "to <outputDir>/buildings.geojson; then saves the project.\n"
+                    "missing, the outline of pending buildings with their method (the project's "
+                    "or the building's \"method\": active-polygon or box-fitting), export of the "
+                    "outlines to <outputDir>/buildings.geojson; then saves the project.\n"
                     "Usage: delineo-cli run PROJECT [options]");
   opts.value("project", "FILE", "project file (may also be given as the first argument)", "")
       .value("sample", "DIR", "create (or reuse) the sample project in DIR and run it", "")
@@ -65,6 +66,7 @@ int run(const std::vector<std::string>& args) {
                  summary.rangeEstimated->range.high);
   }
   for (const auto& message : summary.messages) std::fprintf(stderr, "run: %s\n", message.c_str());
+  if (summary.boxFitted > 0) std::fprintf(stderr, "run: %d building(s) outlined by box-fitting\n", summary.boxFitted);
   if (!opts.has("no-save")) project::saveProject(proj, projectPath);
   std::fprintf(stderr, "run: %s; %d building(s) delineated, %d skipped%s%s\n",
                summary.matched ? "disparity computed" : "disparity already present",

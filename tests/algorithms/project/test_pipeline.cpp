@@ -1,5 +1,6 @@
 // Project processing steps: the active polygon's live contour, roof heights, output folders.
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
 #include "delineo/project/pipeline.hpp"
@@ -16,6 +17,7 @@ struct SceneProject {
   project::Project project;
   project::StereoPair pair;
   project::Building building;
+  core::Polygon truth;  // the building's true footprint
 };
 
 SceneProject makeSceneProject() {
@@ -46,7 +48,14 @@ SceneProject makeSceneProject() {
                               {box.x + box.width + 8, box.y + box.height + 8},
                               {box.x - 8, box.y + box.height + 8}};
   s.building.roofInterval = project::suggestRoofInterval(s.scene.disparity, far->polygon);
+  s.truth = far->polygon;
   return s;
+}
+
+double iou(const core::Polygon& a, const core::Polygon& b, cv::Size size) {
+  const cv::Mat ma = core::rasterize(a, size), mb = core::rasterize(b, size);
+  const double inter = cv::countNonZero(ma & mb), uni = cv::countNonZero(ma | mb);
+  return uni > 0 ? inter / uni : 0.0;
 }
 
 }  // namespace
@@ -143,4 +152,76 @@ TEST(Pipeline, TheProjectsRangeIsTheRangeTheMatcherSearches) {
   const double full = roofsFound(project::computeDisparity(s.project, s.pair.left, s.pair.right, nullptr).disparity);
   EXPECT_LT(narrow, 0.05);
   EXPECT_GT(full, 0.6);
+}
+
+TEST(Pipeline, HeightsComeFromTheDemFileOrTheDisparityThroughTheHeightModel) {
+  project::Project p;
+  cv::Mat disparity(4, 5, CV_32F, cv::Scalar(12.0f));
+  disparity.at<float>(1, 1) = std::nanf("");
+  EXPECT_TRUE(project::projectHeights(p, disparity).empty());  // no height model
+  p.height = {8.0, 0.5, 0.25};
+  const cv::Mat heights = project::projectHeights(p, disparity);
+  ASSERT_EQ(heights.size(), disparity.size());
+  EXPECT_FLOAT_EQ(heights.at<float>(0, 0), 2.0f);
+  EXPECT_TRUE(std::isnan(heights.at<float>(1, 1)));
+  EXPECT_TRUE(project::projectHeights(p, cv::Mat()).empty());
+}
+
+TEST(Pipeline, BoxFittingOutlinesTheBuildingAndRecordsItsMethod) {
+  if (!project::boxFittingAvailable()) GTEST_SKIP() << "no box-fitting in this build";
+  SceneProject s = makeSceneProject();
+  s.project.height = {s.scene.groundDisparity, s.scene.metresPerDisparity, 0.25};
+  const cv::Mat heights = project::projectHeights(s.project, s.scene.disparity);
+  const auto outcome = project::fitBuildingBoxes(s.project, s.building, heights, s.pair.left, nullptr);
+  ASSERT_EQ(outcome.status, core::RunStatus::Completed);
+  ASSERT_TRUE(outcome.hasOutline()) << outcome.message;
+  EXPECT_FALSE(outcome.boxes.empty());
+  for (const auto& box : outcome.boxes) EXPECT_EQ(box.corners.size(), 4u);
+  EXPECT_TRUE(std::isfinite(outcome.energy));
+  const double overlap = iou(outcome.outline, s.truth, s.pair.left.size());
+  EXPECT_GT(overlap, 0.8);
+  const project::Building after =
+      project::withBoxFitOutline(s.project, s.building, outcome, s.scene.disparity, "test");
+  EXPECT_EQ(after.method, project::kBoxFitting);
+  EXPECT_EQ(after.status, project::BuildingStatus::Automatic);
+  EXPECT_TRUE(after.outline.outer == outcome.outline.outer);
+  EXPECT_TRUE(std::isnan(after.energy));  // F(C) is the active polygon's energy: unknown here
+  EXPECT_GT(after.roofHeight, 2.0);
+  ASSERT_FALSE(after.history.empty());
+  EXPECT_EQ(after.history.back().action, "delineated");
+  EXPECT_EQ(after.history.back().detail.rfind("test, box-fitting, ", 0), 0u) << after.history.back().detail;
+  // The project's "boxfit" parameters are used: a minimum height above every roof finds nothing.
+  s.project.parameters["boxfit"] = nlohmann::json{{"min-height", 200.0}};
+  const auto none = project::fitBuildingBoxes(s.project, s.building, heights, s.pair.left, nullptr);
+  EXPECT_FALSE(none.hasOutline());
+  EXPECT_FALSE(none.message.empty());
+  // Without heights box-fitting is refused with a reason.
+  EXPECT_THROW(project::fitBuildingBoxes(s.project, s.building, cv::Mat(), s.pair.left, nullptr), core::Error);
+}
+
+TEST(Pipeline, EnhancedHeightsFollowTheOutlinesAndLeaveTheGroundAlone) {
+  if (!project::demEnhancementAvailable()) GTEST_SKIP() << "no DEM enhancement in this build";
+  SceneProject s = makeSceneProject();
+  s.project.height = {s.scene.groundDisparity, s.scene.metresPerDisparity, 0.25};
+  const cv::Mat heights = project::projectHeights(s.project, s.scene.disparity);
+  // Without an outline nothing changes.
+  s.project.buildings.push_back(s.building);  // pending: no outline yet
+  const auto plain = project::enhanceHeights(s.project, heights, nullptr);
+  EXPECT_EQ(plain.footprints, 0);
+  EXPECT_EQ(plain.dem.data, heights.data);
+  // With the true outline the heights change near it, and not far from it.
+  s.project.buildings.back().outline = s.truth;
+  s.project.buildings.back().status = project::BuildingStatus::Automatic;
+  const auto enhanced = project::enhanceHeights(s.project, heights, nullptr);
+  ASSERT_EQ(enhanced.status, core::RunStatus::Completed);
+  EXPECT_EQ(enhanced.footprints, 1);
+  ASSERT_EQ(enhanced.dem.size(), heights.size());
+  cv::Mat near = core::rasterize(s.truth, heights.size());
+  cv::dilate(near, near, cv::getStructuringElement(cv::MORPH_RECT, {31, 31}));
+  cv::Mat changed = (enhanced.dem != heights) & (heights == heights);
+  EXPECT_GT(cv::countNonZero(changed & near), 0);
+  EXPECT_EQ(cv::countNonZero(changed & ~near), 0);
+  // A rejected building's outline is no footprint.
+  s.project.buildings.back().status = project::BuildingStatus::Rejected;
+  EXPECT_EQ(project::enhanceHeights(s.project, heights, nullptr).footprints, 0);
 }

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include "delineo/core/error.hpp"
@@ -73,6 +74,7 @@ Project sampleProject(const TempDir& dir) {
   b.roofHeight = 9.5;
   b.energy = -1234.5;
   b.energyTerms = project::EnergyTerms{-1000, 200, 15.5, -300, -200, 50};
+  b.method = project::kBoxFitting;
   b.history = {{"picked", "2024-01-01T00:00:00Z", ""}, {"delineated", "2024-01-01T00:01:00Z", "12 vertices"}};
   p.buildings.push_back(b);
   Building pending;
@@ -96,6 +98,36 @@ TEST(ProjectFile, RoundTripKeepsEveryField) {
   EXPECT_FALSE(loaded.buildings[1].roofInterval.has_value());
   EXPECT_EQ(project::parameters<DemoParams>(loaded, "delineation").window, 9);
   EXPECT_EQ(project::parameters<DemoParams>(loaded, "missing-group").window, 7);
+  EXPECT_EQ(loaded.buildings[0].method, project::kBoxFitting);
+  EXPECT_TRUE(loaded.buildings[1].method.empty());
+}
+
+TEST(ProjectFile, FilesWithoutMethodsOutlineWithTheActivePolygon) {
+  // A file as written before outlines had a method: no project-level nor building "method".
+  TempDir dir;
+  const std::string path = dir.file("old.delineo.json");
+  std::ofstream(path) << R"({"format":"delineo-project","version":1,"images":{"left":"l.tif","right":"r.tif"},
+    "buildings":[{"id":1,"status":"automatic","initial":[[[0,0],[9,0],[9,9]]],"outline":[[[1,1],[8,1],[8,8]]]},
+                 {"id":2,"status":"pending","initial":[[[20,20],[29,20],[29,29]]]}]})";
+  Project p = project::loadProject(path);
+  EXPECT_EQ(p.method, project::kActivePolygon);
+  ASSERT_EQ(p.buildings.size(), 2u);
+  EXPECT_TRUE(p.buildings[0].method.empty());
+  EXPECT_EQ(p.methodOf(p.buildings[1]), project::kActivePolygon);
+  // The project's method applies to buildings naming none; a building's own method wins.
+  p.method = project::kBoxFitting;
+  EXPECT_EQ(p.methodOf(p.buildings[1]), project::kBoxFitting);
+  p.buildings[1].method = project::kActivePolygon;
+  EXPECT_EQ(p.methodOf(p.buildings[1]), project::kActivePolygon);
+  // Saved, both are written and read back.
+  project::saveProject(p, path);
+  const Project again = project::loadProject(path);
+  EXPECT_TRUE(again == p);
+  std::ifstream in(path);
+  const nlohmann::json written = nlohmann::json::parse(in);
+  EXPECT_EQ(written["method"], "box-fitting");
+  EXPECT_EQ(written["buildings"][1]["method"], "active-polygon");
+  EXPECT_FALSE(written["buildings"][0].contains("method"));  // none chosen: nothing written
 }
 
 TEST(ProjectFile, PathsUnderTheProjectFolderAreStoredRelative) {
@@ -237,6 +269,10 @@ TEST(ProjectFile, CorruptFilesAreRejectedWithTheFieldNamed) {
     "buildings":[{"id":1,"initial":[[[0,0],[1,0],[1,1]]]},{"id":1,"initial":[[[0,0],[1,0],[1,1]]]}]})", "duplicate");
   expectUnreadable(R"({"format":"delineo-project","version":1,"images":{"left":"l","right":"r"},
     "buildings":[{"id":1,"initial":[[[0,0],[1,0],[1,1]]],"roofInterval":[5,2]}]})", "roofInterval");
+  expectUnreadable(R"({"format":"delineo-project","version":1,"images":{"left":"l","right":"r"},
+    "method":"snakes"})", "method");
+  expectUnreadable(R"({"format":"delineo-project","version":1,"images":{"left":"l","right":"r"},
+    "buildings":[{"id":1,"initial":[[[0,0],[1,0],[1,1]]],"method":"boxes"}]})", "buildings[0].method");
 }
 
 TEST(ProjectFile, MissingProjectIsFileNotFound) {

@@ -2,8 +2,9 @@
 # End-to-end check of `delineo-cli run PROJECT` on a project with pending buildings: a simulated
 # pair, a project file written here with two rough rectangles (one with a roof interval, one
 # without, so the proposed interval is used), then: the run computes the disparity, delineates
-# both buildings, exports them and saves the project; a second run changes nothing; a corrupt
-# project and a missing image give exit code 3 naming the file.
+# both buildings, exports them and saves the project; a second run changes nothing; box-fitting as
+# the project's method (a building's own method wins); a corrupt project, an unknown method and a
+# missing image give exit code 3 naming the file.
 # Usage: e2e_run.sh PATH/TO/delineo-cli WORKDIR      (needs jq)
 set -uo pipefail
 cli="$1"
@@ -109,6 +110,35 @@ cmp -s "$project" "$work/after_first.json" && pass "second run left the project 
   || { fail "second run changed the project"; diff "$work/after_first.json" "$project" | head -10; }
 [ "$(stat -c %Y "$site/output/disparity.tif")" = "$disparity_time" ] && pass "disparity not recomputed" \
   || fail "second run rewrote the disparity"
+
+# ---- box-fitting as a project step: the project's method, a building's own method wins ----------
+# Every building pending again; the project asks for box-fitting, building 1 for the active polygon.
+jq '.method = "box-fitting" | .parameters.boxfit = {"min-area": 200}
+    | .buildings |= map(.status = "pending" | .outline = [] | .energy = null | del(.energyTerms) | del(.method))
+    | .buildings[0].method = "active-polygon"' "$work/after_first.json" >"$site/boxfit.delineo.json"
+run_cli run_boxfit 0 "$((count - 1)) building(s) outlined by box-fitting" -- "$cli" run "$site/boxfit.delineo.json" --quiet
+expect boxfit_methods '.buildings[0].method == "active-polygon" and ([.buildings[1:][].method] | all(. == "box-fitting"))' \
+  "$site/boxfit.delineo.json"
+expect boxfit_project_method '.method == "box-fitting"' "$site/boxfit.delineo.json"
+expect boxfit_statuses '[.buildings[].status] | all(. == "automatic")' "$site/boxfit.delineo.json"
+expect boxfit_history '[.buildings[1:][].history[-1].detail | startswith("delineo-cli run, box-fitting, ")] | all' \
+  "$site/boxfit.delineo.json"
+expect boxfit_heights '[.buildings[].roofHeight] | all(. != null and . > 2)' "$site/boxfit.delineo.json"
+expect boxfit_outlines_inside_rectangles '[.buildings[1:][] |
+    (.initial[0] | [(map(.[0]) | min), (map(.[1]) | min), (map(.[0]) | max), (map(.[1]) | max)]) as $box |
+    (.outline[0] | [(map(.[0]) | add / length), (map(.[1]) | add / length)]) as $c |
+    (.outline[0] | length >= 4) and ($c[0] > $box[0] and $c[0] < $box[2] and $c[1] > $box[1] and $c[1] < $box[3])] | all' \
+  "$site/boxfit.delineo.json"
+expect boxfit_export_methods '[.features[].properties.method] | (.[0] == "active-polygon" and (.[1:] | all(. == "box-fitting")))' \
+  "$site/output/buildings.geojson"
+# Box-fitting needs heights: without a DEM nor a height model the building is skipped (exit 4).
+jq '.heightModel.metresPerPixel = 0 | .buildings[1].status = "pending" | .buildings[1].outline = []' \
+  "$site/boxfit.delineo.json" >"$site/noheights.delineo.json"
+run_cli run_boxfit_no_heights 4 "box-fitting needs heights" -- "$cli" run "$site/noheights.delineo.json" --quiet
+expect noheights_still_pending '.buildings[1].status == "pending"' "$site/noheights.delineo.json"
+# An unknown method is a corrupt project (exit 3), named.
+jq '.method = "snakes"' "$site/boxfit.delineo.json" >"$site/badmethod.delineo.json"
+run_cli run_bad_method 3 "method" -- "$cli" run "$site/badmethod.delineo.json" --quiet
 
 # ---- exclusion mask (images.exclude): an empty one changes nothing; a mis-sized one is refused --
 run_cli simulate_empty 0 "" -- "$cli" simulate --out "$work/empty" --seed 5 --width 256 --height 192 --buildings 0 --trees 0 \

@@ -17,6 +17,8 @@
 #include <QStandardPaths>
 #include <QTabWidget>
 #include <QTableView>
+#include <QTableWidget>
+#include <QComboBox>
 #include <QTemporaryDir>
 #include <QTest>
 #include <QToolBar>
@@ -426,6 +428,164 @@ class MainWindowTest : public QObject {
     QVERIFY(doc->project().find(buildingId_)->outline.outer == squared);
   }
 
+  void boxFittingIsShownBesideTheOutlineAndKeptAsOneStep() {
+    if (!project::boxFittingAvailable()) QSKIP("no box-fitting in this build");
+    gui::Document* doc = window_->document();
+    window_->selectBuilding(buildingId_);
+    const project::Building before = *doc->project().find(buildingId_);
+    QVERIFY(before.hasOutline());
+    QUndoStack* undo = doc->undoStack();
+    const int steps = undo->count();
+    QAction* boxFit = window_->action(QStringLiteral("actionBoxFit"));
+    QAction* keep = window_->action(QStringLiteral("actionKeepBoxFit"));
+    QVERIFY(boxFit->isEnabled());
+    QVERIFY(!keep->isEnabled());
+    QVERIFY(!window_->boxFitPanel()->isVisible());
+    QSignalSpy done(window_.get(), &MainWindow::boxFittingFinished);
+    boxFit->trigger();
+    QTRY_COMPARE_WITH_TIMEOUT(done.count(), 1, 60000);
+    QVERIFY2(window_->hasBoxFitProposal(buildingId_), qPrintable(window_->lastMessage()));
+    // A proposal only: the building is as it was, nothing on the undo stack.
+    QCOMPARE(undo->count(), steps);
+    QVERIFY(doc->project().find(buildingId_)->outline.outer == before.outline.outer);
+    // Drawn beside the building's outline: one dotted guide per box, then the dashed outline,
+    // which lies on the true roof.
+    const auto& guides = window_->leftView()->polygons().guides();
+    QVERIFY(guides.size() >= 2);
+    const widgets::OverlayGuide outline = guides.back();
+    QCOMPARE(outline.style, Qt::DashLine);
+    for (size_t i = 0; i + 1 < guides.size(); ++i) {
+      QCOMPARE(guides[i].style, Qt::DotLine);
+      QCOMPARE(guides[i].polygon.outer.size(), size_t(4));
+    }
+    QVERIFY(outline.colour != window_->leftView()->polygons().selectedPolygon()->colour);
+    const cv::Mat truth = (doc->labels() == 1);
+    const cv::Mat fitted = core::rasterize(outline.polygon, truth.size());
+    const cv::Rect roof = largestBuilding(doc->labels());
+    const double inter = cv::countNonZero(fitted(roof) & truth(roof));
+    const double uni = cv::countNonZero(fitted) + cv::countNonZero(truth(roof)) - inter;
+    qInfo("box-fitting: %zu boxes, IoU %.3f with the true roof", guides.size() - 1, inter / uni);
+    QVERIFY2(inter / uni > 0.7, qPrintable(QString::number(inter / uni)));
+    // Both outlines' attributes side by side.
+    QVERIFY(window_->boxFitPanel()->isVisible());
+    QTableWidget* table = window_->boxFitTable();
+    QCOMPARE(table->item(5, 1)->text().toInt(), static_cast<int>(guides.size() - 1));  // boxes
+    int fittedVertices = static_cast<int>(outline.polygon.outer.size());
+    for (const auto& hole : outline.polygon.holes) fittedVertices += static_cast<int>(hole.size());
+    QCOMPARE(table->item(2, 1)->text().toInt(), fittedVertices);
+    int currentVertices = static_cast<int>(before.outline.outer.size());
+    for (const auto& hole : before.outline.holes) currentVertices += static_cast<int>(hole.size());
+    QCOMPARE(table->item(2, 0)->text().toInt(), currentVertices);
+    QVERIFY(table->item(4, 1)->text().toDouble() > 0.0);  // box energy, px
+    if (const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR"); !dir.isEmpty()) {
+      window_->leftView()->setView(QPointF(roof.x + roof.width / 2.0, roof.y + roof.height / 2.0), 2.0);
+      QTest::qWait(200);
+      window_->grab().save(dir + QStringLiteral("/sample-box-fitting.png"));
+    }
+    // Keeping it is one undoable step that records the method.
+    QVERIFY(keep->isEnabled());
+    keep->trigger();
+    const project::Building* b = doc->project().find(buildingId_);
+    QCOMPARE(undo->count(), steps + 1);
+    QVERIFY(undo->undoText().startsWith(QStringLiteral("Box-fitting outline")));
+    QCOMPARE(QString::fromStdString(b->method), QStringLiteral("box-fitting"));
+    QCOMPARE(st(b->status), st(BuildingStatus::Automatic));
+    const int row = window_->buildingsModel()->rowOf(buildingId_);
+    QCOMPARE(window_->buildingsModel()->data(window_->buildingsModel()->index(row, gui::BuildingsModel::Method),
+                                             Qt::DisplayRole).toString(),
+             QStringLiteral("box-fitting"));
+    QVERIFY(b->outline.outer == outline.polygon.outer);
+    QCOMPARE(QString::fromStdString(b->history.back().action), QStringLiteral("delineated"));
+    QVERIFY(QString::fromStdString(b->history.back().detail).startsWith(QStringLiteral("box-fitting, ")));
+    QVERIFY(!window_->hasBoxFitProposal(buildingId_));
+    QVERIFY(window_->leftView()->polygons().guides().empty());
+    QVERIFY(!window_->boxFitPanel()->isVisible());
+    QVERIFY(window_->leftView()->polygons().selectedPolygon()->polygon.outer == outline.polygon.outer);
+    undo->undo();
+    b = doc->project().find(buildingId_);
+    QVERIFY(b->outline.outer == before.outline.outer);
+    QCOMPARE(st(b->status), st(before.status));
+    QCOMPARE(b->method, before.method);
+    undo->redo();
+    QCOMPARE(QString::fromStdString(doc->project().find(buildingId_)->method), QStringLiteral("box-fitting"));
+    undo->undo();  // the tests after this one work on the active polygon's outline
+  }
+
+  void canceledBoxFittingKeepsTheOutline() {
+    if (!project::boxFittingAvailable()) QSKIP("no box-fitting in this build");
+    gui::Document* doc = window_->document();
+    window_->selectBuilding(buildingId_);
+    window_->discardBoxFitProposal();  // one a test before may have left
+    const project::Building before = *doc->project().find(buildingId_);
+    QUndoStack* undo = doc->undoStack();
+    const int steps = undo->count();
+    QSignalSpy canceled(window_->jobs(), &widgets::JobRunner::canceled);
+    QSignalSpy done(window_.get(), &MainWindow::boxFittingFinished);
+    const widgets::JobId job = window_->startBoxFitting(buildingId_);
+    QVERIFY(job != 0);
+    window_->action(QStringLiteral("actionCancelJobs"))->trigger();
+    QVERIFY(window_->jobs()->waitForIdle(30000));
+    QCOMPARE(canceled.count(), 1);
+    QCOMPARE(done.count(), 0);
+    QVERIFY(!window_->hasBoxFitProposal(buildingId_));
+    QVERIFY(window_->leftView()->polygons().guides().empty());
+    QCOMPARE(undo->count(), steps);
+    QVERIFY(doc->project().find(buildingId_)->outline.outer == before.outline.outer);
+    QCOMPARE(st(doc->project().find(buildingId_)->status), st(before.status));
+    // "Keep the current outline" drops a proposal and changes nothing either.
+    window_->action(QStringLiteral("actionBoxFit"))->trigger();
+    QTRY_COMPARE_WITH_TIMEOUT(done.count(), 1, 60000);
+    QVERIFY(window_->hasBoxFitProposal(buildingId_));
+    QAction* keepCurrent = window_->action(QStringLiteral("actionDiscardBoxFit"));
+    QVERIFY(keepCurrent->isEnabled());
+    keepCurrent->trigger();
+    QVERIFY(!window_->hasBoxFitProposal(buildingId_));
+    QVERIFY(window_->leftView()->polygons().guides().empty());
+    QCOMPARE(undo->count(), steps);
+    QVERIFY(doc->project().find(buildingId_)->outline.outer == before.outline.outer);
+  }
+
+  void enhancedDemToggleChangesTheDemView() {
+    if (!project::demEnhancementAvailable()) QSKIP("no DEM enhancement in this build");
+    gui::Document* doc = window_->document();
+    QVERIFY(doc->project().find(buildingId_)->hasOutline());
+    window_->showDock(QStringLiteral("demDock"));
+    window_->findChild<QComboBox*>(QStringLiteral("demMode"))->setCurrentIndex(1);  // heights
+    QVERIFY(window_->demView()->hasImage());
+    const auto finite = [](const cv::Mat& m) {
+      cv::Mat copy = m.clone();
+      cv::patchNaNs(copy, -9999.0);
+      return copy;
+    };
+    const cv::Mat plain = finite(window_->demView()->image());
+    QCOMPARE(plain.type(), CV_32F);
+    const cv::Mat projectDem = doc->dem().clone();
+    QAction* toggle = window_->action(QStringLiteral("actionEnhancedDem"));
+    QVERIFY(toggle->isEnabled());
+    QSignalSpy enhanced(window_.get(), &MainWindow::demEnhanced);
+    toggle->trigger();
+    QTRY_COMPARE_WITH_TIMEOUT(enhanced.count(), 1, 60000);
+    QVERIFY(toggle->isChecked());
+    const cv::Mat shown = finite(window_->demView()->image());
+    QCOMPARE(shown.size(), plain.size());
+    // The DEM view now shows other heights near the outline, the same ones far from it.
+    const cv::Mat changed = shown != plain;
+    cv::Mat near = core::rasterize(doc->project().find(buildingId_)->outline, plain.size());
+    cv::dilate(near, near, cv::getStructuringElement(cv::MORPH_RECT, {41, 41}));
+    qInfo("enhanced DEM: %d pixels changed near the outline, %d elsewhere", cv::countNonZero(changed & near),
+          cv::countNonZero(changed & ~near));
+    QVERIFY(cv::countNonZero(changed & near) > 50);
+    QCOMPARE(cv::countNonZero(changed & ~near), 0);
+    QVERIFY(window_->shownDem().data != doc->dem().data);
+    // The project's DEM is not touched.
+    QCOMPARE(cv::norm(finite(doc->dem()), finite(projectDem), cv::NORM_INF), 0.0);
+    // Back to the plain DEM.
+    toggle->trigger();
+    QVERIFY(!toggle->isChecked());
+    QCOMPARE(cv::norm(finite(window_->demView()->image()), plain, cv::NORM_INF), 0.0);
+    window_->findChild<QComboBox*>(QStringLiteral("demMode"))->setCurrentIndex(0);
+  }
+
   void acceptsSavesReloadsAndExports() {
     gui::Document* doc = window_->document();
     window_->selectBuilding(buildingId_);
@@ -617,6 +777,8 @@ class MainWindowTest : public QObject {
     QVERIFY(translator.load(QStringLiteral(":/i18n/delineo_fr.qm")));
     QCOMPARE(translator.translate("delineo::gui::MainWindow", "Buildings"), QStringLiteral("Bâtiments"));
     QCOMPARE(translator.translate("delineo::gui::BuildingsModel", "accepted"), QStringLiteral("accepté"));
+    QCOMPARE(translator.translate("delineo::gui::MainWindow", "Bo&x-fitting"), QStringLiteral("Ajustement de &boîtes"));
+    QCOMPARE(translator.translate("delineo::gui::MainWindow", "En&hanced DEM"), QStringLiteral("MNE a&mélioré"));
     QCOMPARE(translator.translate("ErrorText", "The input files do not match each other."),
              QStringLiteral("Les fichiers d’entrée ne correspondent pas entre eux."));
     // Every label of the two parameter forms (their strings come from the structs' visit(),

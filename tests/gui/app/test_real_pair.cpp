@@ -4,7 +4,8 @@
 // active polygon runs at once, its live contour stays on the building), accept, set the height
 // model, look at the DEM and the 3D view, save, export; then a second building. Checks the range
 // against the roof, the outline against a hand-drawn one (tests/bench/data/real_roofs.json),
-// that nothing is written beside the images, and counts the operator's actions.
+// that nothing is written beside the images, and counts the operator's actions; then box-fitting
+// beside the active polygon and the enhanced DEM.
 //
 // DELINEO_DATA_DIR overrides the data folder; DELINEO_SCREENSHOT_DIR keeps a screenshot of each
 // step (the user guide's images: scripts/screenshots.sh).
@@ -14,6 +15,9 @@
 #include <QDirIterator>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QImage>
+#include <QPainter>
+#include <QPixmap>
 #include <QFile>
 #include <QPushButton>
 #include <QSettings>
@@ -298,6 +302,68 @@ class RealPairTest : public QObject {
     QVERIFY(window_->document()->project().find(id)->status == project::BuildingStatus::Accepted);
     qInfo("middle building: %d operator actions", actions_);
     QVERIFY(iou >= 0.85);
+  }
+
+  // Box-fitting beside the active polygon on the big roof (accepted above), then the choice to keep
+  // the active polygon's outline; the enhanced DEM from the two outlines.
+  void boxFittingBesideTheActivePolygon() {
+    if (!project::boxFittingAvailable()) QSKIP("no box-fitting in this build");
+    const core::Polygon hand = handOutline("t51_right_big");
+    window_->selectBuilding(bigRoof_);
+    const project::Building before = *window_->document()->project().find(bigRoof_);
+    QSignalSpy done(window_.get(), &MainWindow::boxFittingFinished);
+    window_->action(QStringLiteral("actionBoxFit"))->trigger();
+    QTRY_VERIFY_WITH_TIMEOUT(!done.isEmpty(), 120000);
+    QVERIFY2(window_->hasBoxFitProposal(bigRoof_), qPrintable(window_->lastMessage()));
+    const widgets::OverlayGuide fitted = window_->leftView()->polygons().guides().back();
+    qInfo("big roof: box-fitting IoU %.3f (%zu vertices, %zu boxes), active polygon IoU %.3f",
+          eval::intersectionOverUnion(fitted.polygon, hand), fitted.polygon.outer.size(),
+          window_->leftView()->polygons().guides().size() - 1, eval::intersectionOverUnion(before.outline, hand));
+    // The left view wide, the right image beside it.
+    window_->showDock(QStringLiteral("rightDock"));
+    window_->resizeDocks({window_->dock(QStringLiteral("rightDock"))}, {420}, Qt::Horizontal);
+    QTest::qWait(100);
+    const cv::Rect2d box = core::boundingBox(hand.outer);
+    frame(QRectF(box.x - 30, box.y - 30, box.width + 60, box.height + 60));
+    shot(QStringLiteral("07-box-fitting"));
+    window_->action(QStringLiteral("actionDiscardBoxFit"))->trigger();
+    QVERIFY(window_->document()->project().find(bigRoof_)->outline.outer == before.outline.outer);
+  }
+
+  void enhancedDemFromTheOutlines() {
+    if (!project::demEnhancementAvailable()) QSKIP("no DEM enhancement in this build");
+    window_->selectBuilding(-1);
+    window_->showDock(QStringLiteral("demDock"));
+    window_->findChild<QComboBox*>(QStringLiteral("demMode"))->setCurrentIndex(0);  // hillshade
+    // The DEM view large enough to read (a floating dock), on the two delineated buildings.
+    QDockWidget* demDock = window_->dock(QStringLiteral("demDock"));
+    demDock->setFloating(true);
+    demDock->resize(820, 520);
+    QTest::qWait(200);
+    const QRectF both(240, 170, 784, 420);
+    widgets::ImageView* demView = window_->demView();
+    demView->setView(both.center(), 0.98 * std::min(demView->width() / both.width(), demView->height() / both.height()));
+    const QPixmap plain = window_->demView()->grab();
+    QSignalSpy enhanced(window_.get(), &MainWindow::demEnhanced);
+    window_->action(QStringLiteral("actionEnhancedDem"))->trigger();
+    QTRY_VERIFY_WITH_TIMEOUT(!enhanced.isEmpty(), 120000);
+    QVERIFY(window_->shownDem().data != window_->document()->dem().data);
+    QTest::qWait(300);
+    // The DEM view before and after, side by side.
+    if (const QString out = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR"); !out.isEmpty()) {
+      const QPixmap after = window_->demView()->grab();
+      QImage pair(plain.width() + after.width() + 8, plain.height(), QImage::Format_RGB32);
+      pair.fill(Qt::white);
+      QPainter painter(&pair);
+      painter.drawPixmap(0, 0, plain);
+      painter.drawPixmap(plain.width() + 8, 0, after);
+      painter.end();
+      QVERIFY(pair.save(QDir(out).filePath(QStringLiteral("08-enhanced-dem.png"))));
+    }
+    demDock->setFloating(false);
+    // Off again: the project's DEM.
+    window_->action(QStringLiteral("actionEnhancedDem"))->trigger();
+    QVERIFY(window_->shownDem().data == window_->document()->dem().data);
   }
 
   void cleanupTestCase() { window_.reset(); }

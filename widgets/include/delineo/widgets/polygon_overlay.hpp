@@ -57,6 +57,15 @@ struct OverlayPolygon {
   QString label;  // drawn near the first vertex when not empty
 };
 
+// A shape drawn for reference only (another method's outline, its parts): never selected nor
+// edited, drawn over the building polygons with a dark underlay so it reads on any image.
+struct OverlayGuide {
+  core::Polygon polygon;  // image pixels
+  QColor colour;
+  double width = 1.5;     // px on screen
+  Qt::PenStyle style = Qt::SolidLine;
+};
+
 class PolygonOverlay : public QObject {
   Q_OBJECT
  public:
@@ -75,6 +84,10 @@ class PolygonOverlay : public QObject {
   void setEvolvingContour(const QPolygonF& contour);
   void clearEvolvingContour();
   QPolygonF evolvingContour() const { return evolving_; }
+
+  // Reference shapes (e.g. box-fitting's boxes and outline beside the building's outline).
+  void setGuides(std::vector<OverlayGuide> guides);
+  const std::vector<OverlayGuide>& guides() const { return guides_; }
 
   // The region of interest rectangle (image pixels); null rectangle = hidden.
   void setRoi(const QRectF& roi);
@@ -180,6 +193,7 @@ class PolygonOverlay : public QObject {
   std::vector<OverlayPolygon> polygons_;
   int selectedId_ = -1;
   QPolygonF evolving_;
+  std::vector<OverlayGuide> guides_;
   QRectF roi_;
   bool snapRightAngles_ = true;
   double rightAngleToleranceDeg_ = 6.0;

@@ -6,8 +6,8 @@
 // segment), the boxes are merged and the
 // merged border is refined into straight lines. docs/boxfit.md explains each stage.
 //
-// No GUI interaction here: the CLI (`delineo-cli boxfit`) and, later, the GUI's job
-// runner call these functions. Coordinates are left-image pixels (x right, y down, pixel (i, j)
+// No GUI interaction here: the CLI (`delineo-cli boxfit`) and, through delineo::project, the
+// GUI's job runner and `delineo-cli run` call these functions. Coordinates are left-image pixels (x right, y down, pixel (i, j)
 // covers [i, i+1) x [j, j+1)).
 #include <optional>
 #include <string>

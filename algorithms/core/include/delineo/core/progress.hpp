@@ -44,19 +44,19 @@ enum class StageId {
   PolygonCourtyard,
   // Project pipeline (number: the building's id).
   DenseMatching,
-  DelineatingBuilding,  // kLastStageId
+  DelineatingBuilding,
   // Box-fitting (number/count: the building of a whole-image run; BoxFittingBuilding: the
-  // project building's id). Not yet worded by the GUI, which shows english() for them until
-  // kLastStageId moves to the last of these.
+  // project building's id).
   BoxFitSegment,
   BoxFitBoxes,
   BoxFitOutline,
   BoxFittingBuilding,
+  // DEM enhancement from the buildings' outlines.
+  EnhancingDem,  // kLastStageId
 };
-// The last identifier the GUI words (its table is checked against it); the box-fitting stages
-// after it are worded in English only for now.
-constexpr StageId kLastStageId = StageId::DelineatingBuilding;
-constexpr StageId kLastEnglishStageId = StageId::BoxFittingBuilding;
+// The last identifier; the GUI words every one up to it (its table is checked against it).
+constexpr StageId kLastStageId = StageId::EnhancingDem;
+constexpr StageId kLastEnglishStageId = kLastStageId;
 
 struct Stage {
   StageId id = StageId::Text;

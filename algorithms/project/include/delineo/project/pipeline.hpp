@@ -5,9 +5,11 @@
 //
 // Each algorithm library is optional at build time: a step whose library is absent throws
 // core::Error(ProcessingFailed) saying so, and the *Available() functions tell callers first.
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -20,9 +22,11 @@ namespace delineo::project {
 bool matchingAvailable();
 bool delineationAvailable();
 bool simulationAvailable();
+bool boxFittingAvailable();
+bool demEnhancementAvailable();
 
 // Checks every parameter group the steps of this build read ("range", "matching",
-// "delineation"): a bad value is found when the project is loaded, not after matching.
+// "delineation", "boxfit", "enhance"): a bad value is found when the project is loaded, not after matching.
 // Throws core::Error(InvalidParameter) naming the group and the parameter.
 void validateParameters(const Project& project);
 
@@ -122,24 +126,68 @@ RegularizationOutcome regularizeOutline(const Project& project, const Building& 
                                         const StereoPair& pair, const core::Polygon& outline,
                                         core::Progress* progress);
 
+// ---- methods on the DEM (src/dem_methods.cpp) ----
+
+// Heights (m, CV_32F, NaN = none) on the left image's grid: the project's DEM raster when it
+// names one, else `disparity` through the height model. Empty when neither is there (no DEM file,
+// and no disparity or no height model). Throws like io::readRaster for a DEM file.
+cv::Mat projectHeights(const Project& project, const cv::Mat& disparity);
+
+// Box-fitting (boxfit::fitBoxes with the project's "boxfit" parameters) on one building, from
+// its initial polygon. `heights` as projectHeights() gives them, `left` the left image (one
+// channel). An empty outline means no building came out, `message` says why.
+struct FittedBox {
+  core::Ring corners;   // four corners, left-image pixels
+  double energy = 0.0;  // px, mean cost of its sides
+};
+struct BoxFitOutcome {
+  core::Polygon outline;
+  std::vector<FittedBox> boxes;
+  double energy = std::nan("");  // px, area-weighted mean energy of the boxes
+  std::string message;
+  core::RunStatus status = core::RunStatus::Completed;
+  bool hasOutline() const { return outline.outer.size() >= 3; }
+};
+BoxFitOutcome fitBuildingBoxes(const Project& project, const Building& building, const cv::Mat& heights,
+                               const cv::Mat& left, core::Progress* progress);
+
+// The building with a box-fitting outline as its result: status Automatic, method kBoxFitting,
+// F(C) unknown (scored later by outlineEnergy when wanted), roof height from `disparity`, and a
+// "delineated" history entry naming the method, its boxes and their energy (`origin` first, e.g.
+// "delineo-cli run").
+Building withBoxFitOutline(const Project& project, const Building& building, const BoxFitOutcome& outcome,
+                           const cv::Mat& disparity, const std::string& origin = {});
+
+// DEM enhancement (dem::enhanceDem with the project's "enhance" parameters) of `heights` with the
+// outlines of the buildings that have one, rejected ones left out. Without any outline `dem` is
+// `heights` itself and `footprints` 0. Canceled: `heights` unchanged, status Canceled.
+struct EnhancedDemOutcome {
+  cv::Mat dem;
+  int footprints = 0;
+  core::RunStatus status = core::RunStatus::Completed;
+};
+EnhancedDemOutcome enhanceHeights(const Project& project, const cv::Mat& heights, core::Progress* progress);
+
 // `delineo-cli run`: the disparity range estimated when the project has none, matching when
 // the disparity is missing (written to
-// `outputDir`/disparity.tif and recorded in the project), then the active polygon for every
-// Pending building (status becomes Automatic, history updated), then export of accepted +
+// `outputDir`/disparity.tif and recorded in the project), then the outline of every Pending
+// building with its method (Project::methodOf: the active polygon, or box-fitting on
+// projectHeights(); status becomes Automatic, method and history updated), then export of accepted +
 // automatic + corrected outlines to `outputDir`/buildings.geojson. `outputDir` is the resolved
 // folder (outputDirectory()). The caller saves the project.
 struct RunSummary {
   std::optional<RangeOutcome> rangeEstimated;  // set when the range was estimated
   bool matched = false;
-  int delineated = 0;
-  int skipped = 0;  // pending buildings whose active polygon failed (reason in `messages`)
+  int delineated = 0;  // outlined by either method
+  int boxFitted = 0;   // of which by box-fitting
+  int skipped = 0;     // pending buildings whose method failed (reason in `messages`)
   std::vector<std::string> messages;
   std::string exported;  // path of the written GeoJSON, empty when nothing was written
   core::RunStatus status = core::RunStatus::Completed;
 };
 RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress);
 
-// Features of the buildings with the given statuses (attributes: id, status, vertices,
+// Features of the buildings with the given statuses (attributes: id, status, method, vertices,
 // roof_height_m, energy), in left-image pixels.
 std::vector<core::Feature> buildingFeatures(const Project& project,
                                             const std::vector<BuildingStatus>& statuses);

@@ -33,6 +33,13 @@ std::string toString(BuildingStatus status);
 // Throws core::Error(UnreadableFile) for an unknown name.
 BuildingStatus statusFromString(const std::string& name);
 
+// The methods an outline comes from (Building::method, Project::method): the statistical
+// active polygon on the stereo pair (docs/delineation.md) or box-fitting on the DEM and the left
+// image's edges (docs/boxfit.md).
+inline constexpr const char* kActivePolygon = "active-polygon";
+inline constexpr const char* kBoxFitting = "box-fitting";
+bool isOutlineMethod(const std::string& name);
+
 // One entry of a building's history: what happened, when (UTC, ISO 8601) and a short detail.
 struct HistoryEntry {
   std::string action;  // "picked", "delineated", "edited", "accepted", "rejected", "reopened"
@@ -63,6 +70,9 @@ struct Building {
   double roofHeight = std::nan("");  // m above ground, NaN when unknown
   double energy = std::nan("");      // active polygon energy F(C) of the outline, NaN when unknown
   std::optional<EnergyTerms> energyTerms;  // its terms, when known
+  // The method that produced the outline (kActivePolygon, kBoxFitting); for a Pending building
+  // the one `delineo-cli run` uses. Empty: not chosen (the project's method applies).
+  std::string method;
   std::vector<HistoryEntry> history;
   // Keys of the building's JSON object this version does not know, written back on save.
   nlohmann::json unknownKeys = nlohmann::json::object();
@@ -100,6 +110,8 @@ struct Project {
   // The pair's full disparity search range (px); unset until estimated from the images or given.
   std::optional<DisparityInterval> disparityRange;
   HeightModel height;
+  // The method `delineo-cli run` outlines Pending buildings with when they name none.
+  std::string method = kActivePolygon;
   // Algorithm parameters by group ("matching", "delineation", ...): each value is the JSON of a
   // parameter struct (core::toJson). Kept as JSON so the project does not depend on every
   // algorithm library; typed access through parameters()/setParameters().
@@ -112,8 +124,10 @@ struct Project {
   Building* find(int id);
   const Building* find(int id) const;
   int nextBuildingId() const;
-  // Buildings that still need the active polygon (Pending with a roof interval or not).
+  // Buildings that still need an outline (Pending with a roof interval or not).
   std::vector<int> pendingBuildings() const;
+  // The method a building is (or is to be) outlined with: its own, else the project's.
+  const std::string& methodOf(const Building& building) const;
   // Paths of the inputs that are named but do not exist on disk (left, right, ...).
   std::vector<std::string> missingFiles() const;
   bool operator==(const Project&) const;
