@@ -118,8 +118,8 @@ int main(int argc, char** argv) {
   std::ifstream in(labels);
   const nlohmann::json data = nlohmann::json::parse(in);
   std::map<std::string, cv::Mat> maps;
-  std::printf("%-18s %9s %6s | %-6s %6s %6s | %-6s %6s %6s %4s %7s %6s\n", "roof", "click", "ground", "before",
-              "ground", "err", "after", "ground", "err", "ref", "px", "ms");
+  std::printf("%-18s %9s %6s | %-6s %6s %6s | %-6s %6s %6s %4s %4s %7s %6s\n", "roof", "click", "ground",
+              "before", "ground", "err", "after", "ground", "err", "ref", "vtx", "px", "ms");
   int runs = 0, beforeGood = 0, afterGood = 0;
   double beforeSum = 0.0, afterSum = 0.0;
   for (const auto& roof : data.at("roofs")) {
@@ -142,10 +142,10 @@ int main(int argc, char** argv) {
     const delineation::AboveGroundObject object = delineation::aboveGroundObjectAt(map, click, metresPerPixel, params);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     const double after = object.outcome == delineation::PickOutcome::Found ? iou(object.mask, handMask) : 0.0;
-    std::printf("%-18s %4d,%4d %6.1f | %6.3f %6.1f %+6.1f | %6.3f %6.1f %+6.1f %4d %7d %6.0f\n",
+    std::printf("%-18s %4d,%4d %6.1f | %6.3f %6.1f %+6.1f | %6.3f %6.1f %+6.1f %4d %4zu %7d %6.0f\n",
                 roof.at("name").get<std::string>().c_str(), click.x, click.y, groundRef, before, formerGround,
                 formerGround - groundRef, after, object.groundLevel, object.groundLevel - groundRef,
-                object.refinements, object.pixels, ms);
+                object.refinements, object.outline.outer.size(), object.pixels, ms);
     ++runs;
     beforeSum += before, afterSum += after;
     beforeGood += before >= 0.8 ? 1 : 0;

@@ -16,6 +16,7 @@ using core::ErrorCode;
 void AboveGroundParams::validate() const {
   core::checkDeclaredRanges(*this);
   if (opening % 2 == 0) throw Error(ErrorCode::InvalidParameter, "opening must be odd");
+  if (smoothing % 2 == 0) throw Error(ErrorCode::InvalidParameter, "smoothing must be odd");
   if (maxSearchRadius < searchRadius) {
     throw Error(ErrorCode::InvalidParameter, "max-search-radius must not be below search-radius");
   }
@@ -150,9 +151,19 @@ cv::Mat withThinParts(const cv::Mat& region, const cv::Mat& above, const cv::Mat
   return out;
 }
 
-// The object: grown from the seed, with its thin parts, its holes filled (its outer outline).
-cv::Mat objectAt(const cv::Mat& above, const cv::Mat& disparity, cv::Point seed, double maxStep, int thinWidth) {
-  const cv::Mat region = withThinParts(growObject(above, disparity, seed, maxStep), above, disparity, maxStep, thinWidth);
+// The object: grown from the seed, with its thin parts, smoothed (a closing then an opening by a
+// `smoothing` px square: the matcher's ragged edges and no-data notches), its holes filled.
+cv::Mat objectAt(const cv::Mat& above, const cv::Mat& disparity, cv::Point seed, const AboveGroundParams& params,
+                 double maxStep) {
+  cv::Mat region =
+      withThinParts(growObject(above, disparity, seed, maxStep), above, disparity, maxStep, params.thinWidth);
+  if (params.smoothing > 1) {
+    const cv::Mat square = cv::getStructuringElement(cv::MORPH_RECT, {params.smoothing, params.smoothing});
+    cv::Mat smoothed;
+    cv::morphologyEx(region, smoothed, cv::MORPH_CLOSE, square);
+    cv::morphologyEx(smoothed, smoothed, cv::MORPH_OPEN, square);
+    if (smoothed.at<uchar>(seed) != 0) region = smoothed;  // a small object may vanish: keep it raw
+  }
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(region.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
   cv::Mat filled = cv::Mat::zeros(region.size(), CV_8U);
@@ -237,7 +248,7 @@ AboveGroundObject aboveGroundObjectAt(const cv::Mat& disparity, cv::Point2d clic
   }
   // Then the ground next to the object, as the histogram reads it, until the object stops changing.
   const double maxStep = params.maxStep / std::abs(metresPerPixel);
-  cv::Mat region = objectAt(above, disparity, seed, maxStep, params.thinWidth);
+  cv::Mat region = objectAt(above, disparity, seed, params, maxStep);
   core::Polygon outline = traceOutline(region, seed, params.simplification);
   double level = estimateGroundLevel(disparity, outline, ground);
   for (int i = 0; i < params.refinements && std::isfinite(level); ++i) {
@@ -248,7 +259,7 @@ AboveGroundObject aboveGroundObjectAt(const cv::Mat& disparity, cv::Point2d clic
     ++object.refinements;
     object.groundLevel = level;
     seed = nextSeed;
-    region = objectAt(next, disparity, seed, maxStep, params.thinWidth);
+    region = objectAt(next, disparity, seed, params, maxStep);
     outline = traceOutline(region, seed, params.simplification);
     level = estimateGroundLevel(disparity, outline, ground);
   }

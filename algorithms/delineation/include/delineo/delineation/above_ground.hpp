@@ -21,10 +21,11 @@ struct AboveGroundParams {
   double heightMargin = 2.5;       // m, an object's pixels stand at least this above the ground
   double searchRadius = 120.0;     // px, band around the click where the ground is first sought
   double maxSearchRadius = 2000.0; // px, the band doubles up to this while the click is not above it
-  double maxStep = 1.5;            // m, largest height step between neighbouring pixels of one object
+  double maxStep = 0.75;           // m, largest height step between neighbouring pixels of one object
   int thinWidth = 9;               // px, above-ground parts this narrow touching the object join it
   double snapRadius = 4.0;         // px, a click on no data takes the nearest object pixel this near
   int opening = 3;                 // px, side of the square opening that cuts thin links (1: off)
+  int smoothing = 7;               // px, side of the square closing then opening of the object's mask
   double simplification = 2.0;     // px, Douglas-Peucker tolerance of the outline
   int refinements = 3;             // times the ground is estimated again next to the object found
 
@@ -56,6 +57,11 @@ struct AboveGroundParams {
     v(ParamInfo{"opening", "Opening", "px",
                 "Side of the square opening that cuts thin links between objects (1: none)", 1, 51},
       opening);
+    v(ParamInfo{"smoothing", "Outline smoothing", "px",
+                "Side of the square closing then opening that smooths the object before its outline is "
+                "traced (1: none)",
+                1, 51},
+      smoothing);
     v(ParamInfo{"simplification", "Outline simplification", "px",
                 "Largest distance between the traced outline and its simplified polygon", 0, 50},
       simplification);
@@ -63,7 +69,7 @@ struct AboveGroundParams {
                 "Times the ground is estimated again next to the object found", 0, 20},
       refinements);
   }
-  // Throws core::Error(InvalidParameter): a field outside its domain, an even opening or a
+  // Throws core::Error(InvalidParameter): a field outside its domain, an even opening or smoothing, a
   // largest search radius below the first.
   void validate() const;
 };
