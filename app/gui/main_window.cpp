@@ -171,8 +171,13 @@ void MainWindow::onObjectPicked(QPointF imagePos) {
   // The connected region above the local ground, with the ground estimate of the histogram's
   // line (algorithms: delineation::aboveGroundObjectAt through the project's steps).
   using Outcome = project::ObjectPick::Outcome;
-  const project::ObjectPick pick =
-      project::pickAboveGroundObject(document_->project(), disparity, dem, {imagePos.x(), imagePos.y()});
+  project::ObjectPick pick;
+  try {
+    pick = project::pickAboveGroundObject(document_->project(), disparity, dem, {imagePos.x(), imagePos.y()});
+  } catch (const core::Error& e) {  // e.g. the project's "pick" parameters are out of their domain
+    showMessage(tr("Pick an object"), errorSentence(e.code()) + QStringLiteral("\n\n") + QString::fromStdString(e.what()));
+    return;
+  }
   switch (pick.outcome) {
     case Outcome::Found: onPicked(pick.outline); return;
     case Outcome::NoHeights:
