@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -83,10 +84,10 @@ double Options::getDouble(const std::string& key) const {
   try {
     size_t used = 0;
     const double v = std::stod(s, &used);
-    if (used != s.size()) throw std::invalid_argument(s);
+    if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument(s);
     return v;
   } catch (const std::exception&) {
-    throw UsageError("--" + key + " expects a number, got '" + s + "'");
+    throw UsageError("--" + key + " expects a finite number, got '" + s + "'");
   }
 }
 
@@ -110,9 +111,9 @@ std::vector<double> Options::getList(const std::string& key) const {
     try {
       size_t used = 0;
       out.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
+      if (used != item.size() || !std::isfinite(out.back())) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw UsageError("--" + key + ": '" + item + "' is not a number");
+      throw UsageError("--" + key + ": '" + item + "' is not a finite number");
     }
   }
   return out;
@@ -174,7 +175,8 @@ void StderrProgress::setStage(const core::Stage& info) {
   if (quiet_ || stage == lastStage_) return;
   if (tty_ && !lastStage_.empty()) std::fprintf(stderr, "\n");
   lastStage_ = stage;
-  lastPercent_ = -1;
+  // On a terminal each stage redraws its own line; in a log, one line per 10 % of the run.
+  if (tty_) lastPercent_ = -1;
 }
 
 void StderrProgress::finish() {
@@ -188,6 +190,19 @@ StderrProgress& commandProgress() {
 
 void throwIfCanceled(const core::Progress& p) {
   if (p.canceled()) throw Canceled();
+}
+
+void checkOutputs(const Options& opts, const std::vector<std::pair<std::string, io::OutputFormat>>& outputs,
+                  const std::vector<std::string>& inputs) {
+  std::vector<io::OutputFile> files;
+  for (const auto& [key, format] : outputs) {
+    if (opts.has(key)) files.push_back({opts.get(key), format});
+  }
+  std::vector<std::string> inputFiles;
+  for (const auto& key : inputs) {
+    if (opts.has(key)) inputFiles.push_back(opts.get(key));
+  }
+  io::checkOutputs(files, inputFiles);
 }
 
 namespace {

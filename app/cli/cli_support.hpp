@@ -10,6 +10,7 @@
 
 #include "delineo/core/params.hpp"
 #include "delineo/core/progress.hpp"
+#include "delineo/io/output_file.hpp"
 
 namespace delineo::cli {
 
@@ -143,6 +144,11 @@ class StderrProgress : public core::Progress {
 StderrProgress& commandProgress();
 // Throws Canceled when the progress was canceled (to unwind a command cleanly).
 void throwIfCanceled(const core::Progress& p);
+
+// The output policy (io/output_file.hpp) before any work: the files of the `outputs` options
+// given, against those of the `inputs` options given.
+void checkOutputs(const Options& opts, const std::vector<std::pair<std::string, io::OutputFormat>>& outputs,
+                  const std::vector<std::string>& inputs);
 
 using CommandFn = std::function<int(const std::vector<std::string>& args)>;
 struct CommandInfo {

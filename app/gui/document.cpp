@@ -223,8 +223,15 @@ void Document::setRoofInterval(int id, project::DisparityInterval interval) {
 void Document::setParameters(const std::string& group, const nlohmann::json& values) {
   auto it = project_.parameters.find(group);
   const nlohmann::json before = it == project_.parameters.end() ? nlohmann::json() : *it;
-  if (before == values) return;
-  undo_.push(new ParametersCommand(this, group, before, values,
+  // Keys of the group the form does not know (a newer version's) stay in the project.
+  nlohmann::json merged = values;
+  if (before.is_object() && merged.is_object()) {
+    for (auto key = before.begin(); key != before.end(); ++key) {
+      if (!merged.contains(key.key())) merged[key.key()] = key.value();
+    }
+  }
+  if (before == merged) return;
+  undo_.push(new ParametersCommand(this, group, before, merged,
                                    tr("Change %1 parameters").arg(QString::fromStdString(group))));
 }
 

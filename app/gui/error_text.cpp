@@ -15,6 +15,8 @@ QString errorSentence(core::ErrorCode code, const QString& path) {
     case core::ErrorCode::UnsupportedInput: return QCoreApplication::translate("ErrorText", "The file %1 is not supported.").arg(file);
     case core::ErrorCode::MismatchedInputs: return QCoreApplication::translate("ErrorText", "The input files do not match each other.");
     case core::ErrorCode::WriteFailed: return QCoreApplication::translate("ErrorText", "Delineo could not write %1.").arg(file);
+    case core::ErrorCode::UnusableOutput:
+      return QCoreApplication::translate("ErrorText", "Delineo does not write %1: choose another file.").arg(file);
     case core::ErrorCode::ProcessingFailed: return QCoreApplication::translate("ErrorText", "The processing failed.");
   }
   return QCoreApplication::translate("ErrorText", "An unexpected error occurred.");

@@ -28,6 +28,8 @@
 #include "delineo/delineation/delineate.hpp"
 #include "delineo/delineation/roof_interval.hpp"
 #include "delineo/io/raster.hpp"
+#include "delineo/stereo/cost_service.hpp"
+#include "energy_diag.hpp"
 #include "real_roofs.hpp"
 
 namespace fs = std::filesystem;
@@ -104,6 +106,126 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+
+delineation::IntPolygon localPolygon(const core::Polygon& p, cv::Point origin) {
+  auto ring = [&](const core::Ring& r) {
+    delineation::IntRing out;
+    for (const auto& v : r) {
+      const cv::Point q(static_cast<int>(std::lround(v.x)) - origin.x,
+                        static_cast<int>(std::lround(v.y)) - origin.y);
+      if (out.empty() || out.back() != q) out.push_back(q);
+    }
+    while (out.size() > 1 && out.front() == out.back()) out.pop_back();
+    return out;
+  };
+  delineation::IntPolygon out{ring(p.outer), {}};
+  for (const auto& h : p.holes) out.holes.push_back(ring(h));
+  return out;
+}
+
+double medianIn(const cv::Mat& values, const cv::Mat& mask) {
+  std::vector<float> v;
+  for (int y = 0; y < values.rows; ++y)
+    for (int x = 0; x < values.cols; ++x)
+      if (mask.at<uchar>(y, x) && std::isfinite(values.at<float>(y, x)))
+        v.push_back(values.at<float>(y, x));
+  if (v.empty()) return std::nan("");
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// --diag: the energy of the labelled outline against the delineated one on the same prepared
+// energy, term by term, the estimated intervals against the roof's ground reference, and where
+// they differ (energy_diag.hpp). With --dump, DIR/<roof>_diag.png: the left image, the label
+// pairs (bench_delineation's colours, excluded pixels grey) and c_roof < c_ground (white).
+void diagnoseRoof(const std::string& name, const cv::Mat& left, const cv::Mat& right,
+                  const cv::Mat& map, const delineation::DelineationRequest& request,
+                  const delineation::DelineationParams& params, const delineation::DelineationResult& r,
+                  const core::Polygon& truth, const core::Polygon& groundRef, const std::string& dumpDir) {
+  using namespace delineation;
+  stereo::CostParams cp;
+  cp.window = params.costWindow;
+  cp.brightnessScale = params.costBrightness;
+  const auto costs = stereo::CorrelationCostService::compute(left, right, r.roi, request.searchRange->min,
+                                                            request.searchRange->max, cp);
+  const PreparedEnergy pe = prepareEnergy(*costs, left, right, request, params);
+  const IntPolygon truthLocal = localPolygon(truth, r.roi.tl()), rawLocal = localPolygon(r.rawPolygon, r.roi.tl());
+  const EnergyWeights w{params.edgeWeight, params.rigidity, params.edgeContrast, params.minAngle, params.minGap};
+  const EnergyTerms ft = referenceEnergy(pe.images, w, truthLocal), fr = referenceEnergy(pe.images, w, rawLocal);
+  const double groundLevel = medianIn(map, core::rasterize(groundRef, map.size()));
+  std::printf("    diag ground ref %.1f, estimated interval %d:%d (level %.1f; searched %d:%d), roof %d:%d "
+              "(searched %d:%d), roof d %.1f, side %d, NoMatchCost %.3f, region init %d\n",
+              groundLevel, pe.ground.min, pe.ground.max, pe.groundDisparity, pe.groundSearched.min,
+              pe.groundSearched.max, request.roof.min, request.roof.max, pe.roofSearched.min, pe.roofSearched.max,
+              pe.roofDisparity, pe.images.occlusionSide, pe.images.noMatchCost, pe.regionInit ? 1 : 0);
+  for (const auto& [label, t] : {std::pair{"hand", ft}, std::pair{"raw ", fr}}) {
+    std::printf("    F(%s) %9.1f = roof %8.1f ground %8.1f band %8.1f edgesL %7.1f edgesR %7.1f shape %6.1f\n",
+                label, t.total(), t.term[0], t.term[1], t.term[2], t.term[3], t.term[4], t.term[5]);
+  }
+  std::printf("    dF hand - raw %+.1f\n", ft.total() - fr.total());
+  bench::DiagTable table;
+  cv::Mat picture;
+  bench::diagnose(pe.images, pe.excluded, truthLocal, rawLocal, table, dumpDir.empty() ? nullptr : &picture);
+  bench::printDiag(table, "    ", false);
+  if (picture.empty()) return;
+  fs::create_directories(dumpDir);
+  cv::Mat img;
+  cv::normalize(left(r.roi), img, 0, 255, cv::NORM_MINMAX, CV_8U);
+  cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
+  cv::Mat better = (pe.images.uncappedDifference.empty() ? pe.images.groundCost - pe.images.roofCost
+                                                          : pe.images.uncappedDifference) > 0;
+  cv::cvtColor(better, better, cv::COLOR_GRAY2BGR);
+  better.setTo(cv::Scalar(0, 0, 160), pe.excluded);
+  // The matcher's disparities and the cost service's argmin by class: ground interval blue, roof
+  // interval green, between them yellow, above the roof red, below the ground magenta, none black.
+  auto classes = [&](const cv::Mat& d) {
+    cv::Mat out(d.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+    for (int y = 0; y < d.rows; ++y) {
+      for (int x = 0; x < d.cols; ++x) {
+        const float v = d.at<float>(y, x);
+        if (!std::isfinite(v)) continue;
+        cv::Vec3b c;
+        if (v < pe.ground.min - 0.5f) c = {255, 0, 255};
+        else if (v <= pe.ground.max + 0.5f) c = {255, 80, 0};
+        else if (v < request.roof.min - 0.5f) c = {0, 220, 255};
+        else if (v <= request.roof.max + 0.5f) c = {0, 200, 0};
+        else c = {0, 0, 255};
+        out.at<cv::Vec3b>(y, x) = c;
+      }
+    }
+    return out;
+  };
+  cv::Mat wta;
+  costs->bestDisparity().convertTo(wta, CV_32F);
+  wta.setTo(std::nanf(""), costs->bestCost() > pe.images.noMatchCost);
+  // Six panels (the last blank) on a 3x2 grid, 2x3 for tall regions.
+  const int columns = r.roi.height > r.roi.width ? 3 : 2;
+  std::vector<cv::Mat> panels{img, picture, better, classes(map(r.roi)), classes(wta),
+                              cv::Mat(img.size(), CV_8UC3, cv::Scalar(0, 0, 0))};
+  std::vector<cv::Mat> rows;
+  for (size_t i = 0; i < panels.size(); i += static_cast<size_t>(columns)) {
+    cv::Mat row;
+    cv::hconcat(std::vector<cv::Mat>(panels.begin() + static_cast<long>(i),
+                                     panels.begin() + static_cast<long>(i) + columns),
+                row);
+    rows.push_back(row);
+  }
+  cv::Mat both;
+  cv::vconcat(rows, both);
+  const int k = std::max(1, std::min(3, 1600 / std::max(both.cols, both.rows)));
+  cv::resize(both, both, {}, k, k, cv::INTER_NEAREST);
+  for (int panel = 0; panel < 5; ++panel) {
+    const cv::Point shift((panel % columns) * r.roi.width, (panel / columns) * r.roi.height);
+    auto draw = [&](const IntPolygon& p, cv::Scalar colour) {
+      std::vector<cv::Point> pts;
+      for (const auto& v : p.outer) pts.emplace_back((v + shift) * k);
+      cv::polylines(both, pts, true, colour, 1);
+    };
+    draw(truthLocal, {255, 255, 255});
+    draw(rawLocal, {0, 220, 255});
+  }
+  cv::imwrite((fs::path(dumpDir) / (name + "_diag.png")).string(), both);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -113,6 +235,11 @@ int main(int argc, char** argv) {
   std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
   std::string dumpDir;
   int grow = 30;
+  // --ground: the request's ground interval: "estimated" (none given: the active polygon's own
+  // estimate), "proposed" (estimateGroundLevel on the matcher's map ± ground-tolerance) or
+  // "reference" (the labelled ground reference's median ± ground-tolerance, an upper bound).
+  std::string groundMode = "estimated";
+  bool diag = false;  // --diag: energy of the labelled outline vs the delineated one
   std::vector<double> tolerances;  // --tolerances A,B,...: the raw outline regularized at each too
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
@@ -125,6 +252,10 @@ int main(int argc, char** argv) {
       dumpDir = argv[++i];
     } else if (!std::strcmp(argv[i], "--grow") && i + 1 < argc) {
       grow = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--ground") && i + 1 < argc) {
+      groundMode = argv[++i];
+    } else if (!std::strcmp(argv[i], "--diag")) {
+      diag = true;
     } else if (!std::strcmp(argv[i], "--tolerances") && i + 1 < argc) {
       for (const char* p = argv[++i]; *p;) {
         char* end = nullptr;
@@ -135,7 +266,7 @@ int main(int argc, char** argv) {
       std::fprintf(
           stderr,
           "usage: bench_real_outlines [--data DIR] [--labels real_roofs.json] [--cache DIR] "
-          "[--grow PX] [--tolerances A,B,...] [--dump DIR]\n");
+          "[--grow PX] [--tolerances A,B,...] [--dump DIR] [--diag] [--ground estimated|proposed|reference]\n");
       return 2;
     }
   }
@@ -195,6 +326,16 @@ int main(int argc, char** argv) {
     request.init = rect;
     request.roof = {proposal.low, proposal.high};
     request.searchRange = delineation::DisparityInterval{dmin, dmax};
+    if (groundMode == "below") {
+      request.ground = delineation::DisparityInterval{dmin, proposal.low - 2};
+    } else if (groundMode != "estimated") {
+      const double level =
+          groundMode == "reference"
+              ? medianIn(map, core::rasterize(bench::ringOf(roof.at("ground")), map.size()))
+              : delineation::estimateGroundLevel(map, rect);
+      const int g = static_cast<int>(std::lround(level)), t = params.groundTolerance;
+      request.ground = delineation::DisparityInterval{g - t, std::min(g + t, proposal.low - 1)};
+    }
     try {
       const auto r = delineation::delineate(lefts[pairName], rights[pairName], request, params);
       // The stage alone, CPU time of this thread, best of 3 (the machine may be shared).
@@ -228,6 +369,10 @@ int main(int argc, char** argv) {
                     g.reason.c_str());
         tolIou[t].push_back(iou(g.polygon, truth, size));
         tolVertices[t].push_back(g.outputVertices);
+      }
+      if (diag) {
+        diagnoseRoof(name, lefts[pairName], rights[pairName], map, request, params, r, truth,
+                     bench::ringOf(roof.at("ground")), dumpDir);
       }
       if (std::getenv("BENCH_VERBOSE")) {
         const auto g =

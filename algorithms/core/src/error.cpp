@@ -10,6 +10,7 @@ std::string_view toString(ErrorCode code) {
     case ErrorCode::UnsupportedInput: return "unsupported input";
     case ErrorCode::MismatchedInputs: return "mismatched inputs";
     case ErrorCode::WriteFailed: return "write failed";
+    case ErrorCode::UnusableOutput: return "unusable output";
     case ErrorCode::ProcessingFailed: return "processing failed";
   }
   return "unknown error";

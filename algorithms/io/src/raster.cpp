@@ -14,6 +14,7 @@
 
 #include "delineo/core/error.hpp"
 #include "delineo/core/nan_mask.hpp"
+#include "delineo/io/output_file.hpp"
 #include "gdal_support.hpp"
 
 namespace delineo::io {
@@ -231,8 +232,10 @@ cv::Mat readMask(const std::string& path, cv::Size expected) {
   return values != 0;
 }
 
-void writeGeoTiff(const std::string& path, const cv::Mat& image, const GeoReference& geo,
-                  const WriteOptions& options) {
+namespace {
+// Writes the GeoTIFF at `path` itself; writeGeoTiff() points it at a temporary file.
+void writeGeoTiffAt(const std::string& path, const cv::Mat& image, const GeoReference& geo,
+                    const WriteOptions& options) {
   detail::ensureGdalRegistered();
   if (image.empty()) throw Error(ErrorCode::WriteFailed, "the image to write is empty", path);
   GDALDataType gdalType = GDT_Unknown;
@@ -309,6 +312,13 @@ void writeGeoTiff(const std::string& path, const cv::Mat& image, const GeoRefere
     VSIUnlink(path.c_str());
     throw Error(ErrorCode::WriteFailed, message, path);
   }
+}
+
+}  // namespace
+
+void writeGeoTiff(const std::string& path, const cv::Mat& image, const GeoReference& geo,
+                  const WriteOptions& options) {
+  writeAtomically(path, [&](const std::string& file) { writeGeoTiffAt(file, image, geo, options); });
 }
 
 void writeFloatGeoTiff(const std::string& path, const cv::Mat& image, const GeoReference& geo) {

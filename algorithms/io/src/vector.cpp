@@ -11,6 +11,7 @@
 #include <ogr_srs_api.h>
 
 #include "delineo/core/error.hpp"
+#include "delineo/io/output_file.hpp"
 #include "gdal_support.hpp"
 
 namespace delineo::io {
@@ -73,20 +74,42 @@ bool isDegenerate(const core::Ring& ring) {
   return std::abs(core::signedArea(ring)) <= 1e-12 * boxArea;
 }
 
+// Vertices of one polygon, rings together: far beyond any building outline, and what the
+// outline algorithms can take without running for minutes.
+constexpr int kMaxPolygonVertices = 50000;
+
+void requireFiniteRing(const core::Ring& ring, const std::string& where, const std::string& path) {
+  for (const auto& p : ring) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
+      throw Error(ErrorCode::UnreadableFile, where + " has a vertex that is not a finite number", path);
+    }
+  }
+}
+
 core::Polygon readPolygon(OGRGeometryH polygon, const GeoReference& geo, const std::string& where,
                           const std::string& path) {
   const int rings = OGR_G_GetGeometryCount(polygon);
   if (OGR_G_IsEmpty(polygon) || rings == 0) {
     throw Error(ErrorCode::UnreadableFile, where + " has an empty polygon", path);
   }
+  long long vertices = 0;
+  for (int i = 0; i < rings; ++i) vertices += OGR_G_GetPointCount(OGR_G_GetGeometryRef(polygon, i));
+  if (vertices > kMaxPolygonVertices) {
+    throw Error(ErrorCode::UnsupportedInput,
+                where + " has " + std::to_string(vertices) + " vertices; at most " +
+                    std::to_string(kMaxPolygonVertices) + " are supported (simplify it first)",
+                path);
+  }
   core::Polygon result;
   result.outer = readRing(OGR_G_GetGeometryRef(polygon, 0), geo);
+  requireFiniteRing(result.outer, where, path);
   if (isDegenerate(result.outer)) {
     throw Error(ErrorCode::UnreadableFile,
                 where + " has a degenerate polygon (fewer than 3 distinct vertices or zero area)", path);
   }
   for (int i = 1; i < rings; ++i) {
     core::Ring hole = readRing(OGR_G_GetGeometryRef(polygon, i), geo);
+    requireFiniteRing(hole, where, path);
     if (isDegenerate(hole)) {
       throw Error(ErrorCode::UnreadableFile, where + " has a degenerate hole (ring " + std::to_string(i) + ")",
                   path);
@@ -216,10 +239,9 @@ OGRGeometryH makeRing(const core::Ring& ring, const GeoReference& geo) {
   return result;
 }
 
-}  // namespace
-
-void writeFeatures(const std::string& path, const std::vector<core::Feature>& features, const GeoReference& geo,
-                   const std::string& layerName) {
+// Writes the file at `path` itself; writeFeatures() points it at a temporary file.
+void writeFeaturesAt(const std::string& path, const std::vector<core::Feature>& features,
+                     const GeoReference& geo, const std::string& layerName) {
   detail::ensureGdalRegistered();
   const std::string driverName = driverForExtension(path);
   if (driverName.empty()) {
@@ -302,6 +324,13 @@ void writeFeatures(const std::string& path, const std::vector<core::Feature>& fe
     if (!detail::isVirtualPath(path)) std::filesystem::remove(path, ec);
     throw Error(ErrorCode::WriteFailed, message, path);
   }
+}
+
+}  // namespace
+
+void writeFeatures(const std::string& path, const std::vector<core::Feature>& features, const GeoReference& geo,
+                   const std::string& layerName) {
+  writeAtomically(path, [&](const std::string& file) { writeFeaturesAt(file, features, geo, layerName); });
 }
 
 }  // namespace delineo::io

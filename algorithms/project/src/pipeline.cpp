@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
+#include "delineo/io/output_file.hpp"
 #include "delineo/io/vector.hpp"
 
 #ifdef DELINEO_HAVE_STEREO
@@ -19,6 +20,7 @@
 #ifdef DELINEO_HAVE_DELINEATION
 #include "delineation_bridge.hpp"
 #include "delineo/delineation/above_ground.hpp"
+#include "delineo/delineation/params.hpp"
 #include "delineo/delineation/roof_interval.hpp"
 #endif
 
@@ -50,6 +52,28 @@ bool simulationAvailable() {
 #else
   return false;
 #endif
+}
+
+namespace {
+template <class Params>
+void validateGroup(const Project& project, const std::string& group) {
+  try {
+    (void)parameters<Params>(project, group);
+  } catch (const Error& e) {
+    throw Error(ErrorCode::InvalidParameter, "parameters." + group + ": " + e.detail());
+  }
+}
+}  // namespace
+
+void validateParameters(const Project& project) {
+#ifdef DELINEO_HAVE_STEREO
+  validateGroup<stereo::RangeEstimateParams>(project, "range");
+  validateGroup<stereo::MatchParams>(project, "matching");
+#endif
+#ifdef DELINEO_HAVE_DELINEATION
+  validateGroup<delineation::DelineationParams>(project, "delineation");
+#endif
+  (void)project;
 }
 
 StereoPair readStereoPair(const Project& project) {
@@ -323,6 +347,15 @@ int exportBuildings(const Project& project, const std::string& path,
 
 RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress) {
   RunSummary summary;
+  // The outputs are checked before any work: never over an input of the project.
+  std::error_code mk;
+  fs::create_directories(outputDir, mk);
+  std::vector<io::OutputFile> outputs{{(fs::path(outputDir) / "buildings.geojson").string(), io::OutputFormat::Vector}};
+  if (project.disparity.empty()) {
+    outputs.push_back({(fs::path(outputDir) / "disparity.tif").string(), io::OutputFormat::GeoTiff});
+  }
+  io::checkOutputs(outputs, {project.left, project.right, project.disparity, project.dem, project.labels,
+                             project.exclude});
   const StereoPair pair = readStereoPair(project);
   const std::vector<int> pending = project.pendingBuildings();
   const double matchShare = project.disparity.empty() ? (pending.empty() ? 1.0 : 0.5) : 0.0;
@@ -403,6 +436,15 @@ std::string ensureSampleProject(const std::string& directory, core::Progress* pr
   std::error_code ec;
   if (fs::exists(projectPath, ec) && fs::exists(dir / "left.tif", ec) && fs::exists(dir / "right.tif", ec)) {
     return projectPath.string();
+  }
+  // Without the sample's project file, same-named files in the folder are someone else's.
+  for (const char* name : {"left.tif", "right.tif", "dem.tif", "labels.tif"}) {
+    if (fs::exists(dir / name, ec)) {
+      throw Error(ErrorCode::UnusableOutput,
+                  std::string("the folder already holds ") + name +
+                      " but not the sample project: it is not replaced; choose an empty or new folder",
+                  directory);
+    }
   }
 #ifdef DELINEO_HAVE_SIM
   sim::SceneParams params;

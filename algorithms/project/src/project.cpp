@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include "delineo/core/error.hpp"
+#include "delineo/io/output_file.hpp"
+#include "delineo/project/pipeline.hpp"
 
 namespace delineo::project {
 
@@ -134,6 +136,34 @@ json polygonToJson(const core::Polygon& polygon) {
   throw Error(ErrorCode::UnreadableFile, "field '" + field + "': " + problem);
 }
 
+// Bounds of the numbers a project may hold: beyond them a value is a typo or a corrupt file.
+constexpr double kMaxCoordinate = 1e7;    // px
+constexpr int kMaxDisparity = 100000;     // px
+constexpr double kMaxMetresPerPixel = 1e4;
+
+// [low, high] integers within +-kMaxDisparity with low <= high.
+DisparityInterval intervalFromJson(const json& in, const std::string& field) {
+  if (!in.is_array() || in.size() != 2 || !in[0].is_number_integer() || !in[1].is_number_integer()) {
+    badField(field, "must be [low, high] integers, or null");
+  }
+  const auto low = in[0].get<long long>(), high = in[1].get<long long>();
+  if (low > high || std::abs(low) > kMaxDisparity || std::abs(high) > kMaxDisparity) {
+    badField(field, "must be [low, high] with low <= high, within +-" + std::to_string(kMaxDisparity) + " px");
+  }
+  return {static_cast<int>(low), static_cast<int>(high)};
+}
+
+// The keys of `object` outside `known`: kept as they are and written back on save.
+json unknownKeys(const json& object, std::initializer_list<const char*> known) {
+  json out = json::object();
+  for (auto it = object.begin(); it != object.end(); ++it) {
+    if (std::none_of(known.begin(), known.end(), [&](const char* k) { return it.key() == k; })) {
+      out[it.key()] = it.value();
+    }
+  }
+  return out;
+}
+
 core::Ring ringFromJson(const json& in, const std::string& field) {
   if (!in.is_array()) badField(field, "a ring must be an array of [x, y] pairs");
   core::Ring ring;
@@ -141,7 +171,11 @@ core::Ring ringFromJson(const json& in, const std::string& field) {
     if (!point.is_array() || point.size() != 2 || !point[0].is_number() || !point[1].is_number()) {
       badField(field, "a vertex must be [x, y] with two numbers");
     }
-    ring.emplace_back(point[0].get<double>(), point[1].get<double>());
+    const double x = point[0].get<double>(), y = point[1].get<double>();
+    if (!(std::abs(x) <= kMaxCoordinate && std::abs(y) <= kMaxCoordinate)) {
+      badField(field, "a vertex lies beyond " + std::to_string(static_cast<long long>(kMaxCoordinate)) + " px");
+    }
+    ring.emplace_back(x, y);
   }
   if (ring.size() < 3) badField(field, "a ring needs at least 3 vertices");
   return ring;
@@ -230,9 +264,18 @@ json toJson(const Project& project, const std::string& baseDir) {
       history.push_back({{"action", h.action}, {"time", h.time}, {"detail", h.detail}});
     }
     jb["history"] = std::move(history);
+    for (auto it = b.unknownKeys.begin(); it != b.unknownKeys.end(); ++it) jb.emplace(it.key(), it.value());
     buildings.push_back(std::move(jb));
   }
   out["buildings"] = std::move(buildings);
+  // Keys this version does not know (a newer version's, a user's own) are written back as read.
+  for (auto it = project.unknownKeys.begin(); it != project.unknownKeys.end(); ++it) {
+    if (it.key() == "images" && it->is_object()) {
+      for (auto image = it->begin(); image != it->end(); ++image) out["images"].emplace(image.key(), image.value());
+    } else {
+      out.emplace(it.key(), it.value());
+    }
+  }
   return out;
 }
 
@@ -263,17 +306,21 @@ Project fromJson(const json& in, const std::string& baseDir) {
   p.outputDir = get<std::string>(in, "outputDir", "output", "");
   if (p.outputDir.empty()) badField("outputDir", "must not be empty (the default is \"output\")");
   if (auto it = in.find("disparityRange"); it != in.end() && !it->is_null()) {
-    if (!it->is_array() || it->size() != 2 || !(*it)[0].is_number_integer() ||
-        !(*it)[1].is_number_integer() || (*it)[0].get<int>() > (*it)[1].get<int>()) {
-      badField("disparityRange", "must be [min, max] integers with min <= max, or null");
-    }
-    p.disparityRange = DisparityInterval{(*it)[0].get<int>(), (*it)[1].get<int>()};
+    p.disparityRange = intervalFromJson(*it, "disparityRange");
   }
   if (auto it = in.find("heightModel"); it != in.end() && it->is_object()) {
     p.height.groundDisparity = get<double>(*it, "groundDisparity", 0.0, "heightModel.");
     p.height.metresPerPixel = get<double>(*it, "metresPerPixel", 0.0, "heightModel.");
     p.height.gsd = get<double>(*it, "gsd", 1.0, "heightModel.");
-    if (!(p.height.gsd > 0)) badField("heightModel.gsd", "must be positive");
+    if (!(p.height.gsd > 0 && p.height.gsd <= kMaxMetresPerPixel)) {
+      badField("heightModel.gsd", "must be positive, at most " + std::to_string(kMaxMetresPerPixel) + " m");
+    }
+    if (!(std::abs(p.height.metresPerPixel) <= kMaxMetresPerPixel)) {
+      badField("heightModel.metresPerPixel", "must be within +-" + std::to_string(kMaxMetresPerPixel));
+    }
+    if (!(std::abs(p.height.groundDisparity) <= kMaxDisparity)) {
+      badField("heightModel.groundDisparity", "must be within +-" + std::to_string(kMaxDisparity) + " px");
+    }
   }
   p.parameters = in.value("parameters", json::object());
   if (!p.parameters.is_object()) badField("parameters", "must be an object of groups");
@@ -295,6 +342,11 @@ Project fromJson(const json& in, const std::string& baseDir) {
     matching->erase("dmin");
     matching->erase("dmax");
   }
+  // Older files kept the active polygon's ground ring width; the ground is now estimated like the
+  // roof interval's proposal (docs/delineation.md, Ground interval), without a parameter.
+  if (auto delineation = p.parameters.find("delineation"); delineation != p.parameters.end()) {
+    delineation->erase("ring-width");
+  }
   const json buildings = in.value("buildings", json::array());
   if (!buildings.is_array()) badField("buildings", "must be an array");
   for (size_t i = 0; i < buildings.size(); ++i) {
@@ -310,11 +362,7 @@ Project fromJson(const json& in, const std::string& baseDir) {
     b.outline = polygonFromJson(jb.value("outline", json::array()), where + "outline");
     if (b.initial.outer.empty()) badField(where + "initial", "a building needs an initial polygon");
     if (auto it = jb.find("roofInterval"); it != jb.end() && !it->is_null()) {
-      if (!it->is_array() || it->size() != 2 || !(*it)[0].is_number_integer() ||
-          !(*it)[1].is_number_integer() || (*it)[0].get<int>() > (*it)[1].get<int>()) {
-        badField(where + "roofInterval", "must be [low, high] integers with low <= high");
-      }
-      b.roofInterval = DisparityInterval{(*it)[0].get<int>(), (*it)[1].get<int>()};
+      b.roofInterval = intervalFromJson(*it, where + "roofInterval");
     }
     b.roofHeight = get<double>(jb, "roofHeight", std::nan(""), where);
     b.energy = get<double>(jb, "energy", std::nan(""), where);
@@ -334,7 +382,15 @@ Project fromJson(const json& in, const std::string& baseDir) {
                            get<std::string>(h, "time", "", where + "history."),
                            get<std::string>(h, "detail", "", where + "history.")});
     }
+    b.unknownKeys = unknownKeys(jb, {"id", "status", "initial", "outline", "roofInterval", "roofHeight",
+                                     "energy", "energyTerms", "history"});
     p.buildings.push_back(std::move(b));
+  }
+  p.unknownKeys = unknownKeys(in, {"format", "version", "name", "images", "outputDir", "disparityRange",
+                                   "heightModel", "parameters", "buildings"});
+  if (json imageExtras = unknownKeys(images, {"left", "right", "disparity", "dem", "labels", "exclude"});
+      !imageExtras.empty()) {
+    p.unknownKeys["images"] = std::move(imageExtras);
   }
   return p;
 }
@@ -352,7 +408,9 @@ Project loadProject(const std::string& path) {
   }
   const std::string baseDir = fs::absolute(path).parent_path().lexically_normal().string();
   try {
-    return fromJson(document, baseDir);
+    Project project = fromJson(document, baseDir);
+    validateParameters(project);
+    return project;
   } catch (const Error& e) {
     throw Error(e.code(), e.detail(), path);
   }
@@ -362,28 +420,11 @@ void saveProject(const Project& project, const std::string& path) {
   const fs::path target = fs::absolute(path).lexically_normal();
   std::error_code ec;
   fs::create_directories(target.parent_path(), ec);
-  const std::string text = toJson(project, target.parent_path().string()).dump(2) + "\n";
-  // Temporary file in the same folder so that the rename stays on one file system (atomic).
-  // (Built with append(): GCC 12 reports a false -Wrestrict on "." + std::string at -O3.)
-  std::string tempName(".");
-  tempName.append(target.filename().string()).append(".tmp").append(std::to_string(::getpid()));
-  const fs::path temp = target.parent_path() / tempName;
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(ErrorCode::WriteFailed, "cannot create a temporary file in the project folder", path);
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(temp, ec);
-      throw Error(ErrorCode::WriteFailed, "writing the project failed (disk full?)", path);
-    }
-  }
-  fs::rename(temp, target, ec);
-  if (ec) {
-    fs::remove(temp, ec);
-    throw Error(ErrorCode::WriteFailed, "cannot replace the project file: " + ec.message(), path);
-  }
+  // The output policy: never over an image of the project, never over a read-only file; a
+  // symlinked project is saved into the file it names, with that file's permissions.
+  io::checkOutputs({{path, io::OutputFormat::Text}},
+                   {project.left, project.right, project.disparity, project.dem, project.labels, project.exclude});
+  io::writeTextFile(path, toJson(project, target.parent_path().string()).dump(2) + "\n");
 }
 
 std::string outputDirectory(const Project& project, const std::string& projectPath) {

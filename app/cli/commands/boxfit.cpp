@@ -119,6 +119,8 @@ int run(const std::vector<std::string>& args) {
   if (!opts.parse(args)) return cli::kExitOk;
   boxfit::BoxFitParams params;
   opts.apply(params);
+  cli::checkOutputs(opts, {{"out", io::OutputFormat::Vector}, {"boxes", io::OutputFormat::Vector}},
+                    {"image", "dem", "disparity", "init"});
   auto& progress = cli::commandProgress();
   const bool quiet = opts.has("quiet");
   progress.setQuiet(quiet);

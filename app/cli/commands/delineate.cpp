@@ -19,26 +19,45 @@ namespace {
 using namespace delineo;
 using delineation::DisparityInterval;
 
+// Disparities beyond this many pixels are no disparity of a real pair: a sign of a bad value.
+constexpr double kMaxDisparity = 100000;
+
 DisparityInterval intervalFlag(const cli::Options& opts, const std::string& key) {
   const auto [a, b] = opts.getPair(key);
   if (a != std::floor(a) || b != std::floor(b)) {
     throw cli::UsageError("--" + key + " expects integer disparities A:B");
   }
+  if (std::abs(a) > kMaxDisparity || std::abs(b) > kMaxDisparity || a > b) {
+    throw cli::UsageError("--" + key + " expects A:B with A <= B, both within +-" +
+                          std::to_string(static_cast<int>(kMaxDisparity)) + " px");
+  }
   return {static_cast<int>(a), static_cast<int>(b)};
 }
 
-std::optional<double> numberAttribute(const core::Feature& f, const std::string& key) {
+// A numeric property of an initial polygon: absent, or a finite number of magnitude at most
+// `limit`; anything else is an error naming the feature and the file.
+std::optional<double> numberAttribute(const core::Feature& f, const std::string& key, double limit,
+                                      const std::string& feature, const std::string& file) {
   const auto it = f.attributes.find(key);
-  if (it == f.attributes.end()) return std::nullopt;
-  if (const auto* i = std::get_if<long long>(&it->second)) return static_cast<double>(*i);
-  if (const auto* d = std::get_if<double>(&it->second)) return *d;
+  if (it == f.attributes.end() || std::holds_alternative<std::monostate>(it->second)) return std::nullopt;
+  std::optional<double> value;
+  if (const auto* i = std::get_if<long long>(&it->second)) value = static_cast<double>(*i);
+  if (const auto* d = std::get_if<double>(&it->second)) value = *d;
   if (const auto* s = std::get_if<std::string>(&it->second)) {
     try {
-      return std::stod(*s);
+      size_t used = 0;
+      value = std::stod(*s, &used);
+      if (used != s->size()) value.reset();
     } catch (const std::exception&) {
     }
   }
-  return std::nullopt;
+  if (!value || !std::isfinite(*value) || std::abs(*value) > limit) {
+    throw core::Error(core::ErrorCode::InvalidParameter,
+                      feature + ": property " + key + " must be a finite number within +-" +
+                          std::to_string(static_cast<long long>(limit)),
+                      file);
+  }
+  return value;
 }
 
 // The estimated search range widened to hold the building's intervals: the operator's (or the
@@ -50,8 +69,105 @@ DisparityInterval hull(DisparityInterval range, const DisparityInterval& roof,
   return range;
 }
 
+std::string text(const DisparityInterval& d) {
+  return "[" + std::to_string(d.min) + ", " + std::to_string(d.max) + "]";
+}
+
 std::string statusName(core::RunStatus s) {
   return s == core::RunStatus::Completed ? "completed" : "canceled";
+}
+
+// One building of the batch: its id and what the active polygon is asked.
+struct BuildingJob {
+  long long id = 0;
+  delineation::DelineationRequest request;
+  std::string missing;  // why the building cannot run (reported as failed), empty when it can
+};
+
+struct Flags {
+  std::optional<DisparityInterval> roof, ground, search;
+};
+
+// Every building's request, checked whole before any work: a bad property of one feature is an
+// input error (exit 3) naming its id, not a failure found after matching.
+std::vector<BuildingJob> buildingJobs(const std::vector<core::Feature>& inits, const Flags& flags,
+                                      const delineation::DelineationParams& params,
+                                      const std::string& file) {
+  std::vector<BuildingJob> jobs;
+  for (size_t i = 0; i < inits.size(); ++i) {
+    const core::Feature& init = inits[i];
+    const std::string position = "feature " + std::to_string(i + 1);
+    BuildingJob job;
+    const auto id = numberAttribute(init, "id", 9e15, position, file);
+    job.id = id ? static_cast<long long>(*id) : static_cast<long long>(i + 1);
+    const std::string name = "building id " + std::to_string(job.id);
+    auto& req = job.request;
+    req.init = init.polygon;
+    req.init.holes.clear();
+    const auto rmin = numberAttribute(init, "roof_disparity_min", kMaxDisparity, name, file);
+    const auto rmax = numberAttribute(init, "roof_disparity_max", kMaxDisparity, name, file);
+    if (rmin && rmax) {
+      req.roof = {static_cast<int>(std::floor(*rmin)), static_cast<int>(std::ceil(*rmax))};
+      if (req.roof.min > req.roof.max) {
+        throw core::Error(core::ErrorCode::InvalidParameter,
+                          name + ": roof_disparity_min is above roof_disparity_max", file);
+      }
+    } else if (flags.roof) {
+      req.roof = *flags.roof;
+    } else {
+      // Not malformed, only not ready: the batch goes on and reports this building as failed.
+      job.missing = "no roof disparity interval: give --roof-disparity or the feature's "
+                    "roof_disparity_min/max";
+    }
+    if (const auto g = numberAttribute(init, "ground_disparity", kMaxDisparity, name, file)) {
+      const int c = static_cast<int>(std::lround(*g));
+      req.ground = DisparityInterval{c - params.groundTolerance, c + params.groundTolerance};
+    } else {
+      req.ground = flags.ground;
+    }
+    if (job.missing.empty() && req.ground && req.ground->max >= req.roof.min) {
+      throw core::Error(core::ErrorCode::InvalidParameter,
+                        name + ": the ground disparity " + text(*req.ground) +
+                            " is not below the roof interval " + text(req.roof) +
+                            " (a roof's disparities are larger than its ground's)",
+                        file);
+    }
+    jobs.push_back(std::move(job));
+  }
+  return jobs;
+}
+
+std::vector<core::Feature> initialPolygons(const cli::Options& opts, const io::GeoReference& geo) {
+  if (opts.has("init")) return io::readFeatures(opts.get("init"), geo);
+  const auto v = opts.getList("roi");
+  if (v.size() != 4 || v[2] <= 0 || v[3] <= 0) {
+    throw cli::UsageError("--roi expects X,Y,W,H with positive W and H");
+  }
+  core::Feature f;
+  f.polygon.outer = {{v[0], v[1]}, {v[0] + v[2], v[1]}, {v[0] + v[2], v[1] + v[3]}, {v[0], v[1] + v[3]}};
+  return {f};
+}
+
+// The delineated building as an output feature with its energies and what the stage did.
+void describeResult(const delineation::DelineationResult& r, core::Feature& result) {
+  result.polygon = r.polygon;
+  result.attributes["status"] = statusName(r.status);
+  result.attributes["energy"] = r.terms.total();
+  static const char* names[6] = {"e_roof", "e_ground", "e_occlusion", "e_edges_left",
+                                 "e_edges_right", "e_shape"};
+  for (int k = 0; k < 6; ++k) result.attributes[names[k]] = r.terms.term[k];
+  result.attributes["iterations"] = static_cast<long long>(r.iterations);
+  result.attributes["vertices"] = static_cast<long long>(r.vertexCount);
+  result.attributes["regularization"] = delineation::toString(r.regularization.status);
+  if (!r.regularization.reason.empty()) result.attributes["regularization_note"] = r.regularization.reason;
+  long long rawVertices = static_cast<long long>(r.rawPolygon.outer.size());
+  for (const auto& hole : r.rawPolygon.holes) rawVertices += static_cast<long long>(hole.size());
+  result.attributes["raw_vertices"] = rawVertices;
+  result.attributes["roof_disparity_min"] = static_cast<long long>(r.roof.min);
+  result.attributes["roof_disparity_max"] = static_cast<long long>(r.roof.max);
+  result.attributes["ground_disparity_min"] = static_cast<long long>(r.ground.min);
+  result.attributes["ground_disparity_max"] = static_cast<long long>(r.ground.max);
+  result.attributes["no_match_cost"] = r.noMatchCost;
 }
 
 int run(const std::vector<std::string>& args) {
@@ -83,6 +199,11 @@ int run(const std::vector<std::string>& args) {
   }
   delineation::DelineationParams params;
   opts.apply(params);
+  Flags flags;
+  if (opts.has("roof-disparity")) flags.roof = intervalFlag(opts, "roof-disparity");
+  if (opts.has("ground-disparity")) flags.ground = intervalFlag(opts, "ground-disparity");
+  if (opts.has("disparity-range")) flags.search = intervalFlag(opts, "disparity-range");
+  cli::checkOutputs(opts, {{"out", io::OutputFormat::Vector}}, {"left", "right", "init", "exclude"});
 
   auto& progress = cli::commandProgress();
   const bool quiet = opts.has("quiet");
@@ -95,28 +216,14 @@ int run(const std::vector<std::string>& args) {
     throw core::Error(core::ErrorCode::MismatchedInputs,
                       "left and right images differ in size", opts.get("right"));
   }
-
-  std::vector<core::Feature> inits;
-  if (opts.has("init")) {
-    inits = io::readFeatures(opts.get("init"), geo);
-  } else {
-    const auto v = opts.getList("roi");
-    if (v.size() != 4 || v[2] <= 0 || v[3] <= 0) {
-      throw cli::UsageError("--roi expects X,Y,W,H with positive W and H");
-    }
-    core::Feature f;
-    f.polygon.outer = {{v[0], v[1]}, {v[0] + v[2], v[1]}, {v[0] + v[2], v[1] + v[3]}, {v[0], v[1] + v[3]}};
-    inits.push_back(f);
-  }
+  const std::vector<BuildingJob> jobs =
+      buildingJobs(initialPolygons(opts, geo), flags, params, opts.has("init") ? opts.get("init") : "");
   cv::Mat exclude;
   if (opts.has("exclude")) exclude = io::readMask(opts.get("exclude"), left.size());
-  std::optional<DisparityInterval> roofFlag, groundFlag, searchFlag;
-  if (opts.has("roof-disparity")) roofFlag = intervalFlag(opts, "roof-disparity");
-  if (opts.has("ground-disparity")) groundFlag = intervalFlag(opts, "ground-disparity");
-  if (opts.has("disparity-range")) searchFlag = intervalFlag(opts, "disparity-range");
-  core::Progress::Range buildingsProgress(&progress, searchFlag ? 0.0 : 0.05, 1.0);
+
+  core::Progress::Range buildingsProgress(&progress, flags.search ? 0.0 : 0.05, 1.0);
   std::optional<DisparityInterval> estimated;
-  if (!searchFlag) {
+  if (!flags.search) {
     core::Progress::Range rangeProgress(&progress, 0.0, 0.05);
     try {
       const auto e = cli::estimateRangeForCommand(left, right, "give --disparity-range", quiet,
@@ -131,76 +238,36 @@ int run(const std::vector<std::string>& args) {
 
   std::vector<core::Feature> out;
   int failed = 0;
-  bool canceled = false;
-  const size_t count = inits.size();
+  const size_t count = jobs.size();
   for (size_t i = 0; i < count; ++i) {
-    const core::Feature& init = inits[i];
     core::Feature result;
-    result.polygon = init.polygon;
-    const auto id = numberAttribute(init, "id");
-    result.attributes["id"] = static_cast<long long>(id ? *id : static_cast<double>(i + 1));
+    result.polygon = jobs[i].request.init;
+    result.attributes["id"] = jobs[i].id;
     progress.setStage("building " + std::to_string(i + 1) + "/" + std::to_string(count));
     core::Progress::Range range(&buildingsProgress, double(i) / count, double(i + 1) / count);
     try {
-      delineation::DelineationRequest req;
-      req.init = init.polygon;
-      req.init.holes.clear();
-      const auto rmin = numberAttribute(init, "roof_disparity_min");
-      const auto rmax = numberAttribute(init, "roof_disparity_max");
-      if (rmin && rmax) {
-        req.roof = {static_cast<int>(std::floor(*rmin)), static_cast<int>(std::ceil(*rmax))};
-      } else if (roofFlag) {
-        req.roof = *roofFlag;
-      } else {
-        throw core::Error(core::ErrorCode::InvalidParameter,
-                          "no roof disparity interval: give --roof-disparity or the feature's "
-                          "roof_disparity_min/max");
-      }
-      const auto g = numberAttribute(init, "ground_disparity");
-      if (g) {
-        const int c = static_cast<int>(std::lround(*g));
-        req.ground = DisparityInterval{c - params.groundTolerance, c + params.groundTolerance};
-      } else {
-        req.ground = groundFlag;
-      }
-      req.searchRange = searchFlag;
+      if (!jobs[i].missing.empty()) throw core::Error(core::ErrorCode::InvalidParameter, jobs[i].missing);
+      delineation::DelineationRequest req = jobs[i].request;
+      req.searchRange = flags.search;
       if (estimated) req.searchRange = hull(*estimated, req.roof, req.ground);
       req.excludeMask = exclude;
       const auto r = delineation::delineate(left, right, req, params, {}, &range);
-      result.polygon = r.polygon;
-      result.attributes["status"] = statusName(r.status);
-      result.attributes["energy"] = r.terms.total();
-      static const char* names[6] = {"e_roof", "e_ground", "e_occlusion", "e_edges_left",
-                                     "e_edges_right", "e_shape"};
-      for (int k = 0; k < 6; ++k) result.attributes[names[k]] = r.terms.term[k];
-      result.attributes["iterations"] = static_cast<long long>(r.iterations);
-      result.attributes["vertices"] = static_cast<long long>(r.vertexCount);
-      result.attributes["regularization"] = delineation::toString(r.regularization.status);
-      if (!r.regularization.reason.empty()) result.attributes["regularization_note"] = r.regularization.reason;
-      long long rawVertices = static_cast<long long>(r.rawPolygon.outer.size());
-      for (const auto& hole : r.rawPolygon.holes) rawVertices += static_cast<long long>(hole.size());
-      result.attributes["raw_vertices"] = rawVertices;
-      result.attributes["roof_disparity_min"] = static_cast<long long>(r.roof.min);
-      result.attributes["roof_disparity_max"] = static_cast<long long>(r.roof.max);
-      result.attributes["ground_disparity_min"] = static_cast<long long>(r.ground.min);
-      result.attributes["ground_disparity_max"] = static_cast<long long>(r.ground.max);
-      result.attributes["no_match_cost"] = r.noMatchCost;
-      if (r.status == core::RunStatus::Canceled) canceled = true;
+      // A canceled batch writes nothing: the previous output, if any, stays as it was.
+      if (r.status == core::RunStatus::Canceled || progress.canceled()) throw cli::Canceled();
+      describeResult(r, result);
     } catch (const core::Error& e) {
       // One bad building does not stop the batch; a single-building run reports the error.
       if (count == 1) throw;
       ++failed;
       result.attributes["status"] = std::string("failed");
       result.attributes["error"] = e.detail();
-      std::fprintf(stderr, "building %zu: %s\n", i + 1, e.what());
+      std::fprintf(stderr, "building id %lld: %s\n", jobs[i].id, e.what());
     }
     out.push_back(std::move(result));
-    if (canceled) break;
   }
   io::writeFeatures(opts.get("out"), out, geo, "buildings");
   progress.report(1.0);
   progress.finish();
-  if (canceled) throw cli::Canceled();
   return failed > 0 ? cli::kExitProcessing : cli::kExitOk;
 }
 

@@ -42,6 +42,7 @@ int run(const std::vector<std::string>& args) {
   dem::EnhanceParams params;
   opts.apply(params);
 
+  cli::checkOutputs(opts, {{"out", io::OutputFormat::GeoTiff}}, {"dem", "footprints"});
   auto& progress = cli::commandProgress();
   progress.setQuiet(opts.has("quiet"));
   progress.setStage("reading");

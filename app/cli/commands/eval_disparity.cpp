@@ -14,6 +14,9 @@
 namespace {
 using namespace delineo;
 
+// A scale of magnitude 1e-6..1e6: beyond, float32 disparities overflow or vanish.
+bool usableScale(double v) { return std::isfinite(v) && std::abs(v) >= 1e-6 && std::abs(v) <= 1e6; }
+
 // "0.5", "1/256" → the number; UsageError otherwise.
 double parseScale(const std::string& key, const std::string& text) {
   try {
@@ -21,20 +24,20 @@ double parseScale(const std::string& key, const std::string& text) {
     size_t used = 0;
     if (slash == std::string::npos) {
       const double v = std::stod(text, &used);
-      if (used == text.size() && std::isfinite(v) && v != 0) return v;
+      if (used == text.size() && usableScale(v)) return v;
     } else {
       const std::string numText = text.substr(0, slash), denText = text.substr(slash + 1);
       size_t usedDen = 0;
       const double num = std::stod(numText, &used);
       const double den = std::stod(denText, &usedDen);
       const double v = num / den;
-      if (used == numText.size() && usedDen == denText.size() && std::isfinite(v) && v != 0) {
+      if (used == numText.size() && usedDen == denText.size() && usableScale(v)) {
         return v;
       }
     }
   } catch (const std::exception&) {
   }
-  throw cli::UsageError("--" + key + " expects a non-zero number or a fraction like 1/256, got '" +
+  throw cli::UsageError("--" + key + " expects a number or a fraction like 1/256 of magnitude 1e-6 to 1e6, got '" +
                         text + "'");
 }
 
@@ -109,6 +112,7 @@ int run(const std::vector<std::string>& args) {
     throw cli::UsageError("--roof-value needs --roof-mask");
   }
 
+  cli::checkOutputs(opts, {{"json", io::OutputFormat::Json}}, {"pred", "truth", "mask", "roof-mask"});
   auto& progress = cli::commandProgress();
   progress.setStage("reading");
   const io::Raster pred = readSingleBand(opts.get("pred"), io::PixelType::Float32, "prediction");
@@ -138,10 +142,7 @@ int run(const std::vector<std::string>& args) {
 
   printTable(result);
   if (opts.has("json")) {
-    const std::string path = opts.get("json");
-    std::ofstream out(path);
-    out << eval::disparityReport(result).dump(2) << "\n";
-    if (!out) throw core::Error(core::ErrorCode::WriteFailed, "cannot write the JSON report", path);
+    io::writeTextFile(opts.get("json"), eval::disparityReport(result).dump(2) + "\n");
   }
   return cli::kExitOk;
 }

@@ -76,6 +76,7 @@ int run(const std::vector<std::string>& args) {
   eval::FootprintMetricsParams params;
   opts.apply(params);
 
+  cli::checkOutputs(opts, {{"json", io::OutputFormat::Json}}, {"pred", "truth", "raster"});
   auto& progress = cli::commandProgress();
   progress.setStage("reading");
   io::GeoReference geo;
@@ -106,10 +107,7 @@ int run(const std::vector<std::string>& args) {
   std::printf("\n");
 
   if (opts.has("json")) {
-    const std::string path = opts.get("json");
-    std::ofstream out(path);
-    out << eval::footprintReport(result, predIds, truthIds).dump(2) << "\n";
-    if (!out) throw core::Error(core::ErrorCode::WriteFailed, "cannot write the JSON report", path);
+    io::writeTextFile(opts.get("json"), eval::footprintReport(result, predIds, truthIds).dump(2) + "\n");
   }
   return cli::kExitOk;
 }

@@ -24,7 +24,7 @@ int run(const std::vector<std::string>& args) {
       .required("out", "FILE", "output disparity GeoTIFF (float32, NaN = rejected)")
       .value("dmin", "PX", "smallest disparity searched, x_right = x_left - d; estimated from the pair when absent")
       .value("dmax", "PX", "largest disparity searched; estimated from the pair when absent")
-      .value("score", "FILE", "optional output of the correlation score (NCC of the match)", "")
+      .value("score", "FILE", "optional output of the correlation score (NCC of the match)")
       .flag("quiet", "no progress on stderr");
   opts.params(stereo::MatchParams{});
   // --levels also accepts "auto", the same as 0 (depth from the range, as in the paper).
@@ -45,6 +45,7 @@ int run(const std::vector<std::string>& args) {
   params.dmax = opts.has("dmax") ? opts.getInt("dmax") : 100000;
   params.validate();
 
+  cli::checkOutputs(opts, {{"out", io::OutputFormat::GeoTiff}, {"score", io::OutputFormat::GeoTiff}}, {"left", "right"});
   auto& progress = cli::commandProgress();
   const bool quiet = opts.has("quiet");
   progress.setQuiet(quiet);
@@ -75,7 +76,7 @@ int run(const std::vector<std::string>& args) {
   progress.finish();
 
   io::writeFloatGeoTiff(opts.get("out"), result.disparity, geo);
-  if (!opts.get("score").empty()) io::writeFloatGeoTiff(opts.get("score"), result.score, geo);
+  if (opts.has("score")) io::writeFloatGeoTiff(opts.get("score"), result.score, geo);
   if (quiet) return cli::kExitOk;
   const int valid = cv::countNonZero(result.disparity == result.disparity);
   std::fprintf(stderr,

@@ -64,6 +64,7 @@ int run(const std::vector<std::string>& args) {
   stereo::RangeEstimateParams params;
   opts.apply(params);
 
+  cli::checkOutputs(opts, {{"json", io::OutputFormat::Json}}, {"left", "right"});
   auto& progress = cli::commandProgress();
   const bool quiet = opts.has("quiet");
   progress.setQuiet(quiet);
@@ -83,10 +84,7 @@ int run(const std::vector<std::string>& args) {
   progress.finish();
 
   if (opts.has("json")) {
-    const std::string path = opts.get("json");
-    std::ofstream out(path);
-    out << report(r, params).dump(2) << "\n";
-    if (!out) throw core::Error(core::ErrorCode::WriteFailed, "cannot write the JSON report", path);
+    io::writeTextFile(opts.get("json"), report(r, params).dump(2) + "\n");
   }
   std::printf("--dmin %d --dmax %d\n", r.dmin, r.dmax);
   if (!quiet) {

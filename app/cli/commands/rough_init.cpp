@@ -27,6 +27,7 @@ int run(const std::vector<std::string>& args) {
   const double jitter = opts.getDouble("jitter");
   if (grow < 0 || jitter < 0) throw cli::UsageError("--grow and --jitter must be >= 0");
 
+  cli::checkOutputs(opts, {{"out", io::OutputFormat::Vector}}, {"truth"});
   auto features = io::readFeatures(opts.get("truth"));
   std::mt19937 rng(static_cast<unsigned>(opts.getInt("seed")));
   std::uniform_real_distribution<double> unit(-1.0, 1.0);

@@ -22,13 +22,24 @@ int run(const std::vector<std::string>& args) {
       .value("sample", "DIR", "create (or reuse) the sample project in DIR and run it", "")
       .flag("no-save", "do not write the project file back (outputs are still written)")
       .flag("quiet", "no progress on stderr");
-  std::vector<std::string> rest = args;
+  // PROJECT may stand anywhere among the options: the one argument that is neither an option
+  // nor an option's value.
+  std::vector<std::string> rest;
   std::string projectPath;
-  if (!rest.empty() && rest.front().rfind("-", 0) != 0) {
-    projectPath = rest.front();
-    rest.erase(rest.begin());
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool takesValue = (a == "--project" || a == "--sample") && i + 1 < args.size();
+    if (a.rfind("-", 0) == 0) {
+      rest.push_back(a);
+      if (takesValue) rest.push_back(args[++i]);
+    } else if (projectPath.empty()) {
+      projectPath = a;
+    } else {
+      throw cli::UsageError("unexpected argument '" + a + "': give one PROJECT");
+    }
   }
   if (!opts.parse(rest)) return cli::kExitOk;
+  if (!projectPath.empty() && opts.has("project")) throw cli::UsageError("give PROJECT or --project, not both");
   if (projectPath.empty()) projectPath = opts.get("project");
   auto& progress = cli::commandProgress();
   progress.setQuiet(opts.has("quiet"));

@@ -1,6 +1,7 @@
 // delineo-cli simulate: a synthetic urban epipolar pair with exact ground truth
 // (docs/simulator.md), written as GeoTIFFs, a GeoJSON of roof outlines and scene.json.
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <string>
 
@@ -37,15 +38,21 @@ int run(const std::vector<std::string>& args) {
 
   progress.setStage("writing");
   auto path = [&](const char* name) { return (dir / name).string(); };
-  io::writeGeoTiff(path(sim::SceneFiles::left), scene.left);
-  io::writeGeoTiff(path(sim::SceneFiles::right), scene.right);
-  io::writeFloatGeoTiff(path(sim::SceneFiles::disparity), scene.disparity);
-  io::writeFloatGeoTiff(path(sim::SceneFiles::disparityRight), scene.disparityRight);
-  io::writeGeoTiff(path(sim::SceneFiles::occlusion), scene.occlusion);
-  io::writeFloatGeoTiff(path(sim::SceneFiles::dem), scene.dem);
-  io::writeGeoTiff(path(sim::SceneFiles::labels), scene.labels);
-  io::writeFeatures(path(sim::SceneFiles::footprints), scene.footprints, {}, "buildings");
-  sim::writeSceneJson(path(sim::SceneFiles::description), scene, params);
+  // Ctrl-C is honoured between files: each one is whole, the old or the new.
+  const std::vector<std::function<void()>> writes{
+      [&] { io::writeGeoTiff(path(sim::SceneFiles::left), scene.left); },
+      [&] { io::writeGeoTiff(path(sim::SceneFiles::right), scene.right); },
+      [&] { io::writeFloatGeoTiff(path(sim::SceneFiles::disparity), scene.disparity); },
+      [&] { io::writeFloatGeoTiff(path(sim::SceneFiles::disparityRight), scene.disparityRight); },
+      [&] { io::writeGeoTiff(path(sim::SceneFiles::occlusion), scene.occlusion); },
+      [&] { io::writeFloatGeoTiff(path(sim::SceneFiles::dem), scene.dem); },
+      [&] { io::writeGeoTiff(path(sim::SceneFiles::labels), scene.labels); },
+      [&] { io::writeFeatures(path(sim::SceneFiles::footprints), scene.footprints, {}, "buildings"); },
+      [&] { sim::writeSceneJson(path(sim::SceneFiles::description), scene, params); }};
+  for (const auto& write : writes) {
+    cli::throwIfCanceled(progress);
+    write();
+  }
   progress.report(1.0);
 
   std::cout << "simulated " << params.width << "x" << params.height << " scene (seed "

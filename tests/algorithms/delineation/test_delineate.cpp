@@ -1,3 +1,5 @@
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -160,6 +162,39 @@ TEST(Delineate, CarvesTheNotchOfAnLShapedRoofFromABox) {
   req.ground = DisparityInterval{3, 5};
   const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
   EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.93);
+}
+
+// A roof between two taller blocks that fill the band next to its north and south sides: the
+// ground lies beyond them, east and west. Painter's order builds the right view (x_right = x - d):
+// the ground, then each block from the lowest.
+TEST(Delineate, EstimatesTheGroundBeyondTallerNeighbours) {
+  const cv::Size size(220, 240);
+  const int dg = 6;
+  struct Block { cv::Rect rect; int d; int seed; };
+  const cv::Rect roof(60, 92, 100, 56);
+  const std::vector<Block> blocks = {{roof, 18, 2}, {{0, 20, 220, 68}, 40, 3}, {{0, 152, 220, 68}, 40, 4}};
+  const cv::Mat ground = texture(size + cv::Size(64, 0), 100, 25, 1);
+  cv::Mat left(size, CV_32F), right(size, CV_32F);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) left.at<float>(y, x) = ground.at<float>(y, x), right.at<float>(y, x) = ground.at<float>(y, x + dg);
+  for (const Block& b : blocks) {
+    const cv::Mat top = texture(size, 160, 25, b.seed);
+    for (int y = b.rect.y; y < b.rect.br().y; ++y) {
+      for (int x = b.rect.x; x < b.rect.br().x; ++x) {
+        left.at<float>(y, x) = top.at<float>(y, x);
+        if (x - b.d >= 0) right.at<float>(y, x - b.d) = top.at<float>(y, x);
+      }
+    }
+  }
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {17, 19};
+  req.searchRange = DisparityInterval{-4, 48};  // the pair's range, which holds the blocks
+  const auto r = delineate(left, right, req, DelineationParams{});
+  EXPECT_NEAR(0.5 * (r.ground.min + r.ground.max), dg, 1.0);
+  core::Polygon truth;
+  truth.outer = {{60, 92}, {160, 92}, {160, 148}, {60, 148}};
+  EXPECT_GT(iou(r.polygon, truth, size), 0.85);  // 0.896: no walls are rendered
 }
 
 TEST(Delineate, EstimatesTheGroundFromTheRing) {
@@ -337,6 +372,25 @@ TEST(Delineate, RejectsBadInputs) {
   DelineationRequest smallMask = ok;
   smallMask.excludeMask = cv::Mat::zeros(100, 100, CV_8U);
   expectCode(smallMask, core::ErrorCode::MismatchedInputs, pair.right);
+  // A roof is nearer than its ground: a ground interval at or above the roof's is refused.
+  DelineationRequest groundAbove = ok;
+  groundAbove.ground = DisparityInterval{20, 24};
+  expectCode(groundAbove, core::ErrorCode::InvalidParameter, pair.right);
+  DelineationRequest groundOverlap = ok;
+  groundOverlap.ground = DisparityInterval{10, 13};
+  expectCode(groundOverlap, core::ErrorCode::InvalidParameter, pair.right);
+  // Nothing to delineate: no data under the polygon, or all of it excluded.
+  const cv::Mat noData(pair.left.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  try {
+    regionOfInterest(noData, pair.right, ok, params);
+    ADD_FAILURE() << "an all-NaN left image was accepted";
+  } catch (const core::Error& e) {
+    EXPECT_EQ(e.code(), core::ErrorCode::UnsupportedInput) << e.what();
+  }
+  expectCode(ok, core::ErrorCode::UnsupportedInput, noData);
+  DelineationRequest allExcluded = ok;
+  allExcluded.excludeMask = cv::Mat(pair.left.size(), CV_8U, cv::Scalar(255));
+  expectCode(allExcluded, core::ErrorCode::InvalidParameter, pair.right);
   EXPECT_NO_THROW(regionOfInterest(pair.left, pair.right, ok, params));
   // The cost box filter is centred: an even side is rejected.
   DelineationParams even;

@@ -1,4 +1,6 @@
+#include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -175,6 +177,34 @@ TEST(VectorIoErrors, DegenerateAndEmptyPolygonsNameTheFeature) {
   const core::Error none = captureError([&] { readFeatures(empty); });
   EXPECT_EQ(none.code(), ErrorCode::UnreadableFile) << none.what();
   EXPECT_NE(none.detail().find("feature 0"), std::string::npos) << none.what();
+}
+
+TEST(VectorIoErrors, ANonFiniteVertexIsRefusedNamingTheFeature) {
+  TempDir dir;
+  const std::string path = dir.file("nan.geojson");
+  writeText(path, R"({"type":"FeatureCollection","features":[
+    {"type":"Feature","id":5,"properties":{},"geometry":{"type":"Polygon","coordinates":[[[0,0],[NaN,0],[4,4],[0,4],[0,0]]]}}]})");
+  const core::Error error = captureError([&] { readFeatures(path); });
+  EXPECT_TRUE(error.code() == ErrorCode::UnreadableFile) << error.what();
+  EXPECT_NE(std::string(error.what()).find("feature 0"), std::string::npos) << error.what();
+}
+
+TEST(VectorIoErrors, APolygonWithTooManyVerticesIsRefusedAtOnce) {
+  TempDir dir;
+  const std::string path = dir.file("huge.geojson");
+  std::ostringstream text;
+  text << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},)"
+       << R"("geometry":{"type":"Polygon","coordinates":[[)";
+  const int n = 60000;
+  for (int i = 0; i <= n; ++i) {
+    const double a = 2 * 3.14159265358979 * (i % n) / n;
+    text << (i ? "," : "") << "[" << 1000 + 900 * std::cos(a) << "," << 1000 + 900 * std::sin(a) << "]";
+  }
+  text << "]]}}]}";
+  writeText(path, text.str());
+  const core::Error error = captureError([&] { readFeatures(path); });
+  EXPECT_EQ(error.code(), ErrorCode::UnsupportedInput) << error.what();
+  EXPECT_NE(error.detail().find("at most 50000"), std::string::npos) << error.what();
 }
 
 TEST(VectorIoErrors, NonPolygonGeometry) {

@@ -200,14 +200,14 @@ TEST(ProjectFile, SaveIsAtomicAndLeavesNoTemporaryFile) {
   EXPECT_EQ(project::loadProject(path).name, "second");
 }
 
-TEST(ProjectFile, SaveIntoUnwritableLocationThrowsWriteFailed) {
+TEST(ProjectFile, SaveIntoAFileInsteadOfAFolderIsRefused) {
   TempDir dir;
   touch(dir.file("not-a-folder"));
   try {
     project::saveProject(sampleProject(dir), dir.file("not-a-folder/p.json"));
-    FAIL() << "expected WriteFailed";
+    FAIL() << "expected UnusableOutput";
   } catch (const core::Error& e) {
-    EXPECT_EQ(e.code(), core::ErrorCode::WriteFailed);
+    EXPECT_EQ(e.code(), core::ErrorCode::UnusableOutput);
   }
 }
 

@@ -114,7 +114,8 @@ if has simulate; then
   # Ctrl-C: the command stops at its next progress poll and exits with 130.
   "$cli" simulate --out "$work/big" --width 3000 --height 3000 --buildings 40 >"$work/sigint.out" 2>"$work/sigint.err" &
   pid=$!
-  sleep 1
+  # Interrupt once the simulation is under way (a fixed delay misfires on a loaded machine).
+  for _ in $(seq 100); do grep -q "%" "$work/sigint.err" 2>/dev/null && break; sleep 0.1; done
   kill -INT "$pid"
   wait "$pid"
   rc=$?

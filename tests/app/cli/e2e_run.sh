@@ -135,5 +135,47 @@ expect missing_project_untouched '.buildings[0].status == "pending"' "$site/miss
 run_cli run_no_project 3 "nope.delineo.json" -- "$cli" run "$work/nope.delineo.json" --quiet
 run_cli run_usage 2 "" -- "$cli" run
 
+# ---- what a run must never lose or overwrite --------------------------------------------------
+# Bad parameters are found at load (exit 3), before any matching.
+jq '.parameters.delineation = {"occlusion": -5} | .images.disparity = "" |
+    .buildings |= map(.status = "pending" | .outline = [])' "$work/after_first.json" >"$site/badparams.delineo.json"
+run_cli run_bad_params 3 "parameters.delineation" -- "$cli" run "$site/badparams.delineo.json" --quiet
+grep -q "matching" "$work/run_bad_params.err" && fail "run_bad_params: matching ran before the check" \
+  || pass "bad parameters found before matching"
+# An output folder that would put disparity.tif on the left image: refused, the image untouched.
+mkdir -p "$work/clash"
+cp "$site/left.tif" "$work/clash/disparity.tif"
+sum=$(sha1sum <"$work/clash/disparity.tif")
+jq --arg d "$work/clash" '.images.left = ($d + "/disparity.tif") | .images.disparity = "" | .outputDir = $d' \
+  "$work/after_first.json" >"$site/clash.delineo.json"
+run_cli run_output_is_input 3 "input of this run" -- "$cli" run "$site/clash.delineo.json" --quiet
+[ "$(sha1sum <"$work/clash/disparity.tif")" = "$sum" ] && pass "the clashing image is untouched" \
+  || fail "run overwrote the left image"
+# Unknown keys survive a save; the file mode is kept; a symlinked project stays a link.
+jq '.buildings[0].status = "pending" | .buildings[0].outline = [] | .myTool = {"kept": 1} |
+    .buildings[0].reviewer = "ann" | .parameters.delineation = {"future-parameter": 3}' \
+  "$work/after_first.json" >"$site/real.delineo.json"
+chmod 640 "$site/real.delineo.json"
+ln -sf "real.delineo.json" "$site/link.delineo.json"
+run_cli run_through_link_quiet_first 0 "" -- "$cli" run --quiet "$site/link.delineo.json"
+[ -L "$site/link.delineo.json" ] && pass "the project link is still a link" || fail "run replaced the link by a file"
+[ "$(stat -c %a "$site/real.delineo.json")" = "640" ] && pass "the project's mode is kept" \
+  || fail "mode $(stat -c %a "$site/real.delineo.json"), expected 640"
+expect unknown_keys_kept '.myTool.kept == 1 and .buildings[0].reviewer == "ann" and
+    .parameters.delineation["future-parameter"] == 3 and .buildings[0].status == "automatic"' "$site/real.delineo.json"
+# A read-only project is not overwritten.
+jq '.buildings[0].status = "pending" | .buildings[0].outline = []' "$work/after_first.json" >"$site/locked.delineo.json"
+chmod 444 "$site/locked.delineo.json"
+run_cli run_read_only 3 "read-only" -- "$cli" run --quiet "$site/locked.delineo.json"
+expect read_only_untouched '.buildings[0].status == "pending"' "$site/locked.delineo.json"
+# --sample never replaces someone else's images; a relative folder works.
+mkdir -p "$work/mine"
+echo "my image" >"$work/mine/left.tif"
+run_cli sample_over_user_files 3 "left.tif" -- "$cli" run --sample "$work/mine" --quiet
+grep -q "my image" "$work/mine/left.tif" && pass "the user's left.tif is untouched" || fail "--sample replaced left.tif"
+(cd "$work" && "$cli" run --sample rel-sample --quiet >"$work/sample_relative.out" 2>"$work/sample_relative.err") \
+  && [ -s "$work/rel-sample/output/disparity.tif" ] && pass "run --sample with a relative folder" \
+  || { fail "run --sample rel-sample"; tail -3 "$work/sample_relative.err"; }
+
 echo "e2e_run: $passed passed, $failures failed"
 [ "$failures" -eq 0 ]

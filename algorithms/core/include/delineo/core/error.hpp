@@ -14,6 +14,7 @@ enum class ErrorCode {
   UnsupportedInput,  // decodable but not supported (band count, data type, geometry type)
   MismatchedInputs,  // inputs that must agree do not (sizes, CRS)
   WriteFailed,       // an output could not be written
+  UnusableOutput,    // an output path refused before any work (no folder, wrong extension, an input, read-only)
   ProcessingFailed,  // the algorithm could not produce a result from valid input
 };
 

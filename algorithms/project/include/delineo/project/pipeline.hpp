@@ -23,6 +23,11 @@ bool matchingAvailable();
 bool delineationAvailable();
 bool simulationAvailable();
 
+// Checks every parameter group the steps of this build read ("range", "matching",
+// "delineation"): a bad value is found when the project is loaded, not after matching.
+// Throws core::Error(InvalidParameter) naming the group and the parameter.
+void validateParameters(const Project& project);
+
 // The pair as float32 grey (NaN = no data). Throws FileNotFound / UnreadableFile naming the
 // image, MismatchedInputs when the two images differ in size (an epipolar pair shares rows).
 struct StereoPair {

@@ -64,6 +64,8 @@ struct Building {
   double energy = std::nan("");      // active polygon energy F(C) of the outline, NaN when unknown
   std::optional<EnergyTerms> energyTerms;  // its terms, when known
   std::vector<HistoryEntry> history;
+  // Keys of the building's JSON object this version does not know, written back on save.
+  nlohmann::json unknownKeys = nlohmann::json::object();
 
   bool hasOutline() const { return outline.outer.size() >= 3; }
   // The outline when there is one, else the initial polygon.
@@ -103,6 +105,9 @@ struct Project {
   // algorithm library; typed access through parameters()/setParameters().
   nlohmann::json parameters = nlohmann::json::object();
   std::vector<Building> buildings;
+  // Keys of the project file this version does not know (a newer version's, a user's own),
+  // written back on save as they were read ("images" holds those of the images object).
+  nlohmann::json unknownKeys = nlohmann::json::object();
 
   Building* find(int id);
   const Building* find(int id) const;
@@ -114,17 +119,29 @@ struct Project {
   bool operator==(const Project&) const;
 };
 
-// Typed parameter access: default-constructed struct overlaid with the stored keys.
+// Typed parameter access: default-constructed struct overlaid with the stored keys. Keys the
+// struct does not know (a newer version's parameter, a removed one) are ignored here and kept
+// in the file; a known key with a bad value throws core::Error(InvalidParameter).
 template <class Params>
 Params parameters(const Project& project, const std::string& group) {
   Params params;
   auto it = project.parameters.find(group);
-  if (it != project.parameters.end()) core::fromJson(params, *it);
+  if (it == project.parameters.end() || !it->is_object()) return params;
+  nlohmann::json known = nlohmann::json::object();
+  params.visit([&](const core::ParamInfo& info, auto&) {
+    const std::string key(info.key);
+    if (auto value = it->find(key); value != it->end()) known[key] = *value;
+  });
+  core::fromJson(params, known);
   return params;
 }
+// Stores `params` in `group`, keeping the group's keys the struct does not know.
 template <class Params>
 void setParameters(Project& project, const std::string& group, const Params& params) {
-  project.parameters[group] = core::toJson(params);
+  nlohmann::json& stored = project.parameters[group];
+  if (!stored.is_object()) stored = nlohmann::json::object();
+  const nlohmann::json values = core::toJson(params);
+  for (auto it = values.begin(); it != values.end(); ++it) stored[it.key()] = it.value();
 }
 
 // JSON conversion. `baseDir` is the folder paths are made relative to (toJson) or resolved
