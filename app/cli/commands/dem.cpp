@@ -71,6 +71,7 @@ int run(const std::vector<std::string>& args) {
   opts.apply(gaps);
   const dem::HeightModel model = heightModel(opts);
 
+  cli::checkOutputs(opts, {{"out", io::OutputFormat::GeoTiff}}, {"disparity", "scene"});
   auto& progress = cli::commandProgress();
   progress.setQuiet(opts.has("quiet"));
   progress.setStage("reading");

@@ -4,7 +4,7 @@
 # (merged: filled with the ground) and a no-data strip beside the roof's left wall (kept; filled
 # with the ground under --fill). Heights are compared with eval-disparity (its RMS works on any
 # float raster); the output keeps the map's georeferencing; bad inputs give the documented exit
-# codes.
+# codes (2 usage, 3 input or output refused).
 #
 # Usage: e2e_dem.sh DELINEO_CLI WORK_DIR
 # Exit status 0 when every check passes; otherwise 1, with one line per failed check on stderr.
@@ -92,8 +92,12 @@ expect_rc bad_param 3 "$CLI" dem --disparity "$WORK/disparity.asc" --metres-per-
 expect_rc no_out 2 "$CLI" dem --disparity "$WORK/disparity.asc" --metres-per-pixel 0.5
 expect_rc unknown_flag 2 "$CLI" dem --disparity "$WORK/disparity.asc" --metres-per-pixel 0.5 --out "$WORK/x.tif" \
   --frobnicate 1
-expect_rc unwritable 4 "$CLI" dem --disparity "$WORK/disparity.asc" --metres-per-pixel 0.5 \
+# Outputs are checked before any work (the output policy): a missing folder, the input itself.
+expect_rc unwritable 3 "$CLI" dem --disparity "$WORK/disparity.asc" --metres-per-pixel 0.5 \
   --out "$WORK/no/such/folder/x.tif"
+cp "$WORK/dem.tif" "$WORK/input.tif"
+expect_rc onto_input 3 "$CLI" dem --disparity "$WORK/input.tif" --metres-per-pixel 0.5 --out "$WORK/input.tif"
+cmp -s "$WORK/dem.tif" "$WORK/input.tif" || fail "writing onto the input must leave it untouched"
 
 if ((failures > 0)); then
   echo "e2e_dem: $failures check(s) failed" >&2
