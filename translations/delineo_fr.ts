@@ -1058,6 +1058,10 @@
         <translation>Aucun objet sursol sous le curseur.</translation>
     </message>
     <message>
+        <source>Picking an above-ground object is not part of this build.</source>
+        <translation>La sélection d&apos;un objet sursol ne fait pas partie de cette version.</translation>
+    </message>
+    <message>
         <source>Edit outline</source>
         <translation>Modifier le contour</translation>
     </message>

@@ -122,11 +122,7 @@ void Document::deriveDem() {
   // Without a DEM file, heights come from the disparity through the project's height model.
   if (project_.dem.empty()) {
     demDerived_ = true;
-    if (!disparity_.empty() && project_.height.known()) {
-      dem_ = (disparity_ - project_.height.groundDisparity) * project_.height.metresPerPixel;
-    } else {
-      dem_ = cv::Mat();
-    }
+    dem_ = project::heightsFromDisparity(project_, disparity_);  // empty without a height model
   }
 }
 

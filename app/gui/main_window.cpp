@@ -14,12 +14,10 @@
 #include <QStatusBar>
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <vector>
 
-#include <opencv2/imgproc.hpp>
-
 #include "delineo/core/error.hpp"
+#include "delineo/project/pipeline.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "delineo/widgets/terrain3d_view.hpp"
@@ -30,38 +28,6 @@ namespace delineo::gui {
 
 using project::Building;
 using project::BuildingStatus;
-
-namespace {
-
-// Median of the finite values of `values` in a band of `width` px around the polygon (outside
-// it): the local ground level next to a building.
-std::optional<double> ringMedian(const cv::Mat& values, const core::Polygon& polygon, int width) {
-  if (values.empty() || polygon.outer.size() < 3) return std::nullopt;
-  const cv::Rect2d box = core::boundingBox(polygon.outer);
-  cv::Rect roi(static_cast<int>(box.x) - width - 2, static_cast<int>(box.y) - width - 2,
-               static_cast<int>(box.width) + 2 * width + 4, static_cast<int>(box.height) + 2 * width + 4);
-  roi &= cv::Rect(0, 0, values.cols, values.rows);
-  if (roi.empty()) return std::nullopt;
-  core::Polygon local = polygon;
-  for (auto& p : local.outer) p -= cv::Point2d(roi.x, roi.y);
-  local.holes.clear();
-  const cv::Mat inside = core::rasterize(local, roi.size());
-  cv::Mat grown;
-  cv::dilate(inside, grown, cv::getStructuringElement(cv::MORPH_RECT, {2 * width + 1, 2 * width + 1}));
-  std::vector<float> samples;
-  const cv::Mat patch = values(roi);
-  for (int y = 0; y < roi.height; ++y) {
-    for (int x = 0; x < roi.width; ++x) {
-      const float v = patch.at<float>(y, x);
-      if (grown.at<uchar>(y, x) != 0 && inside.at<uchar>(y, x) == 0 && std::isfinite(v)) samples.push_back(v);
-    }
-  }
-  if (samples.empty()) return std::nullopt;
-  std::nth_element(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples.size() / 2), samples.end());
-  return samples[samples.size() / 2];
-}
-
-}  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   setObjectName(QStringLiteral("MainWindow"));
@@ -186,7 +152,8 @@ void MainWindow::refresh3D() {
   std::vector<widgets::BuildingOutline> outlines;
   for (const Building& b : document_->project().buildings) {
     if (!b.hasOutline() || b.status == BuildingStatus::Rejected || !std::isfinite(b.roofHeight)) continue;
-    const double base = ringMedian(dem, b.outline, 6).value_or(0.0);
+    // The ground next to the building, as the histogram's ground line reads it.
+    const double base = project::groundHeightNextTo(document_->project(), dem, b.outline).value_or(0.0);
     outlines.push_back({b.outline, base, b.roofHeight});
   }
   view3D_->setBuildings(outlines);
@@ -198,43 +165,37 @@ void MainWindow::refresh3D() {
 
 void MainWindow::onObjectPicked(QPointF imagePos) {
   if (!document_) return;
+  const cv::Mat& disparity = document_->disparity();
   const cv::Mat& dem = document_->dem();
-  const int x = static_cast<int>(imagePos.x());
-  const int y = static_cast<int>(imagePos.y());
-  if (dem.empty() || x < 0 || y < 0 || x >= dem.cols || y >= dem.rows) {
-    showMessage(tr("Pick an object"), tr("Picking an above-ground object needs a DEM or a disparity map."));
+  const cv::Size size = !disparity.empty() ? disparity.size() : dem.size();
+  if (imagePos.x() < 0 || imagePos.y() < 0 || imagePos.x() >= size.width || imagePos.y() >= size.height) {
+    if (size.area() > 0) showMessage(tr("Pick an object"), tr("No above-ground object under the cursor."));
+    else showMessage(tr("Pick an object"), tr("Picking an above-ground object needs a DEM or a disparity map."));
     return;
   }
-  // Above-ground region: pixels at least 2.5 m above the local ground (the low quantile of the
-  // heights in a window around the click), connected to the clicked pixel.
-  const cv::Rect window = cv::Rect(x - 60, y - 60, 121, 121) & cv::Rect(0, 0, dem.cols, dem.rows);
-  std::vector<float> heights;
-  for (int yy = window.y; yy < window.y + window.height; ++yy) {
-    for (int xx = window.x; xx < window.x + window.width; ++xx) {
-      const float h = dem.at<float>(yy, xx);
-      if (std::isfinite(h)) heights.push_back(h);
-    }
-  }
-  if (heights.empty()) return;
-  std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 10), heights.end());
-  const float ground = heights[heights.size() / 10];
-  cv::Mat above = (dem > ground + 2.5f);
-  cv::morphologyEx(above, above, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
-  if (above.at<uchar>(y, x) == 0) {
-    showMessage(tr("Pick an object"), tr("No above-ground object under the cursor."));
+  // The connected region above the local ground, with the ground estimate of the histogram's
+  // line (algorithms: delineation::aboveGroundObjectAt through the project's steps).
+  using Outcome = project::ObjectPick::Outcome;
+  project::ObjectPick pick;
+  try {
+    pick = project::pickAboveGroundObject(document_->project(), disparity, dem, {imagePos.x(), imagePos.y()});
+  } catch (const core::Error& e) {  // e.g. the project's "pick" parameters are out of their domain
+    showMessage(tr("Pick an object"), errorSentence(e.code()) + QStringLiteral("\n\n") + QString::fromStdString(e.what()));
     return;
   }
-  cv::Mat mask = cv::Mat::zeros(dem.rows + 2, dem.cols + 2, CV_8U);
-  cv::floodFill(above, mask, cv::Point(x, y), 128, nullptr, 0, 0, 4 | cv::FLOODFILL_MASK_ONLY | (255 << 8));
-  cv::Mat region = mask(cv::Rect(1, 1, dem.cols, dem.rows));
-  std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(region, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
-  if (contours.empty()) return;
-  std::vector<cv::Point> simplified;
-  cv::approxPolyDP(contours.front(), simplified, 2.0, true);
-  core::Polygon p;
-  for (const auto& q : simplified) p.outer.emplace_back(q.x + 0.5, q.y + 0.5);
-  onPicked(p);
+  switch (pick.outcome) {
+    case Outcome::Found: onPicked(pick.outline); return;
+    case Outcome::NoHeights:
+      showMessage(tr("Pick an object"), tr("Picking an above-ground object needs a DEM or a disparity map."));
+      return;
+    case Outcome::Unavailable:
+      showMessage(tr("Pick an object"), tr("Picking an above-ground object is not part of this build."));
+      return;
+    case Outcome::NoGround:
+    case Outcome::NotAboveGround:
+      showMessage(tr("Pick an object"), tr("No above-ground object under the cursor."));
+      return;
+  }
 }
 
 }  // namespace delineo::gui

@@ -25,6 +25,7 @@
 #endif
 #ifdef DELINEO_HAVE_DELINEATION
 #include "delineation_bridge.hpp"
+#include "delineo/delineation/above_ground.hpp"
 #include "delineo/delineation/params.hpp"
 #include "delineo/delineation/roof_interval.hpp"
 #endif
@@ -217,6 +218,67 @@ std::optional<double> suggestSceneGroundLevel(const cv::Mat& disparity) {
   (void)disparity;
   return std::nullopt;
 #endif
+}
+
+dem::HeightModel demHeightModel(const HeightModel& model) {
+  if (!model.known()) throw Error(ErrorCode::InvalidParameter, "the project has no height model");
+  dem::HeightModel out;
+  out.metresPerPixel = model.metresPerPixel;
+  out.groundDisparity = model.groundDisparity;
+  return out;
+}
+
+cv::Mat heightsFromDisparity(const Project& project, const cv::Mat& disparity) {
+  if (disparity.empty() || !project.height.known()) return {};
+  return dem::heightsFromDisparity(disparity, demHeightModel(project.height));
+}
+
+namespace {
+// A DEM in metres brought to disparity by the project's height model (1 m per px without one).
+cv::Mat demAsDisparity(const Project& project, const cv::Mat& dem) {
+  return project.height.known() ? dem::disparityFromHeights(dem, demHeightModel(project.height)) : dem;
+}
+double metresPerPixelOf(const Project& project) { return project.height.known() ? project.height.metresPerPixel : 1.0; }
+}  // namespace
+
+ObjectPick pickAboveGroundObject(const Project& project, const cv::Mat& disparity, const cv::Mat& dem,
+                                 cv::Point2d click) {
+  ObjectPick pick;
+  cv::Mat map;
+  if (!disparity.empty() && project.height.known()) {
+    map = disparity;
+  } else if (!dem.empty()) {
+    map = demAsDisparity(project, dem);
+  } else {
+    return pick;  // NoHeights
+  }
+#ifdef DELINEO_HAVE_DELINEATION
+  const auto params = parameters<delineation::AboveGroundParams>(project, "pick");
+  const delineation::AboveGroundObject object =
+      delineation::aboveGroundObjectAt(map, click, metresPerPixelOf(project), params);
+  switch (object.outcome) {
+    case delineation::PickOutcome::Found: pick.outcome = ObjectPick::Outcome::Found; break;
+    case delineation::PickOutcome::NoGround: pick.outcome = ObjectPick::Outcome::NoGround; break;
+    case delineation::PickOutcome::NotAboveGround: pick.outcome = ObjectPick::Outcome::NotAboveGround; break;
+  }
+  pick.outline = object.outline;
+  pick.groundLevel = object.groundLevel;
+  if (project.height.known() && std::isfinite(object.groundLevel)) {
+    pick.groundHeight = project.height.heightAt(object.groundLevel);
+  }
+  return pick;
+#else
+  (void)click;
+  pick.outcome = ObjectPick::Outcome::Unavailable;
+  return pick;
+#endif
+}
+
+std::optional<double> groundHeightNextTo(const Project& project, const cv::Mat& dem, const core::Polygon& polygon) {
+  if (dem.empty()) return std::nullopt;
+  const auto level = suggestGroundLevel(demAsDisparity(project, dem), polygon);
+  if (!level) return std::nullopt;
+  return project.height.known() ? project.height.heightAt(*level) : *level;
 }
 
 double roofHeight(const Project& project, const cv::Mat& disparity, const core::Polygon& polygon) {

@@ -56,3 +56,36 @@ TEST(Suggestions, TheScenesGroundLevelIsTheStreetNotTheBiggestRoof) {
   EXPECT_NEAR(*ground, 8.0, 1.0);
   EXPECT_FALSE(project::suggestSceneGroundLevel(cv::Mat()).has_value());
 }
+
+// The GUI's "Pick an above-ground object" and the 3D view's block base read the same ground as
+// the histogram's line: suggestGroundLevel of the picked outline, in px or in metres.
+TEST(Suggestions, ThePickedObjectsGroundIsTheHistogramsGround) {
+  if (!project::delineationAvailable()) GTEST_SKIP() << "the active polygon is not part of this build";
+  const cv::Mat map = roofScene();
+  project::Project p;
+  p.height = {8.0, 0.25, 0.05};
+  const cv::Mat dem = project::heightsFromDisparity(p, map);
+  ASSERT_FALSE(dem.empty());
+  EXPECT_NEAR(dem.at<float>(200, 200), (map.at<float>(200, 200) - 8.0f) * 0.25f, 1e-5);
+  const project::ObjectPick pick = project::pickAboveGroundObject(p, map, dem, {210, 200});
+  ASSERT_EQ(pick.outcome, project::ObjectPick::Outcome::Found);
+  const cv::Rect2d box = core::boundingBox(pick.outline.outer);
+  EXPECT_NEAR(box.x, 100.5, 1.0);
+  EXPECT_NEAR(box.y, 100.5, 1.0);
+  EXPECT_NEAR(box.width, 219.0, 1.0);
+  EXPECT_NEAR(box.height, 199.0, 1.0);
+  const auto histogramGround = project::suggestGroundLevel(map, pick.outline);
+  ASSERT_TRUE(histogramGround.has_value());
+  EXPECT_EQ(pick.groundLevel, *histogramGround);
+  EXPECT_NEAR(pick.groundHeight, (*histogramGround - 8.0) * 0.25, 1e-9);
+  const auto base = project::groundHeightNextTo(p, dem, pick.outline);
+  ASSERT_TRUE(base.has_value());
+  EXPECT_NEAR(*base, pick.groundHeight, 1e-3);
+  // Without a disparity map the DEM is read; without either there is nothing to pick from.
+  const project::ObjectPick fromDem = project::pickAboveGroundObject(p, cv::Mat(), dem, {210, 200});
+  EXPECT_EQ(fromDem.outcome, project::ObjectPick::Outcome::Found);
+  EXPECT_EQ(project::pickAboveGroundObject(p, cv::Mat(), cv::Mat(), {210, 200}).outcome,
+            project::ObjectPick::Outcome::NoHeights);
+  EXPECT_EQ(project::pickAboveGroundObject(p, map, dem, {20, 350}).outcome,
+            project::ObjectPick::Outcome::NotAboveGround);
+}

@@ -2,7 +2,8 @@
 // skipped when it is absent), driven through the real main window with mouse and keys: open the
 // pair (the range is estimated, the disparity computed), pick the big roof with a rectangle (the
 // active polygon runs at once, its live contour stays on the building), accept, set the height
-// model, look at the DEM and the 3D view, save, export; then a second building. Checks the range
+// model, look at the DEM and the 3D view, save, export; then a second building, and the big roof
+// again with "Pick an above-ground object" (a click in its middle). Checks the range
 // against the roof, the outline against a hand-drawn one (tests/bench/data/real_roofs.json),
 // that nothing is written beside the images, and counts the operator's actions; then box-fitting
 // beside the active polygon and the enhanced DEM.
@@ -364,6 +365,41 @@ class RealPairTest : public QObject {
     // Off again: the project's DEM.
     window_->action(QStringLiteral("actionEnhancedDem"))->trigger();
     QVERIFY(window_->shownDem().data == window_->document()->dem().data);
+  }
+
+  // "Pick an above-ground object" (O, then a click) in the middle of the big roof: the roof,
+  // whose 350 px extent the former pick's 121 px window could not see past, becomes the initial
+  // polygon, and the histogram's ground line is the ground that cut it out.
+  void picksTheBigRoofAsAnAboveGroundObject() {
+    const core::Polygon hand = handOutline("t51_right_big");
+    window_->activateWindow();
+    QTRY_VERIFY(window_->isActiveWindow());
+    frame(QRectF(560, 140, 464, 460));
+    widgets::ImageView* view = window_->leftView();
+    QTest::keyClick(view, Qt::Key_O);
+    QCOMPARE(view->interactionMode(), widgets::InteractionMode::PickPoint);
+    const int before = window_->selectedBuilding();
+    QSignalSpy finished(window_.get(), &MainWindow::delineationFinished);
+    const QPointF click(760.5, 380.5);
+    QTest::mouseClick(view, Qt::LeftButton, Qt::NoModifier, view->imageToWidget(click).toPoint());
+    const int id = window_->selectedBuilding();
+    QVERIFY2(id > 0 && id != before, qPrintable(QStringLiteral("no object picked: %1").arg(window_->lastMessage())));
+    const gui::Document* doc = window_->document();
+    const core::Polygon initial = doc->project().find(id)->initial;
+    const double iou = eval::intersectionOverUnion(initial, hand);
+    const project::ObjectPick pick =
+        project::pickAboveGroundObject(doc->project(), doc->disparity(), doc->dem(), {click.x(), click.y()});
+    qInfo("picked object: IoU %.3f against the hand outline, %zu vertices, ground %.2f px (%.2f m)", iou,
+          initial.outer.size(), pick.groundLevel, pick.groundHeight);
+    QVERIFY2(iou >= 0.85, qPrintable(QStringLiteral("IoU %1").arg(iou)));
+    const auto line = window_->histogram()->groundLevel();
+    QVERIFY(line.has_value());
+    QCOMPARE(*line, pick.groundLevel);
+    shot(QStringLiteral("09-object-picked"));
+    QTRY_VERIFY_WITH_TIMEOUT(!finished.isEmpty(), 300000);
+    qInfo("picked object after the active polygon: IoU %.3f",
+          eval::intersectionOverUnion(doc->project().find(id)->outline, hand));
+    shot(QStringLiteral("10-object-delineated"));
   }
 
   void cleanupTestCase() { window_.reset(); }

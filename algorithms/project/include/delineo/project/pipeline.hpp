@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "delineo/core/progress.hpp"
+#include "delineo/dem/heights.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/project/project.hpp"
 
@@ -76,6 +77,37 @@ std::optional<double> suggestGroundLevel(const cv::Mat& disparity, const core::P
 // The ground level (px) of the whole map, by the same estimate (the height model's ground
 // disparity, proposed to the operator). nullopt when nothing is finite.
 std::optional<double> suggestSceneGroundLevel(const cv::Mat& disparity);
+
+// The project's height model as the DEM library takes it (reference height 0 at the ground
+// disparity). Throws InvalidParameter when the model is unknown.
+dem::HeightModel demHeightModel(const HeightModel& model);
+
+// Heights (m) from the disparity map through the project's height model (dem::heightsFromDisparity);
+// an empty matrix when the map is empty or the model unknown.
+cv::Mat heightsFromDisparity(const Project& project, const cv::Mat& disparity);
+
+// The above-ground object under `click` (left-image pixels), for "Pick an above-ground object":
+// delineation::aboveGroundObjectAt() with the project's "pick" parameters and the ground estimate
+// of suggestGroundLevel(). It reads the disparity map when there is one and the height model is
+// known, else the DEM brought to disparity by the height model (or read as disparity at 1 m per
+// px without one). Outcome NoHeights when there is neither, Unavailable without the active
+// polygon's library.
+struct ObjectPick {
+  enum class Outcome { Found, NoHeights, NoGround, NotAboveGround, Unavailable };
+  Outcome outcome = Outcome::NoHeights;
+  core::Polygon outline;  // Found: the initial polygon of a new building
+  double groundLevel = std::nan("");   // px of disparity of the map read (suggestGroundLevel of the outline)
+  double groundHeight = std::nan("");  // m, the same ground by the height model (NaN when unknown)
+};
+ObjectPick pickAboveGroundObject(const Project& project, const cv::Mat& disparity, const cv::Mat& dem,
+                                 cv::Point2d click);
+
+// Ground height (m) next to `polygon` on a DEM in metres (the 3D view's block base): the ground
+// estimate of suggestGroundLevel() on the DEM brought to disparity by the height model, brought
+// back to metres; with a DEM derived from the disparity, the histogram's ground line in metres.
+// Without a height model the DEM is read as disparity at 1 m per px. nullopt when no height is
+// near the polygon or the active polygon's library is absent.
+std::optional<double> groundHeightNextTo(const Project& project, const cv::Mat& dem, const core::Polygon& polygon);
 
 // Median disparity inside `polygon` turned into metres by the project's height model; NaN when
 // the model is unknown or no disparity is finite there.
