@@ -9,7 +9,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
-#include "delineo/delineation/roof_interval.hpp"
 #include "delineo/stereo/cost_service.hpp"
 
 namespace delineo::delineation {
@@ -317,52 +316,6 @@ cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
   return grown & cv::Rect(0, 0, left.cols, left.rows);
 }
 
-// Ground level next to the init when the request gives none: the proposal's estimate
-// (estimateGroundLevel: the lowest well-populated level of a band `margin` px wide outside the
-// polygon, then the ground plane beside it) on the best disparities of a half-resolution cost
-// volume over that band. The ROI's own ring is too narrow: between taller neighbours it holds
-// no ground (docs/delineation.md, Ground interval).
-double wideGroundLevel(const cv::Mat& left, const cv::Mat& right, const core::Polygon& init, int dmin, int dmax,
-                       const DelineationParams& params) {
-  RoofIntervalParams rp;  // the proposal's defaults: the GUI's ground line is the same estimate
-  const double margin = rp.groundMargin;
-  const cv::Rect2d box = core::boundingBox(init.outer);
-  const cv::Rect image(0, 0, left.cols, left.rows);
-  const int m = static_cast<int>(std::ceil(margin));
-  cv::Rect band = cv::Rect(static_cast<int>(std::floor(box.x)) - m, static_cast<int>(std::floor(box.y)) - m,
-                           static_cast<int>(std::ceil(box.width)) + 2 * m + 1,
-                           static_cast<int>(std::ceil(box.height)) + 2 * m + 1) & image;
-  // The crop holds the band and, on the right image, every x - d of it: x from band.x - dmax.
-  cv::Rect crop(band.x - std::max(0, dmax), band.y, band.width + std::max(0, dmax) - std::min(0, dmin), band.height);
-  crop &= image;
-  crop.x -= crop.x % 2, crop.y -= crop.y % 2;  // even offsets: the half-resolution grid
-  crop.width -= crop.width % 2, crop.height -= crop.height % 2;
-  cv::Mat l, r;
-  cv::pyrDown(toFloat(left(crop)), l);
-  cv::pyrDown(toFloat(right(crop)), r);
-  const cv::Rect bandSmall = cv::Rect((band.x - crop.x) / 2, (band.y - crop.y) / 2, band.width / 2, band.height / 2) &
-                             cv::Rect(0, 0, l.cols, l.rows);
-  stereo::CostParams cp;
-  cp.window = params.costWindow;
-  cp.brightnessScale = params.costBrightness;
-  const int lo = static_cast<int>(std::floor(dmin / 2.0)), hi = static_cast<int>(std::ceil(dmax / 2.0));
-  const auto costs = stereo::CorrelationCostService::compute(l, r, bandSmall, lo, hi, cp);
-  if (!costs) return std::numeric_limits<double>::quiet_NaN();
-  const cv::Mat best = costs->bestCost();
-  cv::Mat disparity;
-  costs->bestDisparity().convertTo(disparity, CV_32F, 2.0);
-  // Unmatched: among the worst occlusionPercent, or no window inside the right image at all
-  // (cost 1 at every disparity: the argmin is only the range's first).
-  const double worst = std::min(quantile(best, 1.0 - params.occlusionPercent / 100.0), 1.0 - 1e-6);
-  disparity.setTo(std::numeric_limits<float>::quiet_NaN(), best > worst);
-  core::Polygon local = init;
-  local.holes.clear();
-  for (auto& v : local.outer) v = {(v.x - crop.x) / 2.0 - bandSmall.x, (v.y - crop.y) / 2.0 - bandSmall.y};
-  rp.groundMargin = margin / 2.0;  // half-resolution pixels; disparities are full-resolution
-  rp.groundReach /= 2.0;
-  return estimateGroundLevel(disparity, local, rp);
-}
-
 PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const cv::Mat& left,
                              const cv::Mat& right, const DelineationRequest& request,
                              const DelineationParams& params) {
@@ -388,17 +341,24 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   im.noMatchCost = static_cast<float>(quantile(bestCost, 1.0 - params.occlusionPercent / 100.0));
   if (!std::isfinite(im.noMatchCost)) im.noMatchCost = 1.0f;
 
-  // Ground interval: given, or the ground level next to the init (wideGroundLevel).
+  // Ground interval: given, or the median best disparity in a ring outside the init.
   if (request.ground) {
     out.ground = *request.ground;
     out.groundDisparity = 0.5 * (out.ground.min + out.ground.max);
   } else {
-    const double level = wideGroundLevel(left, right, init, costs.dmin(), costs.dmax(), params);
-    if (!std::isfinite(level)) {
+    cv::Mat ring;
+    cv::dilate(initMask, ring, cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                                          {2 * params.ringWidth + 1, 2 * params.ringWidth + 1}));
+    ring &= ~initMask;
+    ring &= (bestCost <= im.noMatchCost);
+    cv::Mat bestDisparity;
+    costs.bestDisparity().convertTo(bestDisparity, CV_32F);
+    const double median = quantile(bestDisparity, 0.5, ring);
+    if (!std::isfinite(median)) {
       throw Error(ErrorCode::ProcessingFailed,
                   "cannot estimate the ground disparity: no matched pixel around the initial polygon");
     }
-    const int g = static_cast<int>(std::lround(level));
+    const int g = static_cast<int>(std::lround(median));
     out.ground = {g - params.groundTolerance, g + params.groundTolerance};
     // The ground interval must not overlap the roof's, or both costs would agree on the roof.
     if (g < request.roof.min) out.ground.max = std::min(out.ground.max, request.roof.min - 1);

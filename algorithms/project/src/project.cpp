@@ -356,11 +356,6 @@ Project fromJson(const json& in, const std::string& baseDir) {
     matching->erase("dmin");
     matching->erase("dmax");
   }
-  // Older files kept the active polygon's ground ring width; the ground is now estimated like the
-  // roof interval's proposal (docs/delineation.md, Ground interval), without a parameter.
-  if (auto delineation = p.parameters.find("delineation"); delineation != p.parameters.end()) {
-    delineation->erase("ring-width");
-  }
   const json buildings = in.value("buildings", json::array());
   if (!buildings.is_array()) badField("buildings", "must be an array");
   for (size_t i = 0; i < buildings.size(); ++i) {

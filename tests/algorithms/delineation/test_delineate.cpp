@@ -164,39 +164,6 @@ TEST(Delineate, CarvesTheNotchOfAnLShapedRoofFromABox) {
   EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.93);
 }
 
-// A roof between two taller blocks that fill the band next to its north and south sides: the
-// ground lies beyond them, east and west. Painter's order builds the right view (x_right = x - d):
-// the ground, then each block from the lowest.
-TEST(Delineate, EstimatesTheGroundBeyondTallerNeighbours) {
-  const cv::Size size(220, 240);
-  const int dg = 6;
-  struct Block { cv::Rect rect; int d; int seed; };
-  const cv::Rect roof(60, 92, 100, 56);
-  const std::vector<Block> blocks = {{roof, 18, 2}, {{0, 20, 220, 68}, 40, 3}, {{0, 152, 220, 68}, 40, 4}};
-  const cv::Mat ground = texture(size + cv::Size(64, 0), 100, 25, 1);
-  cv::Mat left(size, CV_32F), right(size, CV_32F);
-  for (int y = 0; y < size.height; ++y)
-    for (int x = 0; x < size.width; ++x) left.at<float>(y, x) = ground.at<float>(y, x), right.at<float>(y, x) = ground.at<float>(y, x + dg);
-  for (const Block& b : blocks) {
-    const cv::Mat top = texture(size, 160, 25, b.seed);
-    for (int y = b.rect.y; y < b.rect.br().y; ++y) {
-      for (int x = b.rect.x; x < b.rect.br().x; ++x) {
-        left.at<float>(y, x) = top.at<float>(y, x);
-        if (x - b.d >= 0) right.at<float>(y, x - b.d) = top.at<float>(y, x);
-      }
-    }
-  }
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {17, 19};
-  req.searchRange = DisparityInterval{-4, 48};  // the pair's range, which holds the blocks
-  const auto r = delineate(left, right, req, DelineationParams{});
-  EXPECT_NEAR(0.5 * (r.ground.min + r.ground.max), dg, 1.0);
-  core::Polygon truth;
-  truth.outer = {{60, 92}, {160, 92}, {160, 148}, {60, 148}};
-  EXPECT_GT(iou(r.polygon, truth, size), 0.85);  // 0.896: no walls are rendered
-}
-
 TEST(Delineate, EstimatesTheGroundFromTheRing) {
   const cv::Rect roof(40, 30, 70, 60);
   const Pair pair = raisedRoof({160, 130}, roof, 18, 6);
