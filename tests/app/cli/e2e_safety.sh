@@ -83,7 +83,7 @@ keep previous "$WORK/previous.geojson"
 "$CLI" delineate --left "$S/left.tif" --right "$S/right.tif" --init "$WORK/batch.geojson" --disparity-range 0:60 \
   --out "$WORK/previous.geojson" >"$WORK/cancel.out" 2>"$WORK/cancel.err" &
 pid=$!
-for _ in $(seq 600); do grep -q "building" "$WORK/cancel.err" 2>/dev/null && break; sleep 0.05; done
+for _ in $(seq 600); do grep -q "%" "$WORK/cancel.err" 2>/dev/null && break; sleep 0.05; done
 kill -INT "$pid"
 wait "$pid"
 rc=$?
