@@ -286,7 +286,7 @@ class MainWindow : public QMainWindow {
   QSpinBox* rangeMin_ = nullptr;
   QSpinBox* rangeMax_ = nullptr;
   QLabel* rangeNote_ = nullptr;
-  QString rangeSource_;  // how the current range was obtained, when estimated in this session
+  QString rangeSource_;  // how the current range was obtained, when estimated since the project was opened
   QWidget* heightModelNotice_ = nullptr;
   QLabel* view3DNotice_ = nullptr;
   // Outlines whose energy was asked for, so that one that cannot be scored is not asked again.
