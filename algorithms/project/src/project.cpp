@@ -238,7 +238,9 @@ json toJson(const Project& project, const std::string& baseDir) {
 
 Project fromJson(const json& in, const std::string& baseDir) {
   if (!in.is_object()) badField("(root)", "a project must be a JSON object");
-  if (in.value("format", std::string()) != "delineo-project") {
+  // (find, not value(): value() throws json's type_error when "format" is not a string.)
+  if (const auto format = in.find("format");
+      format == in.end() || !format->is_string() || *format != "delineo-project") {
     badField("format", "not a Delineo project (expected \"delineo-project\")");
   }
   const int version = get<int>(in, "version", 0, "");
