@@ -51,6 +51,18 @@ TEST(ProjectMalformed, OtherFieldsOfTheWrongTypeNameTheField) {
   }
 }
 
+TEST(ProjectMalformed, IntegerFieldsOutOfRangeAreRefused) {
+  // Found by fuzz_project: an id of 1e128 was converted to int (undefined behaviour).
+  const std::string head = R"({"format": "delineo-project", "images": {"left": "l", "right": "r"}, )";
+  for (const char* rest : {R"("version": 1e128})", R"("version": -1e300})",
+                           R"("version": 1, "buildings": [{"id": 1.11e128, "initial": [[[0,0],[4,0],[4,4]]]}]})"}) {
+    EXPECT_EQ(loadError(head + rest), ErrorCode::UnreadableFile) << rest;
+  }
+  // A whole number written as a float still loads, as before.
+  const json ok = json::parse(head + R"("version": 1.0, "buildings": [{"id": 3.0, "initial": [[[0,0],[4,0],[4,4]]]}]})");
+  EXPECT_EQ(delineo::project::fromJson(ok, "/projects").buildings.at(0).id, 3);
+}
+
 TEST(ProjectMalformed, LoadProjectNamesTheFile) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("delineo_malformed_" + std::to_string(::getpid()) + ".delineo.json");
