@@ -114,7 +114,12 @@ if has simulate; then
   # Ctrl-C: the command stops at its next progress poll and exits with 130.
   "$cli" simulate --out "$work/big" --width 3000 --height 3000 --buildings 40 >"$work/sigint.out" 2>"$work/sigint.err" &
   pid=$!
-  sleep 1
+  # Interrupt once it is working (its handler installed): a slow start (sanitizer builds, a
+  # loaded machine) would otherwise get the signal while a background job still ignores it.
+  for _ in $(seq 1 300); do
+    grep -q "rendering" "$work/sigint.err" 2>/dev/null && break
+    sleep 0.1
+  done
   kill -INT "$pid"
   wait "$pid"
   rc=$?
