@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 (bookworm) package Delineo needs to build, test and run.
+# Installs every Debian 12 (bookworm) package Delineo needs to build, test and run (clang and
+# its sanitizer/libFuzzer runtimes for the fuzz preset, docs/testing.md).
 # Idempotent: packages already present are skipped; apt runs only when something is missing.
 set -euo pipefail
 
@@ -13,6 +14,7 @@ packages=(
   libgdal-dev gdal-bin
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri mesa-utils
+  clang libclang-rt-14-dev
 )
 
 missing=()

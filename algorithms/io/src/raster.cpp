@@ -1,6 +1,8 @@
 #include "delineo/io/raster.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -112,6 +114,47 @@ cv::Mat greyFromFloat(const cv::Mat& asFloat) {
   return grey;
 }
 
+// Refuses a declared size before the pixel buffer is allocated: above `maxBytes` decoded, or,
+// for an uncompressed GeoTIFF, more pixel bytes than the whole file holds (a header of a few
+// bytes may declare 100000 x 100000 pixels).
+void checkDeclaredSize(GDALDatasetH ds, int width, int height, int bands, int decodedDepth,
+                       std::uint64_t maxBytes, const std::string& path) {
+  const auto pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+  const auto bytesPerPixel = static_cast<std::uint64_t>(bands) *
+                             static_cast<std::uint64_t>(CV_ELEM_SIZE1(decodedDepth));
+  const std::string size = std::to_string(width) + " x " + std::to_string(height) + " x " +
+                           std::to_string(bands) + " band(s)";
+  if (pixels > maxBytes / bytesPerPixel) {
+    throw Error(ErrorCode::UnsupportedInput,
+                "declared size " + size + " needs more than the " + std::to_string(maxBytes >> 20) +
+                    " MiB allowed for one raster (io::ReadOptions::maxBytes)",
+                path);
+  }
+  GDALDriverH driver = GDALGetDatasetDriver(ds);
+  const bool uncompressedTiff = driver != nullptr && std::string(GDALGetDriverShortName(driver)) == "GTiff" &&
+                                GDALGetMetadataItem(ds, "COMPRESSION", "IMAGE_STRUCTURE") == nullptr;
+  if (!uncompressedTiff) return;
+  VSIStatBufL stat{};
+  if (VSIStatL(path.c_str(), &stat) != 0) return;
+  // Bits per stored sample: NBITS (1..7 bit TIFFs) or the data type's size.
+  GDALRasterBandH first = GDALGetRasterBand(ds, 1);
+  const char* nbits = GDALGetMetadataItem(first, "NBITS", "IMAGE_STRUCTURE");
+  const int bits = nbits != nullptr ? std::atoi(nbits) : GDALGetDataTypeSizeBits(GDALGetRasterDataType(first));
+  // A sparse GeoTIFF (GDAL's SPARSE_OK) leaves blocks out of the file; they read as zeros.
+  if (bits <= 0 || GDALGetMetadataItem(first, "BLOCK_OFFSET_0_0", "TIFF") == nullptr) return;
+  // A lower bound for every layout (rows may be padded to whole bytes, bands interleaved or not).
+  const std::uint64_t rowBytes = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(bands) *
+                                 static_cast<std::uint64_t>(bits) / 8;
+  const std::uint64_t needed = rowBytes * static_cast<std::uint64_t>(height);
+  if (needed > static_cast<std::uint64_t>(stat.st_size)) {
+    throw Error(ErrorCode::UnreadableFile,
+                "declared size " + size + " needs " + std::to_string(needed) +
+                    " bytes of uncompressed pixels but the file holds only " +
+                    std::to_string(stat.st_size) + " bytes (truncated or corrupt)",
+                path);
+  }
+}
+
 }  // namespace
 
 Raster readRaster(const std::string& path, const ReadOptions& options) {
@@ -147,6 +190,8 @@ Raster readRaster(const std::string& path, const ReadOptions& options) {
     const GDALDataType type = GDALGetRasterDataType(GDALGetRasterBand(ds, b));
     if (GDALDataTypeIsComplex(type) || GDALGetDataTypeSizeBytes(type) > 4) layoutFor(type, path);
   }
+
+  checkDeclaredSize(ds, width, height, bands, layout.depth, options.maxBytes, path);
 
   Raster raster;
   raster.path = path;

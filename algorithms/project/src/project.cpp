@@ -5,7 +5,9 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <type_traits>
 #include <unistd.h>
 
 #include "delineo/core/error.hpp"
@@ -209,6 +211,18 @@ template <class T>
 T get(const json& object, const char* key, const T& fallback, const std::string& where) {
   auto it = object.find(key);
   if (it == object.end() || it->is_null()) return fallback;
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    // json's get<int>() of a float outside int's range is undefined behaviour (found by
+    // fuzz_project: "id": 1e128); in range, a float still truncates as get<int>() does.
+    if (it->is_number_float()) {
+      const double value = it->get<double>();
+      if (!(value >= static_cast<double>(std::numeric_limits<T>::min()) &&
+            value <= static_cast<double>(std::numeric_limits<T>::max()))) {
+        badField(where + key, "number out of range");
+      }
+      return static_cast<T>(value);
+    }
+  }
   try {
     return it->get<T>();
   } catch (const json::exception&) {
@@ -292,7 +306,9 @@ json toJson(const Project& project, const std::string& baseDir) {
 
 Project fromJson(const json& in, const std::string& baseDir) {
   if (!in.is_object()) badField("(root)", "a project must be a JSON object");
-  if (in.value("format", std::string()) != "delineo-project") {
+  // (find, not value(): value() throws json's type_error when "format" is not a string.)
+  if (const auto format = in.find("format");
+      format == in.end() || !format->is_string() || *format != "delineo-project") {
     badField("format", "not a Delineo project (expected \"delineo-project\")");
   }
   const int version = get<int>(in, "version", 0, "");

@@ -1,4 +1,7 @@
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <thread>
@@ -347,6 +350,86 @@ TEST(RasterIoErrors, TruncatedTiffCompressedAndUncompressed) {
     EXPECT_EQ(error.code(), ErrorCode::UnreadableFile) << error.what();
     EXPECT_NE(std::string(error.what()).find(path), std::string::npos);
   }
+}
+
+// A classic little-endian TIFF of ~130 bytes declaring width x height 8-bit grey pixels in one
+// uncompressed strip, of which it holds 8 bytes.
+void writeTinyTiffDeclaring(const std::string& path, uint32_t width, uint32_t height) {
+  std::vector<unsigned char> bytes{'I', 'I', 42, 0, 8, 0, 0, 0};
+  auto put = [&](uint64_t value, int size) {
+    for (int i = 0; i < size; ++i) bytes.push_back(static_cast<unsigned char>(value >> (8 * i)));
+  };
+  // (tag, type: 3 SHORT / 4 LONG, value); the strip starts after the directory.
+  const std::vector<std::array<uint32_t, 3>> entries{
+      {256, 4, width}, {257, 4, height}, {258, 3, 8}, {259, 3, 1}, {262, 3, 1},
+      {273, 4, 8 + 2 + 9 * 12 + 4}, {277, 3, 1}, {278, 4, height}, {279, 4, 8}};
+  put(entries.size(), 2);
+  for (const auto& [tag, type, value] : entries) {
+    put(tag, 2);
+    put(type, 2);
+    put(1, 4);
+    put(value, 4);
+  }
+  put(0, 4);  // no next directory
+  put(0x0101010101010101ULL, 8);
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
+                                              static_cast<std::streamsize>(bytes.size()));
+}
+
+TEST(RasterIoErrors, DeclaredSizeAboveTheLimitIsRefusedBeforeAllocating) {
+  // 100000 x 100000 bytes = 9.3 GiB declared by a 130-byte file: refused, nothing allocated.
+  TempDir dir;
+  const std::string path = dir.file("huge.tif");
+  writeTinyTiffDeclaring(path, 100000, 100000);
+  ASSERT_LT(std::filesystem::file_size(path), 200U);
+  for (const auto type : {PixelType::Keep, PixelType::Float32}) {
+    const core::Error error = captureError([&] { readRaster(path, ReadOptions{type, true}); });
+    EXPECT_EQ(error.code(), ErrorCode::UnsupportedInput) << error.what();
+    EXPECT_EQ(error.path(), path);
+    EXPECT_NE(error.detail().find("100000 x 100000"), std::string::npos) << error.detail();
+  }
+}
+
+TEST(RasterIoErrors, UncompressedTiffDeclaringMoreThanItHoldsIsRefused) {
+  // 20000 x 20000 bytes (400 MB, under the limit) declared, 130 bytes in the file.
+  TempDir dir;
+  const std::string path = dir.file("short.tif");
+  writeTinyTiffDeclaring(path, 20000, 20000);
+  const core::Error error = captureError([&] { readRaster(path); });
+  EXPECT_EQ(error.code(), ErrorCode::UnreadableFile) << error.what();
+  EXPECT_EQ(error.path(), path);
+  EXPECT_NE(error.detail().find("file holds only"), std::string::npos) << error.detail();
+  // The same header declaring what it holds reads.
+  writeTinyTiffDeclaring(path, 4, 2);
+  EXPECT_EQ(readRaster(path).data.size(), cv::Size(4, 2));
+}
+
+TEST(RasterIoErrors, SizeLimitIsConfigurable) {
+  TempDir dir;
+  const std::string path = dir.file("small.tif");
+  writeGeoTiff(path, randomImage(32, 64, CV_16UC1, 0, 1000, 9));  // 4096 bytes decoded
+  ReadOptions options;
+  options.maxBytes = 4095;
+  const core::Error error = captureError([&] { readRaster(path, options); });
+  EXPECT_EQ(error.code(), ErrorCode::UnsupportedInput) << error.what();
+  options.maxBytes = 4096;
+  EXPECT_EQ(readRaster(path, options).data.size(), cv::Size(64, 32));
+}
+
+TEST(RasterIo, SparseGeoTiffReadsAsZeros) {
+  // GDAL's SPARSE_OK leaves unwritten blocks out of the file: not a short file.
+  TempDir dir;
+  const std::string path = dir.file("sparse.tif");
+  GDALAllRegister();
+  const char* createOptions[] = {"SPARSE_OK=TRUE", nullptr};
+  GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GTiff"), path.c_str(), 2000, 1500, 1, GDT_Byte,
+                               const_cast<char**>(createOptions));
+  ASSERT_NE(ds, nullptr);
+  GDALClose(ds);
+  ASSERT_LT(std::filesystem::file_size(path), 100000U);
+  const cv::Mat data = readRaster(path).data;
+  ASSERT_EQ(data.size(), cv::Size(2000, 1500));
+  EXPECT_EQ(cv::countNonZero(data), 0);
 }
 
 TEST(RasterIoErrors, CorruptFileAndNotARaster) {

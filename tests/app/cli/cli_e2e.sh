@@ -114,8 +114,12 @@ if has simulate; then
   # Ctrl-C: the command stops at its next progress poll and exits with 130.
   "$cli" simulate --out "$work/big" --width 3000 --height 3000 --buildings 40 >"$work/sigint.out" 2>"$work/sigint.err" &
   pid=$!
-  # Interrupt once the simulation is under way (a fixed delay misfires on a loaded machine).
-  for _ in $(seq 100); do grep -q "%" "$work/sigint.err" 2>/dev/null && break; sleep 0.1; done
+  # Interrupt once it is working (its handler installed): a slow start (sanitizer builds, a
+  # loaded machine) would otherwise get the signal before the handler is in place.
+  for _ in $(seq 1 300); do
+    grep -q "%" "$work/sigint.err" 2>/dev/null && break
+    sleep 0.1
+  done
   kill -INT "$pid"
   wait "$pid"
   rc=$?

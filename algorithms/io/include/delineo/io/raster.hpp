@@ -1,6 +1,7 @@
 #pragma once
 // Raster I/O through GDAL. Every error names the file and the problem (core::Error).
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -34,10 +35,14 @@ struct ReadOptions {
   // Any number of bands is accepted when false; when true the result has exactly one channel
   // (grey conversion: 1 band as is, 3+ bands as 0.299 R + 0.587 G + 0.114 B of the first three).
   bool toGrey = false;
+  // Largest decoded pixel buffer accepted (bytes, all bands at the decoded depth), checked on
+  // the declared size before anything is allocated. Default 4 GiB: 1 Gpx of float32.
+  std::uint64_t maxBytes = std::uint64_t{4} << 30;
 };
 
-// Reads a raster. Throws FileNotFound, UnreadableFile (truncated / corrupt / not a raster),
-// UnsupportedInput (complex or 64-bit types, 2 bands).
+// Reads a raster. Throws FileNotFound, UnreadableFile (truncated / corrupt / not a raster, or an
+// uncompressed GeoTIFF declaring more pixel data than the file holds), UnsupportedInput (complex
+// or 64-bit types, 2 bands, a declared size above ReadOptions::maxBytes).
 Raster readRaster(const std::string& path, const ReadOptions& options = {});
 
 // Reads a raster as a single-band float32 image ready for matching (grey, NaN for nodata).
