@@ -43,6 +43,10 @@
         <source>File: %1</source>
         <translation>Fichier : %1</translation>
     </message>
+    <message>
+        <source>Delineo does not write %1: choose another file.</source>
+        <translation>Delineo n’écrit pas %1 : choisissez un autre fichier.</translation>
+    </message>
 </context>
 <context>
     <name>Parameters</name>
@@ -362,6 +366,178 @@
         <source>Regularize image edges</source>
         <translation>Contours de l’image pour la régularisation</translation>
     </message>
+    <message>
+        <source>Bilateral sigma</source>
+        <translation>Sigma bilatéral</translation>
+    </message>
+    <message>
+        <source>Edge contrast</source>
+        <translation>Contraste des contours</translation>
+    </message>
+    <message>
+        <source>Min height</source>
+        <translation>Hauteur minimale</translation>
+    </message>
+    <message>
+        <source>Ground window</source>
+        <translation>Fenêtre du sol</translation>
+    </message>
+    <message>
+        <source>Threshold fraction</source>
+        <translation>Fraction du seuil</translation>
+    </message>
+    <message>
+        <source>Roof band</source>
+        <translation>Bande du toit</translation>
+    </message>
+    <message>
+        <source>Erosion radius</source>
+        <translation>Rayon d’érosion</translation>
+    </message>
+    <message>
+        <source>Min area</source>
+        <translation>Aire minimale</translation>
+    </message>
+    <message>
+        <source>Leash</source>
+        <translation>Laisse</translation>
+    </message>
+    <message>
+        <source>Piece length</source>
+        <translation>Longueur des morceaux</translation>
+    </message>
+    <message>
+        <source>Window factor</source>
+        <translation>Facteur de fenêtre</translation>
+    </message>
+    <message>
+        <source>Skip covered seeds</source>
+        <translation>Ignorer les germes couverts</translation>
+    </message>
+    <message>
+        <source>Angle step</source>
+        <translation>Pas angulaire</translation>
+    </message>
+    <message>
+        <source>Angle resolution</source>
+        <translation>Résolution angulaire</translation>
+    </message>
+    <message>
+        <source>Strip inside</source>
+        <translation>Bande intérieure</translation>
+    </message>
+    <message>
+        <source>Snap inward</source>
+        <translation>Accrochage vers l’intérieur</translation>
+    </message>
+    <message>
+        <source>Snap outward</source>
+        <translation>Accrochage vers l’extérieur</translation>
+    </message>
+    <message>
+        <source>Edge distance cap</source>
+        <translation>Plafond de distance aux contours</translation>
+    </message>
+    <message>
+        <source>Segment weight</source>
+        <translation>Poids du segment</translation>
+    </message>
+    <message>
+        <source>Orientation tolerance</source>
+        <translation>Tolérance d’orientation</translation>
+    </message>
+    <message>
+        <source>Max energy</source>
+        <translation>Énergie maximale</translation>
+    </message>
+    <message>
+        <source>Closing radius</source>
+        <translation>Rayon de fermeture</translation>
+    </message>
+    <message>
+        <source>Refine length</source>
+        <translation>Longueur d’affinage</translation>
+    </message>
+    <message>
+        <source>Corner tolerance</source>
+        <translation>Tolérance des coins</translation>
+    </message>
+    <message>
+        <source>Min hole area</source>
+        <translation>Aire minimale des trous</translation>
+    </message>
+    <message>
+        <source>Wall band</source>
+        <translation>Bande des murs</translation>
+    </message>
+    <message>
+        <source>Gradient sigma</source>
+        <translation>Sigma du gradient</translation>
+    </message>
+    <message>
+        <source>Small median window</source>
+        <translation>Petite fenêtre médiane</translation>
+    </message>
+    <message>
+        <source>Large median window</source>
+        <translation>Grande fenêtre médiane</translation>
+    </message>
+    <message>
+        <source>Roof object pixels</source>
+        <translation>Pixels d’objet sur le toit</translation>
+    </message>
+    <message>
+        <source>Ground median window</source>
+        <translation>Fenêtre médiane du sol</translation>
+    </message>
+    <message>
+        <source>Outline tolerance</source>
+        <translation>Tolérance du contour</translation>
+    </message>
+    <message>
+        <source>Outline reach</source>
+        <translation>Portée du contour</translation>
+    </message>
+    <message>
+        <source>Height margin</source>
+        <translation>Marge de hauteur</translation>
+    </message>
+    <message>
+        <source>Ground search radius</source>
+        <translation>Rayon de recherche du sol</translation>
+    </message>
+    <message>
+        <source>Largest ground search radius</source>
+        <translation>Plus grand rayon de recherche du sol</translation>
+    </message>
+    <message>
+        <source>Largest step</source>
+        <translation>Plus grande marche</translation>
+    </message>
+    <message>
+        <source>Thin part width</source>
+        <translation>Largeur des parties fines</translation>
+    </message>
+    <message>
+        <source>Snap radius</source>
+        <translation>Rayon d’accrochage</translation>
+    </message>
+    <message>
+        <source>Opening</source>
+        <translation>Ouverture</translation>
+    </message>
+    <message>
+        <source>Outline smoothing</source>
+        <translation>Lissage du contour</translation>
+    </message>
+    <message>
+        <source>Outline simplification</source>
+        <translation>Simplification du contour</translation>
+    </message>
+    <message>
+        <source>Ground refinements</source>
+        <translation>Affinages du sol</translation>
+    </message>
 </context>
 <context>
     <name>Stages</name>
@@ -622,6 +798,14 @@
     <message>
         <source>Box-fitting outline for building %1</source>
         <translation>Contour par ajustement de boîtes du bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Outline with box-fitting</source>
+        <translation>Contourer par ajustement de boîtes</translation>
+    </message>
+    <message>
+        <source>Outline with the active polygon</source>
+        <translation>Contourer par le polygone actif</translation>
     </message>
 </context>
 <context>
@@ -1401,6 +1585,38 @@
             <numerusform>MNE amélioré à partir de %n contour.</numerusform>
             <numerusform>MNE amélioré à partir de %n contours.</numerusform>
         </translation>
+    </message>
+    <message>
+        <source>Building %1 outlined by box-fitting.</source>
+        <translation>Bâtiment %1 contouré par ajustement de boîtes.</translation>
+    </message>
+    <message>
+        <source>Building → Box-fitting: the building&apos;s region from the DEM, boxes grown on the left image&apos;s edges.</source>
+        <translation>Bâtiment → Ajustement de boîtes : la région du bâtiment d&apos;après le MNE, des boîtes étendues sur les contours de l&apos;image gauche.</translation>
+    </message>
+    <message>
+        <source>View → Enhanced DEM: vertical walls at the outlines and filtered roofs.</source>
+        <translation>Affichage → MNE amélioré : murs verticaux aux contours et toits filtrés.</translation>
+    </message>
+    <message>
+        <source>Object pick</source>
+        <translation>Pointé d’objet</translation>
+    </message>
+    <message>
+        <source>Pick an above-ground object: the raised object under a click, above the ground beside it.</source>
+        <translation>Pointer un objet au-dessus du sol : l’objet surélevé sous le clic, au-dessus du sol voisin.</translation>
+    </message>
+    <message>
+        <source>Outline with</source>
+        <translation>Contourer par</translation>
+    </message>
+    <message>
+        <source>active polygon</source>
+        <translation>polygone actif</translation>
+    </message>
+    <message>
+        <source>The method that outlines a picked building; box-fitting needs the DEM.</source>
+        <translation>La méthode qui contoure un bâtiment pointé ; l’ajustement de boîtes demande le MNE.</translation>
     </message>
 </context>
 <context>

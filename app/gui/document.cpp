@@ -254,7 +254,7 @@ void Document::setDisparity(const cv::Mat& disparity) {
 }
 
 Document::Settings Document::settings() const {
-  Settings s{project_.outputDir, project_.disparityRange, project_.height, {}};
+  Settings s{project_.outputDir, project_.disparityRange, project_.height, project_.method, {}};
   for (const Building& b : project_.buildings) s.roofHeights[b.id] = b.roofHeight;
   return s;
 }
@@ -290,9 +290,17 @@ void Document::setHeightModel(const project::HeightModel& model) {
   pushSettings(after, tr("Height model"));
 }
 
+void Document::setMethod(const std::string& method) {
+  if (method == project_.method) return;
+  Settings after = settings();
+  after.method = method;
+  pushSettings(after, method == project::kBoxFitting ? tr("Outline with box-fitting") : tr("Outline with the active polygon"));
+}
+
 void Document::restoreSettings(const Settings& settings) {
   const bool newModel = !(settings.height == project_.height);
   project_.outputDir = settings.outputDir;
+  project_.method = settings.method;
   project_.disparityRange = settings.disparityRange;
   project_.height = settings.height;
   for (Building& b : project_.buildings) {

@@ -70,6 +70,8 @@ class Document : public QObject {
   void setOutputDir(const std::string& dir);
   void setDisparityRange(const std::optional<project::DisparityInterval>& range, const QString& description);
   void setHeightModel(const project::HeightModel& model);
+  // The method buildings that name none are outlined with (project::kActivePolygon, kBoxFitting).
+  void setMethod(const std::string& method);
   // A derived value, not an edit (no undo step): the energy of a building's outline, recorded
   // only while the building's outline is still `outline`.
   void setOutlineEnergy(int id, const core::Polygon& outline, double energy,
@@ -86,6 +88,7 @@ class Document : public QObject {
     std::string outputDir;
     std::optional<project::DisparityInterval> disparityRange;
     project::HeightModel height;
+    std::string method;  // the project's outline method (Project::method)
     std::map<int, double> roofHeights;
   };
   Settings settings() const;

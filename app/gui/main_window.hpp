@@ -80,6 +80,8 @@ class MainWindow : public QMainWindow {
   // Starts the active polygon on the building (key "delineate-<id>": a new run on the same
   // building cancels the previous one); returns the job id or 0.
   widgets::JobId startDelineation(int id);
+  // Outlines a building with its method (Project::methodOf): the active polygon or box-fitting.
+  widgets::JobId outlineBuilding(int id);
   void acceptSelected();
   void rejectSelected();
   void autosaveNow();
@@ -116,8 +118,12 @@ class MainWindow : public QMainWindow {
   widgets::ImageView* demView() const { return demView_; }
   widgets::DisparityHistogramWidget* histogram() const { return histogram_; }
   widgets::Terrain3DView* view3D() const { return view3D_; }
-  widgets::ParameterForm* delineationForm() const { return delineationForm_; }
-  widgets::ParameterForm* matchingForm() const { return matchingForm_; }
+  widgets::ParameterForm* delineationForm() const { return parameterForm("delineation"); }
+  widgets::ParameterForm* matchingForm() const { return parameterForm("matching"); }
+  // The form of a parameter group of the project file ("delineation", "matching", "boxfit",
+  // "enhance", "pick"); null when this build has no such algorithm.
+  widgets::ParameterForm* parameterForm(const std::string& group) const;
+  QComboBox* methodChoice() const { return methodChoice_; }
   QTableView* buildingsTable() const { return buildingsTable_; }
   BuildingsModel* buildingsModel() const { return buildingsModel_; }
   widgets::JobRunner* jobs() const { return jobs_; }
@@ -208,7 +214,11 @@ class MainWindow : public QMainWindow {
   QString rangeEndWarning(const cv::Mat& roiDisparities) const;
   QWidget* createRangeEditor();
   void loadRangeFromDocument();
-  void readFormIntoDocument(const widgets::ParameterForm* form);
+  template <class Params>
+  void addParameterGroup(QTabWidget* tabs, const std::string& group, const QString& title,
+                         const QString& description);
+  QWidget* createMethodChoice();
+  void writeFormIntoDocument(const std::string& group);
   void loadFormsFromDocument();
 
   // main_window_actions.cpp: actions, menus, toolbar.
@@ -267,8 +277,15 @@ class MainWindow : public QMainWindow {
   cv::Mat view3DDem_;  // the DEM the 3D view's exaggeration was chosen for
   widgets::DisparityHistogramWidget* histogram_ = nullptr;
   QLabel* intervalLabel_ = nullptr;
-  widgets::ParameterForm* delineationForm_ = nullptr;
-  widgets::ParameterForm* matchingForm_ = nullptr;
+  // One form per parameter group of the project file, and how it reads and writes the group.
+  struct ParameterGroup {
+    std::string group;
+    widgets::ParameterForm* form = nullptr;
+    std::function<void(const project::Project&)> load;
+    std::function<void(Document&)> write;
+  };
+  std::vector<ParameterGroup> parameterGroups_;
+  QComboBox* methodChoice_ = nullptr;
   QTableView* buildingsTable_ = nullptr;
   BuildingsModel* buildingsModel_ = nullptr;
   QLabel* readout_ = nullptr;

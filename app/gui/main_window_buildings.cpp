@@ -61,12 +61,19 @@ void MainWindow::onPicked(const core::Polygon& polygon) {
   const int id = document_->addBuilding(polygon);
   selectBuilding(id);
   leftView_->setInteractionMode(InteractionMode::Navigate);
-  // The pick is the request: the active polygon starts at once with the proposed interval (or
-  // as soon as the disparity is there).
+  // The pick is the request: the project's method starts at once (the active polygon with the
+  // proposed interval), or as soon as the disparity is there.
   if (action(QStringLiteral("actionDelineateOnPick"))->isChecked()) {
     if (document_->disparity().empty()) awaitingDisparity_ = id;
-    else startDelineation(id);
+    else outlineBuilding(id);
   }
+}
+
+widgets::JobId MainWindow::outlineBuilding(int id) {
+  if (!document_) return 0;
+  const Building* b = document_->project().find(id);
+  if (b != nullptr && document_->project().methodOf(*b) == project::kBoxFitting) return startBoxFitting(id);
+  return startDelineation(id);
 }
 
 void MainWindow::onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description) {

@@ -129,6 +129,10 @@ widgets::JobId MainWindow::startBoxFitting(int id) {
           showMessage(tr("Box-fitting"), tr("Box-fitting found no building in building %1's initial polygon: %2")
                                              .arg(id)
                                              .arg(QString::fromStdString(proposal.outcome.message)));
+        } else if (!doc->project().find(id)->hasOutline()) {
+          // Nothing to compare with: the building takes the outline (one undoable step).
+          doc->setBoxFitResult(id, proposal.outcome, proposal.activeEnergy);
+          statusBar()->showMessage(tr("Building %1 outlined by box-fitting.").arg(id), 10000);
         } else {
           const int boxes = static_cast<int>(proposal.outcome.boxes.size());
           boxFitProposals_[id] = std::move(proposal);

@@ -101,7 +101,7 @@ widgets::JobId MainWindow::startMatching() {
         statusBar()->showMessage(tr("Disparity computed."), 5000);
         const int waiting = std::exchange(awaitingDisparity_, -1);
         const Building* b = doc->project().find(waiting);
-        if (b != nullptr && b->status == BuildingStatus::Pending) startDelineation(waiting);
+        if (b != nullptr && b->status == BuildingStatus::Pending) outlineBuilding(waiting);
         emit matchingFinished();
       },
       QStringLiteral("matching"));
@@ -119,7 +119,7 @@ widgets::JobId MainWindow::startDelineation(int id) {
     showMessage(tr("Active polygon"), tr("Compute the disparity (or choose a roof interval) first."));
     return 0;
   }
-  readFormIntoDocument(delineationForm_);
+  writeFormIntoDocument("delineation");
   Building building = *current;
   if (id == selectedId_ && histogram_->sampleCount() > 0) {
     building.roofInterval = project::DisparityInterval{histogram_->lowerBound(), histogram_->upperBound()};

@@ -1,7 +1,9 @@
 // MainWindow's parameters dock: the roof interval on the ROI histogram (with the warning when
 // the matched range cuts it), the pair's disparity search range, and the parameter forms, kept
 // in step with the document's parameter groups.
+#include <QComboBox>
 #include <QGridLayout>
+#include <QHBoxLayout>
 #include <QGroupBox>
 #include <QLabel>
 #include <QPushButton>
@@ -23,8 +25,13 @@
 #include "error_text.hpp"
 #include "main_window.hpp"
 
+#include "delineo/dem/enhance.hpp"
 #ifdef DELINEO_HAVE_DELINEATION
+#include "delineo/delineation/above_ground.hpp"
 #include "delineo/delineation/params.hpp"
+#endif
+#ifdef DELINEO_HAVE_BOXFIT
+#include "delineo/boxfit/params.hpp"
 #endif
 #ifdef DELINEO_HAVE_STEREO
 #include "delineo/stereo/match.hpp"
@@ -40,6 +47,7 @@ using project::BuildingStatus;
 void MainWindow::createParametersDock() {
   auto* paramsPage = new QWidget;
   auto* paramsLayout = new QVBoxLayout(paramsPage);
+  paramsLayout->addWidget(createMethodChoice());
   auto* intervalTitle = new QLabel(tr("<b>Roof disparity interval</b> (drag on the histogram of the ROI; the line marks the ground)"));
   intervalTitle->setWordWrap(true);
   paramsLayout->addWidget(intervalTitle);
@@ -57,9 +65,11 @@ void MainWindow::createParametersDock() {
   connect(histogram_, &widgets::DisparityHistogramWidget::intervalEditingFinished, this, [this](int a, int b) {
     if (!document_ || selectedId_ <= 0) return;
     document_->setRoofInterval(selectedId_, {a, b});
-    // A new interval for an outline nobody has edited yet: the active polygon runs again with it.
+    // A new interval for an outline nobody has edited yet: the active polygon runs again with it
+    // (box-fitting does not read the interval).
     const Building* building = document_->project().find(selectedId_);
     if (building != nullptr && action(QStringLiteral("actionDelineateOnPick"))->isChecked() &&
+        document_->project().methodOf(*building) == project::kActivePolygon &&
         (building->status == BuildingStatus::Pending || building->status == BuildingStatus::Automatic)) {
       startDelineation(selectedId_);
     }
@@ -71,36 +81,96 @@ void MainWindow::createParametersDock() {
 // The parameter forms, one tab per algorithm; the Matching tab starts with the pair's range.
 QTabWidget* MainWindow::createParameterTabs() {
   auto* tabs = new QTabWidget;
-  delineationForm_ = new widgets::ParameterForm;
-  delineationForm_->setObjectName(QStringLiteral("delineationForm"));
-  matchingForm_ = new widgets::ParameterForm;
-  matchingForm_->setObjectName(QStringLiteral("matchingForm"));
+  tabs->setObjectName(QStringLiteral("parameterTabs"));
+  tabs->setUsesScrollButtons(true);
 #ifdef DELINEO_HAVE_DELINEATION
-  delineationForm_->setParams(delineation::DelineationParams{});
+  addParameterGroup<delineation::DelineationParams>(tabs, "delineation", tr("Active polygon"), {});
 #endif
 #ifdef DELINEO_HAVE_STEREO
-  matchingForm_->setParams(stereo::MatchParams{});
+  addParameterGroup<stereo::MatchParams>(tabs, "matching", tr("Matching"), {});
 #endif
-  for (auto* form : {delineationForm_, matchingForm_}) {
-    connect(form, &widgets::ParameterForm::changed, this, [this, form] {
-      if (!updatingForms_) readFormIntoDocument(form);
-    });
-  }
-  auto* delineationScroll = new QScrollArea;
-  delineationScroll->setWidget(delineationForm_);
-  delineationScroll->setWidgetResizable(true);
-  auto* matchingPage = new QWidget;
-  auto* matchingLayout = new QVBoxLayout(matchingPage);
-  matchingLayout->setContentsMargins(0, 0, 0, 0);
-  matchingLayout->addWidget(createRangeEditor());
-  matchingLayout->addWidget(matchingForm_);
-  matchingLayout->addStretch(1);
-  auto* matchingScroll = new QScrollArea;
-  matchingScroll->setWidget(matchingPage);
-  matchingScroll->setWidgetResizable(true);
-  tabs->addTab(delineationScroll, tr("Active polygon"));
-  tabs->addTab(matchingScroll, tr("Matching"));
+#ifdef DELINEO_HAVE_BOXFIT
+  addParameterGroup<boxfit::BoxFitParams>(
+      tabs, "boxfit", tr("Box-fitting"),
+      tr("Building → Box-fitting: the building's region from the DEM, boxes grown on the left image's edges."));
+#endif
+  addParameterGroup<dem::EnhanceParams>(
+      tabs, "enhance", tr("Enhanced DEM"),
+      tr("View → Enhanced DEM: vertical walls at the outlines and filtered roofs."));
+#ifdef DELINEO_HAVE_DELINEATION
+  addParameterGroup<delineation::AboveGroundParams>(
+      tabs, "pick", tr("Object pick"),
+      tr("Pick an above-ground object: the raised object under a click, above the ground beside it."));
+#endif
   return tabs;
+}
+
+// A tab with the form of one parameter group (the Matching tab has the pair's range above it).
+// Each edit is written to the document at once, as one undoable step.
+template <class Params>
+void MainWindow::addParameterGroup(QTabWidget* tabs, const std::string& group, const QString& title,
+                                   const QString& description) {
+  auto* form = new widgets::ParameterForm;
+  form->setObjectName(QString::fromStdString(group) + QStringLiteral("Form"));
+  form->setParams(Params{});
+  connect(form, &widgets::ParameterForm::changed, this, [this, group] {
+    if (!updatingForms_) writeFormIntoDocument(group);
+  });
+  ParameterGroup entry{group, form,
+                       [form, group](const project::Project& p) { form->setValues(project::parameters<Params>(p, group)); },
+                       [form, group](Document& doc) {
+                         auto params = project::parameters<Params>(doc.project(), group);
+                         form->readInto(params);
+                         doc.setParameters(group, core::toJson(params));
+                       }};
+  parameterGroups_.push_back(std::move(entry));
+
+  auto* page = new QWidget;
+  auto* layout = new QVBoxLayout(page);
+  layout->setContentsMargins(0, 0, 0, 0);
+  if (group == "matching") layout->addWidget(createRangeEditor());
+  if (!description.isEmpty()) {
+    auto* label = new QLabel(description);
+    label->setWordWrap(true);
+    label->setContentsMargins(6, 4, 6, 0);
+    layout->addWidget(label);
+  }
+  layout->addWidget(form);
+  layout->addStretch(1);
+  auto* scroll = new QScrollArea;
+  scroll->setWidget(page);
+  scroll->setWidgetResizable(true);
+  tabs->addTab(scroll, title);
+}
+
+widgets::ParameterForm* MainWindow::parameterForm(const std::string& group) const {
+  for (const ParameterGroup& g : parameterGroups_) {
+    if (g.group == group) return g.form;
+  }
+  return nullptr;
+}
+
+// The method that outlines a picked building (the project's `method`): the active polygon or
+// box-fitting. Buildings that already name their method keep it.
+QWidget* MainWindow::createMethodChoice() {
+  auto* row = new QWidget;
+  auto* layout = new QHBoxLayout(row);
+  layout->setContentsMargins(0, 0, 0, 0);
+  auto* label = new QLabel(tr("Outline with"));
+  methodChoice_ = new QComboBox;
+  methodChoice_->setObjectName(QStringLiteral("methodChoice"));
+  methodChoice_->addItem(tr("active polygon"), QString::fromLatin1(project::kActivePolygon));
+  methodChoice_->addItem(tr("box-fitting"), QString::fromLatin1(project::kBoxFitting));
+  if (!project::boxFittingAvailable()) methodChoice_->setEnabled(false);
+  methodChoice_->setToolTip(tr("The method that outlines a picked building; box-fitting needs the DEM."));
+  label->setBuddy(methodChoice_);
+  layout->addWidget(label);
+  layout->addWidget(methodChoice_, 1);
+  connect(methodChoice_, &QComboBox::currentIndexChanged, this, [this] {
+    if (!document_ || updatingForms_) return;
+    document_->setMethod(methodChoice_->currentData().toString().toStdString());
+  });
+  return row;
 }
 
 void MainWindow::refreshHistogram() {
@@ -231,42 +301,26 @@ void MainWindow::loadRangeFromDocument() {
                              : rangeSource_.isEmpty() ? use : rangeSource_ + QLatin1Char(' ') + use);
 }
 
-void MainWindow::readFormIntoDocument(const widgets::ParameterForm* form) {
-  Q_UNUSED(form);  // (in a build without both algorithms)
+void MainWindow::writeFormIntoDocument(const std::string& group) {
   if (!document_) return;
   // Only the edited form's group is written: one edit, one undo entry. Writing a group reloads
-  // both forms from the project, and the other form shows its stored group already (each edit
-  // is written at once), so nothing of it is lost. (Writing both groups made two undo entries
-  // when the stored one lacked a field, and, written in the wrong order, lost the edit.)
-#ifdef DELINEO_HAVE_DELINEATION
-  if (form == delineationForm_) {
-    auto params = project::parameters<delineation::DelineationParams>(document_->project(), "delineation");
-    delineationForm_->readInto(params);
-    document_->setParameters("delineation", core::toJson(params));
+  // every form from the project; the others show their stored groups already (each edit is
+  // written at once), so nothing of them is lost.
+  for (const ParameterGroup& g : parameterGroups_) {
+    if (g.group == group) g.write(*document_);
   }
-#endif
-#ifdef DELINEO_HAVE_STEREO
-  if (form == matchingForm_) {
-    auto params = project::parameters<stereo::MatchParams>(document_->project(), "matching");
-    matchingForm_->readInto(params);
-    document_->setParameters("matching", core::toJson(params));
-  }
-#endif
 }
 
 void MainWindow::loadFormsFromDocument() {
   if (!document_) return;
   updatingForms_ = true;
   try {
-#ifdef DELINEO_HAVE_DELINEATION
-    delineationForm_->setValues(project::parameters<delineation::DelineationParams>(document_->project(), "delineation"));
-#endif
-#ifdef DELINEO_HAVE_STEREO
-    matchingForm_->setValues(project::parameters<stereo::MatchParams>(document_->project(), "matching"));
-#endif
+    for (const ParameterGroup& g : parameterGroups_) g.load(document_->project());
   } catch (const core::Error& e) {
     showMessage(tr("Parameters"), errorMessage(e));
   }
+  const int method = methodChoice_->findData(QString::fromStdString(document_->project().method));
+  methodChoice_->setCurrentIndex(std::max(0, method));
   updatingForms_ = false;
 }
 

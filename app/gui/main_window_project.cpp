@@ -210,8 +210,12 @@ void MainWindow::connectDocument(Document* doc) {
     refresh3D();
     updateActions();
   });
-  connect(doc, &Document::parametersChanged, this, [this] { loadFormsFromDocument(); });
+  connect(doc, &Document::parametersChanged, this, [this, demChanged](const QString& group) {
+    loadFormsFromDocument();
+    if (group == QLatin1String("enhance")) demChanged();  // the enhanced DEM is made with them
+  });
   connect(doc, &Document::settingsChanged, this, [this] {
+    loadFormsFromDocument();  // the method choice
     loadRangeFromDocument();
     refreshRasters();
     refreshHeightModelNotice();

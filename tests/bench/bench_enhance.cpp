@@ -508,6 +508,72 @@ void runReal(const std::string& dataRoot, const std::string& labels, const std::
   }
 }
 
+// Dublin against its LiDAR: the matcher's disparity map (as heights, 1 unit per px of disparity)
+// before and after enhancement with the hand outline of the one labelled roof, scored on the
+// LiDAR's valid pixels in the wall band (wallBand px on both sides of the outline), the roof's
+// core and everywhere else (which must not change).
+void runDublin(const std::string& dataRoot, const nlohmann::json& data, const std::string& cache,
+               const dem::EnhanceParams& params) {
+  const auto pairIt = data.at("pairs").find("dublin_0004");
+  if (pairIt == data.at("pairs").end()) return;
+  const nlohmann::json& pair = *pairIt;
+  const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
+  const std::string right = (fs::path(dataRoot) / pair.at("right").get<std::string>()).string();
+  const std::string truthPath = (fs::path(dataRoot) / pair.at("ground_truth_disparity").get<std::string>()).string();
+  if (!fs::exists(left) || !fs::exists(right) || !fs::exists(truthPath)) {
+    std::printf("skipped dublin_0004: %s missing\n", left.c_str());
+    return;
+  }
+  const cv::Mat disparity = bench::disparityFor("dublin_0004", left, right, pair.at("disparity_range").at(0),
+                                                pair.at("disparity_range").at(1), cache);
+  cv::Mat truth = cv::imread(truthPath, cv::IMREAD_UNCHANGED);
+  truth.convertTo(truth, CV_32F, 1.0 / 256.0);
+  const cv::Mat lidar = truth > 0;
+  std::vector<core::Polygon> roofs;
+  for (const auto& roof : data.at("roofs")) {
+    if (roof.at("pair") == "dublin_0004") roofs.push_back(bench::ringOf(roof.at("outline")));
+  }
+  const dem::EnhanceResult r = dem::enhanceDem(disparity, roofs, params);
+  cv::Mat inside = cv::Mat::zeros(disparity.size(), CV_8U);
+  for (const auto& roof : roofs) inside |= core::rasterize(roof, disparity.size());
+  cv::Mat depth, away;
+  cv::distanceTransform(inside, depth, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(inside == 0, away, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  const double band = params.wallBand;
+  const cv::Mat wall = ((inside != 0) & (depth <= band)) | ((inside == 0) & (away <= band));
+  const cv::Mat core = (inside != 0) & (depth > band);
+  const cv::Mat elsewhere = (inside == 0) & (away > band);
+  // RMS of (dem - truth) over LiDAR pixels of `mask` with a value in `dem` (and in `also` when
+  // given: both DEMs scored on the same pixels), and their count.
+  auto rms = [&](const cv::Mat& dem, const cv::Mat& mask, const cv::Mat& also = cv::Mat()) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < dem.rows; ++y) {
+      for (int x = 0; x < dem.cols; ++x) {
+        const float d = dem.at<float>(y, x);
+        if (mask.at<uchar>(y, x) == 0 || lidar.at<uchar>(y, x) == 0 || !std::isfinite(d)) continue;
+        if (!also.empty() && !std::isfinite(also.at<float>(y, x))) continue;
+        const double e = d - truth.at<float>(y, x);
+        sum += e * e;
+        ++n;
+      }
+    }
+    return std::make_pair(n > 0 ? std::sqrt(sum / n) : std::nan(""), n);
+  };
+  std::printf("\ndublin_0004 against the LiDAR disparity (%zu hand outline(s)); RMS in px of disparity, "
+              "before / after: on the LiDAR pixels both have (pixels) | on those each has (pixels)\n",
+              roofs.size());
+  const std::pair<const char*, cv::Mat> zones[] = {{"wall band", wall}, {"roof core", core}, {"elsewhere", elsewhere}};
+  for (const auto& [name, mask] : zones) {
+    const auto [bc, n] = rms(disparity, mask, r.dem);
+    const auto [ac, nc] = rms(r.dem, mask, disparity);
+    const auto [b, nb] = rms(disparity, mask);
+    const auto [a, na] = rms(r.dem, mask);
+    std::printf("  %-10s %7.3f / %7.3f (%d) | %7.3f (%d) / %7.3f (%d)\n", name, bc, ac, n, b, nb, a, na);
+    (void)nc;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -558,5 +624,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   runReal(dataRoot, labels, cache, pngDir, params);
+  std::ifstream in(labels);
+  runDublin(dataRoot, nlohmann::json::parse(in), cache, params);
   return 0;
 }

@@ -7,15 +7,8 @@
 # Usage: e2e_boxfit.sh DELINEO_CLI WORK_DIR
 # Exit status 0 when every check passes; otherwise 1, with one line per failed check on stderr.
 set -u
-CLI=${1:?usage: e2e_boxfit.sh DELINEO_CLI WORK_DIR}
-WORK=${2:?usage: e2e_boxfit.sh DELINEO_CLI WORK_DIR}
-rm -rf "$WORK"
-mkdir -p "$WORK"
 E2E_NAME=e2e_boxfit
-source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh"
-count() { grep -Eo -- "$2" "$1" | wc -l; }
-mean_iou() { tr -d '\n ' <"$1" | grep -Eo '"mean":\{[^}]*\}' | grep -Eo '"iou":[0-9.eE+-]+' | cut -d: -f2; }
-above() { awk -v v="$1" -v f="$2" 'BEGIN { exit !(v != "" && v + 0 > f + 0) }'; }
+source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh" "$@"
 
 S=$WORK/scene
 # Seed 2 at 320x240 gives 3 flat-roofed buildings (U, rectangle and angled footprints).

@@ -7,18 +7,8 @@
 # Usage: e2e_delineate.sh DELINEO_CLI WORK_DIR
 # Exit status 0 when every check passes; otherwise 1, with one line per failed check on stderr.
 set -u
-CLI=${1:?usage: e2e_delineate.sh DELINEO_CLI WORK_DIR}
-WORK=${2:?usage: e2e_delineate.sh DELINEO_CLI WORK_DIR}
-rm -rf "$WORK"
-mkdir -p "$WORK"
 E2E_NAME=e2e_delineate
-source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh"
-# count FILE PATTERN: number of matches of PATTERN in FILE (one feature per line in OGR GeoJSON).
-count() { grep -Eo -- "$2" "$1" | wc -l; }
-# mean_iou JSON: the "iou" value of the "mean" object of an eval-footprints report.
-mean_iou() { tr -d '\n ' <"$1" | grep -Eo '"mean":\{[^}]*\}' | grep -Eo '"iou":[0-9.eE+-]+' | cut -d: -f2; }
-# above VALUE FLOOR: true when VALUE > FLOOR (awk: bash has no floating point).
-above() { awk -v v="$1" -v f="$2" 'BEGIN { exit !(v != "" && v + 0 > f + 0) }'; }
+source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh" "$@"
 
 S=$WORK/scene
 # Seed 2 at 320x240 gives 3 flat-roofed buildings (U, rectangle and angled footprints).

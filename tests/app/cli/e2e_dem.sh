@@ -9,32 +9,16 @@
 # Usage: e2e_dem.sh DELINEO_CLI WORK_DIR
 # Exit status 0 when every check passes; otherwise 1, with one line per failed check on stderr.
 set -u
-CLI=${1:?usage: e2e_dem.sh DELINEO_CLI WORK_DIR}
-WORK=${2:?usage: e2e_dem.sh DELINEO_CLI WORK_DIR}
-rm -rf "$WORK"
-mkdir -p "$WORK"
 E2E_NAME=e2e_dem
-source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh" "$@"
 
-# grid FILE FUNCTION: a 12 x 12 ESRI ASCII grid of FUNCTION(col, row), 0.5 m cells, top-left
-# corner at map (1000, 2006), -9999 = no data.
-grid() {
-  local file=$1 fn=$2
-  {
-    printf 'ncols 12\nnrows 12\nxllcorner 1000\nyllcorner 2000\ncellsize 0.5\nNODATA_value -9999\n'
-    for ((r = 0; r < 12; r++)); do
-      for ((c = 0; c < 12; c++)); do printf '%s ' "$($fn "$c" "$r")"; done
-      printf '\n'
-    done
-  } >"$file"
-}
 inbox() { (($1 >= 4 && $1 <= 7 && $2 >= 4 && $2 <= 7)); }
 hole() { (($1 >= 9 && $1 <= 10 && $2 >= 1 && $2 <= 2)); }
 wall() { (($1 == 3 && $2 >= 4 && $2 <= 7)); }
 disparity() { if hole "$1" "$2" || wall "$1" "$2"; then echo -9999; elif inbox "$1" "$2"; then echo 24; else echo 4; fi; }
 heights() { if inbox "$1" "$2"; then echo 10; else echo 0; fi; }
-grid "$WORK/disparity.asc" disparity
-grid "$WORK/expected.asc" heights
+grid12 "$WORK/disparity.asc" disparity
+grid12 "$WORK/expected.asc" heights
 printf '{"width":12,"height":12,"disparity_min":0,"disparity_max":30,"gsd_m":0.5,"metres_per_disparity":0.5,"ground_disparity":4,"seed":1}\n' \
   >"$WORK/scene.json"
 

@@ -7,31 +7,15 @@
 # Usage: e2e_enhance.sh DELINEO_CLI WORK_DIR
 # Exit status 0 when every check passes; otherwise 1, with one line per failed check on stderr.
 set -u
-CLI=${1:?usage: e2e_enhance.sh DELINEO_CLI WORK_DIR}
-WORK=${2:?usage: e2e_enhance.sh DELINEO_CLI WORK_DIR}
-rm -rf "$WORK"
-mkdir -p "$WORK"
 E2E_NAME=e2e_enhance
-source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh" "$@"
 
-# grid FILE VALUE_AT(col,row) function name: a 12 x 12 ESRI ASCII grid, 0.5 m cells, whose
-# top-left corner is at map (1000, 2006).
-grid() {
-  local file=$1 fn=$2
-  {
-    printf 'ncols 12\nnrows 12\nxllcorner 1000\nyllcorner 2000\ncellsize 0.5\nNODATA_value -9999\n'
-    for ((r = 0; r < 12; r++)); do
-      for ((c = 0; c < 12; c++)); do printf '%s ' "$($fn "$c" "$r")"; done
-      printf '\n'
-    done
-  } >"$file"
-}
 inbox() { (($1 >= 4 && $1 <= 7 && $2 >= 4 && $2 <= 7)); }
 nearbox() { (($1 >= 3 && $1 <= 8 && $2 >= 3 && $2 <= 8)); }
 ramped() { if inbox "$1" "$2"; then echo 10; elif nearbox "$1" "$2"; then echo 5; else echo 0; fi; }
 sharp() { if inbox "$1" "$2"; then echo 10; else echo 0; fi; }
-grid "$WORK/dem.asc" ramped
-grid "$WORK/expected.asc" sharp
+grid12 "$WORK/dem.asc" ramped
+grid12 "$WORK/expected.asc" sharp
 
 # The roof's outline in map coordinates (pixels 4..8 in x and y).
 feature() {  # feature X0 Y0 X1 Y1 (map coordinates)

@@ -6,11 +6,8 @@
 # Usage: e2e_eval.sh DELINEO_CLI WORK_DIR
 # Exit status 0 when every check passes; otherwise 1, with one line per failed check on stderr.
 set -u
-CLI=${1:?usage: e2e_eval.sh DELINEO_CLI WORK_DIR}
-WORK=${2:?usage: e2e_eval.sh DELINEO_CLI WORK_DIR}
-mkdir -p "$WORK"
 E2E_NAME=e2e_eval
-source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh" "$@"
 
 grid() {  # grid FILE NCOLS NROWS VALUES...
   local file=$1 cols=$2 rows=$3

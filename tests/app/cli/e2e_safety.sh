@@ -6,12 +6,8 @@
 #
 # Usage: e2e_safety.sh DELINEO_CLI WORK_DIR
 set -u
-CLI=${1:?usage: e2e_safety.sh DELINEO_CLI WORK_DIR}
-WORK=${2:?usage: e2e_safety.sh DELINEO_CLI WORK_DIR}
-rm -rf "$WORK"
-mkdir -p "$WORK"
 E2E_NAME=e2e_safety
-source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh"
+source "$(dirname "${BASH_SOURCE[0]}")/e2e_lib.sh" "$@"
 # unchanged NAME FILE: FILE still has the checksum kept in $WORK/NAME.sum.
 keep() { sha1sum "$2" >"$WORK/$1.sum"; }
 unchanged() { sha1sum -c --status "$WORK/$1.sum" || fail "$1: $2 was modified"; }

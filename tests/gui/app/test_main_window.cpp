@@ -34,7 +34,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "buildings_model.hpp"
+#include "delineo/boxfit/params.hpp"
+#include "delineo/delineation/above_ground.hpp"
 #include "delineo/delineation/params.hpp"
+#include "delineo/dem/enhance.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
@@ -781,7 +784,7 @@ class MainWindowTest : public QObject {
     QCOMPARE(translator.translate("delineo::gui::MainWindow", "En&hanced DEM"), QStringLiteral("MNE a&mélioré"));
     QCOMPARE(translator.translate("ErrorText", "The input files do not match each other."),
              QStringLiteral("Les fichiers d’entrée ne correspondent pas entre eux."));
-    // Every label of the two parameter forms (their strings come from the structs' visit(),
+    // Every label of the parameter forms (their strings come from the structs' visit(),
     // which lupdate cannot see: app/gui/parameter_labels.cpp must list each new one).
     QStringList untranslated;
     const auto check = [&](const delineo::core::ParamInfo& info, auto&) {
@@ -794,6 +797,12 @@ class MainWindowTest : public QObject {
     delineation.visit(check);
     delineo::stereo::MatchParams matching;
     matching.visit(check);
+    delineo::delineation::AboveGroundParams pick;
+    pick.visit(check);
+    delineo::dem::EnhanceParams enhance;
+    enhance.visit(check);
+    delineo::boxfit::BoxFitParams boxFit;
+    boxFit.visit(check);
     QVERIFY2(untranslated.isEmpty(), qPrintable(untranslated.join(QStringLiteral(", "))));
     // The reusable widgets' strings are in the same translation.
     QCOMPARE(translator.translate("delineo::widgets::JobProgressWidget", "Idle"), QStringLiteral("Inactif"));

@@ -1,7 +1,9 @@
 // The project's own settings in the main window: the disparity range the Matching tab edits and
 // every computation uses, where outputs go, the height model and the roof heights it gives, the
 // warning when a roof reaches the matched range's end, and the energy of an edited outline.
+#include <QAbstractSpinBox>
 #include <QAction>
+#include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QLabel>
 #include <QLineEdit>
@@ -9,12 +11,16 @@
 #include <QSignalSpy>
 #include <QSpinBox>
 #include <QStandardPaths>
+#include <QTabWidget>
 #include <QTemporaryDir>
 #include <QTest>
 #include <QUndoStack>
 #include <filesystem>
 #include <thread>
 
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/geometry.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/widgets/disparity_histogram.hpp"
@@ -242,6 +248,88 @@ class ProjectSettingsTest : public QObject {
     QVERIFY(second != id);
     QTRY_COMPARE_WITH_TIMEOUT(finished.count(), 1, 120000);
     QCOMPARE(finished.takeFirst().at(0).toInt(), second);
+  }
+
+  void aPickIsOutlinedWithTheProjectsMethod() {
+    if (!project::boxFittingAvailable() || !project::matchingAvailable()) QSKIP("needs the matcher and box-fitting");
+    QVERIFY(window_->openProject(projectPath_));
+    gui::Document* doc = window_->document();
+    QSignalSpy matched(window_.get(), &MainWindow::matchingFinished);
+    window_->startMatching();
+    QTRY_COMPARE_WITH_TIMEOUT(matched.count(), 1, 120000);
+    QVERIFY2(!doc->dem().empty(), "the sample has a height model");
+    // The method is a project setting, one undoable step.
+    QComboBox* method = window_->methodChoice();
+    QCOMPARE(method->currentData().toString(), QStringLiteral("active-polygon"));
+    const int entries = doc->undoStack()->count();
+    method->setCurrentIndex(method->findData(QStringLiteral("box-fitting")));
+    QCOMPARE(doc->project().method, std::string(project::kBoxFitting));
+    QCOMPARE(doc->undoStack()->count(), entries + 1);
+    QCOMPARE(doc->undoStack()->undoText(), QStringLiteral("Outline with box-fitting"));
+    // A pick is outlined by box-fitting at once: no proposal to choose from, the building has it.
+    QSignalSpy fitted(window_.get(), &MainWindow::boxFittingFinished);
+    QSignalSpy delineated(window_.get(), &MainWindow::delineationFinished);
+    cv::Mat stats, centroids, components;
+    const cv::Mat roofs = doc->labels() == 1;
+    const int n = cv::connectedComponentsWithStats(roofs, components, stats, centroids);
+    int largest = 1;
+    for (int i = 2; i < n; ++i) {
+      if (stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(largest, cv::CC_STAT_AREA)) largest = i;
+    }
+    const cv::Rect roof(stats.at<int>(largest, cv::CC_STAT_LEFT), stats.at<int>(largest, cv::CC_STAT_TOP),
+                        stats.at<int>(largest, cv::CC_STAT_WIDTH), stats.at<int>(largest, cv::CC_STAT_HEIGHT));
+    emit window_->leftView()->rectanglePicked(QRectF(roof.x - 8, roof.y - 8, roof.width + 16, roof.height + 16));
+    const int id = window_->selectedBuilding();
+    QTRY_COMPARE_WITH_TIMEOUT(fitted.count(), 1, 120000);
+    QCOMPARE(delineated.count(), 0);
+    const project::Building* b = doc->project().find(id);
+    QVERIFY(b->hasOutline());
+    QCOMPARE(b->method, std::string(project::kBoxFitting));
+    QVERIFY(b->status == project::BuildingStatus::Automatic);
+    QVERIFY(!window_->hasBoxFitProposal(id));
+    const double inter = cv::countNonZero(core::rasterize(b->outline, roofs.size())(roof) & roofs(roof));
+    const double iou = inter / (core::area(b->outline) + cv::countNonZero(roofs(roof)) - inter);
+    qInfo("picked roof outlined by box-fitting: IoU %.3f", iou);
+    QVERIFY2(iou > 0.7, qPrintable(QString::number(iou)));
+    // Back to the active polygon: the method choice follows undo.
+    doc->undoStack()->undo();  // the outline
+    doc->undoStack()->undo();  // the pick
+    doc->undoStack()->undo();  // the method
+    QCOMPARE(doc->project().method, std::string(project::kActivePolygon));
+    QCOMPARE(method->currentData().toString(), QStringLiteral("active-polygon"));
+  }
+
+  void boxFittingEnhancementAndPickHaveTheirForms() {
+    if (!window_->document()) QVERIFY(window_->openProject(projectPath_));
+    gui::Document* doc = window_->document();
+    const std::vector<std::pair<std::string, std::string>> groups = {
+        {"boxfit", "min-height"}, {"enhance", "wall-band"}, {"pick", "height-margin"}};
+    for (const auto& [group, key] : groups) {
+      if (group == "boxfit" && !project::boxFittingAvailable()) continue;
+      widgets::ParameterForm* form = window_->parameterForm(group);
+      QVERIFY2(form != nullptr, group.c_str());
+      auto* spin = form->findChild<QAbstractSpinBox*>(QString::fromStdString(key));
+      QVERIFY2(spin != nullptr, key.c_str());
+      const auto stored = [&, group = group, key = key] {
+        const nlohmann::json& all = doc->project().parameters;
+        return all.contains(group) ? all.at(group).value(key, nlohmann::json()) : nlohmann::json();
+      };
+      const nlohmann::json before = stored();
+      const int step = doc->undoStack()->index();
+      spin->stepBy(1);
+      QCOMPARE(doc->undoStack()->index(), step + 1);
+      QVERIFY2(stored().is_number() && stored() != before, key.c_str());
+      doc->undoStack()->undo();
+      QCOMPARE(stored().dump(), before.dump());
+      if (const QString dir = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR"); !dir.isEmpty()) {
+        auto* tabs = window_->findChild<QTabWidget*>(QStringLiteral("parameterTabs"));
+        for (int i = 0; i < tabs->count(); ++i) {
+          if (tabs->widget(i)->isAncestorOf(form)) tabs->setCurrentIndex(i);
+        }
+        QTest::qWait(100);
+        window_->grab().save(dir + QStringLiteral("/%1-tab.png").arg(QString::fromStdString(group)));
+      }
+    }
   }
 
   void cleanupTestCase() { window_.reset(); }
