@@ -291,6 +291,10 @@
         <translation>Garde des hauteurs intermédiaires</translation>
     </message>
     <message>
+        <source>Other height cost</source>
+        <translation>Coût d’une autre hauteur</translation>
+    </message>
+    <message>
         <source>Band best cost</source>
         <translation>Coût de bande selon l’appariement</translation>
     </message>

@@ -94,6 +94,7 @@ void Document::loadRasters() {
   leftColour_ = toDisplayColour(project_.left);
   rightColour_ = toDisplayColour(project_.right);
   disparity_ = project::readDisparity(project_, pair_.left.size());
+  pair_.disparity = disparity_;
   if (!project_.labels.empty()) {
     io::Raster labels = io::readRaster(project_.labels);
     if (labels.data.size() != pair_.left.size() || labels.data.channels() != 1) {
@@ -357,6 +358,7 @@ void Document::restoreParameters(const std::string& group, const nlohmann::json&
 
 void Document::restoreDisparity(const cv::Mat& disparity, const std::string& path) {
   disparity_ = disparity;
+  pair_.disparity = disparity;
   project_.disparity = path;
   disparityOnDisk_ = !path.empty() || disparity.empty();
   deriveDem();

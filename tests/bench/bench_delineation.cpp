@@ -24,6 +24,7 @@
 #include "delineo/delineation/delineate.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/cost_service.hpp"
+#include "delineo/stereo/match.hpp"
 #include "energy_diag.hpp"
 #ifdef DELINEO_HAVE_EVAL
 #include "delineo/eval/footprint_metrics.hpp"
@@ -214,6 +215,9 @@ int main(int argc, char** argv) {
   std::string dumpDir;  // --dump DIR: one diagnostic PNG per run
   std::string onlyInit;  // --init box+8|jit6: run one initialisation only
   bool oracleVegetation = false;  // --oracle-vegetation: true tree pixels given as excluded
+  // --map: each scene matched (stereo::matchStereo over its ground - 8 .. highest roof + 8 px), the
+  // map and that range given with every request, as the GUI and `run` do (the other-height class).
+  bool withMap = false;
   bool diag = false;     // --diag: spatial decomposition of F(truth) - F(result) (implies BENCH_VERBOSE)
   std::map<std::string, DiagTable> diagTotals;  // by init
   sim::SceneParams sceneParams;
@@ -244,6 +248,8 @@ int main(int argc, char** argv) {
       oracleVegetation = true;
     } else if (!std::strcmp(argv[i], "--diag")) {
       diag = true;
+    } else if (!std::strcmp(argv[i], "--map")) {
+      withMap = true;
     } else if (!std::strcmp(argv[i], "--init") && i + 1 < argc) {
       onlyInit = argv[++i];
     } else {
@@ -251,7 +257,7 @@ int main(int argc, char** argv) {
                    "usage: bench_delineation [--tiny] [--scenes N] [--seed FIRST] [--size WxH] "
                    "[--buildings N] "
                    "[--trees N] [--init box+8|jit6] [--reference-runs N] [--dump DIR] [--diag] "
-                   "[--oracle-vegetation]\n");
+                   "[--oracle-vegetation] [--map]\n");
       return 2;
     }
   }
@@ -280,11 +286,29 @@ int main(int argc, char** argv) {
     cv::Mat left, right;
     scene.left.convertTo(left, CV_32F);
     scene.right.convertTo(right, CV_32F);
+    cv::Mat map;
+    DisparityInterval range{0, 0};
+    if (withMap) {
+      double low = 1e9, high = -1e9;
+      for (const auto& fp : scene.footprints) {
+        low = std::min(low, number(fp, "ground_disparity", 0));
+        high = std::max(high, number(fp, "roof_disparity_max", 0));
+      }
+      range = {static_cast<int>(std::floor(low)) - 8, static_cast<int>(std::ceil(high)) + 8};
+      stereo::MatchParams mp;
+      mp.dmin = range.min;
+      mp.dmax = range.max;
+      map = stereo::matchStereo(left, right, mp).disparity;
+    }
     for (const auto& fp : scene.footprints) {
       const int id = static_cast<int>(number(fp, "id", 0));
       DelineationRequest base;
       // Oracle run: how much of the remaining error trees at roof height explain.
       if (oracleVegetation) base.excludeMask = scene.labels == sim::kLabelVegetation;
+      if (withMap) {
+        base.disparity = map;
+        base.searchRange = range;
+      }
       base.roof = {static_cast<int>(std::floor(number(fp, "roof_disparity_min", 0))),
                    static_cast<int>(std::ceil(number(fp, "roof_disparity_max", 0)))};
       const int g = static_cast<int>(std::lround(number(fp, "ground_disparity", 0)));

@@ -5,7 +5,8 @@
 // interval, closed then opened 7x7, largest component, polygonised (1 px). Prints IoU against the
 // labelled outline and vertex counts; `--dump DIR` draws them over the left image (labelled
 // green, rectangle blue, naive cyan, raw yellow, regularized red). Skips cleanly (exit 0) when the
-// data folder is missing. Disparity maps are cached as in bench_roof_interval.
+// data folder is missing. Disparity maps are cached as in bench_roof_interval. The matcher's map is
+// also the request's disparity map (the other-height class); BENCH_NO_MAP=1 leaves it out.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -326,6 +327,7 @@ int main(int argc, char** argv) {
     request.init = rect;
     request.roof = {proposal.low, proposal.high};
     request.searchRange = delineation::DisparityInterval{dmin, dmax};
+    if (!std::getenv("BENCH_NO_MAP")) request.disparity = map;
     if (groundMode == "below") {
       request.ground = delineation::DisparityInterval{dmin, proposal.low - 2};
     } else if (groundMode != "estimated") {

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -204,6 +207,35 @@ std::vector<IntPolygon> regionStageCandidates(const EnergyImages& im, const cv::
   return candidates;
 }
 
+// c_other: Crit at the matcher's disparity (best of d_m - 1, d_m, d_m + 1) where the matcher's
+// map puts the pixel outside the operator's roof interval (widened by `intermediate-guard`) and the
+// ground's; the worst Crit (1) elsewhere, unmatched pixels included. Per pixel, before
+// aggregation. Not the cost volume's own minimum over the range: on a repeated texture (a
+// corrugated roof) a 5x5 window matches some other disparity better than its own, while the
+// matcher's validated map holds the roof's.
+cv::Mat otherHeightCost(const stereo::CorrelationCostService& costs, const cv::Mat& disparity,
+                        const DisparityInterval& roof, const DisparityInterval& ground,
+                        const DelineationParams& params) {
+  const cv::Rect roi = costs.roi();
+  const float r0 = static_cast<float>(roof.min - params.intermediateGuard) - 0.5f;
+  const float r1 = static_cast<float>(roof.max + params.intermediateGuard) + 0.5f;
+  const float g0 = static_cast<float>(ground.min) - 0.5f, g1 = static_cast<float>(ground.max) + 0.5f;
+  cv::Mat other(roi.size(), CV_32F, cv::Scalar(1.0f));
+  for (int y = 0; y < roi.height; ++y) {
+    const float* dm = disparity.ptr<float>(roi.y + y) + roi.x;
+    float* out = other.ptr<float>(y);
+    for (int x = 0; x < roi.width; ++x) {
+      const float d = dm[x];
+      if (!std::isfinite(d) || (d >= r0 && d <= r1) || (d >= g0 && d <= g1)) continue;
+      const int c = static_cast<int>(std::lround(d));
+      for (int k = std::max(c - 1, costs.dmin()); k <= std::min(c + 1, costs.dmax()); ++k) {
+        out[x] = std::min(out[x], costs.cost(roi.x + x, roi.y + y, k));
+      }
+    }
+  }
+  return other;
+}
+
 }  // namespace
 
 std::pair<DisparityInterval, DisparityInterval> costIntervals(const DisparityInterval& roof,
@@ -285,6 +317,12 @@ cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
                                                    " lies outside the search range " +
                                                    str(*request.searchRange));
     }
+  }
+  if (!request.disparity.empty() && (request.disparity.size() != left.size() || request.disparity.type() != CV_32F)) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "the disparity map must be single-band float of the left image's size (" +
+                    std::to_string(left.cols) + "x" + std::to_string(left.rows) + "), not " +
+                    std::to_string(request.disparity.cols) + "x" + std::to_string(request.disparity.rows));
   }
   if (!request.excludeMask.empty() &&
       (request.excludeMask.size() != left.size() || request.excludeMask.type() != CV_8U)) {
@@ -374,10 +412,22 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
       costIntervals(request.roof, out.ground, params.balanceIntervals);
   im.roofCost = costs.minCost(out.roofSearched.min, out.roofSearched.max);
   im.groundCost = costs.minCost(out.groundSearched.min, out.groundSearched.max);
+  cv::Mat otherCost;
+  if (params.otherHeightCost < 1 && !request.disparity.empty()) {
+    otherCost = otherHeightCost(costs, request.disparity, request.roof, out.groundSearched, params);
+  }
   if (params.costAggregation > 1) {
     const cv::Size k(params.costAggregation, params.costAggregation);
     cv::blur(im.roofCost, im.roofCost, k, {-1, -1}, cv::BORDER_REPLICATE);
     cv::blur(im.groundCost, im.groundCost, k, {-1, -1}, cv::BORDER_REPLICATE);
+    if (!otherCost.empty()) cv::blur(otherCost, otherCost, k, {-1, -1}, cv::BORDER_REPLICATE);
+  }
+  if (!otherCost.empty()) {
+    // The outside class is a mixture: ground, or a surface at another height at a prior cost.
+    // A neighbour at another height than the roof matches the roof interval better than the
+    // ground's (NCC of a smooth texture degrades slowly with the shift), its own height better
+    // still.
+    im.groundCost = cv::min(im.groundCost, otherCost + static_cast<float>(params.otherHeightCost));
   }
 
   out.excluded = cv::Mat::zeros(size, CV_8U);

@@ -21,6 +21,7 @@ delineation::DelineationRequest requestFor(const Project& project, const Buildin
     request.searchRange = delineation::DisparityInterval{project.disparityRange->low, project.disparityRange->high};
   }
   request.excludeMask = pair.exclude;
+  request.disparity = pair.disparity;
   return request;
 }
 

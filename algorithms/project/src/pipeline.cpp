@@ -392,7 +392,7 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
   }
   io::checkOutputs(outputs, {project.left, project.right, project.disparity, project.dem, project.labels,
                              project.exclude});
-  const StereoPair pair = readStereoPair(project);
+  StereoPair pair = readStereoPair(project);
   const std::vector<int> pending = project.pendingBuildings();
   const double matchShare = project.disparity.empty() ? (pending.empty() ? 1.0 : 0.5) : 0.0;
   cv::Mat disparity;
@@ -423,6 +423,7 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
   } else {
     disparity = readDisparity(project, pair.left.size());
   }
+  pair.disparity = disparity;
   cv::Mat heights;  // for box-fitting, read when a building asks for it
   for (size_t i = 0; i < pending.size(); ++i) {
     const double begin = matchShare + (1.0 - matchShare) * static_cast<double>(i) / static_cast<double>(pending.size());

@@ -190,6 +190,9 @@ int run(const std::vector<std::string>& args) {
       .value("exclude", "FILE",
              "mask of the left image's size, non-zero where a pixel is known not to be roof "
              "(vegetation, a neighbour's roof); kept outside every outline")
+      .value("disparity", "FILE",
+             "the matcher's disparity map (float, the left image's size, NaN = none): pixels it "
+             "puts at another height than the roof and the ground may stay outside as that surface")
       .required("out", "FILE", "output polygons (GeoJSON/GeoPackage) with energies and status")
       .flag("quiet", "no progress and no range estimate on stderr")
       .params(delineation::DelineationParams{});
@@ -203,7 +206,7 @@ int run(const std::vector<std::string>& args) {
   if (opts.has("roof-disparity")) flags.roof = intervalFlag(opts, "roof-disparity");
   if (opts.has("ground-disparity")) flags.ground = intervalFlag(opts, "ground-disparity");
   if (opts.has("disparity-range")) flags.search = intervalFlag(opts, "disparity-range");
-  cli::checkOutputs(opts, {{"out", io::OutputFormat::Vector}}, {"left", "right", "init", "exclude"});
+  cli::checkOutputs(opts, {{"out", io::OutputFormat::Vector}}, {"left", "right", "init", "exclude", "disparity"});
 
   auto& progress = cli::commandProgress();
   const bool quiet = opts.has("quiet");
@@ -220,6 +223,17 @@ int run(const std::vector<std::string>& args) {
       buildingJobs(initialPolygons(opts, geo), flags, params, opts.has("init") ? opts.get("init") : "");
   cv::Mat exclude;
   if (opts.has("exclude")) exclude = io::readMask(opts.get("exclude"), left.size());
+  cv::Mat disparity;
+  if (opts.has("disparity")) {
+    io::ReadOptions options;
+    options.type = io::PixelType::Float32;
+    options.toGrey = true;
+    disparity = io::readRaster(opts.get("disparity"), options).data;
+    if (disparity.size() != left.size()) {
+      throw core::Error(core::ErrorCode::MismatchedInputs,
+                        "the disparity map does not have the size of the left image", opts.get("disparity"));
+    }
+  }
 
   core::Progress::Range buildingsProgress(&progress, flags.search ? 0.0 : 0.05, 1.0);
   std::optional<DisparityInterval> estimated;
@@ -251,6 +265,7 @@ int run(const std::vector<std::string>& args) {
       req.searchRange = flags.search;
       if (estimated) req.searchRange = hull(*estimated, req.roof, req.ground);
       req.excludeMask = exclude;
+      req.disparity = disparity;
       const auto r = delineation::delineate(left, right, req, params, {}, &range);
       // A canceled batch writes nothing: the previous output, if any, stays as it was.
       if (r.status == core::RunStatus::Canceled || progress.canceled()) throw cli::Canceled();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -308,6 +309,50 @@ TEST(Delineate, KeepsWhatMatchesBetweenTheGroundAndTheRoofOut) {
   EXPECT_EQ(cv::countNonZero(plain.excluded), 0);
 }
 
+// A smooth texture: NCC of a window degrades slowly with a wrong shift.
+cv::Mat smoothTexture(cv::Size size, double mean, double contrast, int seed) {
+  cv::Mat t = texture(size, 0, 1, seed);
+  cv::GaussianBlur(t, t, {0, 0}, 3.0);
+  cv::Scalar m, s;
+  cv::meanStdDev(t, m, s);
+  return (t - m[0]) * (contrast / s[0]) + mean;
+}
+
+TEST(Delineate, LeavesANeighbourAtAnotherHeightOutside) {
+  // A taller block along the roof's south side, as bright as the roof, with a smooth texture:
+  // at the roof's disparities it matches better than at the ground's (5 px off against 15), so
+  // c_roof < c_ground there, and the operator's rectangle takes in part of it. The matcher's
+  // map (here the true disparities) puts it at its own height, where it matches best.
+  const cv::Rect roof(50, 40, 60, 50), neighbour(40, 90, 80, 30);
+  const cv::Size size(180, 160);
+  const Pair pair = layeredPair(size, 4,
+                                {{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
+                                 {neighbour, 19, smoothTexture(size + cv::Size(64, 0), 160, 25, 5)}});
+  cv::Mat disparity(size, CV_32F, cv::Scalar(4.0f));
+  disparity(neighbour).setTo(19.0f);
+  disparity(roof).setTo(14.0f);
+  const core::Polygon truth{{{50, 40}, {110, 40}, {110, 90}, {50, 90}}, {}};
+  DelineationRequest req;
+  req.init = grownBox(cv::Rect(roof.x, roof.y, roof.width, roof.height + 20), 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  req.searchRange = DisparityInterval{0, 28};
+  req.disparity = disparity;
+  DelineationParams off;
+  off.otherHeightCost = 1;
+  const DelineationParams on;
+  const double without = iou(delineate(pair.left, pair.right, req, off).polygon, truth, size);
+  const double with = iou(delineate(pair.left, pair.right, req, on).polygon, truth, size);
+  RecordProperty("iou_without", std::to_string(without));
+  RecordProperty("iou_with", std::to_string(with));
+  EXPECT_LT(without, 0.85) << "without the other-height class the neighbour is taken as roof";
+  EXPECT_GT(with, 0.93) << "without " << without;
+  // Without a map the term has nothing to read: the outline is the ground-only one.
+  DelineationRequest noMap = req;
+  noMap.disparity.release();
+  EXPECT_NEAR(iou(delineate(pair.left, pair.right, noMap, on).polygon, truth, size), without, 1e-9);
+}
+
 TEST(Delineate, RejectsBadInputs) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
@@ -339,6 +384,12 @@ TEST(Delineate, RejectsBadInputs) {
   DelineationRequest smallMask = ok;
   smallMask.excludeMask = cv::Mat::zeros(100, 100, CV_8U);
   expectCode(smallMask, core::ErrorCode::MismatchedInputs, pair.right);
+  DelineationRequest smallMap = ok;
+  smallMap.disparity = cv::Mat::zeros(100, 100, CV_32F);
+  expectCode(smallMap, core::ErrorCode::MismatchedInputs, pair.right);
+  DelineationRequest intMap = ok;
+  intMap.disparity = cv::Mat::zeros(pair.left.size(), CV_16S);
+  expectCode(intMap, core::ErrorCode::MismatchedInputs, pair.right);
   // A roof is nearer than its ground: a ground interval at or above the roof's is refused.
   DelineationRequest groundAbove = ok;
   groundAbove.ground = DisparityInterval{20, 24};

@@ -38,6 +38,10 @@ struct DelineationRequest {
   // more than the occlusion band outside it: trees at roof height match the roof interval as
   // well as a roof does, and the correlation costs alone cannot keep them out.
   cv::Mat excludeMask;
+  // Optional CV_32F of the left image's size: the matcher's disparity map (NaN = unmatched). Where
+  // it puts a pixel at another height than the roof and the ground, the pixel may be explained
+  // outside the outline as that surface (`other-height-cost`); empty = ground only.
+  cv::Mat disparity;
 };
 
 // The energy inputs of one building, in ROI coordinates, plus what was derived on the way.
