@@ -12,7 +12,8 @@
 // rectangle and its proposed roof interval. Skips cleanly when the data folder is missing.
 //
 // `--dump DIR` draws each run over the left image: true outline green, init blue, segment border
-// yellow, seeds magenta, boxes cyan, outline red; beside it the Canny edges and the segment.
+// yellow, seeds magenta, boxes cyan, outline red; beside it the Canny edges and the segment, and
+// the heights above the local ground (colour map up to 1.25 x the roof height, segment white).
 // `--tiny` is the ctest smoke run.
 #include <algorithm>
 #include <cmath>
@@ -137,6 +138,23 @@ void dump(const std::string& path, const cv::Mat& left, const boxfit::BoxFitBuil
   }
   cv::Mat both;
   cv::hconcat(img, side, both);
+  if (b && !b->diagnostics.aboveGround.empty()) {
+    // Third panel: heights above the local ground, 0 to 1.25 x the roof height (colour map),
+    // with the segment's border (white) and the truth (green).
+    cv::Mat h8;
+    b->diagnostics.aboveGround.convertTo(h8, CV_8U, 255.0 / (1.25 * std::max(0.1, b->diagnostics.roofHeight)));
+    cv::Mat heights;
+    cv::applyColorMap(h8, heights, cv::COLORMAP_JET);
+    cv::resize(heights, heights, {}, k, k, cv::INTER_NEAREST);
+    drawPolygon(heights, truth, origin, k, {0, 255, 0});
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(b->diagnostics.segment.clone(), contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
+    for (auto& c : contours) {
+      for (auto& p : c) p = p * k + cv::Point(k / 2, k / 2);
+    }
+    cv::drawContours(heights, contours, -1, {255, 255, 255}, 1);
+    cv::hconcat(both, heights, both);
+  }
   cv::imwrite(path, both);
 }
 
@@ -203,6 +221,16 @@ int simulated(int scenes, int firstSeed, sim::SceneParams sceneParams, const box
                     b ? b->diagnostics.vertices : 0, b ? b->energy : 0.0, b ? "" : result.message.c_str());
         if (b && std::getenv("BENCH_VERBOSE")) {
           const auto& d = b->diagnostics;
+          // Where the outline and the segment go wrong: area outside the truth (extra) and truth
+          // area they miss, in % of the truth's area.
+          const cv::Mat t = core::rasterize(fp.polygon, left.size()) > 0;
+          const cv::Mat o = core::rasterize(b->outline, left.size()) > 0;
+          cv::Mat sg = cv::Mat::zeros(left.size(), CV_8U);
+          d.segment.copyTo(sg(b->roi));
+          const double ta = std::max(1, cv::countNonZero(t));
+          std::printf("      outline extra %.0f %% missed %.0f %%; segment extra %.0f %% missed %.0f %%\n",
+                      100.0 * cv::countNonZero(o & ~t) / ta, 100.0 * cv::countNonZero(t & ~o) / ta,
+                      100.0 * cv::countNonZero(sg & ~t) / ta, 100.0 * cv::countNonZero(t & ~sg) / ta);
           std::printf("      roof %.1f m thr %.1f m seg %d px skel %d junctions %d seeds %zu skipped %d angles %d "
                       "main %.0f deg (%d boxes) merged %d px; ms seg %.1f seeds %.1f boxes %.1f outline %.1f\n",
                       d.roofHeight, d.threshold, d.segmentArea, d.skeletonPixels, d.junctions, d.seeds.size(), d.seedsSkipped, d.anglesEvaluated, d.mainOrientationDeg, d.boxesAtMainOrientation, d.mergedArea,

@@ -340,9 +340,33 @@ int main(int argc, char** argv) {
     }
     try {
       const auto r = delineation::delineate(lefts[pairName], rights[pairName], request, params);
-      // The stage alone, CPU time of this thread, best of 3 (the machine may be shared).
+      // The stage alone, CPU time of this thread, best of 3 (the machine may be shared;
+      // BENCH_REG_REPS=N repeats it N times, for a profiler).
       double ms = 1e300;
-      for (int rep = 0; rep < 3; ++rep) {
+      if (const char* path = std::getenv("BENCH_DUMP_OUTLINES")) {
+        // One JSON line per roof: the raw outline and the stage's own result (before the
+        // energy gate), to check that a change of the stage leaves its results as they were.
+        auto rings = [](const core::Polygon& p) {
+          nlohmann::json out = nlohmann::json::array();
+          std::vector<const core::Ring*> all{&p.outer};
+          for (const auto& h : p.holes) all.push_back(&h);
+          for (const core::Ring* ring0 : all) {
+            nlohmann::json ring = nlohmann::json::array();
+            for (const auto& v : *ring0) ring.push_back({v.x, v.y});
+            out.push_back(ring);
+          }
+          return out;
+        };
+        const auto stage = delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
+        const nlohmann::json line{{"roof", name}, {"raw", rings(r.rawPolygon)}, {"regularized", rings(stage.polygon)},
+                                  {"status", delineation::toString(stage.status)}, {"reason", stage.reason}};
+        if (FILE* f = std::fopen(path, "a")) {
+          std::fprintf(f, "%s\n", line.dump().c_str());
+          std::fclose(f);
+        }
+      }
+      const int reps = std::getenv("BENCH_REG_REPS") ? std::max(1, std::atoi(std::getenv("BENCH_REG_REPS"))) : 3;
+      for (int rep = 0; rep < reps; ++rep) {
         const double t0 = cpuMs();
         (void)delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
         ms = std::min(ms, cpuMs() - t0);

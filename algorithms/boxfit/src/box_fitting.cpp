@@ -94,6 +94,7 @@ bool fitOne(const cv::Mat& above, const cv::Mat& initMask, double roofHeight, co
   BoxFitDiagnostics& d = out.diagnostics;
   out.roi = roi;
   d.roofHeight = roofHeight;
+  d.aboveGround = above;
   d.threshold = std::max(params.minHeight, params.thresholdFraction * roofHeight);
   core::setStage(progress, core::StageId::BoxFitSegment);
   auto t0 = std::chrono::steady_clock::now();

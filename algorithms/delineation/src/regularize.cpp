@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <set>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -40,12 +43,17 @@ double cross(cv::Point2d a, cv::Point2d b) {
   return a.x * b.y - a.y * b.x;
 }
 
-double segmentDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
+// Squared distance from p to the segment ab; segmentDistance is its root.
+double segmentDistance2(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
   const cv::Point2d ab = b - a;
   const double len2 = ab.dot(ab);
   const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
   const cv::Point2d d = p - (a + t * ab);
-  return std::sqrt(d.dot(d));
+  return d.dot(d);
+}
+
+double segmentDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
+  return std::sqrt(segmentDistance2(p, a, b));
 }
 
 double ringDistance(cv::Point2d p, const core::Ring& ring) {
@@ -62,6 +70,62 @@ using EdgeKey = std::array<double, 4>;
 EdgeKey edgeKey(cv::Point2d a, cv::Point2d b) {
   return {a.x, a.y, b.x, b.y};
 }
+// A set of edges (exact end points): open addressing on the bits of the coordinates, so that
+// the many lookups while removing short edges cost no comparison chains and no allocation.
+class EdgeSet {
+ public:
+  // Empties the set, with room for n keys without growing.
+  void reset(size_t n) {
+    size_t capacity = 16;
+    while (capacity < 2 * n + 2) capacity *= 2;
+    if (slots_.size() < capacity) slots_.resize(capacity);
+    used_.assign(std::max(capacity, slots_.size()), 0);
+    size_ = 0;
+  }
+  void insert(const EdgeKey& k) {
+    if (2 * (size_ + 1) > slots_.size()) grow();
+    size_t i = hash(k) & (slots_.size() - 1);
+    while (used_[i]) {
+      if (slots_[i] == k) return;
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    slots_[i] = k, used_[i] = 1, ++size_;
+  }
+  bool count(const EdgeKey& k) const {
+    if (slots_.empty()) return false;
+    for (size_t i = hash(k) & (slots_.size() - 1); used_[i]; i = (i + 1) & (slots_.size() - 1)) {
+      if (slots_[i] == k) return true;
+    }
+    return false;
+  }
+
+ private:
+  static size_t hash(const EdgeKey& k) {
+    uint64_t h = 1469598103934665603ull;
+    for (double v : k) {
+      const double z = v + 0.0;  // -0.0 and 0.0 are equal: one hash
+      uint64_t bits = 0;
+      std::memcpy(&bits, &z, sizeof bits);
+      h = (h ^ bits) * 1099511628211ull;
+      h ^= h >> 29;
+    }
+    return static_cast<size_t>(h);
+  }
+  void grow() {
+    std::vector<EdgeKey> old;
+    std::vector<char> oldUsed;
+    old.swap(slots_), oldUsed.swap(used_);
+    slots_.assign(std::max<size_t>(16, 2 * old.size()), EdgeKey{});
+    used_.assign(slots_.size(), 0);
+    size_ = 0;
+    for (size_t i = 0; i < old.size(); ++i) {
+      if (oldUsed[i]) insert(old[i]);
+    }
+  }
+  std::vector<EdgeKey> slots_;
+  std::vector<char> used_;
+  size_t size_ = 0;
+};
 
 // The edges of a ring bucketed on a square grid: distances to the ring near a point without
 // visiting every edge (an outline cleaned on the pixel grid has hundreds).
@@ -83,25 +147,34 @@ class EdgeGrid {
       }
     }
   }
-  // Distance from p to the ring when it is at most `limit`, else some value above `limit`.
+  // Distance from p to the ring when it is at most `limit`, else some value above `limit` (the
+  // least distance to the edges in the cells within `limit`). The cells within half a cell are
+  // searched first: an edge in no searched cell lies farther than the searched reach, so a
+  // distance within that reach is already the least.
   double distance(cv::Point2d p, double limit) const {
-    double best = kInf;
-    const int x0 = col(p.x - limit), x1 = col(p.x + limit), y0 = row(p.y - limit),
-              y1 = row(p.y + limit);
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        for (int k : cells_[static_cast<size_t>(y * cols_ + x)]) {
-          best =
-              std::min(best, segmentDistance(p, ring_[static_cast<size_t>(k)],
-                                             ring_[(static_cast<size_t>(k) + 1) % ring_.size()]));
-        }
-      }
-    }
-    return best;
+    const double near = std::min(limit, 0.5 * cell_);
+    const double d = distanceWithin(p, near);
+    return d <= near ? d : distanceWithin(p, limit);
   }
   const core::Ring& ring() const { return ring_; }
 
  private:
+  // The least distance from p to the edges in the cells within `reach` of p.
+  double distanceWithin(cv::Point2d p, double reach) const {
+    double best = kInf;  // squared until the end (the root of the least is the least root)
+    const int x0 = col(p.x - reach), x1 = col(p.x + reach), y0 = row(p.y - reach),
+              y1 = row(p.y + reach);
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        for (int k : cells_[static_cast<size_t>(y * cols_ + x)]) {
+          best =
+              std::min(best, segmentDistance2(p, ring_[static_cast<size_t>(k)],
+                                              ring_[(static_cast<size_t>(k) + 1) % ring_.size()]));
+        }
+      }
+    }
+    return std::sqrt(best);
+  }
   int col(double x) const {
     return std::clamp(static_cast<int>(std::floor((x - origin_.x) / cell_)), 0, cols_ - 1);
   }
@@ -115,19 +188,54 @@ class EdgeGrid {
   std::vector<std::vector<int>> cells_;
 };
 
-double maxDeviation(const core::Ring& result, const EdgeGrid& input, double stopAbove,
-                    const std::set<EdgeKey>* skip = nullptr, double step = 1.0) {
-  double worst = 0;
-  for (size_t i = 0; i < result.size(); ++i) {
-    const cv::Point2d a = result[i], b = result[(i + 1) % result.size()];
+// Calls f(point) for the vertices of `ring` and its points every `step` px along each edge
+// (edges in `skip` left out), in ring order, until f returns false.
+template <class F>
+void forEachSample(const core::Ring& ring, const EdgeSet* skip, double step, F&& f) {
+  for (size_t i = 0; i < ring.size(); ++i) {
+    const cv::Point2d a = ring[i], b = ring[(i + 1) % ring.size()];
     if (skip && skip->count(edgeKey(a, b))) continue;
     const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a) / step)));
     for (int s = 0; s < steps; ++s) {
-      worst = std::max(
-          worst, input.distance(a + (b - a) * (static_cast<double>(s) / steps), stopAbove + 1.0));
-      if (worst > stopAbove) return worst;
+      if (!f(a + (b - a) * (static_cast<double>(s) / steps))) return;
     }
   }
+}
+
+// Farthest sample of `result` (see forEachSample) from the outline `input`: exact up to
+// `stopAbove`; above it, the first sample's distance above `stopAbove`. The distance to the
+// input changes by at most as much as the sample moves, so a sample closer to the last measured
+// one than that one's margin below the maximum so far cannot raise the maximum and is not
+// measured; a first pass over every 8th sample finds a high maximum early. When that pass meets
+// a distance above `stopAbove`, every sample is measured in order (which one is first matters).
+double maxDeviation(const core::Ring& result, const EdgeGrid& input, double stopAbove,
+                    const EdgeSet* skip = nullptr, double step = 1.0) {
+  const double limit = stopAbove + 1.0;
+  double worst = 0;
+  size_t k = 0;
+  bool above = false;
+  forEachSample(result, skip, step, [&](cv::Point2d p) {
+    if (k++ % 8 == 0) worst = std::max(worst, input.distance(p, limit));
+    above = worst > stopAbove;
+    return !above;
+  });
+  if (above) {
+    worst = 0;
+    forEachSample(result, skip, step, [&](cv::Point2d p) {
+      worst = std::max(worst, input.distance(p, limit));
+      return worst <= stopAbove;
+    });
+    return worst;
+  }
+  cv::Point2d last(kInf, kInf);
+  double lastDistance = kInf;
+  forEachSample(result, skip, step, [&](cv::Point2d p) {
+    if (lastDistance + cv::norm(p - last) <= worst - 1e-9) return true;  // (rounding)
+    last = p;
+    lastDistance = input.distance(p, limit);
+    worst = std::max(worst, lastDistance);
+    return worst <= stopAbove;
+  });
   return worst;
 }
 
@@ -178,25 +286,31 @@ void outlineVotes(const core::Ring& ring, double epsilon, std::vector<Vote>& vot
   }
 }
 
-// Grey level of a single-channel image of any common depth, NaN as 0.
-double grey(const cv::Mat& image, int x, int y) {
-  switch (image.depth()) {
-    case CV_8U:
-      return image.at<uchar>(y, x);
-    case CV_16U:
-      return image.at<ushort>(y, x);
-    case CV_16S:
-      return image.at<short>(y, x);
-    case CV_32F: {
-      const float v = image.at<float>(y, x);
-      return std::isfinite(v) ? v : 0.0;
+// The 5x5 Sobel gradients at `count` (at most 5) pixels (xs[s], ys[s]) of a single-channel
+// image of pixel type T (NaN read as 0). Each pixel's sums run in the same order; the pixels
+// side by side let their sums proceed together.
+template <class T>
+void sobel5(const cv::Mat& image, const int* xs, const int* ys, int count, double* gx, double* gy) {
+  static const double w[5] = {1, 4, 6, 4, 1}, d[5] = {-1, -2, 0, 2, 1};
+  double v[5][5][5];  // [j][i][sample]
+  for (int s = 0; s < count; ++s) {
+    gx[s] = 0, gy[s] = 0;
+    for (int j = 0; j < 5; ++j) {
+      const T* row = image.ptr<T>(ys[s] + j - 2) + (xs[s] - 2);
+      for (int i = 0; i < 5; ++i) {
+        double value = row[i];
+        if constexpr (std::is_floating_point_v<T>) value = std::isfinite(value) ? value : 0.0;
+        v[j][i][s] = value;
+      }
     }
-    case CV_64F: {
-      const double v = image.at<double>(y, x);
-      return std::isfinite(v) ? v : 0.0;
+  }
+  for (int j = 0; j < 5; ++j) {
+    for (int i = 0; i < 5; ++i) {
+      for (int s = 0; s < count; ++s) {
+        gx[s] += w[j] * d[i] * v[j][i][s];
+        gy[s] += d[j] * w[i] * v[j][i][s];
+      }
     }
-    default:
-      return 0.0;
   }
 }
 
@@ -209,17 +323,16 @@ void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<
                 double& total) {
   std::vector<float> magnitudes;
   std::vector<Vote> local;
-  static const double w[5] = {1, 4, 6, 4, 1}, d[5] = {-1, -2, 0, 2, 1};
-  auto sample = [&](int x, int y, double along) {
-    if (x < 2 || y < 2 || x >= image.cols - 2 || y >= image.rows - 2) return;
-    double gx = 0, gy = 0;
-    for (int j = 0; j < 5; ++j) {
-      for (int i = 0; i < 5; ++i) {
-        const double v = grey(image, x + i - 2, y + j - 2);
-        gx += w[j] * d[i] * v;
-        gy += d[j] * w[i] * v;
-      }
-    }
+  void (*gradient)(const cv::Mat&, const int*, const int*, int, double*, double*) = nullptr;
+  switch (image.depth()) {
+    case CV_8U: gradient = sobel5<uchar>; break;
+    case CV_16U: gradient = sobel5<ushort>; break;
+    case CV_16S: gradient = sobel5<short>; break;
+    case CV_32F: gradient = sobel5<float>; break;
+    case CV_64F: gradient = sobel5<double>; break;
+    default: return;  // refused by regularizeOutline
+  }
+  auto sample = [&](double gx, double gy, double along) {
     const double m = std::hypot(gx, gy);
     magnitudes.push_back(static_cast<float>(m));
     // Only edges running along the outline (gradient across it, within 20°) vote: texture on
@@ -238,10 +351,16 @@ void imageVotes(const core::Polygon& outline, const cv::Mat& image, std::vector<
       const int steps = static_cast<int>(std::ceil(len / 2));
       for (int s = 0; s < steps; ++s) {
         const cv::Point2d p = a + (b - a) * (static_cast<double>(s) / steps);
+        int xs[5], ys[5], count = 0;
         for (int o = -2; o <= 2; ++o) {
           const cv::Point2d q = p + n * static_cast<double>(o);
-          sample(static_cast<int>(std::floor(q.x)), static_cast<int>(std::floor(q.y)), along);
+          const int x = static_cast<int>(std::floor(q.x)), y = static_cast<int>(std::floor(q.y));
+          if (x < 2 || y < 2 || x >= image.cols - 2 || y >= image.rows - 2) continue;
+          xs[count] = x, ys[count] = y, ++count;
         }
+        double gx[5], gy[5];
+        gradient(image, xs, ys, count, gx, gy);
+        for (int k = 0; k < count; ++k) sample(gx[k], gy[k], along);
       }
     }
   };
@@ -315,12 +434,18 @@ double votePeak(const std::vector<Vote>& votes) {
 // ---- Lines along the outline ----------------------------------------------------------------
 
 struct Line {
-  double angle = 0;      // direction of travel along the ring, radians
+  double angle = 0;      // direction of travel along the ring, radians (set with setAngle)
+  cv::Point2d dir{1, 0}, nrm{0, 1};  // direction(angle) and normal(angle), computed once
   double offset = 0;     // normal(angle) · p for the points p of the line
   double weight = 0;     // px of input outline behind it
   cv::Point2d centroid;  // length-weighted centre of that outline (offset = normal · centroid)
   cv::Point2d start;     // input point where its piece of outline starts (connectors go there)
   bool fixed = false;    // along the image border: keeps its direction and offset
+  void setAngle(double a) {
+    angle = a;
+    dir = direction(a);
+    nrm = normal(a);
+  }
 };
 
 bool parallel(const Line& a, const Line& b) {
@@ -339,14 +464,14 @@ Line merged(const Line& a, const Line& b) {
                wb = m.weight > 0 ? b.weight : 0.5;
   m.centroid = (a.centroid * wa + b.centroid * wb) / w;
   const cv::Point2d d =
-      direction(a.angle) * wa + direction(b.angle) * wb;  // same angle when snapped
-  m.angle = std::atan2(d.y, d.x);
-  m.offset = normal(m.angle).dot(m.centroid);
+      a.dir * wa + b.dir * wb;  // same angle when snapped
+  m.setAngle(std::atan2(d.y, d.x));
+  m.offset = m.nrm.dot(m.centroid);
   return m;
 }
 
 cv::Point2d intersection(const Line& a, const Line& b) {
-  const cv::Point2d na = normal(a.angle), nb = normal(b.angle);
+  const cv::Point2d na = a.nrm, nb = b.nrm;
   const double det = cross(na, nb);
   return {(a.offset * nb.y - b.offset * na.y) / det, (na.x * b.offset - nb.x * a.offset) / det};
 }
@@ -363,7 +488,7 @@ core::Ring vertices(const std::vector<Line>& lines) {
 std::vector<double> edgeLengths(const std::vector<Line>& lines, const core::Ring& ring) {
   std::vector<double> out(lines.size());
   for (size_t k = 0; k < lines.size(); ++k)
-    out[k] = direction(lines[k].angle).dot(ring[(k + 1) % ring.size()] - ring[k]);
+    out[k] = lines[k].dir.dot(ring[(k + 1) % ring.size()] - ring[k]);
   return out;
 }
 
@@ -372,22 +497,27 @@ std::vector<double> edgeLengths(const std::vector<Line>& lines, const core::Ring
 // opposite directions (a zero-width spike or slit) → both removed. False when fewer than
 // `minLines` remain.
 bool tidy(std::vector<Line>& lines, bool connectors, size_t minLines) {
+  // Each pass handles the first parallel pair from the start of the ring. A change at (i, i+1)
+  // leaves the pairs before i-1 as they were (non-parallel), so the next pass resumes at i-1;
+  // a change across the ring's end (j = 0) moves every index and starts over.
+  size_t resume = 0;
   for (size_t guard = 0; guard < 4 * lines.size() + 8 && lines.size() >= minLines; ++guard) {
     bool changed = false;
-    for (size_t i = 0; i < lines.size() && lines.size() >= minLines; ++i) {
+    for (size_t i = std::min(resume, lines.size()); i < lines.size() && lines.size() >= minLines; ++i) {
       const size_t j = (i + 1) % lines.size();
+      resume = j == 0 ? 0 : (i > 0 ? i - 1 : 0);
       if (!parallel(lines[i], lines[j])) continue;
       if (!sameDirection(lines[i], lines[j])) {
         const size_t first = std::max(i, j), second = std::min(i, j);
         lines.erase(lines.begin() + static_cast<long>(first));
         lines.erase(lines.begin() + static_cast<long>(second));
       } else {
-        const double gap = normal(lines[i].angle).dot(lines[j].centroid) - lines[i].offset;
+        const double gap = lines[i].nrm.dot(lines[j].centroid) - lines[i].offset;
         if (connectors && std::abs(gap) > kJogMerge) {
           Line c;
-          c.angle = lines[i].angle + (gap > 0 ? kPi / 2 : -kPi / 2);
+          c.setAngle(lines[i].angle + (gap > 0 ? kPi / 2 : -kPi / 2));
           c.start = c.centroid = lines[j].start;
-          c.offset = normal(c.angle).dot(c.centroid);
+          c.offset = c.nrm.dot(c.centroid);
           lines.insert(lines.begin() + static_cast<long>(i) + 1, c);
         } else {
           lines[i] = merged(lines[i], lines[j]);
@@ -447,10 +577,29 @@ std::vector<size_t> breakpoints(const core::Ring& ring, double epsilon) {
   return out;
 }
 
+// Per edge k of a ring (from vertex k to k+1): its norm, and the length-weighted doubled-angle
+// terms of its axis; computed once per ring for all the pieces and candidates that sum them.
+struct RingEdgeTerms {
+  std::vector<double> norm, len, s2, c2;
+  explicit RingEdgeTerms(const core::Ring& ring) {
+    const size_t n = ring.size();
+    norm.resize(n), len.resize(n), s2.resize(n), c2.resize(n);
+    for (size_t k = 0; k < n; ++k) {
+      const cv::Point2d e = ring[(k + 1) % n] - ring[k];
+      norm[k] = cv::norm(e);
+      len[k] = std::hypot(e.x, e.y);
+      const double a = std::atan2(e.y, e.x);
+      s2[k] = len[k] * std::sin(2 * a);
+      c2[k] = len[k] * std::cos(2 * a);
+    }
+  }
+};
+
 struct RingContext {
   RegularizationMode mode;
   double theta;     // dominant orientation, radians in [0, π/2)
   cv::Size bounds;  // image size, or empty
+  const RingEdgeTerms* edges = nullptr;  // of the ring being regularized
 };
 
 // The allowed direction nearest to `angle`; any-angle mode snaps only within kParallelAngle.
@@ -485,12 +634,12 @@ bool borderLine(const core::Ring& ring, size_t i0, size_t i1, const RingContext&
     if (!all) continue;
     const cv::Point2d chord = ring[i1] - ring[i0];
     const bool vertical = side < 2;
-    line.angle = vertical ? (chord.y >= 0 ? kPi / 2 : -kPi / 2) : (chord.x >= 0 ? 0.0 : kPi);
+    line.setAngle(vertical ? (chord.y >= 0 ? kPi / 2 : -kPi / 2) : (chord.x >= 0 ? 0.0 : kPi));
     line.centroid = side == 0   ? cv::Point2d(0, 0)
                     : side == 1 ? cv::Point2d(w, 0)
                     : side == 2 ? cv::Point2d(0, 0)
                                 : cv::Point2d(0, h);
-    line.offset = normal(line.angle).dot(line.centroid);
+    line.offset = line.nrm.dot(line.centroid);
     line.fixed = true;
     return true;
   }
@@ -503,35 +652,33 @@ bool borderLine(const core::Ring& ring, size_t i0, size_t i1, const RingContext&
 // across the edge do not pull it).
 Line lineOfPiece(const core::Ring& ring, size_t i0, size_t i1, const RingContext& ctx) {
   const size_t n = ring.size();
+  const RingEdgeTerms& edges = *ctx.edges;
   Line line;
   line.start = ring[i0];
-  for (size_t k = i0; k != i1; k = (k + 1) % n)
-    line.weight += cv::norm(ring[(k + 1) % n] - ring[k]);
+  for (size_t k = i0; k != i1; k = (k + 1) % n) line.weight += edges.norm[k];
   if (borderLine(ring, i0, i1, ctx, line)) return line;
   double s2 = 0, c2 = 0;
   for (size_t k = i0; k != i1; k = (k + 1) % n) {
-    const cv::Point2d e = ring[(k + 1) % n] - ring[k];
-    const double len = std::hypot(e.x, e.y), a = std::atan2(e.y, e.x);
-    s2 += len * std::sin(2 * a);
-    c2 += len * std::cos(2 * a);
+    s2 += edges.s2[k];
+    c2 += edges.c2[k];
   }
   double angle = 0.5 * std::atan2(s2, c2);
   if (direction(angle).dot(ring[i1] - ring[i0]) < 0) angle += kPi;
-  line.angle = snapped(angle, ctx);
+  line.setAngle(snapped(angle, ctx));
   cv::Point2d sum(0, 0);
   double weight = 0;
   for (int pass = 0; pass < 2 && weight == 0; ++pass) {
     for (size_t k = i0; k != i1; k = (k + 1) % n) {
       const cv::Point2d e = ring[(k + 1) % n] - ring[k];
-      const double len = std::hypot(e.x, e.y);
+      const double len = edges.len[k];
       if (len < 1e-9) continue;
-      if (pass == 0 && direction(line.angle).dot(e) < std::cos(kPi / 6) * len) continue;
+      if (pass == 0 && line.dir.dot(e) < std::cos(kPi / 6) * len) continue;
       sum += len * 0.5 * (ring[k] + ring[(k + 1) % n]);
       weight += len;
     }
   }
   line.centroid = weight > 0 ? sum / weight : 0.5 * (ring[i0] + ring[i1]);
-  line.offset = normal(line.angle).dot(line.centroid);
+  line.offset = line.nrm.dot(line.centroid);
   return line;
 }
 
@@ -545,7 +692,7 @@ void addPieceLines(const core::Ring& ring, size_t i0, size_t i1, const RingConte
   const Line line = lineOfPiece(ring, i0, i1, ctx);
   const size_t span = (i1 + n - i0) % n;
   if (span >= 2 && !line.fixed && depth < 12) {
-    const cv::Point2d nrm = normal(line.angle);
+    const cv::Point2d nrm = line.nrm;
     double far = 0;
     for (size_t k = i0;; k = (k + 1) % n) {
       far = std::max(far, std::abs(nrm.dot(ring[k]) - line.offset));
@@ -585,7 +732,7 @@ bool insideBounds(const core::Ring& ring, cv::Size bounds) {
 
 // isSimple() for a ring whose edges in `unchanged` are known not to cross each other: only the
 // other edges are tested (against all).
-bool simpleAround(const core::Ring& ring, const std::set<EdgeKey>& unchanged) {
+bool simpleAround(const core::Ring& ring, const EdgeSet& unchanged) {
   const size_t n = ring.size();
   if (n < 3) return false;
   for (size_t i = 0; i < n; ++i) {
@@ -609,9 +756,10 @@ bool simpleAround(const core::Ring& ring, const std::set<EdgeKey>& unchanged) {
 void removeShortEdges(std::vector<Line>& lines, const EdgeGrid& input,
                       const RegularizationParams& params, const RingContext& ctx, size_t minLines) {
   std::set<std::array<EdgeKey, 3>> failed;
+  EdgeSet unchanged;
   for (size_t round = 0; round < 4 * input.ring().size() + 16; ++round) {
     const core::Ring ring = vertices(lines);
-    std::set<EdgeKey> unchanged;
+    unchanged.reset(ring.size());
     for (size_t i = 0; i < ring.size(); ++i)
       unchanged.insert(edgeKey(ring[i], ring[(i + 1) % ring.size()]));
     const std::vector<double> lengths = edgeLengths(lines, ring);
@@ -715,8 +863,11 @@ RingCandidate regularizeRing(const core::Ring& input, const RegularizationParams
   }
   RingCandidate best, firstFailure;
   const EdgeGrid grid(input);
+  const RingEdgeTerms edges(input);
+  RingContext ringCtx = ctx;
+  ringCtx.edges = &edges;
   for (double e : epsilons) {
-    RingCandidate c = regularizeRingAt(input, grid, e, params, ctx);
+    RingCandidate c = regularizeRingAt(input, grid, e, params, ringCtx);
     if (!c.failure.empty()) {
       if (firstFailure.failure.empty()) firstFailure = std::move(c);
       continue;
@@ -796,6 +947,39 @@ bool hasThinParts(const core::Ring& ring, double width) {
   return false;
 }
 
+// True when an 8-connected component of the non-zero pixels of `mask` (CV_8U) has at least
+// `area` pixels. A flood fill from each pixel not yet reached, stopped at that size: the changed
+// pixels of an opening are few and scattered along the outline, and labelling the whole raster
+// (connectedComponentsWithStats) cost more than the rest of the stage on a large roof.
+bool hasComponentOfArea(const cv::Mat& mask, double area) {
+  cv::Mat seen = cv::Mat::zeros(mask.size(), CV_8U);
+  std::vector<cv::Point> stack;
+  for (int y = 0; y < mask.rows; ++y) {
+    const uchar* m = mask.ptr<uchar>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      if (!m[x] || seen.at<uchar>(y, x)) continue;
+      int count = 0;
+      seen.at<uchar>(y, x) = 1;
+      stack.assign(1, cv::Point(x, y));
+      while (!stack.empty()) {
+        const cv::Point p = stack.back();
+        stack.pop_back();
+        if (++count >= area) return true;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int qx = p.x + dx, qy = p.y + dy;
+            if (qx < 0 || qy < 0 || qx >= mask.cols || qy >= mask.rows) continue;
+            if (!mask.at<uchar>(qy, qx) || seen.at<uchar>(qy, qx)) continue;
+            seen.at<uchar>(qy, qx) = 1;
+            stack.emplace_back(qx, qy);
+          }
+        }
+      }
+    }
+  }
+  return false;
+}
+
 bool withoutThinParts(const core::Polygon& in, double minWidth, core::Polygon& out) {
   const int r = static_cast<int>(std::floor(minWidth / 2));
   if (r < 1) return false;
@@ -816,12 +1000,7 @@ bool withoutThinParts(const core::Polygon& in, double minWidth, core::Polygon& o
   const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1});
   cv::morphologyEx(mask, cleaned, cv::MORPH_OPEN, disk);
   cv::morphologyEx(cleaned, cleaned, cv::MORPH_CLOSE, disk);
-  cv::Mat changed = mask != cleaned, labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(changed, labels, stats, centroids, 8);
-  bool thin = false;
-  for (int i = 1; i < n && !thin; ++i)
-    thin = stats.at<int>(i, cv::CC_STAT_AREA) >= minWidth * minWidth;
-  if (!thin) return false;
+  if (!hasComponentOfArea(mask != cleaned, minWidth * minWidth)) return false;
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;
   cv::findContours(cleaned, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);

@@ -133,6 +133,23 @@ TEST(BoxFitting, RotatedBoxFollowsItsOrientation) {
   EXPECT_NEAR(b.diagnostics.mainOrientationDeg, 27.0, 2.0);
 }
 
+TEST(BoxFitting, AStreakOfRoofHeightsBeyondTheInitStaysOutOfTheOutline) {
+  // A matcher spreads the roof's disparity along the rows past the wall (an occlusion filled
+  // from the roof, a facade): heights at roof level 24 px beyond the east wall, where the image
+  // shows ground. The segment stops at the operator's rectangle (10 px past the wall) and the
+  // east side snaps back onto the wall's edge, within snap-inward.
+  const core::Polygon truth = rectangle(50, 50, 90, 60);
+  Scene s = makeScene(kSize, {truth});
+  const cv::Mat streak = core::rasterize(rectangle(140, 50, 24, 60), kSize);
+  cv::Mat raised = s.heights + 9.0;
+  raised.copyTo(s.heights, streak);
+  const BoxFitBuilding b = fitOne(s, roughBox(truth, 10));
+  EXPECT_GT(iou(b.outline, truth, kSize), 0.93);
+  double east = 0;
+  for (const auto& v : b.outline.outer) east = std::max(east, v.x);
+  EXPECT_LT(east, 145.0);  // the wall at 140 (158 when the segment reached 8 px past the init)
+}
+
 TEST(BoxFitting, TwoBuildingsInTheWholeImageWithoutAnInit) {
   const core::Polygon a = rectangle(20, 20, 70, 50), c = rectangle(120, 90, 70, 60);
   const Scene s = makeScene(kSize, {a, c});

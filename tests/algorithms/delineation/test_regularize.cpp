@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
+#include "delineo/core/geometry.hpp"
 #include "delineo/delineation/regularize.hpp"
 
 using namespace delineo;
@@ -302,6 +305,50 @@ TEST(Regularize, TakesAFewMillisecondsAtMost) {
   EXPECT_EQ(r.status, RegularizationStatus::Regularized) << r.reason;
   EXPECT_LT(ms, 50.0) << ms;  // the target is 5 ms; loose for debug and sanitizer builds
   std::printf("regularization of a 320-vertex outline: %.2f ms CPU\n", ms);
+}
+
+// The slowest case of the labelled real roofs: the raw outline of a 665 px long roof (Toulouse
+// 0032, t32_middle from the box + 30 px) with thin parts, a slit and a hole, along the image
+// border: the thin-part raster and the many-vertex outline it gives.
+TEST(Regularize, ALongRaggedRoofWithThinPartsTakesAFewMilliseconds) {
+  const core::Ring outer{
+      {400, 0},   {401, 136}, {400, 223}, {400, 258}, {407, 258}, {407, 376}, {400, 376}, {400, 607},
+      {445, 607}, {445, 639}, {447, 639}, {447, 665}, {551, 665}, {543, 623}, {579, 623}, {544, 554},
+      {578, 538}, {582, 537}, {590, 535}, {561, 414}, {554, 380}, {538, 387}, {532, 373}, {589, 345},
+      {523, 345}, {523, 343}, {546, 343}, {546, 312}, {544, 312}, {544, 271}, {592, 208}, {598, 200},
+      {606, 206}, {621, 185}, {618, 107}, {657, 62},  {645, 50},  {642, 47},  {630, 59},  {625, 54},
+      {619, 48},  {619, 22},  {620, 22},  {620, 0},   {511, 6},   {511, 0},   {502, 0},   {502, 4},
+      {435, 4},   {435, 0}};
+  const core::Polygon input{outer, {{{539, 388}, {534, 388}, {534, 428}, {539, 428}}}};
+  // The roof bright on a darker ground, with a texture (integer grey levels, as 8-bit imagery).
+  cv::Mat image(800, 1000, CV_32F);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) image.at<float>(y, x) = static_cast<float>(80 + (x * 7 + y * 13) % 23);
+  }
+  image.setTo(170, core::rasterize(input, image.size()));
+  auto cpuMs = [] {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+  };
+  double best = 1e300;
+  RegularizationOutcome r;
+  for (int run = 0; run < 10; ++run) {  // best of 10: the machine may be shared
+    const double t0 = cpuMs();
+    r = regularizeOutline(input, RegularizationParams{}, image);
+    best = std::min(best, cpuMs() - t0);
+  }
+  // The raw outline strays from any clean shape: the gate keeps it and says why.
+  EXPECT_EQ(r.status, RegularizationStatus::KeptRaw);
+  EXPECT_NE(r.reason.find("deviation"), std::string::npos) << r.reason;
+#if defined(NDEBUG) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+  // The target is 5 ms per building; CPU time on a 2-core machine shared with other builds
+  // varies by half (4.1-6.7 ms measured for this case, the former code 8.9-12.2 ms).
+  EXPECT_LT(best, 8.0) << best;
+#else
+  EXPECT_LT(best, 100.0) << best;
+#endif
+  std::printf("regularization of the long ragged roof: %.2f ms CPU (best of 10)\n", best);
 }
 
 TEST(Regularize, EditingHelpersKeepTheAngles) {

@@ -41,6 +41,7 @@ struct BoxFitDiagnostics {
   double groundHeight = 0.0;  // median local ground in the ROI (m)
   double roofHeight = 0.0;    // roof height above the local ground used for the threshold (m)
   double threshold = 0.0;     // local threshold above the ground (m)
+  cv::Mat aboveGround;        // CV_32F, ROI size: heights above the local ground (m)
   int segmentArea = 0;        // px
   cv::Mat segment;            // CV_8U, ROI size, 255 on the building segment
   // Seeds.

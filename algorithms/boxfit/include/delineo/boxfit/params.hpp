@@ -16,7 +16,7 @@ struct BoxFitParams {
   double roofBand = 0.5;           // heights above (1 + this) x roof + min-height: another building
   int erosionRadius = 2;           // px, disk separating touching segments (paper: 2)
   int minArea = 500;               // px, smaller segments are dropped (paper: 500)
-  int leash = 8;                   // px the segment may reach outside the initial polygon
+  int leash = 0;                   // px the segment may reach outside the initial polygon (0: inside)
   int roiMargin = 24;              // px added around the initial polygon (or segment)
   // Seeds (the paper: skeleton, junctions, pieces of 20 px, centres of mass).
   int pieceLength = 20;         // px, skeleton pieces between junctions (paper: 20)
@@ -76,7 +76,9 @@ struct BoxFitParams {
                 "Segments smaller than this after the erosion are dropped (paper: 500)", 1, 1e8},
       minArea);
     v(ParamInfo{"leash", "Leash", "px",
-                "Farthest the building segment may reach outside the initial polygon", 0, 10000},
+                "Farthest the building segment may reach outside the initial polygon (0 = it "
+                "stays inside)",
+                0, 10000},
       leash);
     v(ParamInfo{"roi-margin", "ROI margin", "px",
                 "Margin added around the initial polygon (or segment) to make the region of "
