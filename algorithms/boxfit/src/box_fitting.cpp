@@ -170,6 +170,15 @@ bool fitOne(const cv::Mat& above, const cv::Mat& initMask, double roofHeight, co
   return true;
 }
 
+// The building's boxes reduced to those its outline is made of (after the whole-image check,
+// which reads every box's energy).
+void keepEssentialBoxes(BoxFitBuilding& building) {
+  const cv::Point2d offset(building.roi.x, building.roi.y);
+  for (auto& b : building.boxes) b.centre -= offset;
+  building.boxes = essentialBoxes(building.boxes, building.roi.size());
+  for (auto& b : building.boxes) b.centre += offset;
+}
+
 }  // namespace
 
 BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFitRequest& request,
@@ -208,6 +217,7 @@ BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFit
     building.diagnostics.groundHeight = groundMedian;
     std::string why;
     if (fitOne(above, initMask, roof, image, roi, size, params, progress, building, why, result.status)) {
+      keepEssentialBoxes(building);
       result.buildings.push_back(std::move(building));
     } else {
       result.message = why;
@@ -249,7 +259,10 @@ BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFit
       // follows straight edges (a tree crown, a heap) is not one.
       const bool straight = std::any_of(building.boxes.begin(), building.boxes.end(),
                                         [&](const Box& b) { return b.energy <= params.maxEnergy; });
-      if (straight) result.buildings.push_back(std::move(building));
+      if (straight) {
+        keepEssentialBoxes(building);
+        result.buildings.push_back(std::move(building));
+      }
     }
     if (result.status == core::RunStatus::Canceled) break;
   }

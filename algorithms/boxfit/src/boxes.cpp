@@ -273,6 +273,33 @@ core::Ring Box::corners() const {
   return {centre - a - b, centre + a - b, centre + a + b, centre - a + b};
 }
 
+core::Ring Box::cornersWithin(cv::Size size) const {
+  // Sutherland-Hodgman against the four sides of the image.
+  core::Ring ring = corners();
+  const auto clip = [&ring](auto inside, auto cross) {
+    core::Ring out;
+    for (size_t i = 0; i < ring.size(); ++i) {
+      const cv::Point2d& a = ring[i];
+      const cv::Point2d& b = ring[(i + 1) % ring.size()];
+      if (inside(a)) out.push_back(a);
+      if (inside(a) != inside(b)) out.push_back(cross(a, b));
+    }
+    ring = std::move(out);
+  };
+  const double w = size.width, h = size.height;
+  const auto atX = [](double x) {
+    return [x](const cv::Point2d& a, const cv::Point2d& b) { return cv::Point2d(x, a.y + (x - a.x) * (b.y - a.y) / (b.x - a.x)); };
+  };
+  const auto atY = [](double y) {
+    return [y](const cv::Point2d& a, const cv::Point2d& b) { return cv::Point2d(a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y), y); };
+  };
+  clip([](const cv::Point2d& p) { return p.x >= 0.0; }, atX(0.0));
+  clip([w](const cv::Point2d& p) { return p.x <= w; }, atX(w));
+  clip([](const cv::Point2d& p) { return p.y >= 0.0; }, atY(0.0));
+  clip([h](const cv::Point2d& p) { return p.y <= h; }, atY(h));
+  return ring.size() >= 3 ? ring : core::Ring{};
+}
+
 BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges, const std::vector<Seed>& seeds,
                         const BoxFitParams& params, const cv::Vec4b& imageBorder, core::Progress* progress) {
   BoxFitting out;

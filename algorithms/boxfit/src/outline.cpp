@@ -318,4 +318,26 @@ core::Polygon mergeBoxes(const std::vector<Box>& boxes, cv::Size roiSize, const 
   return polygon;
 }
 
+std::vector<Box> essentialBoxes(const std::vector<Box>& boxes, cv::Size roiSize, double minShare) {
+  std::vector<size_t> order(boxes.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return boxes[a].area() > boxes[b].area(); });
+  cv::Mat covered = cv::Mat::zeros(roiSize, CV_8U), box = cv::Mat::zeros(roiSize, CV_8U);
+  std::vector<bool> keep(boxes.size(), false);
+  for (size_t i : order) {
+    box.setTo(0);
+    fillConvex(box, boxes[i].corners());
+    const int own = cv::countNonZero(box);
+    const int added = own - cv::countNonZero(box & covered);
+    if (own == 0 || added < minShare * own) continue;
+    keep[i] = true;
+    covered |= box;
+  }
+  std::vector<Box> kept;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (keep[i]) kept.push_back(boxes[i]);
+  }
+  return kept;
+}
+
 }  // namespace delineo::boxfit

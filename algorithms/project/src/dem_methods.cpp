@@ -66,7 +66,10 @@ BoxFitOutcome fitBuildingBoxes(const Project& project, const Building& building,
     const boxfit::BoxFitBuilding& fitted = result.buildings.front();
     outcome.outline = fitted.outline;
     outcome.energy = fitted.energy;
-    for (const boxfit::Box& box : fitted.boxes) outcome.boxes.push_back({box.corners(), box.energy});
+    for (const boxfit::Box& box : fitted.boxes) {
+      core::Ring corners = box.cornersWithin(heights.size());
+      if (!corners.empty()) outcome.boxes.push_back({std::move(corners), box.energy});
+    }
   }
   return outcome;
 #else

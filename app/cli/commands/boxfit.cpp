@@ -83,11 +83,13 @@ core::Feature outlineFeature(const boxfit::BoxFitBuilding& b, long long id) {
   return f;
 }
 
-void appendBoxes(const boxfit::BoxFitBuilding& b, long long id, std::vector<core::Feature>& out) {
+// The boxes of building `id`, each clipped to the image of `size` (attributes: the whole box).
+void appendBoxes(const boxfit::BoxFitBuilding& b, long long id, cv::Size size, std::vector<core::Feature>& out) {
   long long k = 0;
   for (const auto& box : b.boxes) {
     core::Feature f;
-    f.polygon.outer = box.corners();
+    f.polygon.outer = box.cornersWithin(size);
+    if (f.polygon.outer.empty()) continue;
     f.attributes["building_id"] = id;
     f.attributes["box"] = ++k;
     f.attributes["angle_deg"] = box.angleDeg;
@@ -141,7 +143,7 @@ int run(const std::vector<std::string>& args) {
     long long id = 0;
     for (const auto& b : r.buildings) {
       outlines.push_back(outlineFeature(b, ++id));
-      appendBoxes(b, id, boxes);
+      appendBoxes(b, id, image.size(), boxes);
     }
   }
   const size_t count = inits.size();
@@ -158,7 +160,7 @@ int run(const std::vector<std::string>& args) {
       canceled = r.status == core::RunStatus::Canceled;
       if (!r.buildings.empty()) {
         outlines.push_back(outlineFeature(r.buildings.front(), id));
-        appendBoxes(r.buildings.front(), id, boxes);
+        appendBoxes(r.buildings.front(), id, image.size(), boxes);
         continue;
       }
       error = canceled ? "canceled" : r.message;

@@ -335,3 +335,42 @@ TEST(BoxFitStages, AWingNoBoxCoversGetsASeedOfItsOwn) {
   wing.centre = {67.5, 100}, wing.length = 55, wing.width = 40;
   EXPECT_TRUE(uncoveredSeeds(segment, {all, wing}, BoxFitParams{}).empty());
 }
+
+TEST(BoxFitStages, BoxesOthersCoverAreLeftOutOfTheBuildingsBoxes) {
+  // An L's two boxes, and six smaller boxes inside them (seeds along one arm's skeleton grow
+  // boxes that the arm's box covers): only the two remain, in their input order.
+  Box a, b;
+  a.centre = {100, 50}, a.length = 120, a.width = 40, a.angleDeg = 0;
+  b.centre = {60, 100}, b.length = 40, b.width = 120, b.angleDeg = 0;
+  std::vector<Box> boxes;
+  for (int i = 0; i < 6; ++i) {
+    Box inner = a;
+    inner.centre.x = 60 + 16 * i;
+    inner.length = 30, inner.width = 36 - i;
+    boxes.push_back(inner);
+  }
+  boxes.insert(boxes.begin() + 2, b);
+  boxes.push_back(a);
+  const std::vector<Box> kept = essentialBoxes(boxes, {200, 200});
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_EQ(kept[0].centre, b.centre);
+  EXPECT_EQ(kept[1].centre, a.centre);
+  // A box that adds a visible part of its own is kept.
+  Box wing = a;
+  wing.centre = {175, 50}, wing.length = 60;  // half of it beyond a's end
+  EXPECT_EQ(essentialBoxes({a, b, wing}, {200, 200}).size(), 3u);
+}
+
+TEST(BoxFitStages, ABoxIsClippedToTheImage) {
+  Box box;
+  box.centre = {190, 50}, box.length = 40, box.width = 20, box.angleDeg = 0;
+  const core::Ring inside = box.cornersWithin({200, 100});
+  ASSERT_GE(inside.size(), 4u);
+  for (const auto& p : inside) EXPECT_LE(p.x, 200.0);
+  EXPECT_NEAR(std::abs(core::signedArea(inside)), 30.0 * 20.0, 1e-6);
+  // Rotated and crossing a corner: still inside, and a box wholly outside has nothing left.
+  box.centre = {5, 5}, box.angleDeg = 30;
+  for (const auto& p : box.cornersWithin({200, 100})) EXPECT_TRUE(p.x >= 0 && p.y >= 0) << p;
+  box.centre = {-100, -100};
+  EXPECT_TRUE(box.cornersWithin({200, 100}).empty());
+}

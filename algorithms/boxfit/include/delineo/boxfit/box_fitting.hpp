@@ -32,6 +32,9 @@ struct Box {
                         // segment-weight x edge-cap where the segment disagrees with a side)
   cv::Point2d seed;     // the skeleton seed it grew from
   core::Ring corners() const;  // four corners, counter-clockwise on screen
+  // The part of the box inside an image of `size` (a box may reach past the border of an image
+  // that cuts the building): its corners clipped to [0, width] x [0, height]; empty when none.
+  core::Ring cornersWithin(cv::Size size) const;
   double area() const { return length * width; }
 };
 
@@ -63,7 +66,9 @@ struct BoxFitDiagnostics {
 
 struct BoxFitBuilding {
   core::Polygon outline;    // left-image pixels, holes for courtyards
-  std::vector<Box> boxes;   // the merged boxes (dropped ones excluded)
+  // The boxes the outline is made of: those another box (or several) covers to within
+  // 5 % of their area are left out, as are dropped ones.
+  std::vector<Box> boxes;
   double energy = 0.0;      // area-weighted mean energy of the boxes (px)
   cv::Rect roi;             // where it was computed
   BoxFitDiagnostics diagnostics;

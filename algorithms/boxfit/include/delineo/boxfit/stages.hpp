@@ -106,4 +106,9 @@ core::Polygon mergeBoxes(const std::vector<Box>& boxes, cv::Size roiSize,
                          const BoxFitParams& params, const cv::Mat& segment = {},
                          int* mergedArea = nullptr);
 
+// The boxes an outline is made of: largest first, a box is kept when it covers at least
+// `minShare` of its own area that the boxes kept before it do not (the others add nothing an
+// operator could see). ROI coordinates; the order of the kept boxes is the input's.
+std::vector<Box> essentialBoxes(const std::vector<Box>& boxes, cv::Size roiSize, double minShare = 0.05);
+
 }  // namespace delineo::boxfit
