@@ -173,6 +173,13 @@ TEST(RowOrderedTasks, TasksOnTilesRunInOrderWhereTheyShareOne) {
           for (size_t j = 0; j < k; ++j) {
             if (shares(j, k) && !finished[j]) ++startedTooEarly;
           }
+          // The first task waits (up to 2 s) for the second, which shares no tile with it, to
+          // start on the other thread: a loaded machine may start the helper late.
+          const auto start = std::chrono::steady_clock::now();
+          while (k == 0 && helpers > 0 && concurrent.load() < 2 &&
+                 std::chrono::steady_clock::now() - start < std::chrono::seconds(2)) {
+            std::this_thread::yield();
+          }
           std::this_thread::sleep_for(std::chrono::microseconds(500));
           {
             std::lock_guard<std::mutex> lock(logsMutex);
