@@ -3,7 +3,8 @@
 // roof interval, the active polygon's outline before and after its last stage (regularization),
 // and a naive baseline: the matcher's disparities inside the rectangle thresholded at the roof
 // interval, closed then opened 7x7, largest component, polygonised (1 px). Prints IoU against the
-// labelled outline and vertex counts; `--dump DIR` draws them over the left image (labelled
+// labelled outline and vertex counts; `--dump DIR` draws them over the left image, one PNG a roof,
+// and `--montage FILE` all roofs in one picture (labelled
 // green, rectangle blue, naive cyan, raw yellow, regularized red). Skips cleanly (exit 0) when the
 // data folder is missing. Disparity maps are cached as in bench_roof_interval. The matcher's map is
 // also the request's disparity map (the other-height class); BENCH_NO_MAP=1 leaves it out.
@@ -71,8 +72,8 @@ core::Polygon naiveOutline(const cv::Mat& disparity, const core::Polygon& rect, 
   return p;
 }
 
-void dump(const std::string& path, const cv::Mat& left, const cv::Rect& box,
-          const std::vector<std::pair<core::Polygon, cv::Scalar>>& outlines) {
+cv::Mat drawOutlines(const cv::Mat& left, const cv::Rect& box,
+                     const std::vector<std::pair<core::Polygon, cv::Scalar>>& outlines) {
   const cv::Rect crop = cv::Rect(box.x - 10, box.y - 10, box.width + 20, box.height + 20) &
                         cv::Rect(0, 0, left.cols, left.rows);
   const int k = std::max(1, std::min(4, 900 / std::max(crop.width, crop.height)));
@@ -92,7 +93,37 @@ void dump(const std::string& path, const cv::Mat& left, const cv::Rect& box,
     if (p.outer.size() >= 3) ring(p.outer);
     for (const auto& h : p.holes) ring(h);
   }
-  cv::imwrite(path, img);
+  return img;
+}
+
+// One picture of every roof's panel, each scaled to `height` px and named, `columns` a row.
+cv::Mat montage(const std::vector<std::pair<std::string, cv::Mat>>& panels, int height, int columns) {
+  std::vector<cv::Mat> rows, row;
+  int rowWidth = 0, widest = 0;
+  const auto closeRow = [&] {
+    if (row.empty()) return;
+    cv::Mat r;
+    cv::hconcat(row, r);
+    rows.push_back(r);
+    widest = std::max(widest, r.cols);
+    row.clear(), rowWidth = 0;
+  };
+  for (const auto& [name, panel] : panels) {
+    cv::Mat scaled;
+    cv::resize(panel, scaled, {std::max(1, panel.cols * height / panel.rows), height}, 0, 0, cv::INTER_AREA);
+    cv::copyMakeBorder(scaled, scaled, 22, 4, 4, 4, cv::BORDER_CONSTANT, cv::Scalar(255, 255, 255));
+    cv::putText(scaled, name, {6, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    row.push_back(scaled);
+    rowWidth += scaled.cols;
+    if (static_cast<int>(row.size()) == columns) closeRow();
+  }
+  closeRow();
+  for (cv::Mat& r : rows) {
+    if (r.cols < widest) cv::copyMakeBorder(r, r, 0, 0, 0, widest - r.cols, cv::BORDER_CONSTANT, cv::Scalar(255, 255, 255));
+  }
+  cv::Mat all;
+  if (!rows.empty()) cv::vconcat(rows, all);
+  return all;
 }
 
 double cpuMs() {
@@ -234,7 +265,8 @@ int main(int argc, char** argv) {
   std::string dataRoot = "/work/shared/data";
   std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
   std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
-  std::string dumpDir;
+  std::string dumpDir, montagePath;
+  std::vector<std::pair<std::string, cv::Mat>> panels;
   int grow = 30;
   // --ground: the request's ground interval: "estimated" (none given: the active polygon's own
   // estimate), "proposed" (estimateGroundLevel on the matcher's map ± ground-tolerance) or
@@ -251,6 +283,8 @@ int main(int argc, char** argv) {
       cache = argv[++i];
     } else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) {
       dumpDir = argv[++i];
+    } else if (!std::strcmp(argv[i], "--montage") && i + 1 < argc) {
+      montagePath = argv[++i];
     } else if (!std::strcmp(argv[i], "--grow") && i + 1 < argc) {
       grow = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--ground") && i + 1 < argc) {
@@ -267,7 +301,7 @@ int main(int argc, char** argv) {
       std::fprintf(
           stderr,
           "usage: bench_real_outlines [--data DIR] [--labels real_roofs.json] [--cache DIR] "
-          "[--grow PX] [--tolerances A,B,...] [--dump DIR] [--diag] [--ground estimated|proposed|reference]\n");
+          "[--grow PX] [--tolerances A,B,...] [--dump DIR] [--montage FILE.png] [--diag] [--ground estimated|proposed|reference]\n");
       return 2;
     }
   }
@@ -421,16 +455,20 @@ int main(int argc, char** argv) {
       set.regularized += r.regularization.status == delineation::RegularizationStatus::Regularized;
       regMs.push_back(ms);
       ++runs;
-      if (!dumpDir.empty()) {
-        fs::create_directories(dumpDir);
-        dump((fs::path(dumpDir) / (name + ".png")).string(), lefts[pairName],
-             cv::Rect(static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(x1 - x0),
-                      static_cast<int>(y1 - y0)),
-             {{rect, {255, 80, 0}},
-              {truth, {0, 200, 0}},
-              {naive, {255, 255, 0}},
-              {r.rawPolygon, {0, 220, 255}},
-              {r.polygon, {0, 0, 255}}});
+      if (!dumpDir.empty() || !montagePath.empty()) {
+        const cv::Mat panel = drawOutlines(lefts[pairName],
+                                           cv::Rect(static_cast<int>(x0), static_cast<int>(y0),
+                                                    static_cast<int>(x1 - x0), static_cast<int>(y1 - y0)),
+                                           {{rect, {255, 80, 0}},
+                                            {truth, {0, 200, 0}},
+                                            {naive, {255, 255, 0}},
+                                            {r.rawPolygon, {0, 220, 255}},
+                                            {r.polygon, {0, 0, 255}}});
+        if (!dumpDir.empty()) {
+          fs::create_directories(dumpDir);
+          cv::imwrite((fs::path(dumpDir) / (name + ".png")).string(), panel);
+        }
+        panels.emplace_back(name, panel);
       }
     } catch (const core::Error& e) {
       std::printf("%-18s failed: %s\n", name.c_str(), e.what());
@@ -450,6 +488,10 @@ int main(int argc, char** argv) {
                 "regularized %.3f; median vertices naive %.0f, raw %.0f, regularized %.0f; %d regularized",
                 name.c_str(), set.rawIou.size(), grow, mean(set.naiveIou), mean(set.rawIou),
                 mean(set.regIou), median(set.naiveV), median(set.rawV), median(set.regV), set.regularized);
+  }
+  if (!montagePath.empty()) {
+    cv::imwrite(montagePath, montage(panels, 260, 5));
+    std::printf("\nwrote %s\n", montagePath.c_str());
   }
   std::printf("\nregularization time median %.2f ms, max %.2f ms\n", median(regMs),
               *std::max_element(regMs.begin(), regMs.end()));
