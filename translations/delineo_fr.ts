@@ -447,10 +447,6 @@
         <translation>Poids du segment</translation>
     </message>
     <message>
-        <source>Orientation tolerance</source>
-        <translation>Tolérance d’orientation</translation>
-    </message>
-    <message>
         <source>Max energy</source>
         <translation>Énergie maximale</translation>
     </message>

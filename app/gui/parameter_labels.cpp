@@ -111,7 +111,6 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Snap outward"),
     QT_TRANSLATE_NOOP("Parameters", "Edge distance cap"),
     QT_TRANSLATE_NOOP("Parameters", "Segment weight"),
-    QT_TRANSLATE_NOOP("Parameters", "Orientation tolerance"),
     QT_TRANSLATE_NOOP("Parameters", "Max energy"),
     QT_TRANSLATE_NOOP("Parameters", "Closing radius"),
     QT_TRANSLATE_NOOP("Parameters", "Refine length"),

@@ -338,8 +338,8 @@ BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges, const std:
     out.status = core::RunStatus::Canceled;
     return out;
   }
-  // A seed's best angle: the largest box among those within orientation-tolerance of the lowest
-  // energy (without edges every angle costs the cap, and the box that fills the segment wins).
+  // A seed's best angle: the box of lowest energy, the largest among equals (without edges every
+  // angle costs the cap, and the box that fills the segment wins).
   auto bestKey = [&](size_t s) {
     double lowest = 1e300;
     for (const auto& [k, fit] : fits[s]) {
@@ -348,7 +348,7 @@ BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges, const std:
     int key = -1;
     double area = -1;
     for (const auto& [k, fit] : fits[s]) {
-      if (fit.ok && fit.box.energy <= lowest + params.orientationTolerance && fit.box.area() > area) area = fit.box.area(), key = k;
+      if (fit.ok && fit.box.energy <= lowest && fit.box.area() > area) area = fit.box.area(), key = k;
     }
     return key;
   };
@@ -372,8 +372,7 @@ BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges, const std:
       return out;
     }
   }
-  // Each seed's best box; the building's main orientation; boxes that fit nearly as well at it
-  // take it (so that the merged boxes share their walls' directions).
+  // Each seed's best box; the building's main orientation (reported, and counted among the boxes).
   std::vector<int> chosen(seeds.size(), -1);
   std::vector<Box> best;
   for (size_t s = 0; s < seeds.size(); ++s) {
@@ -383,21 +382,6 @@ BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges, const std:
   if (best.empty()) return out;
   out.mainOrientationDeg = mainOrientation(best);
   const int mainKey = angleKey(out.mainOrientationDeg, resolution);
-  if (params.orientationTolerance > 0) {
-    std::vector<size_t> missing;
-    for (size_t s = 0; s < seeds.size(); ++s) {
-      if (chosen[s] >= 0 && !fits[s].count(mainKey)) missing.push_back(s);
-    }
-    if (!missing.empty() && !evaluate({mainKey}, {missing}, 0.9, 1.0)) {
-      out.status = core::RunStatus::Canceled;
-      return out;
-    }
-    for (size_t s = 0; s < seeds.size(); ++s) {
-      if (chosen[s] < 0 || chosen[s] == mainKey) continue;
-      const Fitted& atMain = fits[s][mainKey];
-      if (atMain.ok && atMain.box.energy <= fits[s][chosen[s]].box.energy + params.orientationTolerance) chosen[s] = mainKey;
-    }
-  }
   // Deepest seeds first; a seed inside an earlier box adds nothing (skip-covered).
   for (size_t s = 0; s < seeds.size(); ++s) {
     if (chosen[s] < 0) continue;

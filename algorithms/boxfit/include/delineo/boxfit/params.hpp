@@ -30,8 +30,6 @@ struct BoxFitParams {
   int snapOutward = 4;           // px a side may move outward from the segment onto an edge
   double edgeCap = 3.0;          // px, distance to the nearest edge is capped at this
   double segmentWeight = 1.0;    // weight of the segment's disagreement with a box side (0 = edges only)
-  double orientationTolerance = 0.3;  // px of mean edge distance a box may give up to take the
-                                      // building's main orientation (0 = each box its own)
   double maxEnergy = 2.0;        // px, whole image: a region whose boxes all fit worse is no building
   // Outline (the paper: fill, dilate and erode with radius 2, lines on 20 px pieces).
   int closingRadius = 2;        // px, disk of the closing that fuses the boxes (paper: 2)
@@ -126,11 +124,6 @@ struct BoxFitParams {
                 "(0 = the image's edges alone, as in the paper)",
                 0, 100},
       segmentWeight);
-    v(ParamInfo{"orientation-tolerance", "Orientation tolerance", "px",
-                "A box takes the building's main orientation when its energy rises by at most "
-                "this (0 = every box keeps its own)",
-                0, 100},
-      orientationTolerance);
     v(ParamInfo{"max-energy", "Max energy", "px",
                 "Without an initial polygon, a raised region none of whose boxes lies closer than "
                 "this to the edges on average (a tree crown) is not taken as a building",

@@ -85,8 +85,8 @@ struct BoxFitting {
 
 // Grows one box per seed over the sweep of orientations and keeps, per seed, the orientation of
 // least energy (mean cost of the box sides: capped distance to the nearest edge plus the
-// segment's disagreement, see SideCosts in src/boxes.cpp); boxes then take the
-// building's main orientation when it costs at most orientation-tolerance. `segment` and `edges`
+// segment's disagreement, see SideCosts in src/boxes.cpp), the largest box among equals.
+// `segment` and `edges`
 // are CV_8U of the ROI's size; `imageBorder` says which sides of the ROI are the image's border
 // (left, top, right, bottom), along which a box side needs no edge.
 BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges,
