@@ -201,7 +201,7 @@ void mirrorIntervals(const cv::Mat& lo, const cv::Mat& hi, const cv::Mat& needed
 // One row of validate(): `d` holds the row's disparities (a copy of the map's row), `dy` its
 // line shifts; the inconsistent ones are set to NaN. Also built for AVX2 (one rounding
 // instruction per floor instead of a library call; no FMA, so the same arithmetic).
-__attribute__((target_clones("avx2", "default"))) void validateRow(
+DELINEO_TARGET_CLONES("avx2", "default") void validateRow(
     float* d, const float* dy, int xStart, int y, int W, int H, float sign, double tolerance2,
     const float* otherD, size_t otherStep, const float* otherS, size_t shiftStep) {
   const auto fw = static_cast<float>(W), fh = static_cast<float>(H);
@@ -379,7 +379,7 @@ constexpr int kPointedBandRows = 64;
 // One source row of pointedTo(): marks the pointed pixels in output rows rowStart..rowEnd − 1
 // (`needed` is row 0 of the map), except from the pixels `skip` marks (null: none). Also built
 // for AVX2 (floor in one instruction).
-__attribute__((target_clones("avx2", "default"))) void pointedRow(const float* d, const float* dy,
+DELINEO_TARGET_CLONES("avx2", "default") void pointedRow(const float* d, const float* dy,
                                                                   const uchar* skip, int y, int W,
                                                                   int rowStart, int rowEnd,
                                                                   uchar* needed, size_t step) {
