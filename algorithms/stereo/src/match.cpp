@@ -422,8 +422,8 @@ int threadCount(const MatchParams& p) {
   return std::max(1U, std::thread::hardware_concurrency());
 }
 
-MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                          core::Progress* progress) {
+MatchResult matchAdaptiveSteps(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                               core::Progress* progress) {
   MatchResult result;
   int levels = p.levels > 0 ? p.levels : autoLevels(p.dmin, p.dmax);
   while (levels > 1 && std::min(left.cols, left.rows) / (1 << (levels - 1)) < kMinLevelSide) {
@@ -445,6 +445,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     prepare(isLeft ? left : right, g, isLeft ? base.left : base.right,
             isLeft ? base.leftValid : base.rightValid);
     for (int k = 1; k < levels; ++k) {
+      detail::throwIfCanceled();
       Level& fine = pyramid[static_cast<size_t>(k - 1)];
       Level& coarse = pyramid[static_cast<size_t>(k)];
       cv::pyrDown(isLeft ? fine.left : fine.right, isLeft ? coarse.left : coarse.right);
@@ -814,6 +815,19 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   core::report(progress, 1.0);
   return result;
+}
+
+// The steps poll the cancel within (workers.hpp): a cancel ends the match from any of them.
+MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                          core::Progress* progress) {
+  const detail::CancelScope cancelScope(progress);
+  try {
+    return matchAdaptiveSteps(left, right, p, progress);
+  } catch (const detail::Canceled&) {
+    MatchResult canceled;
+    canceled.status = core::RunStatus::Canceled;
+    return canceled;
+  }
 }
 
 // NCC of the square window at the rounded disparity: the score map of the SGBM backend.
