@@ -9,8 +9,8 @@
 // see it too. forRowBands polls it before each band, runTasks and RowOrderedTasks before each
 // task; once it is canceled they take no more work and, when every worker has returned, throw
 // Canceled on the calling thread, which the match catches (status Canceled, no maps): nothing
-// made after the cancel is read. Outside a match (no scope) nothing is polled. An exception of a helper is
-// rethrown on the calling thread once all workers have returned.
+// made after the cancel is read. Outside a match (no scope) nothing is polled. An exception of a
+// helper is rethrown on the calling thread once all workers have returned.
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
