@@ -5,6 +5,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
+#include "cpu_features.hpp"
 #include "neighbourhood_range.hpp"
 #include "workers.hpp"
 
@@ -22,7 +23,7 @@ constexpr int kWidestRadiusFinest = 16;
 // neighbourhood holds no valid disparity, the wide one (w0, w1); from the widest one (f0, f1)
 // where `beside` (may be null) is non-zero or both are empty; the full range where that is
 // empty too. Also built for AVX2 (floor and ceil in one instruction each).
-__attribute__((target_clones("avx2", "default"))) void coarseIntervalRow(
+DELINEO_TARGET_CLONES("avx2", "default") void coarseIntervalRow(
     const float* n0, const float* n1, const float* w0, const float* w1, const float* f0,
     const float* f1, const uchar* beside, int cw, int dmin, int dmax, int margin, int* l, int* h) {
   for (int x = 0; x < cw; ++x) {

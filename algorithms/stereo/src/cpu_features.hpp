@@ -6,6 +6,16 @@
 #define DELINEO_STEREO_X86 1
 #endif
 
+// A function built for several instruction sets, picked at load time (GCC's target_clones).
+// ThreadSanitizer instruments the pickers (ifunc resolvers), which the loader runs before the
+// sanitizer's runtime is set up: the program crashes at start. Its builds keep the default
+// version only.
+#if defined(__SANITIZE_THREAD__)
+#define DELINEO_TARGET_CLONES(...)
+#else
+#define DELINEO_TARGET_CLONES(...) __attribute__((target_clones(__VA_ARGS__)))
+#endif
+
 namespace delineo::stereo::detail {
 
 inline bool cpuHasAvx2() {

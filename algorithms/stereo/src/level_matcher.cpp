@@ -35,13 +35,14 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "cpu_features.hpp"
 #include "level_shape_int.hpp"
 #include "workers.hpp"
 
 #define DELINEO_LEVEL_MATCHER_BUILD base
 // Functions also built for other instruction sets (target_clones) in the baseline build; plain
 // AVX2 functions in the AVX2 build (a function under the AVX2 pragma cannot be cloned).
-#define DELINEO_LEVEL_MATCHER_CLONES(...) __attribute__((target_clones(__VA_ARGS__)))
+#define DELINEO_LEVEL_MATCHER_CLONES(...) DELINEO_TARGET_CLONES(__VA_ARGS__)
 #else
 #undef DELINEO_LEVEL_MATCHER_BUILD
 #undef DELINEO_LEVEL_MATCHER_CLONES
@@ -348,7 +349,7 @@ __attribute__((always_inline)) inline bool sameWords(const Word4& a, const Word4
 // from a column-major copy of the row words, so the board is one 32-byte load. The AVX-512
 // clone does each doubling step's AND-OR in one three-input logic instruction (the fill's share
 // of the matcher's samples fell by ~17 %).
-__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) bool fillWindow15(
+DELINEO_TARGET_CLONES("arch=x86-64-v4", "avx2", "default") bool fillWindow15(
     const uint16_t* freeRows, const uint64_t* inWindow, int r, uint16_t* reach) {
   Word4 free, rowMask, t;
   __builtin_memcpy(&free, freeRows, sizeof free);

@@ -201,7 +201,7 @@ void mirrorIntervals(const cv::Mat& lo, const cv::Mat& hi, const cv::Mat& needed
 // One row of validate(): `d` holds the row's disparities (a copy of the map's row), `dy` its
 // line shifts; the inconsistent ones are set to NaN. Also built for AVX2 (one rounding
 // instruction per floor instead of a library call; no FMA, so the same arithmetic).
-__attribute__((target_clones("avx2", "default"))) void validateRow(
+DELINEO_TARGET_CLONES("avx2", "default") void validateRow(
     float* d, const float* dy, int xStart, int y, int W, int H, float sign, double tolerance2,
     const float* otherD, size_t otherStep, const float* otherS, size_t shiftStep) {
   const auto fw = static_cast<float>(W), fh = static_cast<float>(H);
@@ -379,7 +379,7 @@ constexpr int kPointedBandRows = 64;
 // One source row of pointedTo(): marks the pointed pixels in output rows rowStart..rowEnd − 1
 // (`needed` is row 0 of the map), except from the pixels `skip` marks (null: none). Also built
 // for AVX2 (floor in one instruction).
-__attribute__((target_clones("avx2", "default"))) void pointedRow(const float* d, const float* dy,
+DELINEO_TARGET_CLONES("avx2", "default") void pointedRow(const float* d, const float* dy,
                                                                   const uchar* skip, int y, int W,
                                                                   int rowStart, int rowEnd,
                                                                   uchar* needed, size_t step) {
@@ -422,8 +422,8 @@ int threadCount(const MatchParams& p) {
   return std::max(1U, std::thread::hardware_concurrency());
 }
 
-MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                          core::Progress* progress) {
+MatchResult matchAdaptiveSteps(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                               core::Progress* progress) {
   MatchResult result;
   int levels = p.levels > 0 ? p.levels : autoLevels(p.dmin, p.dmax);
   while (levels > 1 && std::min(left.cols, left.rows) / (1 << (levels - 1)) < kMinLevelSide) {
@@ -445,6 +445,7 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
     prepare(isLeft ? left : right, g, isLeft ? base.left : base.right,
             isLeft ? base.leftValid : base.rightValid);
     for (int k = 1; k < levels; ++k) {
+      detail::throwIfCanceled();
       Level& fine = pyramid[static_cast<size_t>(k - 1)];
       Level& coarse = pyramid[static_cast<size_t>(k)];
       cv::pyrDown(isLeft ? fine.left : fine.right, isLeft ? coarse.left : coarse.right);
@@ -814,6 +815,19 @@ MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const Match
   }
   core::report(progress, 1.0);
   return result;
+}
+
+// The steps poll the cancel within (workers.hpp): a cancel ends the match from any of them.
+MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                          core::Progress* progress) {
+  const detail::CancelScope cancelScope(progress);
+  try {
+    return matchAdaptiveSteps(left, right, p, progress);
+  } catch (const detail::Canceled&) {
+    MatchResult canceled;
+    canceled.status = core::RunStatus::Canceled;
+    return canceled;
+  }
 }
 
 // NCC of the square window at the rounded disparity: the score map of the SGBM backend.

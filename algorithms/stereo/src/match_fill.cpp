@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <atomic>
 #include <deque>
+#include <exception>
 #include <functional>
-#include <latch>
+#include <mutex>
 #include <limits>
 #include <map>
 #include <optional>
@@ -1627,6 +1629,32 @@ cv::Mat plainPixels(const cv::Mat& image, double sigmas, const LocalMoments* mom
   return flatMask(image, settings, nullptr, moments);
 }
 
+namespace {
+
+// What one of the fill's two tasks hands to the other. A task that stops on an exception (a
+// cancel, an allocation) breaks what it still owes, so that the other is never left waiting:
+// take() then throws HandoverBroken instead of returning what was never made.
+struct HandoverBroken {};
+class Handover {
+ public:
+  void give() { settle(kGiven); }
+  void breakOff() { settle(kBroken); }  // no effect once given
+  void take() const {
+    state_.wait(kWaiting);
+    if (state_.load() == kBroken) throw HandoverBroken{};
+  }
+
+ private:
+  void settle(int to) {
+    int waiting = kWaiting;
+    if (state_.compare_exchange_strong(waiting, to)) state_.notify_all();
+  }
+  static constexpr int kWaiting = 0, kGiven = 1, kBroken = 2;
+  mutable std::atomic<int> state_{kWaiting};
+};
+
+}  // namespace
+
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
                     int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                     int threads, const std::function<void()>& alongside,
@@ -1642,40 +1670,70 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
   if (threads > 1 && settings.planeMinRows > 0) {
     GreyMaps maps;
     RightFlatRegions rightFlat;
-    std::latch mapsReady(1), rightReady(1), regionsOffered(1);
+    Handover mapsReady, rightReady, regionsOffered;
     RowOrderedTasks* regionTasks = nullptr;
+    bool helped = false;  // the second task has been through regionTasks->help()
     int filled = 0;
+    // The exception that stopped a task first (the other's HandoverBroken only follows from it).
+    std::exception_ptr failure;
+    std::mutex failureMutex;
+    const auto keepFailure = [&] {
+      const std::lock_guard lock(failureMutex);
+      if (!failure) failure = std::current_exception();
+    };
     runTasks({[&] {
-                filled = fillRegions(
-                    left, right, settings, dmin, dmax, fillScore, disparity, score,
-                    [&]() -> const GreyMaps& {
-                      mapsReady.wait();
-                      return maps;
-                    },
-                    [&]() -> const RightFlatRegions& {
-                      rightReady.wait();
-                      return rightFlat;
-                    },
-                    1,
-                    [&](RowOrderedTasks& tasks) {
-                      regionTasks = &tasks;
-                      regionsOffered.count_down();
-                    },
-                    leftMoments);
+                try {
+                  filled = fillRegions(
+                      left, right, settings, dmin, dmax, fillScore, disparity, score,
+                      [&]() -> const GreyMaps& {
+                        mapsReady.take();
+                        return maps;
+                      },
+                      [&]() -> const RightFlatRegions& {
+                        rightReady.take();
+                        return rightFlat;
+                      },
+                      1,
+                      [&](RowOrderedTasks& tasks) {
+                        regionTasks = &tasks;
+                        regionsOffered.give();
+                      },
+                      leftMoments);
+                } catch (const HandoverBroken&) {
+                } catch (...) {
+                  keepFailure();
+                }
+                regionsOffered.breakOff();
               },
               [&] {
-                // Reads the disparities before the fill writes any: the fill waits for it first.
-                maps = greyMaps(left, right, disparity, dmin, dmax);
-                mapsReady.count_down();
-                rightFlat = rightFlatRegions(rightFlatMask(), right);
-                rightReady.count_down();
-                if (alongside) alongside();
-                // Then it helps with the regions (the rest of the fill's time is theirs).
-                regionsOffered.wait();
-                regionTasks->help();
-                if (afterRegions) afterRegions();
+                try {
+                  // Reads the disparities before the fill writes any: the fill waits for it first.
+                  maps = greyMaps(left, right, disparity, dmin, dmax);
+                  mapsReady.give();
+                  rightFlat = rightFlatRegions(rightFlatMask(), right);
+                  rightReady.give();
+                  if (alongside) alongside();
+                  // Then it helps with the regions (the rest of the fill's time is theirs).
+                  regionsOffered.take();
+                  helped = true;
+                  regionTasks->help();
+                  if (afterRegions) afterRegions();
+                } catch (const HandoverBroken&) {
+                } catch (...) {
+                  keepFailure();
+                  mapsReady.breakOff();
+                  rightReady.breakOff();
+                  // The regions' owner waits for this helper to leave them: it takes none (they
+                  // are skipped once one failed, or canceled).
+                  try {
+                    regionsOffered.take();
+                    if (!helped) regionTasks->help();
+                  } catch (const HandoverBroken&) {
+                  }
+                }
               }},
-             threads);
+             threads, TaskDependence::MayWait);
+    if (failure) std::rethrow_exception(failure);
     return filled;
   }
   // Else the right view's flat regions only when a region first needs them.

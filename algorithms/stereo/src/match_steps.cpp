@@ -12,6 +12,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "cpu_features.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -66,7 +67,7 @@ struct CutRowSums {
 // within 1 px of `side`, or, off the segments, whose validated value is within 1.5 px of it.
 // Unusable when it leaves the image, touches nodata, has fewer than minPixels pixels or is flat.
 template <int Stride>
-__attribute__((target_clones("avx2", "default"))) void buildCutWindowPadded(
+DELINEO_TARGET_CLONES("avx2", "default") void buildCutWindowPadded(
     const cv::Mat& ref, const cv::Mat& refValid, const cv::Mat& sideD, const cv::Mat& validated,
     float side, int x, int y, int r, int minPixels, CutWindow& w) {
   const int n = w.side;
@@ -175,7 +176,7 @@ int invalidIn(const cv::Mat& invalidSum, int x0, int y0, int x1, int y1) {
 // (compile-time: whole vectors); `rows` points at the other image under row 0, `step` floats
 // apart.
 template <int Stride>
-__attribute__((target_clones("avx2", "default"))) void cutWindowSumsPadded(const CutWindow& w,
+DELINEO_TARGET_CLONES("avx2", "default") void cutWindowSumsPadded(const CutWindow& w,
                                                                            const float* rows,
                                                                            size_t step,
                                                                            float offset, float& sb,

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "components.hpp"
+#include "cpu_features.hpp"
 #include "workers.hpp"
 
 namespace delineo::stereo::detail {
@@ -184,7 +185,7 @@ struct Fit {
 //    up 2 px or more away (`elsewhere`).
 // Also built for AVX2: the ring test's floor and ceil, a few instructions each without SSE4.1,
 // are one each there (the test was the largest part of the facets' time).
-__attribute__((target_clones("avx2", "default"))) Fit bestPlane(
+DELINEO_TARGET_CLONES("avx2", "default") Fit bestPlane(
     const cv::Mat& right, const Samples& sparse, const Samples& medium, const Samples& all,
     const std::vector<cv::Point3d>& ring, double ringShare, double cx, double cy, double lo,
     double hi, double maxSlope, double hopeless) {

@@ -4,11 +4,19 @@
 // thread one of them (threads == 1 runs everything inline), the others a match's parked helpers
 // (WorkerPool) or threads started for the step. Each task writes only its own outputs, so
 // results never depend on the number of threads nor on which runs what.
+//
+// Cancellation: a match makes its progress current on its thread (CancelScope) and its helpers
+// see it too. forRowBands polls it before each band, runTasks and RowOrderedTasks before each
+// task; once it is canceled they take no more work and, when every worker has returned, throw
+// Canceled on the calling thread, which the match catches (status Canceled, no maps): nothing
+// made after the cancel is read. Outside a match (no scope) nothing is polled. An exception of a
+// helper is rethrown on the calling thread once all workers have returned.
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <set>
@@ -16,7 +24,33 @@
 #include <utility>
 #include <vector>
 
+#include "delineo/core/progress.hpp"
+
 namespace delineo::stereo::detail {
+
+// Thrown by a step of a canceled match (see above); never leaves the match.
+struct Canceled {};
+
+// The progress whose cancel the steps run on this thread poll while the scope lives.
+class CancelScope {
+ public:
+  explicit CancelScope(const core::Progress* progress) : previous_(current_) {
+    current_ = progress;
+  }
+  ~CancelScope() { current_ = previous_; }
+  CancelScope(const CancelScope&) = delete;
+  CancelScope& operator=(const CancelScope&) = delete;
+  static const core::Progress* current() { return current_; }
+
+ private:
+  const core::Progress* previous_;
+  static inline thread_local const core::Progress* current_ = nullptr;
+};
+
+inline bool cancelRequested() { return core::isCanceled(CancelScope::current()); }
+inline void throwIfCanceled() {
+  if (cancelRequested()) throw Canceled{};
+}
 
 // Helper threads parked between the many short parallel steps of a match (a few hundred a run
 // at 1 Mpx), lent to them instead of a thread started and joined for each (~38 us a start and
@@ -117,39 +151,66 @@ class WorkerPool {
 };
 
 // worker() on the calling thread and on `helpers` more: the current pool's when it can lend
-// them, threads started for the call otherwise. Returns once every call has returned.
+// them, threads started for the call otherwise. Returns once every call has returned; then
+// rethrows the calling thread's exception, else the first of a helper's.
 template <class Worker>
 void runOnWorkers(const Worker& worker, int helpers) {
   if (helpers <= 0) {
     worker();
     return;
   }
-  WorkerPool* pool = WorkerPool::current();
-  if (pool != nullptr) {
-    const std::function<void()> work = [&worker] { worker(); };
-    if (pool->lend(work, helpers)) {
-      try {
-        worker();
-      } catch (...) {
-        pool->waitLent();  // the helpers still read `work`
-        throw;
-      }
-      pool->waitLent();
-      return;
+  const core::Progress* cancelSource = CancelScope::current();
+  std::exception_ptr helperError;
+  std::mutex errorMutex;
+  const std::function<void()> helper = [&] {
+    const CancelScope scope(cancelSource);
+    try {
+      worker();
+    } catch (...) {
+      const std::lock_guard lock(errorMutex);
+      if (!helperError) helperError = std::current_exception();
     }
+  };
+  WorkerPool* pool = WorkerPool::current();
+  if (pool != nullptr && pool->lend(helper, helpers)) {
+    try {
+      worker();
+    } catch (...) {
+      pool->waitLent();  // the helpers still read `helper`
+      throw;
+    }
+    pool->waitLent();
+  } else {
+    std::vector<std::thread> started;
+    for (int t = 0; t < helpers; ++t) started.emplace_back(helper);
+    try {
+      worker();
+    } catch (...) {
+      for (auto& t : started) t.join();
+      throw;
+    }
+    for (auto& t : started) t.join();
   }
-  std::vector<std::thread> started;
-  for (int t = 0; t < helpers; ++t) started.emplace_back([&worker] { worker(); });
-  worker();
-  for (auto& t : started) t.join();
+  if (helperError) std::rethrow_exception(helperError);
 }
 
-inline void runTasks(const std::vector<std::function<void()>>& tasks, int threads) {
+// Whether the tasks of a runTasks() call may wait for one another's results.
+enum class TaskDependence { Independent, MayWait };
+
+// Once canceled, no more independent tasks start; tasks that may wait for another all run (each
+// polls the cancel within its own steps).
+inline void runTasks(const std::vector<std::function<void()>>& tasks, int threads,
+                     TaskDependence dependence = TaskDependence::Independent) {
+  const bool skipOnCancel = dependence == TaskDependence::Independent;
   std::atomic<size_t> next{0};
   auto worker = [&] {
-    for (size_t i = next++; i < tasks.size(); i = next++) tasks[i]();
+    for (size_t i = next++; i < tasks.size(); i = next++) {
+      if (skipOnCancel && cancelRequested()) return;
+      tasks[i]();
+    }
   };
   runOnWorkers(worker, std::min<int>(threads, static_cast<int>(tasks.size())) - 1);
+  throwIfCanceled();
 }
 
 // band(rowStart, rowEnd) over rows 0..rows−1 in bands of `bandRows`.
@@ -158,11 +219,12 @@ void forRowBands(int rows, int threads, const BandFn& band, int bandRows = 16) {
   const int bands = (rows + bandRows - 1) / bandRows;
   std::atomic<int> next{0};
   auto worker = [&] {
-    for (int b = next++; b < bands; b = next++) {
+    for (int b = next++; b < bands && !cancelRequested(); b = next++) {
       band(b * bandRows, std::min(rows, (b + 1) * bandRows));
     }
   };
   runOnWorkers(worker, std::max(1, std::min(threads, bands)) - 1);
+  throwIfCanceled();
 }
 
 // Tasks 0 .. n−1 whose result must be that of running them in this order, where task k reads and
@@ -214,10 +276,15 @@ class RowOrderedTasks {
         helpers);
   }
 
+  // Rethrows the first exception of a task (a task not run after it or after a cancel counts as
+  // finished), then throws Canceled when canceled.
   void run() {
     std::unique_lock<std::mutex> lock(mutex_);
     workUntilAllFinished(lock);
     changed_.wait(lock, [&] { return helpersToCome_ == 0; });
+    if (error_) std::rethrow_exception(error_);
+    lock.unlock();
+    throwIfCanceled();
   }
 
   void help() {
@@ -236,8 +303,17 @@ class RowOrderedTasks {
       }
       const size_t k = *ready_.begin();  // the earliest ready task
       ready_.erase(ready_.begin());
+      const bool skip = error_ != nullptr;
       lock.unlock();
-      task_(k);
+      if (!skip && !cancelRequested()) {
+        try {
+          task_(k);
+        } catch (...) {
+          lock.lock();
+          if (!error_) error_ = std::current_exception();
+          lock.unlock();
+        }
+      }
       lock.lock();
       for (const size_t next : after_[k]) {
         if (--waitingOn_[next] == 0) ready_.insert(next);
@@ -278,6 +354,7 @@ class RowOrderedTasks {
   std::set<size_t> ready_;                  // not started, nothing left to wait for
   size_t unfinished_;
   int helpersToCome_;  // helpers that have not left help() yet
+  std::exception_ptr error_;  // the first task's exception
   std::mutex mutex_;
   std::condition_variable changed_;
 };

@@ -3,11 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <utility>
 
 #include <opencv2/core.hpp>
 
+#include "delineo/core/progress.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
 
@@ -201,6 +205,90 @@ TEST(MatchSimulated, ACityBlockGivesTheSameBitsOnOneTwoAndThreeThreads) {
     EXPECT_EQ(differing, 0) << threads << " threads: rows differing";
   }
 }
+
+// A progress that counts the polls of its cancel per stage, and cancels itself at the
+// `cancelAt`-th poll (0: never).
+class PollingProgress : public core::Progress {
+ public:
+  explicit PollingProgress(int cancelAt = 0) : cancelAt_(cancelAt) {}
+  bool canceled() const noexcept override {
+    const core::StageId stage = stageInfo().id;
+    const std::lock_guard lock(mutex_);
+    ++polls_[stage];
+    if (cancelAt_ > 0 && ++total_ >= cancelAt_) return true;
+    return Progress::canceled();
+  }
+  void setStage(const core::Stage& stage) override {
+    Progress::setStage(stage);
+    const std::lock_guard lock(mutex_);
+    polls_.try_emplace(stage.id, 0);  // every stage seen, polled or not
+  }
+  using Progress::setStage;
+  std::map<core::StageId, int> polls() const {
+    const std::lock_guard lock(mutex_);
+    return polls_;
+  }
+  int total() const {
+    int n = 0;
+    for (const auto& [stage, count] : polls()) n += count;
+    return n;
+  }
+
+ private:
+  int cancelAt_;
+  mutable std::mutex mutex_;
+  mutable std::map<core::StageId, int> polls_;
+  mutable int total_ = 0;
+};
+
+struct SceneViews {
+  cv::Mat left, right;
+  MatchParams params;
+};
+SceneViews sceneViews(int size, int seed) {
+  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(size, seed));
+  SceneViews v;
+  scene.left.convertTo(v.left, CV_32F);
+  scene.right.convertTo(v.right, CV_32F);
+  v.params.dmin = scene.disparityMin;
+  v.params.dmax = scene.disparityMax;
+  v.params.threads = 2;
+  return v;
+}
+
+// Ctrl-C acts within a second on a 2000² pair only if no stage runs long without polling: every
+// stage polls the cancel throughout, at least once per 32 rows of the image (before each step
+// polled through the worker model, the stages after the levels polled it once at most).
+TEST(MatchSimulated, EveryStagePollsTheCancelThroughout) {
+  const SceneViews v = sceneViews(320, 7);
+  PollingProgress progress;
+  ASSERT_EQ(matchStereo(v.left, v.right, v.params, &progress).status, core::RunStatus::Completed);
+  const std::map<core::StageId, int> polls = progress.polls();
+  for (const core::StageId stage :
+       {core::StageId::ValidatingLevel, core::StageId::FillingFlatRegions,
+        core::StageId::RemovingSpeckles, core::StageId::SnappingDepthSteps,
+        core::StageId::FittingRoofPlanes}) {
+    ASSERT_EQ(polls.count(stage), 1U) << "stage " << static_cast<int>(stage) << " not reached";
+    EXPECT_GE(polls.at(stage), v.left.rows / 32) << "stage " << static_cast<int>(stage);
+  }
+}
+
+// A cancel seen at any poll ends the match: status Canceled and no maps (the steps' workers
+// stop, the fill's two tasks do not wait for each other).
+TEST(MatchSimulated, ACancelAtAnyPollEndsTheMatchWithoutMaps) {
+  const SceneViews v = sceneViews(200, 7);
+  PollingProgress full;
+  ASSERT_EQ(matchStereo(v.left, v.right, v.params, &full).status, core::RunStatus::Completed);
+  const int polls = full.total();
+  ASSERT_GT(polls, 100);
+  for (int at = 1; at <= polls; at += std::max(1, polls / 40)) {
+    PollingProgress progress(at);
+    const MatchResult r = matchStereo(v.left, v.right, v.params, &progress);
+    EXPECT_EQ(r.status, core::RunStatus::Canceled) << "canceled at poll " << at << " of " << polls;
+    EXPECT_TRUE(r.disparity.empty() && r.score.empty()) << "at poll " << at;
+  }
+}
+
 
 }  // namespace
 }  // namespace delineo::stereo

@@ -1,11 +1,14 @@
-// The worker model (workers.hpp): tasks run in an order fixed by the rows they touch.
+// The worker model (workers.hpp): tasks run in an order fixed by the rows they touch; a cancel
+// stops a step's workers and ends it with Canceled.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <set>
+#include <stdexcept>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -301,4 +304,95 @@ TEST(WorkerPool, OrderedTasksGiveTheSameLogsWithThePoolsHelpers) {
     tasks.runWithHelpers();
     logs.expectSerialOrderPerRow();
   }
+}
+
+// Cancellation (workers.hpp): under a CancelScope a step stops taking work once canceled and
+// throws Canceled on the calling thread after every worker has returned.
+TEST(WorkerCancel, BandsStopOnceCanceledAndTheCallerThrows) {
+  detail::WorkerPool pool(1);
+  for (const bool withPool : {false, true}) {
+    for (const int threads : {1, 2, 3}) {
+      std::optional<detail::WorkerPool::Scope> poolScope;
+      if (withPool) poolScope.emplace(pool);
+      delineo::core::Progress progress;
+      const detail::CancelScope scope(&progress);
+      std::atomic<int> bands{0};
+      // 100 bands; the 5th cancels: each other worker finishes at most the band it is in.
+      EXPECT_THROW(detail::forRowBands(1600, threads,
+                                       [&](int, int) {
+                                         if (++bands == 5) progress.cancel();
+                                         std::this_thread::sleep_for(std::chrono::microseconds(200));
+                                       }),
+                   detail::Canceled);
+      EXPECT_LE(bands.load(), 5 + threads - 1) << threads << " threads";
+    }
+  }
+}
+
+TEST(WorkerCancel, WithoutAScopeNothingIsPolled) {
+  delineo::core::Progress progress;
+  progress.cancel();
+  std::atomic<int> bands{0};
+  detail::forRowBands(160, 2, [&](int, int) { ++bands; });
+  EXPECT_EQ(bands.load(), 10);
+  // A scope is this thread's only: another thread's steps do not see it.
+  const detail::CancelScope scope(&progress);
+  std::thread([&] {
+    EXPECT_EQ(detail::CancelScope::current(), nullptr);
+    detail::forRowBands(160, 2, [&](int, int) { ++bands; });
+  }).join();
+  EXPECT_EQ(bands.load(), 20);
+}
+
+TEST(WorkerCancel, HelpersPollTheCallersScopeAndTheirExceptionsReachTheCaller) {
+  delineo::core::Progress progress;
+  const detail::CancelScope scope(&progress);
+  std::atomic<int> sawScope{0};
+  std::atomic<int> arrived{0};
+  // Two tasks on two threads (each waits for the other, so one runs on the helper): the helper
+  // sees the caller's scope; its exception is rethrown here once both have returned.
+  const auto task = [&] {
+    sawScope += detail::CancelScope::current() == &progress ? 1 : 0;
+    ++arrived;
+    while (arrived.load() < 2) std::this_thread::yield();
+  };
+  const std::thread::id caller = std::this_thread::get_id();
+  const auto failing = [&] {
+    task();
+    if (std::this_thread::get_id() != caller) throw std::runtime_error("helper failed");
+  };
+  EXPECT_THROW(detail::runTasks({failing, failing}, 2), std::runtime_error);
+  EXPECT_EQ(sawScope.load(), 2);
+}
+
+TEST(WorkerCancel, OrderedTasksAreSkippedOnceCanceled) {
+  for (const int helpers : {0, 1, 2}) {
+    delineo::core::Progress progress;
+    const detail::CancelScope scope(&progress);
+    const auto rows = someRows();
+    std::atomic<int> runs{0};
+    detail::RowOrderedTasks tasks(
+        rows,
+        [&](size_t) {
+          if (++runs == 3) progress.cancel();
+          std::this_thread::sleep_for(std::chrono::microseconds(200));
+        },
+        helpers);
+    EXPECT_THROW(tasks.runWithHelpers(), detail::Canceled);
+    EXPECT_LE(runs.load(), 3 + helpers) << helpers << " helpers";
+  }
+}
+
+TEST(WorkerCancel, AnOrderedTasksExceptionStopsTheRestAndReachesTheOwner) {
+  const auto rows = someRows();
+  std::atomic<int> runs{0};
+  detail::RowOrderedTasks tasks(
+      rows,
+      [&](size_t k) {
+        ++runs;
+        if (k == 0) throw std::runtime_error("task 0 failed");
+      },
+      1);
+  EXPECT_THROW(tasks.runWithHelpers(), std::runtime_error);
+  EXPECT_LT(runs.load(), static_cast<int>(rows.size()));
 }
