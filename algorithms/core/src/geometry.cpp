@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 
 namespace delineo::core {
@@ -64,17 +65,59 @@ bool segmentsIntersect(const cv::Point2d& p1, const cv::Point2d& p2, const cv::P
   return false;
 }
 
+namespace {
+
+// Whether edges i and j (j > i) of the ring of n vertices cross; adjacent edges share a vertex.
+bool edgesCross(const Ring& ring, size_t i, size_t j) {
+  const size_t n = ring.size();
+  if ((j + 1) % n == i || (i + 1) % n == j) return false;
+  return segmentsIntersect(ring[i], ring[(i + 1) % n], ring[j], ring[(j + 1) % n]);
+}
+
+// Every pair of edges sharing a cell of a square grid (about two edges a cell along the ring),
+// so that a ring of many vertices is checked in near linear time.
+bool anyEdgesCrossInGrid(const Ring& ring) {
+  const size_t n = ring.size();
+  const cv::Rect2d box = boundingBox(ring);
+  double length = 0;
+  for (size_t i = 0; i < n; ++i) length += cv::norm(ring[(i + 1) % n] - ring[i]);
+  // At most about 4n cells.
+  const double cell = std::max({2.0 * length / static_cast<double>(n), std::sqrt(box.width * box.height / (4.0 * n)),
+                                std::max(box.width, box.height) / (4.0 * n), 1e-9});
+  const auto cols = static_cast<size_t>(box.width / cell) + 1, rows = static_cast<size_t>(box.height / cell) + 1;
+  std::vector<std::vector<size_t>> cells(cols * rows);
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point2d& a = ring[i];
+    const cv::Point2d& b = ring[(i + 1) % n];
+    const auto x0 = static_cast<size_t>((std::min(a.x, b.x) - box.x) / cell), x1 = static_cast<size_t>((std::max(a.x, b.x) - box.x) / cell);
+    const auto y0 = static_cast<size_t>((std::min(a.y, b.y) - box.y) / cell), y1 = static_cast<size_t>((std::max(a.y, b.y) - box.y) / cell);
+    for (size_t y = y0; y <= std::min(y1, rows - 1); ++y) {
+      for (size_t x = x0; x <= std::min(x1, cols - 1); ++x) cells[y * cols + x].push_back(i);
+    }
+  }
+  for (const auto& list : cells) {
+    for (size_t p = 0; p < list.size(); ++p) {
+      for (size_t q = p + 1; q < list.size(); ++q) {
+        if (edgesCross(ring, list[p], list[q])) return true;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 bool isSimple(const Ring& ring) {
   const size_t n = ring.size();
   if (n < 3) return false;
   if (std::abs(signedArea(ring)) < 1e-12) return false;
   for (size_t i = 0; i < n; ++i) {
-    const auto& a = ring[i];
-    const auto& b = ring[(i + 1) % n];
-    if (a == b) return false;
+    if (ring[i] == ring[(i + 1) % n]) return false;
+  }
+  if (n > 64) return !anyEdgesCrossInGrid(ring);
+  for (size_t i = 0; i < n; ++i) {
     for (size_t j = i + 1; j < n; ++j) {
-      if (j == i || (j + 1) % n == i || (i + 1) % n == j) continue;  // adjacent edges
-      if (segmentsIntersect(a, b, ring[j], ring[(j + 1) % n])) return false;
+      if (edgesCross(ring, i, j)) return false;
     }
   }
   return true;

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
+#include <optional>
+#include <unordered_map>
+#include <vector>
 
 namespace delineo::eval {
 
@@ -68,22 +72,121 @@ double distanceToEdges(const cv::Point2d& p, const std::vector<Segment>& edges) 
   return best;
 }
 
-// Even-odd rule over all rings, half-open in y so that a point is counted once.
-bool insideRings(const cv::Point2d& p, const std::vector<Ring>& rings) {
-  bool inside = false;
-  for (const auto& r : rings) {
-    const size_t n = r.size();
-    for (size_t i = 0, j = n - 1; i < n; j = i++) {
-      const auto& a = r[i];
-      const auto& b = r[j];
-      if ((a.y > p.y) != (b.y > p.y)) {
-        const double x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
-        if (p.x < x) inside = !inside;
+// The edges of a polygon in a grid of square cells (only the cells an edge's bounding box
+// touches are stored): nearest-edge and near-edge queries look at the cells around a point
+// instead of every edge, so measures between polygons of many vertices stay near linear.
+class EdgeIndex {
+ public:
+  explicit EdgeIndex(const std::vector<Segment>& edges) : edges_(edges), seen_(edges.size(), 0) {
+    if (edges.empty()) return;
+    double minX = 1e300, minY = 1e300, maxX = -1e300, maxY = -1e300, length = 0;
+    for (const auto& e : edges) {
+      minX = std::min({minX, e.from.x, e.to.x}), maxX = std::max({maxX, e.from.x, e.to.x});
+      minY = std::min({minY, e.from.y, e.to.y}), maxY = std::max({maxY, e.from.y, e.to.y});
+      length += std::hypot(e.to.x - e.from.x, e.to.y - e.from.y);
+    }
+    origin_ = {minX, minY};
+    // About two edges a cell along the boundary, and at most 4096 cells a side.
+    const double extent = std::max({maxX - minX, maxY - minY, 1e-9});
+    cell_ = std::max({2.0 * length / static_cast<double>(edges.size()), extent / 4096.0, 1e-9});
+    for (size_t i = 0; i < edges.size(); ++i) {
+      const auto [x0, y0] = cellOf({std::min(edges[i].from.x, edges[i].to.x), std::min(edges[i].from.y, edges[i].to.y)});
+      const auto [x1, y1] = cellOf({std::max(edges[i].from.x, edges[i].to.x), std::max(edges[i].from.y, edges[i].to.y)});
+      for (std::int64_t y = y0; y <= y1; ++y) {
+        for (std::int64_t x = x0; x <= x1; ++x) cells_[key(x, y)].push_back(static_cast<std::uint32_t>(i));
+      }
+    }
+    for (const auto& [k, list] : cells_) {
+      rows_[static_cast<std::int64_t>(static_cast<std::int32_t>(k & 0xffffffffu))].push_back(
+          static_cast<std::int64_t>(static_cast<std::int32_t>(k >> 32)));
+    }
+    for (auto& [row, columns] : rows_) std::sort(columns.begin(), columns.end());
+  }
+
+  // Distance from `p` to the nearest edge: rings of cells around p's cell until no farther ring
+  // can hold a nearer edge (every edge when that would visit more cells than there are edges).
+  double nearest(const cv::Point2d& p) const {
+    if (edges_.empty()) return std::numeric_limits<double>::infinity();
+    const auto [cx, cy] = cellOf(p);
+    double best = std::numeric_limits<double>::infinity();
+    for (std::int64_t r = 0;; ++r) {
+      if ((2 * r + 1) * (2 * r + 1) > static_cast<std::int64_t>(edges_.size()) + 64) return distanceToEdges(p, edges_);
+      for (std::int64_t y = cy - r; y <= cy + r; ++y) {
+        const bool edgeRow = y == cy - r || y == cy + r;
+        for (std::int64_t x = cx - r; x <= cx + r; x += edgeRow ? 1 : 2 * std::max<std::int64_t>(r, 1)) {
+          const auto it = cells_.find(key(x, y));
+          if (it == cells_.end()) continue;
+          for (const std::uint32_t i : it->second) best = std::min(best, pointSegmentDistance(p, edges_[i]));
+        }
+      }
+      // Every cell beyond ring r lies at least r cells from p.
+      if (best <= static_cast<double>(r) * cell_) return best;
+    }
+  }
+
+  // Even-odd rule over the indexed edges, half-open in y so that a point is counted once: only
+  // the cells of p's row to its right can hold an edge that crosses the ray from p towards +x.
+  bool inside(const cv::Point2d& p) const {
+    if (edges_.empty()) return false;
+    const auto [cx, cy] = cellOf(p);
+    bool in = false;
+    ++stamp_;
+    const auto row = rows_.find(cy);
+    if (row == rows_.end()) return false;
+    for (auto column = std::lower_bound(row->second.begin(), row->second.end(), cx); column != row->second.end(); ++column) {
+      const auto it = cells_.find(key(*column, cy));
+      for (const std::uint32_t i : it->second) {
+        if (seen_[i] == stamp_) continue;
+        seen_[i] = stamp_;
+        const cv::Point2d& a = edges_[i].from;
+        const cv::Point2d& b = edges_[i].to;
+        if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)) in = !in;
+      }
+    }
+    return in;
+  }
+
+  // Indices of the edges whose bounding box may come within `reach` of the box [lo, hi], each once.
+  template <class Visit>
+  void near(const cv::Point2d& lo, const cv::Point2d& hi, double reach, Visit&& visit) const {
+    if (edges_.empty()) return;
+    ++stamp_;
+    const auto [x0, y0] = cellOf({lo.x - reach, lo.y - reach});
+    const auto [x1, y1] = cellOf({hi.x + reach, hi.y + reach});
+    if ((x1 - x0 + 1) * (y1 - y0 + 1) > static_cast<std::int64_t>(edges_.size()) + 64) {
+      for (size_t i = 0; i < edges_.size(); ++i) visit(edges_[i]);
+      return;
+    }
+    for (std::int64_t y = y0; y <= y1; ++y) {
+      for (std::int64_t x = x0; x <= x1; ++x) {
+        const auto it = cells_.find(key(x, y));
+        if (it == cells_.end()) continue;
+        for (const std::uint32_t i : it->second) {
+          if (seen_[i] == stamp_) continue;
+          seen_[i] = stamp_;
+          visit(edges_[i]);
+        }
       }
     }
   }
-  return inside;
-}
+
+ private:
+  std::pair<std::int64_t, std::int64_t> cellOf(const cv::Point2d& p) const {
+    return {static_cast<std::int64_t>(std::floor((p.x - origin_.x) / cell_)),
+            static_cast<std::int64_t>(std::floor((p.y - origin_.y) / cell_))};
+  }
+  static std::uint64_t key(std::int64_t x, std::int64_t y) {
+    return (static_cast<std::uint64_t>(x) << 32) ^ (static_cast<std::uint64_t>(y) & 0xffffffffu);
+  }
+
+  const std::vector<Segment>& edges_;
+  cv::Point2d origin_;
+  double cell_ = 1.0;
+  std::unordered_map<std::int64_t, std::vector<std::int64_t>> rows_;  // occupied columns a row, sorted
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+  mutable std::vector<std::uint32_t> seen_;
+  mutable std::uint32_t stamp_ = 0;
+};
 
 double extentOf(const std::vector<Ring>& a, const std::vector<Ring>& b) {
   double m = 1.0;
@@ -98,22 +201,21 @@ double extentOf(const std::vector<Ring>& a, const std::vector<Ring>& b) {
 enum class Location { Outside, Inside, OnBoundarySameSide, OnBoundaryOppositeSide };
 
 // Where the midpoint `m` of a boundary piece running in `direction` lies relative to a polygon.
-Location locate(const cv::Point2d& m, const cv::Point2d& direction, const std::vector<Ring>& rings,
-                const std::vector<Segment>& edges, double tolerance) {
-  for (const auto& e : edges) {
-    if (pointSegmentDistance(m, e) <= tolerance) {
+Location locate(const cv::Point2d& m, const cv::Point2d& direction, const EdgeIndex& edges, double tolerance) {
+  std::optional<Location> onBoundary;
+  edges.near(m, m, tolerance, [&](const Segment& e) {
+    if (!onBoundary && pointSegmentDistance(m, e) <= tolerance) {
       // Both rings have their interior on the left: same direction means same side.
-      return direction.dot(e.to - e.from) > 0 ? Location::OnBoundarySameSide
-                                              : Location::OnBoundaryOppositeSide;
+      onBoundary = direction.dot(e.to - e.from) > 0 ? Location::OnBoundarySameSide : Location::OnBoundaryOppositeSide;
     }
-  }
-  return insideRings(m, rings) ? Location::Inside : Location::Outside;
+  });
+  if (onBoundary) return *onBoundary;
+  return edges.inside(m) ? Location::Inside : Location::Outside;
 }
 
 // Shoelace contribution of the pieces of `ring`'s edges that belong to the boundary of the
 // intersection with the polygon `other`.
-double boundaryContribution(const std::vector<Ring>& rings, const std::vector<Ring>& otherRings,
-                            const std::vector<Segment>& otherEdges, bool countSharedPieces,
+double boundaryContribution(const std::vector<Ring>& rings, const EdgeIndex& otherEdges, bool countSharedPieces,
                             double tolerance) {
   double sum = 0.0;
   std::vector<double> cuts;
@@ -122,7 +224,9 @@ double boundaryContribution(const std::vector<Ring>& rings, const std::vector<Ri
     const double len = std::sqrt(d.dot(d));
     if (len <= 0) continue;
     cuts.assign({0.0, 1.0});
-    for (const auto& o : otherEdges) {
+    const cv::Point2d lo(std::min(e.from.x, e.to.x), std::min(e.from.y, e.to.y));
+    const cv::Point2d hi(std::max(e.from.x, e.to.x), std::max(e.from.y, e.to.y));
+    otherEdges.near(lo, hi, tolerance, [&](const Segment& o) {
       const cv::Point2d f = o.to - o.from;
       const cv::Point2d w = o.from - e.from;
       const double denom = cross(d, f);
@@ -139,13 +243,13 @@ double boundaryContribution(const std::vector<Ring>& rings, const std::vector<Ri
           if (t > 0 && t < 1) cuts.push_back(t);
         }
       }
-    }
+    });
     std::sort(cuts.begin(), cuts.end());
     for (size_t k = 0; k + 1 < cuts.size(); ++k) {
       if ((cuts[k + 1] - cuts[k]) * len <= tolerance) continue;
       const cv::Point2d p0 = e.from + cuts[k] * d;
       const cv::Point2d p1 = e.from + cuts[k + 1] * d;
-      const Location where = locate(0.5 * (p0 + p1), d, otherRings, otherEdges, tolerance);
+      const Location where = locate(0.5 * (p0 + p1), d, otherEdges, tolerance);
       if (where == Location::Inside ||
           (countSharedPieces && where == Location::OnBoundarySameSide)) {
         sum += 0.5 * cross(p0, p1);
@@ -206,8 +310,7 @@ std::vector<cv::Point2d> verticesOf(const std::vector<Ring>& rings) {
   return v;
 }
 
-double directedHausdorff(const std::vector<Segment>& from, const std::vector<Segment>& to,
-                         double step) {
+double directedHausdorff(const std::vector<Segment>& from, const EdgeIndex& to, double step) {
   double worst = 0.0;
   for (const auto& e : from) {
     const cv::Point2d d = e.to - e.from;
@@ -215,7 +318,7 @@ double directedHausdorff(const std::vector<Segment>& from, const std::vector<Seg
     // The edge's end is the next edge's start: sample [0, pieces) here.
     for (int k = 0; k < pieces; ++k) {
       const cv::Point2d p = e.from + (static_cast<double>(k) / pieces) * d;
-      worst = std::max(worst, distanceToEdges(p, to));
+      worst = std::max(worst, to.nearest(p));
     }
   }
   return worst;
@@ -248,8 +351,8 @@ OverlapAreas overlapAreas(const core::Polygon& a, const core::Polygon& b) {
   const auto edgesA = edgesOf(ringsA);
   const auto edgesB = edgesOf(ringsB);
   // Shared pieces are taken from a's pass only, so they count once.
-  const double s = boundaryContribution(ringsA, ringsB, edgesB, true, tolerance) +
-                   boundaryContribution(ringsB, ringsA, edgesA, false, tolerance);
+  const double s = boundaryContribution(ringsA, EdgeIndex(edgesB), true, tolerance) +
+                   boundaryContribution(ringsB, EdgeIndex(edgesA), false, tolerance);
   result.intersection = std::clamp(s, 0.0, std::min(result.a, result.b));
   return result;
 }
@@ -283,9 +386,10 @@ double polisDistance(const core::Polygon& a, const core::Polygon& b) {
   if (verticesA.empty() || verticesB.empty()) return std::numeric_limits<double>::quiet_NaN();
   const auto edgesA = edgesOf(ringsA);
   const auto edgesB = edgesOf(ringsB);
+  const EdgeIndex indexA(edgesA), indexB(edgesB);
   double sumA = 0.0, sumB = 0.0;
-  for (const auto& v : verticesA) sumA += distanceToEdges(v, edgesB);
-  for (const auto& v : verticesB) sumB += distanceToEdges(v, edgesA);
+  for (const auto& v : verticesA) sumA += indexB.nearest(v);
+  for (const auto& v : verticesB) sumB += indexA.nearest(v);
   return 0.5 * sumA / static_cast<double>(verticesA.size()) +
          0.5 * sumB / static_cast<double>(verticesB.size());
 }
@@ -294,7 +398,7 @@ double hausdorffDistance(const core::Polygon& a, const core::Polygon& b, double 
   const auto edgesA = edgesOf(orientedRings(a));
   const auto edgesB = edgesOf(orientedRings(b));
   if (edgesA.empty() || edgesB.empty()) return std::numeric_limits<double>::quiet_NaN();
-  return std::max(directedHausdorff(edgesA, edgesB, step), directedHausdorff(edgesB, edgesA, step));
+  return std::max(directedHausdorff(edgesA, EdgeIndex(edgesB), step), directedHausdorff(edgesB, EdgeIndex(edgesA), step));
 }
 
 std::vector<cv::Point2d> polygonCorners(const core::Polygon& polygon, double minTurnDegrees) {

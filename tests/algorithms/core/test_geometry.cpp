@@ -30,3 +30,21 @@ TEST(Geometry, RasterizeCountsPixelCentres) {
   EXPECT_EQ(m.at<uchar>(2, 2), 0);
   EXPECT_EQ(m.at<uchar>(4, 4), 0);
 }
+
+TEST(Geometry, ARingOfManyVerticesIsCheckedForCrossings) {
+  // 20 000 vertices (the grid path): a circle is simple; swapping two vertices far apart, or
+  // two neighbours, makes edges cross.
+  delineo::core::Ring circle;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2.0 * 3.14159265358979 * i / n;
+    circle.emplace_back(1000.0 + 900.0 * std::cos(a), 1000.0 + 900.0 * std::sin(a));
+  }
+  EXPECT_TRUE(delineo::core::isSimple(circle));
+  delineo::core::Ring far = circle;
+  std::swap(far[100], far[12000]);
+  EXPECT_FALSE(delineo::core::isSimple(far));
+  delineo::core::Ring near = circle;
+  std::swap(near[5000], near[5001]);
+  EXPECT_FALSE(delineo::core::isSimple(near));
+}

@@ -200,3 +200,23 @@ TEST(PolygonMeasures, CornerRmsOnKnownJitter) {
   EXPECT_NEAR(crowded.rms, 0.2, 1e-12);
   EXPECT_TRUE(std::isnan(eval::matchCorners({}, truth, 3.0).rms));
 }
+
+TEST(PolygonMeasures, CirclesOfManyVerticesMatchTheirClosedForms) {
+  // Two 30 000-vertex circles of radius 900 whose centres are 3 apart (the edge grid's paths):
+  // the overlap of two discs (lens area), PoLiS and Hausdorff near the shift.
+  const auto circle = [](double cx, int n) {
+    delineo::core::Polygon p;
+    for (int i = 0; i < n; ++i) {
+      const double a = 2.0 * 3.14159265358979 * i / n;
+      p.outer.emplace_back(cx + 900.0 * std::cos(a), 1000.0 + 900.0 * std::sin(a));
+    }
+    return p;
+  };
+  const delineo::core::Polygon a = circle(1000.0, 30000), b = circle(1003.0, 30000);
+  const double r = 900.0, d = 3.0;
+  const double lens = 2 * r * r * std::acos(d / (2 * r)) - 0.5 * d * std::sqrt(4 * r * r - d * d);
+  const double disc = 3.14159265358979 * r * r;
+  EXPECT_NEAR(eval::intersectionOverUnion(a, b), lens / (2 * disc - lens), 1e-4);
+  EXPECT_NEAR(eval::hausdorffDistance(a, b, 1.0), 3.0, 0.01);
+  EXPECT_NEAR(eval::polisDistance(a, b), 2.0 * 3.0 / 3.14159265358979, 0.02);  // mean |d cos θ|
+}
