@@ -124,15 +124,17 @@ LocalMeasures localMeasures(const cv::Mat& grey, const cv::Mat& above, int side,
   return m;
 }
 
-// Mean of (G - R) / (G + R) over the window's above-ground pixels; empty for a grey image.
+// Mean of the excess green (2G - R - B) / (R + G + B) over the window's above-ground pixels; empty for a grey image.
 cv::Mat greennessOf(const cv::Mat& image, const cv::Mat& above, int side) {
   if (image.channels() != 3) return {};
   cv::Mat bgr[3];
   cv::split(image, bgr);
-  cv::Mat g, r;
+  cv::Mat b, g, r;
+  bgr[0].convertTo(b, CV_32F);
   bgr[1].convertTo(g, CV_32F);
   bgr[2].convertTo(r, CV_32F);
-  const cv::Mat index = (g - r) / cv::max(g + r, 1.0f);
+  // Normalised excess green: grey and bluish-grey roofs stay near 0 where (G - R) alone does not.
+  const cv::Mat index = (2 * g - r - b) / cv::max(r + g + b, 1.0f);
   cv::Mat insideF;
   const cv::Mat inside = above != 0;
   inside.convertTo(insideF, CV_32F, 1.0 / 255.0);

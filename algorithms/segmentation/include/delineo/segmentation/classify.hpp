@@ -27,7 +27,7 @@ struct ClassifyParams {
   double entropyThreshold = 0.95;  // normalised entropy above which a pixel looks like vegetation
   double textureVariation = 0.3;   // std / mean of the window's grey levels above which a dark window is vegetation
   double darkLevel = 90.0;         // grey levels, mean brightness under which a textured window is vegetation (0: off)
-  double greenThreshold = 0.04;    // colour only: (G - R) / (G + R) above which a pixel is vegetation (1: off)
+  double greenThreshold = 0.1;     // colour only: excess green (2G - R - B) / (R + G + B) above which a pixel is vegetation (1: off)
   double regionStep = 1.0;         // m, largest height step inside one region when no region map is given
   double minObjectArea = 10.0;     // m², smaller one-class pieces take the class of the neighbour they share most border with
 
@@ -52,7 +52,7 @@ struct ClassifyParams {
                 "Mean brightness under which a textured window is vegetation (0: off)", 0, 255},
       darkLevel);
     v(ParamInfo{"green-threshold", "Greenness threshold", "",
-                "On colour images, (G - R) / (G + R) above which a pixel is vegetation (1: off)", -1, 1},
+                "On colour images, the excess green (2G - R - B) / (R + G + B) above which a pixel is vegetation (1: off)", -1, 1},
       greenThreshold);
     v(ParamInfo{"region-step", "Region step", "m",
                 "Largest height step between neighbours of one region when no region map is given", 0.05, 100},
@@ -69,7 +69,7 @@ struct Classification {
   cv::Mat labels;      // CV_8U ClassLabel, one class per region
   cv::Mat pixelLabels; // CV_8U ClassLabel per pixel, before the regions' majority
   cv::Mat entropy;     // CV_32F normalised direction entropy in [0, 1], NaN where no gradient votes
-  cv::Mat greenness;   // CV_32F (G - R) / (G + R); empty for a grey image
+  cv::Mat greenness;   // CV_32F excess green (2G - R - B) / (R + G + B), window mean; empty for a grey image
   cv::Mat regions;     // CV_32S region index used for the majority (-1 outside the above-ground mask)
 };
 
