@@ -1,0 +1,266 @@
+#include "delineo/segmentation/ground.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include <opencv2/imgproc/detail/gcgraph.hpp>
+
+#include "delineo/core/error.hpp"
+#include "delineo/segmentation/dtm.hpp"
+#include "delineo/segmentation/ground_model.hpp"
+#include "delineo/segmentation/regions.hpp"
+
+namespace delineo::segmentation {
+
+namespace {
+
+using core::Error;
+using core::ErrorCode;
+using Labels = std::vector<GroundLabel>;
+
+void checkInputs(const cv::Mat& dem, double gsd, const GroundParams& params) {
+  params.validate();
+  if (dem.empty()) throw Error(ErrorCode::UnsupportedInput, "the DEM is empty");
+  if (dem.type() != CV_32FC1) throw Error(ErrorCode::UnsupportedInput, "the DEM must be one band of float32");
+  if (!std::isfinite(gsd) || gsd <= 0.0) {
+    std::ostringstream msg;
+    msg << "the ground size of a pixel (gsd) must be a positive number of metres, not " << gsd;
+    throw Error(ErrorCode::InvalidParameter, msg.str());
+  }
+}
+
+// Metres to whole pixels, clamped to [lo, INT_MAX / 4].
+int toPixels(double metres, double gsd, int lo) {
+  return static_cast<int>(std::clamp(std::round(metres / gsd), static_cast<double>(lo), INT_MAX / 4.0));
+}
+
+// The DTM from the pixels of the regions labelled ground.
+cv::Mat groundDtm(const RegionGraph& graph, const cv::Mat& dem, const Labels& labels, int windowPx,
+                  double binWidth, int* samples = nullptr) {
+  cv::Mat ground(dem.size(), CV_8U);
+  for (int y = 0; y < dem.rows; ++y) {
+    const int* r = graph.labels.ptr<int>(y);
+    unsigned char* g = ground.ptr<unsigned char>(y);
+    for (int x = 0; x < dem.cols; ++x) g[x] = r[x] >= 0 && labels[static_cast<size_t>(r[x])] == GroundLabel::Ground;
+  }
+  const std::vector<GroundSample> points = sampleGround(dem, ground, windowPx, binWidth);
+  if (samples) *samples = static_cast<int>(points.size());
+  return interpolateDtm(points, dem.size());
+}
+
+// Average, lowest and highest DTM height over each region's pixels.
+std::vector<GroundUnder> groundUnderRegions(const RegionGraph& graph, const cv::Mat& dtm) {
+  const size_t n = graph.regions.size();
+  std::vector<GroundUnder> under(n, GroundUnder{0.0, std::numeric_limits<double>::infinity(),
+                                                -std::numeric_limits<double>::infinity()});
+  for (int y = 0; y < dtm.rows; ++y) {
+    const int* r = graph.labels.ptr<int>(y);
+    const float* g = dtm.ptr<float>(y);
+    for (int x = 0; x < dtm.cols; ++x) {
+      if (r[x] < 0) continue;
+      GroundUnder& u = under[static_cast<size_t>(r[x])];
+      u.average += g[x];
+      u.lowest = std::min<double>(u.lowest, g[x]);
+      u.highest = std::max<double>(u.highest, g[x]);
+    }
+  }
+  for (size_t i = 0; i < n; ++i) under[i].average /= graph.regions[i].pixels;
+  return under;
+}
+
+// The labels of least α_d U_d + α_c U_c given the ground under each region. The pair potentials
+// are submodular (V(g,g) + V(a,a) <= V(g,a) + V(a,g) for every step), so a minimum cut gives the
+// exact minimum: source side = ground, sink side = above.
+Labels labelRegions(const RegionGraph& graph, const std::vector<GroundUnder>& under, const GroundParams& params) {
+  const size_t n = graph.regions.size();
+  const double wd = params.dataWeight, wc = 1.0 - params.dataWeight, d0 = params.criticalHeight;
+  std::vector<double> cost0(n, 0.0), cost1(n, 0.0);  // unary cost of ground, of above
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(under[i].average)) continue;  // no DTM at all: no data term
+    cost0[i] = wd * dataPotential(GroundLabel::Ground, graph.regions[i].meanHeight, under[i], d0);
+    cost1[i] = wd * dataPotential(GroundLabel::Above, graph.regions[i].meanHeight, under[i], d0);
+  }
+  cv::detail::GCGraph<double> cut(static_cast<unsigned>(n), static_cast<unsigned>(2 * graph.links.size()));
+  for (size_t i = 0; i < n; ++i) cut.addVtx();
+  bool anyEdge = false;
+  for (const RegionLink& link : graph.links) {
+    const double gg = wc * contextualPotential(GroundLabel::Ground, GroundLabel::Ground, link.step, d0);
+    const double ga = wc * contextualPotential(GroundLabel::Ground, GroundLabel::Above, link.step, d0);
+    const double ag = wc * contextualPotential(GroundLabel::Above, GroundLabel::Ground, link.step, d0);
+    const double aa = wc * contextualPotential(GroundLabel::Above, GroundLabel::Above, link.step, d0);
+    // E(xa, xb) = gg + (ag - gg) xa + (aa - ag) xb + (ga + ag - gg - aa) (1 - xa) xb
+    cost1[static_cast<size_t>(link.a)] += ag - gg;
+    cost1[static_cast<size_t>(link.b)] += aa - ag;
+    const double w = std::max(0.0, ga + ag - gg - aa);
+    if (w > 0.0) {
+      cut.addEdges(link.a, link.b, w, 0.0);
+      anyEdge = true;
+    }
+  }
+  Labels labels(n, GroundLabel::Ground);
+  if (!anyEdge) {
+    for (size_t i = 0; i < n; ++i) labels[i] = cost1[i] < cost0[i] ? GroundLabel::Above : GroundLabel::Ground;
+    return labels;
+  }
+  for (size_t i = 0; i < n; ++i) cut.addTermWeights(static_cast<int>(i), cost1[i], cost0[i]);
+  cut.maxFlow();
+  for (size_t i = 0; i < n; ++i) {
+    labels[i] = cut.inSourceSegment(static_cast<int>(i)) ? GroundLabel::Ground : GroundLabel::Above;
+  }
+  return labels;
+}
+
+struct Rounds {
+  Labels labels;
+  std::vector<bool> oscillating;
+  cv::Mat dtm;
+  int samples = 0;
+  int iterations = 0;
+  bool converged = false;
+  bool canceled = false;
+};
+
+// Regions whose label differs among `states` become ground in `labels`; returns how many.
+int groundOscillating(const std::vector<Labels>& states, Labels& labels, std::vector<bool>& oscillating) {
+  int count = 0;
+  for (size_t i = 0; i < labels.size(); ++i) {
+    bool differs = false;
+    for (const Labels& s : states) differs = differs || s[i] != states.front()[i];
+    if (!differs) continue;
+    oscillating[i] = true;
+    labels[i] = GroundLabel::Ground;
+    ++count;
+  }
+  return count;
+}
+
+// Stages 5 and 6: from all ground, DTM then labels until the labels repeat. A return to an
+// earlier state is an oscillation: the regions that change along the cycle become ground, as
+// do those still changing after the last round.
+Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundParams& params, int windowPx,
+                   core::Progress* progress) {
+  Rounds out;
+  const size_t n = graph.regions.size();
+  out.labels.assign(n, GroundLabel::Ground);
+  out.oscillating.assign(n, false);
+  std::vector<Labels> history{out.labels};
+  out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+  for (int round = 1; round <= params.maxIterations; ++round) {
+    if (core::isCanceled(progress)) {
+      out.canceled = true;
+      return out;
+    }
+    Labels next = labelRegions(graph, groundUnderRegions(graph, out.dtm), params);
+    out.iterations = round;
+    if (next == out.labels) {
+      out.converged = true;
+      return out;
+    }
+    const auto seen = std::find(history.begin(), history.end(), next);
+    const bool cycle = seen != history.end();
+    const bool last = round == params.maxIterations;
+    if (cycle || last) {
+      const std::vector<Labels> states = cycle ? std::vector<Labels>(seen, history.end())
+                                               : std::vector<Labels>{out.labels, next};
+      out.labels = next;
+      groundOscillating(states, out.labels, out.oscillating);
+      out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+      return out;
+    }
+    history.push_back(next);
+    out.labels = std::move(next);
+    out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+    core::report(progress, static_cast<double>(round) / params.maxIterations);
+  }
+  return out;
+}
+
+GroundResult canceledResult(GroundResult result) {
+  result.status = core::RunStatus::Canceled;
+  return result;
+}
+
+}  // namespace
+
+void GroundParams::validate() const {
+  core::checkDeclaredRanges(*this);
+  gaps.validate();
+  if (criticalHeight < 2.0 * regionThreshold) {
+    std::ostringstream msg;
+    msg << "critical-height (" << criticalHeight << " m) must be at least twice region-threshold ("
+        << regionThreshold << " m)";
+    throw Error(ErrorCode::InvalidParameter, msg.str());
+  }
+}
+
+GroundResult segmentGround(const cv::Mat& dem, double gsd, const GroundParams& params, core::Progress* progress) {
+  checkInputs(dem, gsd, params);
+  GroundResult result;
+
+  // 1. Elevation gaps: merged into their surface when their border is level, kept otherwise.
+  core::Progress::Range gapProgress(progress, 0.0, 0.3);
+  const dem::GapResult gaps = dem::handleGaps(dem, params.gaps, &gapProgress);
+  if (gaps.status == core::RunStatus::Canceled) return canceledResult(result);
+  result.demUsed = gaps.dem;
+  result.mergedGapPixels = gaps.mergedPixels;
+  result.keptGapPixels = gaps.keptPixels;
+
+  // 2. Regions of homogeneous height (steps of at most δ_g between 4-neighbours).
+  int count = 0;
+  cv::Mat labels = growRegions(gaps.dem, params.regionThreshold, count);
+  if (core::isCanceled(progress)) return canceledResult(result);
+  core::report(progress, 0.35);
+
+  // 3. Small regions (noise, speckles) merged into the neighbour of closest height.
+  const double minPixels = std::ceil(params.minRegionArea / (gsd * gsd));
+  count = mergeSmallRegions(labels, gaps.dem, count, static_cast<int>(std::min(minPixels, INT_MAX / 4.0)));
+  if (core::isCanceled(progress)) return canceledResult(result);
+  core::report(progress, 0.4);
+
+  // 4. Region adjacency graph, with links across kept gaps along the rows.
+  const RegionGraph graph = buildRegionGraph(labels, gaps.dem, count, toPixels(params.stepBand, gsd, 0),
+                                             toPixels(params.gapLinkLength, gsd, 0));
+  if (core::isCanceled(progress)) return canceledResult(result);
+  core::report(progress, 0.45);
+
+  // 5-6. Labelling and DTM rounds; oscillating regions become ground.
+  core::Progress::Range roundProgress(progress, 0.45, 0.95);
+  const Rounds rounds = labelAndDtm(graph, gaps.dem, params, toPixels(params.dtmWindow, gsd, 1), &roundProgress);
+  if (rounds.canceled) return canceledResult(result);
+
+  // 7. Outputs: regions, above-ground mask, DTM, nDSM.
+  result.regions = graph.labels;
+  result.regionCount = count;
+  result.links = static_cast<int>(graph.links.size());
+  result.gapLinks = graph.gapLinks;
+  result.dtm = rounds.dtm;
+  result.groundSamples = rounds.samples;
+  result.iterations = rounds.iterations;
+  result.converged = rounds.converged;
+  result.aboveGround = cv::Mat(dem.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < dem.rows; ++y) {
+    const int* r = graph.labels.ptr<int>(y);
+    unsigned char* a = result.aboveGround.ptr<unsigned char>(y);
+    for (int x = 0; x < dem.cols; ++x) {
+      if (r[x] >= 0 && rounds.labels[static_cast<size_t>(r[x])] == GroundLabel::Above) a[x] = 255;
+    }
+  }
+  result.regionInfo.resize(static_cast<size_t>(count));
+  for (size_t i = 0; i < result.regionInfo.size(); ++i) {
+    GroundRegionInfo& info = result.regionInfo[i];
+    info.pixels = graph.regions[i].pixels;
+    info.meanHeight = graph.regions[i].meanHeight;
+    info.above = rounds.labels[i] == GroundLabel::Above;
+    info.oscillating = rounds.oscillating[i];
+    result.oscillatingRegions += info.oscillating ? 1 : 0;
+  }
+  cv::subtract(gaps.dem, result.dtm, result.ndsm);  // NaN in either stays NaN
+  core::report(progress, 1.0);
+  return result;
+}
+
+}  // namespace delineo::segmentation
