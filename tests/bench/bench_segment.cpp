@@ -119,6 +119,19 @@ void printScore(const char* scene, const char* demName, const Score& s) {
   if (std::getenv("BENCH_VERBOSE")) std::printf("       DEM error on the false pixels: %+.2f m\n", s.falseDemError);
 }
 
+cv::Mat matcherDem(const sim::Scene& scene) {
+  cv::Mat left, right;
+  scene.left.convertTo(left, CV_32F);
+  scene.right.convertTo(right, CV_32F);
+  stereo::MatchParams mp;
+  mp.dmin = scene.disparityMin;
+  mp.dmax = scene.disparityMax;
+  dem::HeightModel model;
+  model.metresPerPixel = scene.metresPerDisparity;
+  model.groundDisparity = scene.groundDisparity;
+  return dem::heightsFromDisparity(stereo::matchStereo(left, right, mp).disparity, model);
+}
+
 int simulated(int scenes, int firstSeed, sim::SceneParams sceneParams, const segmentation::GroundParams& params,
               bool withMatcher, const std::string& dumpDir) {
   std::printf("%-6s %-8s %8s %8s %9s %9s %7s %5s %5s %8s\n", "scene", "dem", "found%", "false%", "DTM RMS m",
@@ -128,19 +141,7 @@ int simulated(int scenes, int firstSeed, sim::SceneParams sceneParams, const seg
     sceneParams.seed = firstSeed + s;
     const sim::Scene scene = sim::simulateScene(sceneParams);
     std::map<std::string, cv::Mat> dems{{"true", scene.dem}};
-    if (withMatcher) {
-      cv::Mat left, right;
-      scene.left.convertTo(left, CV_32F);
-      scene.right.convertTo(right, CV_32F);
-      stereo::MatchParams mp;
-      mp.dmin = scene.disparityMin;
-      mp.dmax = scene.disparityMax;
-      const cv::Mat disparity = stereo::matchStereo(left, right, mp).disparity;
-      dem::HeightModel model;
-      model.metresPerPixel = scene.metresPerDisparity;
-      model.groundDisparity = scene.groundDisparity;
-      dems["matcher"] = dem::heightsFromDisparity(disparity, model);
-    }
+    if (withMatcher) dems["matcher"] = matcherDem(scene);
     for (const auto& [name, dem] : dems) {
       double ms = 0;
       const auto r = timedSegment(dem, scene.gsd, params, ms);
@@ -184,21 +185,29 @@ long peakResidentKb() {
   return -1;
 }
 
-void timing(int size, const segmentation::GroundParams& params) {
+// Wall time and peak resident memory of one call on a size x size scene's true (and matched) DEM.
+void timing(int size, const segmentation::GroundParams& params, bool withMatcher) {
   sim::SceneParams sp = sim::squareSceneParams(size, 1);
   sp.slope = 10.0;
   const sim::Scene scene = sim::simulateScene(sp);
-  const cv::Mat dem = scene.dem.clone();
-  std::ofstream("/proc/self/clear_refs") << "5";  // peak resident memory := current
-  const long before = peakResidentKb();
-  double ms = 0;
-  const auto r = timedSegment(dem, scene.gsd, params, ms);
-  const long peak = peakResidentKb();
-  const Score sc = score(r, dem, scene);
-  std::printf("\n%d x %d px true DEM (seed 1): %.0f ms wall, peak resident %.0f MB (%.0f MB above the %.0f MB "
-              "before the call); %d regions, %d iterations; found %.1f %%, false %.1f %%, DTM RMS %.3f m\n",
-              size, size, ms, peak / 1024.0, (peak - before) / 1024.0, before / 1024.0, r.regionCount,
-              r.iterations, sc.found, sc.falsePct, sc.dtmRms);
+  std::map<std::string, cv::Mat> dems{{"true", scene.dem.clone()}};
+  if (withMatcher) dems["matcher"] = matcherDem(scene);
+  std::printf("\n%d x %d px, seed 1 (%d buildings, %d trees):\n", size, size, scene.buildingsPlaced,
+              scene.treesPlaced);
+  for (const auto& [name, dem] : dems) {
+    std::ofstream("/proc/self/clear_refs") << "5";  // peak resident memory := current
+    const long before = peakResidentKb();
+    double ms = 0;
+    const auto r = timedSegment(dem, scene.gsd, params, ms);
+    const long peak = peakResidentKb();
+    const Score sc = score(r, dem, scene);
+    const double resultMb = (r.regions.total() * r.regions.elemSize() + r.aboveGround.total() +
+                             (r.dtm.total() + r.ndsm.total() + r.demUsed.total()) * sizeof(float)) / 1048576.0;
+    std::printf("  %-8s %.0f ms wall; peak resident %.0f MB (+%.0f MB over the %.0f MB before the call), result %.0f MB; "
+                "%d regions, %d links (%d across gaps), %d iterations; found %.1f %%, false %.1f %%, DTM RMS %.3f m\n",
+                name.c_str(), ms, peak / 1024.0, (peak - before) / 1024.0, before / 1024.0, resultMb, r.regionCount,
+                r.links, r.gapLinks, r.iterations, sc.found, sc.falsePct, sc.dtmRms);
+  }
 }
 
 }  // namespace
@@ -241,6 +250,6 @@ int main(int argc, char** argv) {
     timeSize = 200;
   }
   simulated(scenes, firstSeed, sceneParams, params, withMatcher, dumpDir);
-  if (timeSize > 0) timing(timeSize, params);
+  if (timeSize > 0) timing(timeSize, params, withMatcher);
   return 0;
 }

@@ -145,7 +145,8 @@ int groundOscillating(const std::vector<Labels>& states, Labels& labels, std::ve
 
 // Stages 5 and 6: from all ground, DTM then labels until the labels repeat. A return to an
 // earlier state is an oscillation: the regions that change along the cycle become ground, as
-// do those still changing after the last round.
+// do those still changing after the last round. A labelling without any ground (no DTM then,
+// and nothing to pull a region back) is refused: the rounds stop at the previous labels.
 Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundParams& params, int windowPx,
                    core::Progress* progress) {
   Rounds out;
@@ -161,6 +162,9 @@ Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundPar
     }
     Labels next = labelRegions(graph, groundUnderRegions(graph, out.dtm), params);
     out.iterations = round;
+    if (std::find(next.begin(), next.end(), GroundLabel::Ground) == next.end() && !next.empty()) {
+      return out;  // no ground left means no DTM: keep the last labels that had one
+    }
     if (next == out.labels) {
       out.converged = true;
       return out;
