@@ -78,11 +78,16 @@ std::vector<GroundUnder> groundUnderRegions(const RegionGraph& graph, const cv::
 Labels labelRegions(const RegionGraph& graph, const std::vector<GroundUnder>& under, const GroundParams& params) {
   const size_t n = graph.regions.size();
   const double wd = params.dataWeight, wc = 1.0 - params.dataWeight, d0 = params.criticalHeight;
+  // A region's data potential counts once per link it has (at least once), so that α_d : α_c
+  // weighs its own height over the DTM against its neighbours whatever their number.
+  std::vector<int> degree(n, 0);
+  for (const RegionLink& link : graph.links) ++degree[static_cast<size_t>(link.a)], ++degree[static_cast<size_t>(link.b)];
   std::vector<double> cost0(n, 0.0), cost1(n, 0.0);  // unary cost of ground, of above
   for (size_t i = 0; i < n; ++i) {
     if (!std::isfinite(under[i].average)) continue;  // no DTM at all: no data term
-    cost0[i] = wd * dataPotential(GroundLabel::Ground, graph.regions[i].meanHeight, under[i], d0);
-    cost1[i] = wd * dataPotential(GroundLabel::Above, graph.regions[i].meanHeight, under[i], d0);
+    const double w = wd * std::max(1, degree[i]);
+    cost0[i] = w * dataPotential(GroundLabel::Ground, graph.regions[i].meanHeight, under[i], d0);
+    cost1[i] = w * dataPotential(GroundLabel::Above, graph.regions[i].meanHeight, under[i], d0);
   }
   cv::detail::GCGraph<double> cut(static_cast<unsigned>(n), static_cast<unsigned>(2 * graph.links.size()));
   for (size_t i = 0; i < n; ++i) cut.addVtx();
@@ -140,7 +145,8 @@ int groundOscillating(const std::vector<Labels>& states, Labels& labels, std::ve
 
 // Stages 5 and 6: from all ground, DTM then labels until the labels repeat. A return to an
 // earlier state is an oscillation: the regions that change along the cycle become ground, as
-// do those still changing after the last round.
+// do those still changing after the last round. A labelling without any ground (no DTM then,
+// and nothing to pull a region back) is refused: the rounds stop at the previous labels.
 Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundParams& params, int windowPx,
                    core::Progress* progress) {
   Rounds out;
@@ -156,6 +162,9 @@ Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundPar
     }
     Labels next = labelRegions(graph, groundUnderRegions(graph, out.dtm), params);
     out.iterations = round;
+    if (std::find(next.begin(), next.end(), GroundLabel::Ground) == next.end() && !next.empty()) {
+      return out;  // no ground left means no DTM: keep the last labels that had one
+    }
     if (next == out.labels) {
       out.converged = true;
       return out;
@@ -209,9 +218,14 @@ GroundResult segmentGround(const cv::Mat& dem, double gsd, const GroundParams& p
   result.mergedGapPixels = gaps.mergedPixels;
   result.keptGapPixels = gaps.keptPixels;
 
-  // 2. Regions of homogeneous height (steps of at most δ_g between 4-neighbours).
+  // 2. Regions of homogeneous height (steps of at most δ_g between 4-neighbours), walls apart.
+  //    In left-image geometry a wall the left view sees is a ramp of small steps from the
+  //    ground to the eave: grown through, it would make the roof and the ground one region.
+  const cv::Mat steep = params.wallSlope < 90.0
+                            ? steepPixels(gaps.dem, std::tan(params.wallSlope * CV_PI / 180.0) * gsd)
+                            : cv::Mat();
   int count = 0;
-  cv::Mat labels = growRegions(gaps.dem, params.regionThreshold, count);
+  cv::Mat labels = growRegions(gaps.dem, params.regionThreshold, steep, count);
   if (core::isCanceled(progress)) return canceledResult(result);
   core::report(progress, 0.35);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <unordered_map>
 
@@ -73,8 +74,34 @@ void addContact(std::unordered_map<std::uint64_t, LinkSum>& sums, const cv::Mat&
 
 }  // namespace
 
-cv::Mat growRegions(const cv::Mat& dem, double maxStep, int& count) {
+cv::Mat steepPixels(const cv::Mat& dem, double maxRise) {
+  cv::Mat steep(dem.size(), CV_8U, cv::Scalar(0));
+  auto height = [&](int x, int y) {
+    return x < 0 || y < 0 || x >= dem.cols || y >= dem.rows ? std::numeric_limits<float>::quiet_NaN()
+                                                             : dem.at<float>(y, x);
+  };
+  // Rise per pixel from the two neighbours along one axis (central, else one-sided, else 0).
+  auto rise = [](float before, float here, float after) {
+    if (std::isfinite(before) && std::isfinite(after)) return 0.5 * (after - before);
+    if (std::isfinite(after)) return static_cast<double>(after - here);
+    if (std::isfinite(before)) return static_cast<double>(here - before);
+    return 0.0;
+  };
+  for (int y = 0; y < dem.rows; ++y) {
+    for (int x = 0; x < dem.cols; ++x) {
+      const float h = dem.at<float>(y, x);
+      if (!std::isfinite(h)) continue;
+      const double gx = rise(height(x - 1, y), h, height(x + 1, y));
+      const double gy = rise(height(x, y - 1), h, height(x, y + 1));
+      if (gx * gx + gy * gy > maxRise * maxRise) steep.at<unsigned char>(y, x) = 255;
+    }
+  }
+  return steep;
+}
+
+cv::Mat growRegions(const cv::Mat& dem, double maxStep, const cv::Mat& steep, int& count) {
   cv::Mat labels(dem.size(), CV_32S, cv::Scalar(-1));
+  const bool split = !steep.empty();
   count = 0;
   std::vector<cv::Point> stack;
   const cv::Point steps[4] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
@@ -93,6 +120,7 @@ cv::Mat growRegions(const cv::Mat& dem, double maxStep, int& count) {
           if (q.x < 0 || q.y < 0 || q.x >= dem.cols || q.y >= dem.rows || labels.at<int>(q) >= 0) continue;
           const float hq = dem.at<float>(q);
           if (!std::isfinite(hq) || std::abs(hq - h) > maxStep) continue;
+          if (split && steep.at<unsigned char>(q) != steep.at<unsigned char>(p)) continue;
           labels.at<int>(q) = label;
           stack.push_back(q);
         }

@@ -4,11 +4,13 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
 #include "delineo/core/nan_mask.hpp"
 #include "delineo/core/progress.hpp"
 #include "delineo/segmentation/ground.hpp"
+#include "delineo/sim/scene.hpp"
 
 using namespace delineo;
 using segmentation::GroundParams;
@@ -39,6 +41,30 @@ void addBox(cv::Mat& dem, const cv::Mat& ground, const cv::Rect& box, float heig
     for (int x = box.x; x < box.br().x; ++x) top = std::max(top, static_cast<double>(ground.at<float>(y, x)));
   }
   dem(box).setTo(cv::Scalar(top + height));
+}
+
+// The wall left of `box` as the left view sees it: a ramp of `step` m per px from the ground up
+// to the roof (walls are ramps of small steps in left-image geometry).
+void addWallRamp(cv::Mat& dem, const cv::Mat& ground, const cv::Rect& box, float step) {
+  for (int y = box.y; y < box.br().y; ++y) {
+    const float roof = dem.at<float>(y, box.x);
+    for (int i = 1; i <= box.x; ++i) {
+      const int x = box.x - i;
+      const float h = roof - step * static_cast<float>(i);
+      if (h <= ground.at<float>(y, x)) break;
+      dem.at<float>(y, x) = h;
+    }
+  }
+}
+
+// A tree crown: a dome of `height` m and `radius` px over the terrain.
+void addCrown(cv::Mat& dem, const cv::Mat& ground, cv::Point centre, int radius, float height) {
+  for (int y = centre.y - radius; y <= centre.y + radius; ++y) {
+    for (int x = centre.x - radius; x <= centre.x + radius; ++x) {
+      const double r2 = (cv::Point(x, y) - centre).ddot(cv::Point(x, y) - centre) / double(radius * radius);
+      if (r2 < 1.0) dem.at<float>(y, x) = ground.at<float>(y, x) + height * static_cast<float>(std::sqrt(1.0 - r2));
+    }
+  }
 }
 
 int countAbove(const GroundResult& r, const cv::Rect& area) { return cv::countNonZero(r.aboveGround(area)); }
@@ -102,6 +128,50 @@ TEST(SegmentGround, BuildingLargerThanTheDtmWindowIsFound) {
   EXPECT_EQ(countAbove(r, box), box.area());
   EXPECT_EQ(cv::countNonZero(r.aboveGround), box.area());
   EXPECT_GE(r.iterations, 2);
+}
+
+TEST(SegmentGround, WallsSeenObliquelyDoNotJoinRoofsToTheGround) {
+  // Ramps of 1 m per px from the ground to each roof (steps at the region threshold): grown
+  // through, roof and ground would be one region.
+  const cv::Mat ground = terrain({300, 220}, 0.10);
+  cv::Mat dem = ground.clone();
+  const cv::Rect a(60, 40, 60, 50), b(180, 120, 80, 60);
+  addBox(dem, ground, a, 9.0f);
+  addBox(dem, ground, b, 12.0f);
+  addWallRamp(dem, ground, a, 0.95f);
+  addWallRamp(dem, ground, b, 0.95f);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  EXPECT_EQ(countAbove(r, a), a.area());
+  EXPECT_EQ(countAbove(r, b), b.area());
+}
+
+TEST(SegmentGround, SceneOfBuildingsAndTreesOnASlopeKeepsItsGround) {
+  // Many neighbours of the one large ground region: its own height over the DTM must still
+  // weigh against them (a region's data term counts once per link).
+  const cv::Mat ground = terrain({400, 300}, 0.10, 0.02, 9);
+  cv::Mat dem = ground.clone();
+  cv::Mat truth(dem.size(), CV_8U, cv::Scalar(0));
+  const cv::Rect boxes[] = {{40, 30, 70, 50}, {160, 40, 60, 90}, {280, 30, 80, 60}, {60, 170, 90, 70}, {250, 180, 100, 80}};
+  float height = 6.0f;
+  for (const cv::Rect& box : boxes) {
+    addBox(dem, ground, box, height);
+    addWallRamp(dem, ground, box, 0.95f);
+    truth(box).setTo(255);
+    height += 2.5f;
+  }
+  const cv::Point crowns[] = {{130, 150}, {200, 250}, {370, 150}, {20, 280}, {230, 160}};
+  for (const cv::Point& c : crowns) {
+    addCrown(dem, ground, c, 14, 7.0f);
+    cv::circle(truth, c, 12, cv::Scalar(255), cv::FILLED);
+  }
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  const int found = cv::countNonZero(r.aboveGround & truth), all = cv::countNonZero(truth);
+  cv::Mat nearObjects;
+  cv::dilate(truth, nearObjects, cv::Mat::ones(45, 45, CV_8U));  // walls: ramps up to 20 px long
+  const int farFalse = cv::countNonZero(r.aboveGround & ~nearObjects);
+  EXPECT_GT(found, 0.97 * all);
+  EXPECT_EQ(farFalse, 0) << "above-ground far from every object";
+  EXPECT_LT(dtmRms(r, ground, nearObjects), 0.1);
 }
 
 TEST(SegmentGround, AdjacentBuildingsOfDifferentHeightsAreBothAboveGround) {
@@ -259,4 +329,32 @@ TEST(SegmentGround, ParamsRoundTripThroughJson) {
   core::fromJson(q, core::toJson(p));
   EXPECT_EQ(q.dtmWindow, 35.0);
   EXPECT_EQ(q.gaps.maxBorderSpread, 0.5);
+}
+
+TEST(SegmentGround, SimulatedSlopedSceneFromItsTrueDem) {
+  // The simulator's small scene (10 % slope, two buildings, two trees; walls seen obliquely):
+  // with the plain sum of data potentials the one large ground region, linked to every object,
+  // followed its neighbours and the whole scene came out above-ground.
+  sim::SceneParams sp;
+  sp.width = 240;
+  sp.height = 200;
+  sp.buildings = 2;
+  sp.trees = 2;
+  sp.slope = 10.0;
+  const sim::Scene scene = sim::simulateScene(sp);
+  const GroundResult r = segmentGround(scene.dem, scene.gsd, GroundParams{});
+  int truth = 0, hit = 0, predicted = 0, wrong = 0;
+  for (int y = 0; y < scene.dem.rows; ++y) {
+    for (int x = 0; x < scene.dem.cols; ++x) {
+      const int label = scene.labels.at<unsigned char>(y, x);
+      if (label == sim::kLabelFacade) continue;  // walls: neither ground nor roof
+      const bool above = r.aboveGround.at<unsigned char>(y, x) != 0;
+      truth += label != sim::kLabelGround;
+      hit += above && label != sim::kLabelGround;
+      predicted += above;
+      wrong += above && label == sim::kLabelGround;
+    }
+  }
+  EXPECT_GT(hit, 0.95 * truth);
+  EXPECT_LT(wrong, 0.05 * predicted);
 }

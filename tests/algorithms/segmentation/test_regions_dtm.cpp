@@ -23,7 +23,7 @@ TEST(Regions, GrowingSplitsAtStepsAboveTheThresholdOnly) {
   dem.colRange(12, 20) += 3.0;  // a 3.5 m step between columns 11 and 12
   dem.at<float>(5, 5) = kNaN;
   int count = 0;
-  const cv::Mat labels = growRegions(dem, 1.0, count);
+  const cv::Mat labels = growRegions(dem, 1.0, cv::Mat(), count);
   EXPECT_EQ(count, 2);
   EXPECT_EQ(labels.at<int>(5, 5), -1);
   EXPECT_EQ(labels.at<int>(0, 0), labels.at<int>(9, 11));
@@ -35,7 +35,7 @@ TEST(Regions, SmallRegionsMergeIntoTheNeighbourOfClosestHeight) {
   dem.colRange(15, 30).setTo(10.0);
   dem(cv::Rect(14, 8, 2, 2)).setTo(7.0);  // 4 px speck on the border, nearer 10 m than 0 m
   int count = 0;
-  cv::Mat labels = growRegions(dem, 1.0, count);
+  cv::Mat labels = growRegions(dem, 1.0, cv::Mat(), count);
   ASSERT_EQ(count, 3);
   count = mergeSmallRegions(labels, dem, count, 5);
   EXPECT_EQ(count, 2);
@@ -50,7 +50,7 @@ TEST(Regions, GraphLinksNeighboursAndRegionsAcrossARowGap) {
   dem.colRange(20, 26).setTo(kNaN);
   dem.colRange(26, 40).setTo(0.2);
   int count = 0;
-  const cv::Mat labels = growRegions(dem, 1.0, count);
+  const cv::Mat labels = growRegions(dem, 1.0, cv::Mat(), count);
   ASSERT_EQ(count, 3);
   const RegionGraph g = buildRegionGraph(labels, dem, count, 4, 8);
   ASSERT_EQ(g.links.size(), 2u);
@@ -81,7 +81,7 @@ TEST(Regions, StepIsReadInsideTheRegionsNotAtTheirMeans) {
   cv::Mat dem(10, 100, CV_32F);
   for (int x = 0; x < 100; ++x) dem.col(x).setTo(0.1 * x + (x >= 60 ? 1.5 : 0.0));
   int count = 0;
-  const cv::Mat labels = growRegions(dem, 1.0, count);
+  const cv::Mat labels = growRegions(dem, 1.0, cv::Mat(), count);
   ASSERT_EQ(count, 2);
   const RegionGraph g = buildRegionGraph(labels, dem, count, 3, 0);
   ASSERT_EQ(g.links.size(), 1u);

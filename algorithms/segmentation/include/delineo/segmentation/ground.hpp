@@ -4,7 +4,8 @@
 //
 // Stages (segmentGround()):
 //   1. elevation gaps: dem::handleGaps() merges the gaps inside one surface, keeps the others;
-//   2. regions: 4-connected growing with steps of at most δ_g between neighbours;
+//   2. regions: 4-connected growing with steps of at most δ_g between neighbours, walls (pixels
+//      steeper than a slope: oblique walls are ramps in left-image geometry) apart;
 //   3. regions smaller than an area merged into the neighbour of closest mean height;
 //   4. region adjacency graph, plus links across kept gaps along the rows (occlusions);
 //   5. labelling ground / above-ground by the exact minimum (graph cut) of α_d U_d + α_c U_c over
@@ -25,6 +26,8 @@ namespace delineo::segmentation {
 
 struct GroundParams {
   double regionThreshold = 1.0;  // m, δ_g: largest height step between 4-neighbours of one region
+  double wallSlope = 60.0;       // °, pixels steeper than this are walls: regions do not grow
+                                 // from them into flatter pixels (90: no split)
   double minRegionArea = 2.0;    // m², smaller regions are merged into the neighbour of closest height
   double criticalHeight = 2.0;   // m, δ_0: least height of an above-ground object over its
                                  // neighbourhood (δ_0 >= 2 δ_g)
@@ -42,6 +45,11 @@ struct GroundParams {
     v(ParamInfo{"region-threshold", "Region step", "m",
                 "Largest height step between neighbouring pixels of one region (paper: 1 m)", 0.001, 1000},
       regionThreshold);
+    v(ParamInfo{"wall-slope", "Wall slope", "°",
+                "Slope from which a pixel belongs to a wall, whose ramp then does not join roofs to the ground (90: "
+                "none)",
+                1, 90},
+      wallSlope);
     v(ParamInfo{"min-region-area", "Smallest region", "m²",
                 "Regions smaller than this are merged into the neighbour of closest height", 0, 1e6},
       minRegionArea);

@@ -3,7 +3,8 @@
 // docs/dem.md "Ground / above-ground segmentation and DTM").
 //
 // A region is a 4-connected set of pixels with a height where neighbours differ by at most a
-// step threshold; small regions are then merged into the neighbour of closest mean height. The
+// step threshold and are alike in steepness (a wall's ramp does not join the roof and the
+// ground it links, see steepPixels()); small regions are then merged into the neighbour of closest mean height. The
 // graph links regions that touch (4-adjacency) and regions on both sides of a no-data run along
 // a row: in an epipolar pair the hidden parts beside walls run along the rows, and the two
 // surfaces at the ends of such a run touch in the other view. Each link carries the height step
@@ -36,9 +37,15 @@ struct RegionGraph {
   int gapLinks = 0;  // links that exist only across a no-data run
 };
 
+// CV_8U, 255 where the DEM's slope (central differences, one-sided beside no data) exceeds
+// `maxRise` metres per pixel. In left-image geometry the walls the left view sees obliquely are
+// ramps of about one pixel of disparity per pixel: much steeper than roofs and terrain.
+cv::Mat steepPixels(const cv::Mat& dem, double maxRise);
+
 // 4-connected regions of `dem` (CV_32F, m, NaN = no data) whose neighbouring pixels differ by at
-// most `maxStep` metres. Returns CV_32S labels 0..count-1, -1 on NaN; `count` receives the count.
-cv::Mat growRegions(const cv::Mat& dem, double maxStep, int& count);
+// most `maxStep` metres and are both steep or both not (`steep` from steepPixels(); empty: no
+// such split). Returns CV_32S labels 0..count-1, -1 on NaN; `count` receives the count.
+cv::Mat growRegions(const cv::Mat& dem, double maxStep, const cv::Mat& steep, int& count);
 
 // Merges every region of fewer than `minPixels` pixels, smallest first, into the 4-adjacent
 // region of closest mean height (a region without neighbours stays). Relabels 0..n-1 and
