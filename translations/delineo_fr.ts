@@ -653,6 +653,14 @@
         <source>enhancing the DEM</source>
         <translation>amélioration du MNE</translation>
     </message>
+    <message>
+        <source>ground and terrain model</source>
+        <translation>sol et modèle numérique de terrain</translation>
+    </message>
+    <message>
+        <source>buildings, vegetation and objects</source>
+        <translation>bâtiments, végétation et objets</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::BuildingsModel</name>

@@ -39,6 +39,8 @@ constexpr const char* kStageWords[] = {
     QT_TRANSLATE_NOOP("Stages", "box-fitting: outline"),
     QT_TRANSLATE_NOOP("Stages", "box-fitting building %1"),
     QT_TRANSLATE_NOOP("Stages", "enhancing the DEM"),
+    QT_TRANSLATE_NOOP("Stages", "ground and terrain model"),
+    QT_TRANSLATE_NOOP("Stages", "buildings, vegetation and objects"),
 };
 static_assert(std::size(kStageWords) == static_cast<size_t>(core::kLastStageId) + 1,
               "one wording per StageId");

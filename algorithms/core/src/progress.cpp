@@ -47,6 +47,8 @@ std::string Stage::english() const {
     case StageId::BoxFitOutline: return "box-fitting: outline";
     case StageId::BoxFittingBuilding: return "box-fitting building " + std::to_string(number);
     case StageId::EnhancingDem: return "enhancing the DEM";
+    case StageId::SegmentingGround: return "ground and terrain model";
+    case StageId::DetectingObjects: return "buildings, vegetation and objects";
   }
   return text;
 }

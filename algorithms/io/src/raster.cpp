@@ -261,6 +261,41 @@ cv::Mat readGreyFloat(const std::string& path, GeoReference* geo) {
   return raster.data;
 }
 
+cv::Mat readImage8(const std::string& path) {
+  ReadOptions options;
+  options.type = PixelType::Float32;
+  const Raster raster = readRaster(path, options);
+  cv::Mat values;
+  if (raster.data.channels() >= 3) {
+    std::vector<cv::Mat> bands;
+    cv::split(raster.data, bands);
+    const std::vector<cv::Mat> bgr{bands[2], bands[1], bands[0]};  // a fourth band is not read
+    cv::merge(bgr, values);
+  } else {
+    values = raster.data;  // one band (two-band rasters are refused by readRaster)
+  }
+  const cv::Mat finiteBands = (values == values);  // NaN != NaN, per band
+  const cv::Mat finite = finiteBands.reshape(1);
+  double lo = 0.0, hi = 255.0;
+  cv::minMaxLoc(values.reshape(1), &lo, &hi, nullptr, nullptr, finite);
+  if (lo >= 0.0 && hi <= 255.0) {
+    lo = 0.0, hi = 255.0;  // 8-bit values keep their grey levels
+  } else if (!(hi > lo)) {
+    hi = lo + 1.0;
+  }
+  cv::Mat finiteAll = finiteBands;
+  if (finiteAll.channels() > 1) {
+    std::vector<cv::Mat> parts;
+    cv::split(finiteAll, parts);
+    finiteAll = parts[0] & parts[1] & parts[2];
+  }
+  const double scale = 255.0 / (hi - lo);
+  cv::Mat out;
+  values.convertTo(out, CV_8U, scale, -lo * scale);
+  out.setTo(cv::Scalar::all(0), finiteAll == 0);
+  return out;
+}
+
 cv::Mat readMask(const std::string& path, cv::Size expected) {
   ReadOptions options;
   options.type = PixelType::Float32;  // nodata becomes NaN

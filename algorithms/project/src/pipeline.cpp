@@ -23,6 +23,9 @@
 #ifdef DELINEO_HAVE_DEM
 #include "delineo/dem/enhance.hpp"
 #endif
+#ifdef DELINEO_HAVE_SEGMENTATION
+#include "delineo/segmentation/scene.hpp"
+#endif
 #ifdef DELINEO_HAVE_DELINEATION
 #include "delineation_bridge.hpp"
 #include "delineo/delineation/above_ground.hpp"
@@ -84,6 +87,12 @@ void validateParameters(const Project& project) {
 #endif
 #ifdef DELINEO_HAVE_DEM
   validateGroup<dem::EnhanceParams>(project, "enhance");
+#endif
+#ifdef DELINEO_HAVE_SEGMENTATION
+  validateGroup<segmentation::GroundParams>(project, kSegmentGroup);
+  validateGroup<segmentation::ClassifyParams>(project, kClassifyGroup);
+  validateGroup<segmentation::ObjectParams>(project, kObjectsGroup);
+  validateGroup<segmentation::DetectParams>(project, kDetectGroup);
 #endif
   (void)project;
 }
@@ -381,20 +390,54 @@ bool delineateOne(const Project& project, Building& b, const StereoPair& pair, c
 
 }  // namespace
 
-RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress) {
+namespace {
+// run --detect: the scene analysis on `heights`, its rasters and objects written into
+// `outputDir`, its proposals added as pending buildings. False when canceled.
+bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& disparity, const io::GeoReference& geo,
+                     const std::string& outputDir, core::Progress* progress, RunSummary& summary) {
+  if (heights.empty()) {
+    throw Error(ErrorCode::InvalidParameter,
+                "detecting buildings needs heights: the project names no DEM and has no height model");
+  }
+  const cv::Mat image = io::readImage8(project.left);
+  const SceneAnalysisOutcome analysis = analyseScene(project, heights, image, disparity, progress);
+  if (analysis.status == core::RunStatus::Canceled) {
+    summary.status = core::RunStatus::Canceled;
+    return false;
+  }
+  const fs::path out(outputDir);
+  io::writeFloatGeoTiff((out / "dtm.tif").string(), analysis.dtm, geo);
+  io::writeFloatGeoTiff((out / "ndsm.tif").string(), analysis.ndsm, geo);
+  io::writeGeoTiff((out / "labels.tif").string(), analysis.classes, geo);
+  io::writeFeatures((out / "objects.geojson").string(), analysis.objects, geo, "objects");
+  summary.objects = static_cast<int>(analysis.objects.size());
+  summary.proposed = static_cast<int>(addProposedBuildings(project, analysis.proposals, "delineo-cli run").size());
+  return true;
+}
+}  // namespace
+
+RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress,
+                           const RunOptions& options) {
   RunSummary summary;
   // The outputs are checked before any work: never over an input of the project.
   std::error_code mk;
   fs::create_directories(outputDir, mk);
-  std::vector<io::OutputFile> outputs{{(fs::path(outputDir) / "buildings.geojson").string(), io::OutputFormat::Vector}};
+  const fs::path out(outputDir);
+  std::vector<io::OutputFile> outputs{{(out / "buildings.geojson").string(), io::OutputFormat::Vector}};
   if (project.disparity.empty()) {
-    outputs.push_back({(fs::path(outputDir) / "disparity.tif").string(), io::OutputFormat::GeoTiff});
+    outputs.push_back({(out / "disparity.tif").string(), io::OutputFormat::GeoTiff});
+  }
+  if (options.detect) {
+    for (const char* name : {"dtm.tif", "ndsm.tif", "labels.tif"}) {
+      outputs.push_back({(out / name).string(), io::OutputFormat::GeoTiff});
+    }
+    outputs.push_back({(out / "objects.geojson").string(), io::OutputFormat::Vector});
   }
   io::checkOutputs(outputs, {project.left, project.right, project.disparity, project.dem, project.labels,
                              project.exclude});
   StereoPair pair = readStereoPair(project);
-  const std::vector<int> pending = project.pendingBuildings();
-  const double matchShare = project.disparity.empty() ? (pending.empty() ? 1.0 : 0.5) : 0.0;
+  const bool work = !project.pendingBuildings().empty() || options.detect;
+  double matchShare = project.disparity.empty() ? (work ? 0.5 : 1.0) : 0.0;
   cv::Mat disparity;
   if (project.disparity.empty() && !project.disparityRange) {
     core::Progress::Range range(progress, 0.0, 0.1 * matchShare);
@@ -414,17 +457,25 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
       summary.status = core::RunStatus::Canceled;
       return summary;
     }
-    const std::string out = (fs::path(outputDir) / "disparity.tif").string();
+    const std::string written = (out / "disparity.tif").string();
     fs::create_directories(outputDir);
-    io::writeFloatGeoTiff(out, matched.disparity, pair.geo);
-    project.disparity = out;
+    io::writeFloatGeoTiff(written, matched.disparity, pair.geo);
+    project.disparity = written;
     disparity = matched.disparity;
     summary.matched = true;
   } else {
     disparity = readDisparity(project, pair.left.size());
   }
   pair.disparity = disparity;
-  cv::Mat heights;  // for box-fitting, read when a building asks for it
+  cv::Mat heights;  // for box-fitting and the scene analysis, read when asked for
+  std::vector<int> pending = project.pendingBuildings();
+  if (options.detect) {
+    core::Progress::Range range(progress, matchShare, matchShare + 0.3 * (1.0 - matchShare));
+    heights = projectHeights(project, disparity);
+    if (!detectBuildings(project, heights, disparity, pair.geo, outputDir, &range, summary)) return summary;
+    pending = project.pendingBuildings();
+    matchShare += 0.3 * (1.0 - matchShare);
+  }
   for (size_t i = 0; i < pending.size(); ++i) {
     const double begin = matchShare + (1.0 - matchShare) * static_cast<double>(i) / static_cast<double>(pending.size());
     const double end = matchShare + (1.0 - matchShare) * static_cast<double>(i + 1) / static_cast<double>(pending.size());

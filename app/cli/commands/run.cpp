@@ -1,6 +1,7 @@
 // delineo-cli run PROJECT: executes a project's pending steps with the same code as the GUI
 // (delineo::project): dense matching when the project has no disparity yet, the outline of every
-// pending building with its method (the active polygon, or box-fitting), export of the
+// pending building with its method (the active polygon, or box-fitting), with --detect first the
+// scene analysis and its building proposals, export of the
 // delineated outlines, then an atomic save of the project. `--sample DIR` first creates (or reuses) the bundled sample project in DIR.
 #include <cstdio>
 
@@ -21,6 +22,7 @@ int run(const std::vector<std::string>& args) {
                     "Usage: delineo-cli run PROJECT [options]");
   opts.value("project", "FILE", "project file (may also be given as the first argument)", "")
       .value("sample", "DIR", "create (or reuse) the sample project in DIR and run it", "")
+      .flag("detect", "first detect buildings (ground, DTM, classes, objects) and add the proposals as pending buildings")
       .flag("no-save", "do not write the project file back (outputs are still written)")
       .flag("quiet", "no progress on stderr");
   // PROJECT may stand anywhere among the options: the one argument that is neither an option
@@ -55,8 +57,10 @@ int run(const std::vector<std::string>& args) {
   for (const auto& missing : proj.missingFiles()) {
     throw core::Error(core::ErrorCode::FileNotFound, "referenced by the project " + projectPath, missing);
   }
+  project::RunOptions runOptions;
+  runOptions.detect = opts.has("detect");
   const project::RunSummary summary =
-      project::runPendingSteps(proj, project::outputDirectory(proj, projectPath), &progress);
+      project::runPendingSteps(proj, project::outputDirectory(proj, projectPath), &progress, runOptions);
   cli::throwIfCanceled(progress);
   if (summary.status == core::RunStatus::Canceled) throw cli::Canceled();
   progress.finish();
@@ -66,6 +70,10 @@ int run(const std::vector<std::string>& args) {
                  summary.rangeEstimated->range.high);
   }
   for (const auto& message : summary.messages) std::fprintf(stderr, "run: %s\n", message.c_str());
+  if (runOptions.detect) {
+    std::fprintf(stderr, "run: %d above-ground object(s), %d new building(s) proposed\n", summary.objects,
+                 summary.proposed);
+  }
   if (summary.boxFitted > 0) std::fprintf(stderr, "run: %d building(s) outlined by box-fitting\n", summary.boxFitted);
   if (!opts.has("no-save")) project::saveProject(proj, projectPath);
   std::fprintf(stderr, "run: %s; %d building(s) delineated, %d skipped%s%s\n",

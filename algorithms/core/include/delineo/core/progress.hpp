@@ -52,10 +52,13 @@ enum class StageId {
   BoxFitOutline,
   BoxFittingBuilding,
   // DEM enhancement from the buildings' outlines.
-  EnhancingDem,  // kLastStageId
+  EnhancingDem,
+  // Scene analysis: ground / above-ground and DTM, then classes, objects and proposals.
+  SegmentingGround,
+  DetectingObjects,  // kLastStageId
 };
 // The last identifier; the GUI words every one up to it (its table is checked against it).
-constexpr StageId kLastStageId = StageId::EnhancingDem;
+constexpr StageId kLastStageId = StageId::DetectingObjects;
 constexpr StageId kLastEnglishStageId = kLastStageId;
 
 struct Stage {

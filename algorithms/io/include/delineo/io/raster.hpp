@@ -48,6 +48,11 @@ Raster readRaster(const std::string& path, const ReadOptions& options = {});
 // Reads a raster as a single-band float32 image ready for matching (grey, NaN for nodata).
 cv::Mat readGreyFloat(const std::string& path, GeoReference* geo = nullptr);
 
+// Reads an image for its colours: CV_8UC3 BGR for a raster of 3 or more bands (the first three
+// read as R, G, B), else CV_8UC1 grey. Deeper or float values are stretched from their finite
+// range to 0..255; nodata becomes 0. Throws like readRaster.
+cv::Mat readImage8(const std::string& path);
+
 // Reads a single-band raster as a mask of the given size: CV_8U, 255 where the value is non-zero
 // and not nodata, 0 elsewhere (exclusion masks, classifications). Throws like readRaster, and
 // MismatchedInputs naming the file when it has several bands or another size.

@@ -203,6 +203,44 @@ struct EnhancedDemOutcome {
 };
 EnhancedDemOutcome enhanceHeights(const Project& project, const cv::Mat& heights, core::Progress* progress);
 
+// ---- scene analysis (src/scene_analysis.cpp) ----
+
+// Parameter groups of the scene analysis in the project file.
+inline constexpr const char* kSegmentGroup = "segment";    // segmentation::GroundParams
+inline constexpr const char* kClassifyGroup = "classify";  // segmentation::ClassifyParams
+inline constexpr const char* kObjectsGroup = "objects";    // segmentation::ObjectParams
+inline constexpr const char* kDetectGroup = "detect";      // segmentation::DetectParams
+// A proposal that covers, or is covered by, an existing building over more than this share of
+// its pixels is that building: it is not added again.
+inline constexpr double kProposalOverlap = 0.3;
+
+bool sceneAnalysisAvailable();
+
+// segmentation::analyseScene() with the project's groups and the height model's gsd: ground /
+// above-ground, DTM, nDSM, building vs vegetation, objects and building proposals. `heights` as
+// projectHeights() gives them, `image` the left image 8-bit grey or BGR (io::readImage8),
+// `disparity` (may be empty) gives the objects their disparity intervals. Throws
+// InvalidParameter without heights or gsd, ProcessingFailed without the segmentation library.
+struct SceneAnalysisOutcome {
+  core::RunStatus status = core::RunStatus::Completed;
+  cv::Mat dtm;          // CV_32F m
+  cv::Mat ndsm;         // CV_32F m, DEM - DTM, NaN where no height
+  cv::Mat classes;      // CV_8U: 0 ground or no data, 1 building, 2 vegetation
+  cv::Mat objectIndex;  // CV_32S, the object id of each pixel, 0 for none
+  std::vector<core::Feature> objects;    // objects.geojson
+  std::vector<core::Feature> proposals;  // one per proposed building (delineate --init)
+  int regions = 0, rounds = 0;
+  bool converged = false;
+};
+SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights, const cv::Mat& image,
+                                  const cv::Mat& disparity, core::Progress* progress);
+
+// Adds each proposal that is not already a building (kProposalOverlap) as a Pending building:
+// its polygon as the initial polygon, its roof interval, a "detected" history entry (`origin`
+// first). Returns the new buildings' ids.
+std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
+                                      const std::string& origin = {});
+
 // `delineo-cli run`: the disparity range estimated when the project has none, matching when
 // the disparity is missing (written to
 // `outputDir`/disparity.tif and recorded in the project), then the outline of every Pending
@@ -216,11 +254,20 @@ struct RunSummary {
   int delineated = 0;  // outlined by either method
   int boxFitted = 0;   // of which by box-fitting
   int skipped = 0;     // pending buildings whose method failed (reason in `messages`)
+  int proposed = 0;    // buildings added from the scene analysis's proposals (RunOptions::detect)
+  int objects = 0;     // above-ground objects the scene analysis found
   std::vector<std::string> messages;
   std::string exported;  // path of the written GeoJSON, empty when nothing was written
   core::RunStatus status = core::RunStatus::Completed;
 };
-RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress);
+// With `detect`, the scene analysis runs after matching on projectHeights() (analyseScene(),
+// writing dtm.tif, ndsm.tif, labels.tif and objects.geojson into `outputDir`) and its proposals
+// become pending buildings (addProposedBuildings()) before the outlines are made.
+struct RunOptions {
+  bool detect = false;
+};
+RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress,
+                           const RunOptions& options = {});
 
 // Features of the buildings with the given statuses (attributes: id, status, method, vertices,
 // roof_height_m, energy), in left-image pixels.

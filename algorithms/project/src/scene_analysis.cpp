@@ -1,0 +1,129 @@
+// The project's scene analysis (segmentation library, optional at build time:
+// DELINEO_HAVE_SEGMENTATION): ground / above-ground, DTM, nDSM, classes, objects and building
+// proposals with the project's parameter groups, and proposals turned into pending buildings.
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include <opencv2/core.hpp>
+
+#include "delineo/core/error.hpp"
+#include "delineo/project/pipeline.hpp"
+
+#ifdef DELINEO_HAVE_SEGMENTATION
+#include "delineo/segmentation/scene.hpp"
+#endif
+
+namespace delineo::project {
+
+using core::Error;
+using core::ErrorCode;
+
+bool sceneAnalysisAvailable() {
+#ifdef DELINEO_HAVE_SEGMENTATION
+  return true;
+#else
+  return false;
+#endif
+}
+
+#ifdef DELINEO_HAVE_SEGMENTATION
+segmentation::SceneParams sceneParameters(const Project& project) {
+  segmentation::SceneParams params;
+  params.ground = parameters<segmentation::GroundParams>(project, kSegmentGroup);
+  params.classify = parameters<segmentation::ClassifyParams>(project, kClassifyGroup);
+  params.objects = parameters<segmentation::ObjectParams>(project, kObjectsGroup);
+  params.detect = parameters<segmentation::DetectParams>(project, kDetectGroup);
+  return params;
+}
+#endif
+
+SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights, const cv::Mat& image,
+                                  const cv::Mat& disparity, core::Progress* progress) {
+#ifdef DELINEO_HAVE_SEGMENTATION
+  if (heights.empty()) {
+    throw Error(ErrorCode::InvalidParameter,
+                "the scene analysis needs heights: a DEM, or the disparity and the height model");
+  }
+  if (!(project.height.gsd > 0.0)) {
+    throw Error(ErrorCode::InvalidParameter, "the scene analysis needs the ground sample distance (height model's gsd > 0)");
+  }
+  const segmentation::SceneAnalysis analysis =
+      segmentation::analyseScene(heights, image, project.height.gsd, sceneParameters(project), disparity, progress);
+  SceneAnalysisOutcome out;
+  out.status = analysis.status;
+  if (analysis.status == core::RunStatus::Canceled) return out;
+  out.dtm = analysis.ground.dtm;
+  out.ndsm = analysis.ground.ndsm;
+  out.classes = analysis.classes();
+  out.objectIndex = analysis.detection.objects.index;
+  out.objects = segmentation::objectFeatures(analysis.detection.objects.objects);
+  out.proposals = analysis.detection.proposals;
+  out.regions = analysis.ground.regionCount;
+  out.rounds = analysis.ground.iterations;
+  out.converged = analysis.ground.converged;
+  return out;
+#else
+  (void)project, (void)heights, (void)image, (void)disparity, (void)progress;
+  throw Error(ErrorCode::ProcessingFailed, "the scene analysis is not part of this build");
+#endif
+}
+
+namespace {
+core::Polygon shifted(core::Polygon polygon, cv::Point2d by) {
+  for (auto& p : polygon.outer) p += by;
+  for (auto& hole : polygon.holes) {
+    for (auto& p : hole) p += by;
+  }
+  return polygon;
+}
+
+// Share of `polygon`'s pixels that lie inside `other`, both rasterized on their common box.
+double coveredShare(const core::Polygon& polygon, const core::Polygon& other) {
+  if (polygon.outer.size() < 3 || other.outer.size() < 3) return 0.0;
+  const cv::Rect2d a = core::boundingBox(polygon.outer), b = core::boundingBox(other.outer);
+  if ((a & b).area() <= 0.0) return 0.0;
+  const cv::Rect box = cv::Rect(a | b) + cv::Size(2, 2);
+  const cv::Point2d by(-box.x, -box.y);
+  const cv::Mat ma = core::rasterize(shifted(polygon, by), box.size());
+  const cv::Mat mb = core::rasterize(shifted(other, by), box.size());
+  const int inside = cv::countNonZero(ma);
+  return inside > 0 ? static_cast<double>(cv::countNonZero(ma & mb)) / inside : 0.0;
+}
+
+std::optional<int> intAttribute(const core::Feature& feature, const char* key) {
+  const auto it = feature.attributes.find(key);
+  if (it == feature.attributes.end()) return std::nullopt;
+  if (const auto* v = std::get_if<long long>(&it->second)) return static_cast<int>(*v);
+  if (const auto* d = std::get_if<double>(&it->second)) return static_cast<int>(std::lround(*d));
+  return std::nullopt;
+}
+}  // namespace
+
+std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
+                                      const std::string& origin) {
+  std::vector<int> added;
+  for (const core::Feature& proposal : proposals) {
+    if (proposal.polygon.outer.size() < 3) continue;
+    // A building the operator already has (any status) is not proposed twice.
+    const bool known = std::any_of(project.buildings.begin(), project.buildings.end(), [&](const Building& b) {
+      return coveredShare(proposal.polygon, b.currentPolygon()) > kProposalOverlap ||
+             coveredShare(b.currentPolygon(), proposal.polygon) > kProposalOverlap;
+    });
+    if (known) continue;
+    Building b;
+    b.id = project.nextBuildingId();
+    b.initial = proposal.polygon;
+    const auto low = intAttribute(proposal, "roof_disparity_min");
+    const auto high = intAttribute(proposal, "roof_disparity_max");
+    if (low && high && *low <= *high) b.roofInterval = DisparityInterval{*low, *high};
+    b.addHistory("detected", origin.empty() ? std::string("building proposal") : origin + ": building proposal");
+    project.buildings.push_back(b);
+    added.push_back(b.id);
+  }
+  return added;
+}
+
+}  // namespace delineo::project

@@ -1,0 +1,33 @@
+#pragma once
+// What `segment` and `detect` share: the DEM, the left image and the ground sample distance
+// read from their flags, and the scene analysis run with the commands' parameters
+// (segmentation::analyseScene, docs/dem.md). Defined in segment.cpp.
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "cli_support.hpp"
+#include "delineo/io/raster.hpp"
+#include "delineo/segmentation/scene.hpp"
+
+namespace delineo::cli {
+
+// Adds --dem, --image, --gsd, --scene, --disparity (required when `needsDisparity`) and --quiet.
+void addSceneInputs(Options& opts, bool needsDisparity);
+
+struct SceneInputs {
+  io::Raster dem;     // CV_32F heights, NaN = no data
+  cv::Mat image;      // CV_8U grey or BGR, the DEM's size
+  cv::Mat disparity;  // CV_32F px, or empty
+  double gsd = 0.0;   // m per pixel
+};
+// Reads the inputs named by the flags. Throws UsageError (neither or both of --gsd and --scene)
+// and core::Error naming the file (unreadable, several bands, sizes that differ).
+SceneInputs readSceneInputs(const Options& opts);
+
+// analyseScene() on the inputs; input errors name the DEM. Throws Canceled on a cancel.
+segmentation::SceneAnalysis analyseSceneForCommand(const SceneInputs& inputs,
+                                                   const segmentation::SceneParams& params,
+                                                   core::Progress* progress);
+
+}  // namespace delineo::cli
