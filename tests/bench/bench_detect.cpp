@@ -2,8 +2,10 @@
 // (docs/dem.md, "Building vs vegetation, objects and proposals") on simulated scenes with a
 // sloping terrain: share of the above-ground pixels classified right (with each rule switched
 // off in turn), proposals found and false against the true footprints, and with `--chain` the
-// active polygon run from each proposal on the matcher's disparity. The above-ground mask and
-// the DTM come from `segmentScene` (the simulator's truth today). `--real DIR` writes overlays
+// active polygon run from each proposal on the matcher's disparity (the whole automatic chain:
+// simulate, match, DEM, segment, detect, delineate). `--ground` chooses where the above-ground
+// mask and the DTM come from: the ground segmentation of the true DEM (default) or of the
+// matcher's DEM, or the simulator's labels (`truth`). `--real DIR` writes overlays
 // of the classification on the real RGB tiles. Plain main printing tables; `--tiny` is the
 // ctest smoke run.
 #include <algorithm>
@@ -23,7 +25,9 @@
 #include "delineo/core/allocator.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/delineation/delineate.hpp"
+#include "delineo/dem/heights.hpp"
 #include "delineo/segmentation/detect.hpp"
+#include "delineo/segmentation/ground.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
 
@@ -33,14 +37,14 @@ using namespace delineo::segmentation;
 namespace {
 
 // The ground/above-ground segmentation the classification starts from: the above-ground mask
-// (CV_8U 255/0), the DTM (CV_32F m) and the nDSM (DEM - DTM, NaN no data).
+// (CV_8U 255/0), the DTM (CV_32F m), the nDSM (DEM - DTM, NaN no data) and the regions.
 struct GroundSegmentation {
-  cv::Mat aboveGround, dtm, ndsm;
+  cv::Mat aboveGround, dtm, ndsm, regions;
 };
 
 // From the simulator's truth: above ground = every non-ground label; the DTM is the DEM of the
 // nearest ground pixel, smoothed over 4 m (the terrain under an object is not seen).
-GroundSegmentation segmentScene(const sim::Scene& scene) {
+GroundSegmentation truthSegmentation(const sim::Scene& scene) {
   GroundSegmentation s;
   s.aboveGround = scene.labels != sim::kLabelGround;
   cv::Mat distance, nearest;
@@ -62,6 +66,30 @@ GroundSegmentation segmentScene(const sim::Scene& scene) {
   return s;
 }
 
+// The product's segmentation (segmentGround, default parameters) of a DEM in metres.
+GroundSegmentation demSegmentation(const cv::Mat& dem, double gsd) {
+  const GroundResult g = segmentGround(dem, gsd, GroundParams{});
+  return {g.aboveGround, g.dtm, g.ndsm, g.regions};
+}
+
+// The matcher's DEM of the scene: its disparity through the scene's height model.
+cv::Mat matcherDem(const sim::Scene& scene, const cv::Mat& disparity) {
+  dem::HeightModel model;
+  model.metresPerPixel = scene.metresPerDisparity;
+  model.groundDisparity = scene.groundDisparity;
+  return dem::heightsFromDisparity(disparity, model);
+}
+
+cv::Mat matchScene(const sim::Scene& scene) {
+  cv::Mat left, right;
+  scene.left.convertTo(left, CV_32F);
+  scene.right.convertTo(right, CV_32F);
+  stereo::MatchParams mp;
+  mp.dmin = scene.disparityMin;
+  mp.dmax = scene.disparityMax;
+  return stereo::matchStereo(left, right, mp).disparity;
+}
+
 double iouOf(const core::Polygon& a, const core::Polygon& b, cv::Size size) {
   const cv::Mat ma = core::rasterize(a, size), mb = core::rasterize(b, size);
   return double(cv::countNonZero(ma & mb)) / std::max(1, cv::countNonZero(ma | mb));
@@ -70,6 +98,7 @@ double iouOf(const core::Polygon& a, const core::Polygon& b, cv::Size size) {
 struct Tally {
   long right = 0, total = 0, rightNoFacade = 0, totalNoFacade = 0;
   long buildingAsVeg = 0, vegAsBuilding = 0, buildings = 0, vegetation = 0;
+  long rightFound = 0, totalFound = 0;  // among the true above-ground pixels labelled above-ground
   void add(const cv::Mat& predicted, const cv::Mat& labels) {
     for (int y = 0; y < labels.rows; ++y) {
       for (int x = 0; x < labels.cols; ++x) {
@@ -78,6 +107,7 @@ struct Tally {
         const uchar truth = l == sim::kLabelVegetation ? kClassVegetation : kClassBuilding;
         const uchar p = predicted.at<uchar>(y, x);
         ++total, right += p == truth;
+        if (p != kClassGround) ++totalFound, rightFound += p == truth;
         if (l != sim::kLabelFacade) ++totalNoFacade, rightNoFacade += p == truth;
         if (truth == kClassBuilding) ++buildings, buildingAsVeg += p == kClassVegetation;
         if (truth == kClassVegetation) ++vegetation, vegAsBuilding += p == kClassBuilding;
@@ -85,7 +115,8 @@ struct Tally {
     }
   }
   void print(const char* name) const {
-    std::printf("  %-34s %6.2f %%  %6.2f %%   %6.2f %%   %6.2f %%\n", name, 100.0 * right / std::max(1L, total),
+    std::printf("  %-34s %6.2f %%  %6.2f %%  %6.2f %%   %6.2f %%   %6.2f %%\n", name, 100.0 * right / std::max(1L, total),
+                100.0 * rightFound / std::max(1L, totalFound),
                 100.0 * rightNoFacade / std::max(1L, totalNoFacade), 100.0 * buildingAsVeg / std::max(1L, buildings),
                 100.0 * vegAsBuilding / std::max(1L, vegetation));
   }
@@ -240,7 +271,7 @@ int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   int scenes = 4, firstSeed = 1;
   bool chain = false, diag = false;
-  std::string realDir, realOut = "/tmp";
+  std::string realDir, realOut = "/tmp", ground = "true-dem";
   sim::SceneParams sp;
   sp.width = 800;
   sp.height = 600;
@@ -267,15 +298,21 @@ int main(int argc, char** argv) {
       chain = true;
     } else if (!std::strcmp(argv[i], "--growth") && i + 1 < argc) {
       detectParams.growth = std::atof(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--ground") && i + 1 < argc) {
+      ground = argv[++i];
     } else if (!std::strcmp(argv[i], "--real") && i + 1 < argc) {
       realDir = argv[++i];
     } else if (!std::strcmp(argv[i], "--real-out") && i + 1 < argc) {
       realOut = argv[++i];
     } else {
       std::fprintf(stderr, "usage: bench_detect [--tiny] [--scenes N] [--seed FIRST] [--chain] [--growth PX] "
-                           "[--real DATA_DIR [--real-out DIR]]\n");
+                           "[--ground true-dem|matcher|truth] [--real DATA_DIR [--real-out DIR]]\n");
       return 2;
     }
+  }
+  if (ground != "true-dem" && ground != "matcher" && ground != "truth") {
+    std::fprintf(stderr, "--ground takes true-dem, matcher or truth\n");
+    return 2;
   }
   if (const char* json = std::getenv("BENCH_CLASSIFY")) core::fromJson(classifyParams, nlohmann::json::parse(json));
   if (!realDir.empty()) {
@@ -313,17 +350,22 @@ int main(int argc, char** argv) {
   for (int s = 0; s < scenes; ++s) {
     sp.seed = firstSeed + s;
     const sim::Scene scene = sim::simulateScene(sp);
-    const GroundSegmentation seg = segmentScene(scene);
+    const bool needMap = chain || ground == "matcher";
+    const cv::Mat map = needMap ? matchScene(scene) : cv::Mat();
+    const GroundSegmentation seg = ground == "truth"     ? truthSegmentation(scene)
+                                   : ground == "matcher" ? demSegmentation(matcherDem(scene, map), scene.gsd)
+                                                         : demSegmentation(scene.dem, scene.gsd);
     if (diag) diagnose(scene, seg, classifyParams);
     for (size_t v = 0; v < variants.size(); ++v) {
       const auto t0 = cv::getTickCount();
-      const Classification c = classify(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, variants[v].params);
+      const Classification c =
+          classify(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, variants[v].params, seg.regions);
       if (v == 0) classifyMs += 1e3 * double(cv::getTickCount() - t0) / cv::getTickFrequency();
       tallies[v].add(variants[v].majority ? c.labels : c.pixelLabels, scene.labels);
     }
     // Proposals with the true disparity (intervals and ground from the truth).
-    const Detection d = detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, scene.disparity, {},
-                                        classifyParams, objectParams, detectParams);
+    const Detection d = detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, scene.disparity,
+                                        seg.regions, classifyParams, objectParams, detectParams);
     std::vector<core::Polygon> polygons;
     for (const auto& f : d.proposals) polygons.push_back(f.polygon);
     scoreProposals(polygons, scene, 100.0, gtScore);
@@ -333,12 +375,8 @@ int main(int argc, char** argv) {
     cv::Mat left, right;
     scene.left.convertTo(left, CV_32F);
     scene.right.convertTo(right, CV_32F);
-    stereo::MatchParams mp;
-    mp.dmin = scene.disparityMin;
-    mp.dmax = scene.disparityMax;
-    const cv::Mat map = stereo::matchStereo(left, right, mp).disparity;
-    const Detection dm = detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, map, {}, classifyParams,
-                                         objectParams, detectParams);
+    const Detection dm = detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, map, seg.regions,
+                                         classifyParams, objectParams, detectParams);
     std::vector<core::Polygon> outlines;
     delineation::DelineationParams params;
     for (const auto& f : dm.proposals) {
@@ -362,9 +400,11 @@ int main(int argc, char** argv) {
     }
     scoreProposals(outlines, scene, 100.0, chainScore);
   }
-  std::printf("building vs vegetation on %d scenes %dx%d, slope %.0f %%, true above-ground mask and DTM\n", scenes,
-              sp.width, sp.height, sp.slope);
-  std::printf("  %-34s %8s  %8s  %9s  %9s\n", "variant", "right", "no facade", "bld->veg", "veg->bld");
+  std::printf("building vs vegetation on %d scenes %dx%d, slope %.0f %%, above-ground mask and DTM: %s\n", scenes,
+              sp.width, sp.height, sp.slope,
+              ground == "truth" ? "true labels" : ground == "matcher" ? "segmented matcher DEM" : "segmented true DEM");
+  std::printf("  %-34s %8s  %8s  %8s  %9s  %9s\n", "variant", "right", "of found", "no facade", "bld->veg",
+              "veg->bld");
   for (size_t v = 0; v < variants.size(); ++v) tallies[v].print(variants[v].name);
   std::printf("  classification time %.0f ms per scene\n", classifyMs / std::max(1, scenes));
   std::printf("proposals (buildings >= 100 m2, IoU >= 0.5)\n");
