@@ -223,54 +223,12 @@ void realTiles(const std::string& dataDir, const std::string& outDir, const Clas
   }
 }
 
-// Percentiles of the entropy per true class (roof, facade, tree), to place the threshold.
-void diagnose(const sim::Scene& scene, const GroundSegmentation& seg, const ClassifyParams& params) {
-  const Classification c = classify(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, params);
-  for (const uchar l : {sim::kLabelBuilding, sim::kLabelFacade, sim::kLabelVegetation}) {
-    std::vector<float> e;
-    long nan = 0;
-    for (int y = 0; y < c.entropy.rows; ++y) {
-      for (int x = 0; x < c.entropy.cols; ++x) {
-        if (scene.labels.at<uchar>(y, x) != l) continue;
-        const float v = c.entropy.at<float>(y, x);
-        if (std::isfinite(v)) e.push_back(v); else ++nan;
-      }
-    }
-    std::sort(e.begin(), e.end());
-    {
-      const int side = static_cast<int>(std::lround(params.window / scene.gsd)) | 1;
-      cv::Mat g, m, m2;
-      scene.left.convertTo(g, CV_32F);
-      cv::blur(g, m, {side, side});
-      cv::blur(g.mul(g), m2, {side, side});
-      cv::Mat sd;
-      cv::sqrt(cv::max(m2 - m.mul(m), 0), sd);
-      std::vector<float> b, st, cvv;
-      for (int y = 0; y < g.rows; ++y) {
-        for (int x = 0; x < g.cols; ++x) {
-          if (scene.labels.at<uchar>(y, x) != l) continue;
-          b.push_back(m.at<float>(y, x));
-          st.push_back(sd.at<float>(y, x));
-          cvv.push_back(sd.at<float>(y, x) / std::max(1.0f, m.at<float>(y, x)));
-        }
-      }
-      for (auto* vec : {&b, &st, &cvv}) std::sort(vec->begin(), vec->end());
-      auto q = [](const std::vector<float>& v, double f) { return v.empty() ? 0.f : v[static_cast<size_t>(f * (v.size() - 1))]; };
-      std::printf("  label %d: mean p10 %.0f p50 %.0f p90 %.0f | std p10 %.1f p50 %.1f p90 %.1f | cv p10 %.3f p50 %.3f p90 %.3f\n", l,
-                  q(b, .1), q(b, .5), q(b, .9), q(st, .1), q(st, .5), q(st, .9), q(cvv, .1), q(cvv, .5), q(cvv, .9));
-    }
-    std::printf("  label %d: %zu px (%ld without entropy) entropy p10 %.3f p25 %.3f p50 %.3f p75 %.3f p90 %.3f\n", l, e.size(), nan,
-                e.empty() ? 0 : e[e.size() / 10], e.empty() ? 0 : e[e.size() / 4], e.empty() ? 0 : e[e.size() / 2],
-                e.empty() ? 0 : e[3 * e.size() / 4], e.empty() ? 0 : e[9 * e.size() / 10]);
-  }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   int scenes = 4, firstSeed = 1;
-  bool chain = false, diag = false;
+  bool chain = false;
   std::string realDir, realOut = "/tmp", ground = "true-dem";
   sim::SceneParams sp;
   sp.width = 800;
@@ -292,8 +250,6 @@ int main(int argc, char** argv) {
       scenes = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) {
       firstSeed = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--diag")) {
-      diag = true;
     } else if (!std::strcmp(argv[i], "--chain")) {
       chain = true;
     } else if (!std::strcmp(argv[i], "--growth") && i + 1 < argc) {
@@ -331,15 +287,11 @@ int main(int argc, char** argv) {
   variants.push_back({"all rules, per pixel", classifyParams, false});
   {
     ClassifyParams p = classifyParams;
-    p.entropyThreshold = 1.0;
-    variants.push_back({"no entropy rule", p, true});
-    p = classifyParams;
     p.darkLevel = 0;
     variants.push_back({"no dark-textured rule", p, true});
     p = classifyParams;
-    p.entropyThreshold = 1.0;
     p.darkLevel = 255;
-    variants.push_back({"no entropy, textured (no dark)", p, true});
+    variants.push_back({"textured at any brightness", p, true});
     p = classifyParams;
     p.minObjectArea = 0;
     variants.push_back({"no small-piece absorption", p, true});
@@ -355,7 +307,6 @@ int main(int argc, char** argv) {
     const GroundSegmentation seg = ground == "truth"     ? truthSegmentation(scene)
                                    : ground == "matcher" ? demSegmentation(matcherDem(scene, map), scene.gsd)
                                                          : demSegmentation(scene.dem, scene.gsd);
-    if (diag) diagnose(scene, seg, classifyParams);
     for (size_t v = 0; v < variants.size(); ++v) {
       const auto t0 = cv::getTickCount();
       const Classification c =

@@ -20,10 +20,6 @@ void ClassifyParams::validate() const { core::checkDeclaredRanges(*this); }
 
 namespace {
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-// Windows with fewer voting gradients than this give no entropy (NaN): too few to tell.
-constexpr double kMinVotes = 6.0;
-
 void checkInputs(const cv::Mat& image, const cv::Mat& above, const cv::Mat& ndsm, const cv::Mat& regions,
                  double gsd) {
   if (image.empty() || (image.type() != CV_8UC1 && image.type() != CV_8UC3)) {
@@ -56,71 +52,22 @@ cv::Mat windowSum(const cv::Mat& values, int side) {
 }
 
 struct LocalMeasures {
-  cv::Mat entropy;    // normalised, NaN with too few votes
-  cv::Mat votes;      // voting pixels in the window
-  cv::Mat pixels;     // above-ground pixels in the window
   cv::Mat brightness; // mean grey of the window's above-ground pixels
   cv::Mat variation;  // their standard deviation over their mean
 };
 
-// Entropy of the gradient directions (mod π/2) of the above-ground pixels of each window, their
-// share of voting pixels and their mean brightness. Only above-ground pixels count, so that the
-// ground next to a roof does not blur its measure.
-LocalMeasures localMeasures(const cv::Mat& grey, const cv::Mat& above, int side, const ClassifyParams& p,
-                            core::Progress* progress) {
-  cv::Mat gx, gy;
-  cv::Sobel(grey, gx, CV_32F, 1, 0, 3, 1.0 / 8.0);
-  cv::Sobel(grey, gy, CV_32F, 0, 1, 3, 1.0 / 8.0);
-  cv::Mat magnitude, angle;
-  cv::cartToPolar(gx, gy, magnitude, angle);  // angle in [0, 2π)
-  const cv::Mat inside = above != 0;
-  const cv::Mat voting = (magnitude >= p.minGradient) & inside;
-  const int bins = p.directionBins;
-  const double quarter = CV_PI / 2.0;
-  cv::Mat binOf(grey.size(), CV_8U);
-  for (int y = 0; y < grey.rows; ++y) {
-    for (int x = 0; x < grey.cols; ++x) {
-      const double a = std::fmod(angle.at<float>(y, x), quarter);
-      binOf.at<uchar>(y, x) = static_cast<uchar>(std::min(bins - 1, static_cast<int>(a / quarter * bins)));
-    }
-  }
+// Mean brightness and variation of the above-ground pixels of each window. Only above-ground
+// pixels count, so that the ground next to a roof does not blur its measure.
+LocalMeasures localMeasures(const cv::Mat& grey, const cv::Mat& above, int side) {
   LocalMeasures m;
-  cv::Mat votingF, insideF;
-  voting.convertTo(votingF, CV_32F, 1.0 / 255.0);
-  inside.convertTo(insideF, CV_32F, 1.0 / 255.0);
-  m.votes = windowSum(votingF, side);
-  cv::Mat weightF = cv::Mat::zeros(grey.size(), CV_32F);
-  magnitude.copyTo(weightF, voting);
-  const cv::Mat weights = windowSum(weightF, side);
-  m.pixels = windowSum(insideF, side);
-  cv::Mat sumGrey = windowSum(grey.mul(insideF), side);
-  m.brightness = sumGrey / cv::max(m.pixels, 1.0f);
+  cv::Mat insideF;
+  above.convertTo(insideF, CV_32F, 1.0 / 255.0);
+  const cv::Mat pixels = cv::max(windowSum(insideF, side), 1.0f);
+  m.brightness = windowSum(grey.mul(insideF), side) / pixels;
   const cv::Mat sumSquares = windowSum(grey.mul(grey).mul(insideF), side);
   cv::Mat deviation;
-  cv::sqrt(cv::max(sumSquares / cv::max(m.pixels, 1.0f) - m.brightness.mul(m.brightness), 0.0f), deviation);
+  cv::sqrt(cv::max(sumSquares / pixels - m.brightness.mul(m.brightness), 0.0f), deviation);
   m.variation = deviation / cv::max(m.brightness, 1.0f);
-  cv::Mat plogp = cv::Mat::zeros(grey.size(), CV_32F);
-  for (int b = 0; b < bins; ++b) {
-    if (core::isCanceled(progress)) return {};
-    const cv::Mat inBin = (binOf == b) & voting;
-    cv::Mat inBinF = cv::Mat::zeros(grey.size(), CV_32F);
-    magnitude.copyTo(inBinF, inBin);
-    const cv::Mat count = windowSum(inBinF, side);
-    for (int y = 0; y < grey.rows; ++y) {
-      const float* c = count.ptr<float>(y);
-      const float* n = weights.ptr<float>(y);
-      float* acc = plogp.ptr<float>(y);
-      for (int x = 0; x < grey.cols; ++x) {
-        if (c[x] > 1e-3f && n[x] > 1e-3f) {
-          const float q = c[x] / n[x];
-          acc[x] -= q * std::log(q);
-        }
-      }
-    }
-    core::report(progress, 0.1 + 0.6 * (b + 1) / bins);
-  }
-  m.entropy = plogp / std::log(static_cast<double>(bins));
-  m.entropy.setTo(kNaN, m.votes < kMinVotes);
   return m;
 }
 
@@ -142,14 +89,13 @@ cv::Mat greennessOf(const cv::Mat& image, const cv::Mat& above, int side) {
   return sum / cv::max(windowSum(insideF, side), 1.0f);
 }
 
-// The per-pixel rules: green (colour), disordered directions, or dark and textured is vegetation.
+// The per-pixel rules: green (colour), or dark and textured, is vegetation.
 cv::Mat pixelRules(const cv::Mat& above, const LocalMeasures& m, const cv::Mat& green, const ClassifyParams& p) {
   cv::Mat labels = cv::Mat::zeros(above.size(), CV_8U);
   for (int y = 0; y < above.rows; ++y) {
     for (int x = 0; x < above.cols; ++x) {
       if (above.at<uchar>(y, x) == 0) continue;
-      const float e = m.entropy.at<float>(y, x);
-      bool vegetation = std::isfinite(e) && e > p.entropyThreshold;
+      bool vegetation = false;
       if (p.darkLevel > 0 && m.variation.at<float>(y, x) > p.textureVariation &&
           m.brightness.at<float>(y, x) < p.darkLevel) {
         vegetation = true;
@@ -277,12 +223,12 @@ Classification classify(const cv::Mat& image, const cv::Mat& aboveGround, const 
     image.convertTo(grey, CV_32F);
   }
   core::report(progress, 0.05);
-  const LocalMeasures m = localMeasures(grey, aboveGround, side, params, progress);
-  if (core::isCanceled(progress) || m.entropy.empty()) {
+  const cv::Mat above = aboveGround != 0;
+  const LocalMeasures m = localMeasures(grey, above, side);
+  if (core::isCanceled(progress)) {
     out.status = core::RunStatus::Canceled;
     return out;
   }
-  out.entropy = m.entropy;
   out.greenness = greennessOf(image, aboveGround, side);
   out.pixelLabels = pixelRules(aboveGround, m, out.greenness, params);
   core::report(progress, 0.8);

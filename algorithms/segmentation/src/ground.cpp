@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <unordered_map>
+#include <vector>
 
 #include <opencv2/imgproc/detail/gcgraph.hpp>
 
@@ -188,6 +190,48 @@ Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundPar
   return out;
 }
 
+// Kept gaps (no height) inside above-ground objects: a gap whose 8-adjacent border pixels are
+// above-ground on more than `share` of them joins the above-ground mask and takes the region its
+// above-ground border meets most. An occlusion beside a wall borders the roof on one side and the
+// ground on the other and stays unlabelled; an unmatched patch of a roof or a crown joins it.
+void labelKeptGaps(const dem::GapResult& gaps, double share, cv::Mat& regions, cv::Mat& above) {
+  const size_t n = gaps.gaps.size();
+  std::vector<int> border(n, 0), aboveBorder(n, 0);
+  std::unordered_map<long long, int> regionVotes;  // (gap << 32 | region) -> border pixels
+  const cv::Mat& g = gaps.gapLabels;
+  for (int y = 0; y < g.rows; ++y) {
+    for (int x = 0; x < g.cols; ++x) {
+      const int gap = g.at<int>(y, x) - 1;
+      if (gap < 0 || gaps.gaps[static_cast<size_t>(gap)].merged) continue;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int yy = y + dy, xx = x + dx;
+          if (yy < 0 || xx < 0 || yy >= g.rows || xx >= g.cols || g.at<int>(yy, xx) != 0) continue;
+          ++border[static_cast<size_t>(gap)];
+          if (above.at<uchar>(yy, xx) == 0) continue;
+          ++aboveBorder[static_cast<size_t>(gap)];
+          ++regionVotes[(static_cast<long long>(gap) << 32) | static_cast<unsigned>(regions.at<int>(yy, xx))];
+        }
+      }
+    }
+  }
+  std::vector<int> regionOf(n, -1), best(n, 0);
+  for (const auto& [key, votes] : regionVotes) {
+    const auto gap = static_cast<size_t>(key >> 32);
+    if (votes > best[gap]) best[gap] = votes, regionOf[gap] = static_cast<int>(key & 0xffffffff);
+  }
+  for (int y = 0; y < g.rows; ++y) {
+    for (int x = 0; x < g.cols; ++x) {
+      const int gap = g.at<int>(y, x) - 1;
+      if (gap < 0 || gaps.gaps[static_cast<size_t>(gap)].merged) continue;
+      const auto i = static_cast<size_t>(gap);
+      if (border[i] == 0 || aboveBorder[i] <= share * border[i]) continue;
+      above.at<uchar>(y, x) = 255;
+      regions.at<int>(y, x) = regionOf[i];
+    }
+  }
+}
+
 GroundResult canceledResult(GroundResult result) {
   result.status = core::RunStatus::Canceled;
   return result;
@@ -247,7 +291,7 @@ GroundResult segmentGround(const cv::Mat& dem, double gsd, const GroundParams& p
   if (rounds.canceled) return canceledResult(result);
 
   // 7. Outputs: regions, above-ground mask, DTM, nDSM.
-  result.regions = graph.labels;
+  result.regions = graph.labels.clone();
   result.regionCount = count;
   result.links = static_cast<int>(graph.links.size());
   result.gapLinks = graph.gapLinks;
@@ -263,6 +307,8 @@ GroundResult segmentGround(const cv::Mat& dem, double gsd, const GroundParams& p
       if (r[x] >= 0 && rounds.labels[static_cast<size_t>(r[x])] == GroundLabel::Above) a[x] = 255;
     }
   }
+  // 8. Kept gaps inside above-ground objects (unmatched roof or crown patches) join them.
+  if (params.gapAboveShare < 1.0) labelKeptGaps(gaps, params.gapAboveShare, result.regions, result.aboveGround);
   result.regionInfo.resize(static_cast<size_t>(count));
   for (size_t i = 0; i < result.regionInfo.size(); ++i) {
     GroundRegionInfo& info = result.regionInfo[i];

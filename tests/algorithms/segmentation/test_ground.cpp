@@ -224,6 +224,25 @@ TEST(SegmentGround, NoDataAlongWallsIsKeptUnlabelledAndTheDtmCoversIt) {
   EXPECT_TRUE(std::isnan(r.ndsm.at<float>(rightGap.y + 30, rightGap.x + 5)));
 }
 
+TEST(SegmentGround, UnmatchedPatchInsideARoofJoinsIt) {
+  // A roof of two levels (10 m and 13 m) with a hole of no data across its step: the hole's
+  // border spreads over 3 m, so the gap is kept, and all of its border is above-ground.
+  const cv::Mat ground = terrain({240, 200}, 0.0);
+  cv::Mat dem = ground.clone();
+  const cv::Rect box(60, 50, 120, 100), upper(120, 50, 60, 100), hole(105, 80, 30, 30);
+  addBox(dem, ground, box, 10.0f);
+  addBox(dem, ground, upper, 13.0f);
+  dem(hole).setTo(kNaN);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  EXPECT_GT(r.keptGapPixels, 0);
+  EXPECT_EQ(countAbove(r, box), box.area());
+  EXPECT_EQ(cv::countNonZero(r.regions(hole) < 0), 0) << "the patch takes its border's region";
+  GroundParams unlabelled;
+  unlabelled.gapAboveShare = 1.0;
+  const GroundResult kept = segmentGround(dem, kGsd, unlabelled);
+  EXPECT_EQ(countAbove(kept, box), box.area() - hole.area());
+}
+
 TEST(SegmentGround, BoxSeparatedFromTheGroundOnlyByGapsIsFound) {
   // A box ringed by no data: only the links across the gaps make it the ground's neighbour.
   const cv::Mat ground = terrain({200, 200}, 0.0);

@@ -1,8 +1,7 @@
 #pragma once
 // Building vs vegetation on the above-ground pixels (Baillard & Maître, docs/dem.md, "Building vs
-// vegetation, objects and proposals"): the entropy of the left image's gradient directions
-// (mod π/2) in a window, a dark-and-textured radiometric rule, a greenness index on colour
-// images, then one label per height-homogeneous region (the majority of its pixels) so that an
+// vegetation, objects and proposals"): a dark-and-textured radiometric rule, a greenness index
+// on colour images, then one label per height-homogeneous region (the majority of its pixels) so that an
 // object is of one class. Left-image geometry throughout. No GUI interaction here.
 #include <cstdint>
 
@@ -22,9 +21,6 @@ enum ClassLabel : std::uint8_t {
 
 struct ClassifyParams {
   double window = 3.0;             // m, side of the square window of the local measures
-  int directionBins = 16;          // bins of the gradient directions over [0, π/2)
-  double minGradient = 3.0;        // grey levels per px, weaker gradients do not vote
-  double entropyThreshold = 0.95;  // normalised entropy above which a pixel looks like vegetation
   double textureVariation = 0.3;   // std / mean of the window's grey levels above which a dark window is vegetation
   double darkLevel = 90.0;         // grey levels, mean brightness under which a textured window is vegetation (0: off)
   double greenThreshold = 0.1;     // colour only: excess green (2G - R - B) / (R + G + B) above which a pixel is vegetation (1: off)
@@ -35,15 +31,6 @@ struct ClassifyParams {
   void visit(V&& v) {
     using core::ParamInfo;
     v(ParamInfo{"window", "Window", "m", "Side of the square window of the local measures", 0.25, 100}, window);
-    v(ParamInfo{"direction-bins", "Direction bins", "",
-                "Bins of the histogram of gradient directions over a quarter turn", 4, 90},
-      directionBins);
-    v(ParamInfo{"min-gradient", "Minimum gradient", "grey levels/px",
-                "Gradients weaker than this do not vote for a direction", 0, 255},
-      minGradient);
-    v(ParamInfo{"entropy-threshold", "Entropy threshold", "",
-                "Normalised direction entropy above which a pixel looks like vegetation", 0, 1},
-      entropyThreshold);
     v(ParamInfo{"texture-variation", "Texture variation", "",
                 "Standard deviation over mean of the window's grey levels above which a dark window is vegetation",
                 0, 10},
@@ -68,7 +55,6 @@ struct Classification {
   core::RunStatus status = core::RunStatus::Completed;  // Canceled: labels empty
   cv::Mat labels;      // CV_8U ClassLabel, one class per region
   cv::Mat pixelLabels; // CV_8U ClassLabel per pixel, before the regions' majority
-  cv::Mat entropy;     // CV_32F normalised direction entropy in [0, 1], NaN where no gradient votes
   cv::Mat greenness;   // CV_32F excess green (2G - R - B) / (R + G + B), window mean; empty for a grey image
   cv::Mat regions;     // CV_32S region index used for the majority (-1 outside the above-ground mask)
 };

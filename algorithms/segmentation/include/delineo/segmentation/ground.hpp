@@ -12,7 +12,9 @@
 //      the graph (ground_model.hpp), alternated with the DTM (dtm.hpp) made from the regions
 //      labelled ground, starting from all ground, until the labels repeat;
 //   6. regions whose label oscillates become ground;
-//   7. above-ground mask and nDSM = DEM - DTM.
+//   7. above-ground mask and nDSM = DEM - DTM;
+//   8. kept gaps whose border is mostly above-ground (unmatched patches of a roof or a crown)
+//      join the above-ground mask and their border's region.
 // No GUI interaction here: the CLI and the GUI call the same function.
 #include <vector>
 
@@ -36,6 +38,8 @@ struct GroundParams {
   double stepBand = 2.0;         // m, how far inside two neighbouring regions their step is read
   double gapLinkLength = 40.0;   // m, longest kept-gap run along a row across which regions are
                                  // linked (0: no links across gaps)
+  double gapAboveShare = 0.5;    // a kept gap whose border is above-ground on more than this share
+                                 // of its pixels is above-ground too (1: kept gaps stay unlabelled)
   int maxIterations = 10;        // rounds of labelling and DTM
   dem::GapParams gaps;           // elevation gaps merged or kept (docs/dem.md)
 
@@ -71,6 +75,9 @@ struct GroundParams {
                 "Longest no-data run along a row across which the regions at its ends are neighbours (0: none)",
                 0, 1e6},
       gapLinkLength);
+    v(ParamInfo{"gap-above-share", "Gap above share", "",
+                "A no-data gap whose border is above-ground on more than this share is above-ground (1: never)", 0, 1},
+      gapAboveShare);
     v(ParamInfo{"max-iterations", "Iterations", "",
                 "Most rounds of labelling and DTM before unstable regions are set to ground", 1, 1000},
       maxIterations);
@@ -89,7 +96,8 @@ struct GroundRegionInfo {
 
 struct GroundResult {
   core::RunStatus status = core::RunStatus::Completed;
-  cv::Mat regions;      // CV_32S region index per pixel, -1 where no height remains (kept gaps)
+  cv::Mat regions;      // CV_32S region index per pixel, -1 where no height remains (kept gaps not
+                        // joined to an above-ground region by stage 8)
   cv::Mat aboveGround;  // CV_8U, 255 above-ground, 0 ground or no height
   cv::Mat dtm;          // CV_32F m, everywhere; NaN only when no region is ground
   cv::Mat ndsm;         // CV_32F m, DEM (merged gaps filled) - DTM, NaN in kept gaps

@@ -1,0 +1,214 @@
+// The scene analysis (segmentation::analyseScene: ground, DTM, classes, objects, proposals) on the
+// real aerial pairs of the data folder (docs/dem.md, "Results on the real pairs"):
+//   - Dublin: above-ground vs the LiDAR disparity on the pixels where the LiDAR has a value;
+//   - every pair: how many hand-labelled roofs (tests/bench/data/real_roofs.json) a proposal
+//     covers, and an overlay PNG (building red, vegetation green, proposals yellow) to look at.
+// Heights come from the matcher's disparity (cached as in bench_real_outlines) through a linear
+// model; the pairs come without camera data, so metres per pixel of disparity is the stated
+// assumption below. Skips cleanly when the data folder is missing.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "delineo/core/allocator.hpp"
+#include "delineo/core/params.hpp"
+#include "delineo/io/raster.hpp"
+#include "delineo/segmentation/scene.hpp"
+#include "real_roofs.hpp"
+
+using namespace delineo;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Metres of height per pixel of disparity and ground sample distance of each pair. Toulouse:
+// 5 cm GSD and a base-to-height ratio near 0.2 (a 25 m block spans about 100 px of disparity)
+// give 0.25 m/px. Dublin: 3.4 cm GSD, the same ratio gives 0.17 m/px.
+struct PairModel {
+  double metresPerPixel, gsd;
+};
+PairModel modelOf(const std::string& pair) {
+  if (pair.rfind("dublin", 0) == 0) return {0.17, 0.034};
+  return {0.25, 0.05};
+}
+
+double percentile(std::vector<float> v, double q) {
+  if (v.empty()) return std::nan("");
+  const auto k = static_cast<long>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<size_t>(k)];
+}
+
+// The LiDAR's ground as a plane of disparity: the 10th percentile of each 128 px window, fitted
+// by least squares, windows more than 3 px above the fit dropped and the fit repeated.
+cv::Mat lidarGround(const cv::Mat& lidar) {
+  std::vector<cv::Vec3d> samples;
+  const int w = 128;
+  for (int y = 0; y + w <= lidar.rows; y += w / 2) {
+    for (int x = 0; x + w <= lidar.cols; x += w / 2) {
+      std::vector<float> v;
+      const cv::Mat win = lidar(cv::Rect(x, y, w, w));
+      for (int r = 0; r < w; ++r) {
+        for (int c = 0; c < w; ++c) {
+          if (std::isfinite(win.at<float>(r, c))) v.push_back(win.at<float>(r, c));
+        }
+      }
+      if (v.size() > 200) samples.push_back({x + w / 2.0, y + w / 2.0, percentile(v, 0.1)});
+    }
+  }
+  cv::Vec3d plane(0, 0, 0);  // d = a x + b y + c
+  for (int round = 0; round < 5 && samples.size() >= 3; ++round) {
+    cv::Mat A(static_cast<int>(samples.size()), 3, CV_64F), b(static_cast<int>(samples.size()), 1, CV_64F);
+    for (size_t i = 0; i < samples.size(); ++i) {
+      A.at<double>(static_cast<int>(i), 0) = samples[i][0];
+      A.at<double>(static_cast<int>(i), 1) = samples[i][1];
+      A.at<double>(static_cast<int>(i), 2) = 1.0;
+      b.at<double>(static_cast<int>(i)) = samples[i][2];
+    }
+    cv::Mat p;
+    cv::solve(A, b, p, cv::DECOMP_SVD);
+    plane = {p.at<double>(0), p.at<double>(1), p.at<double>(2)};
+    std::erase_if(samples, [&](const cv::Vec3d& s) { return s[2] > plane[0] * s[0] + plane[1] * s[1] + plane[2] + 3.0; });
+  }
+  cv::Mat ground(lidar.size(), CV_32F);
+  for (int y = 0; y < lidar.rows; ++y) {
+    for (int x = 0; x < lidar.cols; ++x) ground.at<float>(y, x) = static_cast<float>(plane[0] * x + plane[1] * y + plane[2]);
+  }
+  return ground;
+}
+
+// Above-ground vs the LiDAR: on its valid pixels, above when its disparity exceeds its ground by
+// `margin` px. Pixels within half a margin of that threshold are left out (low walls, cars,
+// kerbs: neither class is wrong there).
+void scoreAgainstLidar(const std::string& gtPath, const cv::Mat& above, const cv::Mat& demValid, double margin) {
+  cv::Mat raw = cv::imread(gtPath, cv::IMREAD_UNCHANGED), lidar;
+  raw.convertTo(lidar, CV_32F, 1.0 / 256.0);
+  lidar.setTo(std::nanf(""), raw == 0);
+  const cv::Mat ground = lidarGround(lidar);
+  long right = 0, total = 0, rightH = 0, totalH = 0, tp = 0, fp = 0, fn = 0;
+  for (int y = 0; y < lidar.rows; ++y) {
+    for (int x = 0; x < lidar.cols; ++x) {
+      const float d = lidar.at<float>(y, x);
+      if (!std::isfinite(d)) continue;
+      const double over = d - ground.at<float>(y, x);
+      if (std::abs(over - margin) < margin / 2) continue;
+      const bool truth = over > margin, found = above.at<uchar>(y, x) != 0;
+      ++total, right += truth == found;
+      if (demValid.at<uchar>(y, x)) ++totalH, rightH += truth == found;
+      tp += truth && found, fp += !truth && found, fn += truth && !found;
+    }
+  }
+  std::printf("  LiDAR check (margin %.1f px = 2 m): accuracy %.1f %% on %ld px (%.1f %% on the %ld with a height); "
+              "above-ground found %.1f %%, false %.1f %%\n",
+              margin, 100.0 * right / std::max(1L, total), total, 100.0 * rightH / std::max(1L, totalH), totalH,
+              100.0 * tp / std::max(1L, tp + fn), 100.0 * fp / std::max(1L, tp + fp));
+}
+
+void drawOverlay(const std::string& path, const cv::Mat& bgr, const segmentation::SceneAnalysis& a) {
+  const cv::Mat& classes = a.classes();
+  cv::Mat tint = bgr.clone();
+  tint.setTo(cv::Scalar(40, 40, 230), classes == segmentation::kClassBuilding);
+  tint.setTo(cv::Scalar(40, 200, 40), classes == segmentation::kClassVegetation);
+  cv::Mat out;
+  cv::addWeighted(bgr, 0.6, tint, 0.4, 0, out);
+  for (const auto& f : a.detection.proposals) {
+    std::vector<cv::Point> ring;
+    for (const auto& p : f.polygon.outer) ring.emplace_back(cvRound(p.x), cvRound(p.y));
+    cv::polylines(out, ring, true, cv::Scalar(0, 230, 255), 3);
+  }
+  cv::imwrite(path, out);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  core::tuneAllocatorForLargeImages();
+  std::string data = "../shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json", out = "/tmp";
+  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) data = argv[++i];
+    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+    else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: bench_segment_real [--data DIR] [--out DIR] [--cache DIR]\n");
+      return 2;
+    }
+  }
+  if (!fs::exists(data)) {
+    std::printf("skipped: data folder %s missing\n", data.c_str());
+    return 0;
+  }
+  const nlohmann::json roofs = nlohmann::json::parse(std::ifstream(labels));
+  // BENCH_PARAMS='{"segment": {...}, "classify": {...}, "objects": {...}, "detect": {...}}' overrides.
+  segmentation::SceneParams params;
+  if (const char* text = std::getenv("BENCH_PARAMS")) {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    if (j.contains("segment")) core::fromJson(params.ground, j.at("segment"));
+    if (j.contains("classify")) core::fromJson(params.classify, j.at("classify"));
+    if (j.contains("objects")) core::fromJson(params.objects, j.at("objects"));
+    if (j.contains("detect")) core::fromJson(params.detect, j.at("detect"));
+  }
+  for (const auto& [name, pair] : roofs.at("pairs").items()) {
+    const fs::path left = fs::path(data) / pair.at("left").get<std::string>();
+    const fs::path right = fs::path(data) / pair.at("right").get<std::string>();
+    if (!fs::exists(left) || !fs::exists(right)) {
+      std::printf("%s: skipped, %s missing\n", name.c_str(), left.string().c_str());
+      continue;
+    }
+    const cv::Mat disparity = bench::disparityFor(name, left.string(), right.string(), pair.at("disparity_range").at(0),
+                                                  pair.at("disparity_range").at(1), cache);
+    const PairModel model = modelOf(name);
+    std::vector<float> finite;
+    for (auto it = disparity.begin<float>(); it != disparity.end<float>(); ++it) {
+      if (std::isfinite(*it)) finite.push_back(*it);
+    }
+    const double base = percentile(finite, 0.5);
+    const cv::Mat dem = (disparity - base) * model.metresPerPixel;  // NaN stays NaN
+    const cv::Mat image = io::readImage8(left.string());
+    const auto t0 = cv::getTickCount();
+    const segmentation::SceneAnalysis a =
+        segmentation::analyseScene(dem, image, model.gsd, params, disparity);
+    const double ms = 1e3 * double(cv::getTickCount() - t0) / cv::getTickFrequency();
+    int buildings = 0;
+    for (const auto& o : a.detection.objects.objects) buildings += o.cls == segmentation::kClassBuilding;
+    std::printf("%s (%.2f m/px of disparity, gsd %.3f m): %d regions, %d rounds, above ground %.1f %%, %d building "
+                "and %zu vegetation objects, %zu proposals, %.0f ms\n",
+                name.c_str(), model.metresPerPixel, model.gsd, a.ground.regionCount, a.ground.iterations,
+                100.0 * cv::countNonZero(a.ground.aboveGround) / double(dem.total()), buildings,
+                a.detection.objects.objects.size() - static_cast<size_t>(buildings), a.detection.proposals.size(), ms);
+    // Hand-labelled roofs: covered when one proposal holds at least half of the roof.
+    int labelled = 0, covered = 0;
+    for (const auto& roof : roofs.at("roofs")) {
+      if (roof.at("pair") != name) continue;
+      const cv::Mat r = core::rasterize(bench::ringOf(roof.at("outline")), dem.size());
+      double best = 0;
+      for (const auto& f : a.detection.proposals) {
+        best = std::max(best, cv::countNonZero(r & core::rasterize(f.polygon, dem.size())) /
+                                  std::max(1.0, double(cv::countNonZero(r))));
+      }
+      ++labelled, covered += best >= 0.5;
+      if (best < 0.5) std::printf("  roof %s not proposed (best cover %.2f)\n", roof.at("name").get<std::string>().c_str(), best);
+    }
+    std::printf("  hand-labelled roofs proposed: %d of %d\n", covered, labelled);
+    if (pair.contains("ground_truth_disparity")) {
+      const fs::path gt = fs::path(data) / pair.at("ground_truth_disparity").get<std::string>();
+      if (fs::exists(gt)) scoreAgainstLidar(gt.string(), a.ground.aboveGround, dem == dem, 2.0 / model.metresPerPixel);
+    }
+    const std::string png = (fs::path(out) / ("scene_" + name + ".png")).string();
+    cv::Mat bgr = image;
+    if (bgr.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+    drawOverlay(png, bgr, a);
+    std::printf("  overlay %s\n", png.c_str());
+  }
+  return 0;
+}
