@@ -66,9 +66,12 @@ GroundSegmentation truthSegmentation(const sim::Scene& scene) {
   return s;
 }
 
-// The product's segmentation (segmentGround, default parameters) of a DEM in metres.
+// The product's segmentation (segmentGround; BENCH_GROUND='{...}' overrides parameters) of a DEM
+// in metres.
 GroundSegmentation demSegmentation(const cv::Mat& dem, double gsd) {
-  const GroundResult g = segmentGround(dem, gsd, GroundParams{});
+  GroundParams params;
+  if (const char* json = std::getenv("BENCH_GROUND")) core::fromJson(params, nlohmann::json::parse(json));
+  const GroundResult g = segmentGround(dem, gsd, params);
   return {g.aboveGround, g.dtm, g.ndsm, g.regions};
 }
 
