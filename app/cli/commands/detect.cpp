@@ -32,22 +32,13 @@ int run(const std::vector<std::string>& args) {
   std::vector<std::pair<std::string, io::OutputFormat>> outputs{{"out", io::OutputFormat::Vector}};
   if (opts.has("objects")) outputs.push_back({"objects", io::OutputFormat::Vector});
   cli::checkOutputs(opts, outputs, {"dem", "image", "disparity", "scene"});
-  auto& progress = cli::commandProgress();
-  progress.setQuiet(opts.has("quiet"));
-  progress.setStage("reading");
-  const cli::SceneInputs inputs = cli::readSceneInputs(opts);
-  cli::throwIfCanceled(progress);
-
-  core::Progress::Range working(&progress, 0.0, 0.95);
-  const segmentation::SceneAnalysis analysis = cli::analyseSceneForCommand(inputs, params, &working);
-
-  progress.setStage("writing");
+  const auto [inputs, analysis] = cli::runSceneAnalysis(opts, params);
   const auto& proposals = analysis.detection.proposals;
   io::writeFeatures(opts.get("out"), proposals, inputs.dem.geo);
   const auto& objects = analysis.detection.objects.objects;
   if (opts.has("objects")) io::writeFeatures(opts.get("objects"), segmentation::objectFeatures(objects), inputs.dem.geo, "objects");
-  progress.report(1.0);
-  progress.finish();
+  cli::commandProgress().report(1.0);
+  cli::commandProgress().finish();
   int buildings = 0;
   for (const auto& object : objects) buildings += object.cls == segmentation::kClassBuilding ? 1 : 0;
   std::printf("detect: %zu building(s) proposed from %d building object(s) (%zu objects in all) -> %s\n",

@@ -25,9 +25,13 @@ struct SceneInputs {
 // and core::Error naming the file (unreadable, several bands, sizes that differ).
 SceneInputs readSceneInputs(const Options& opts);
 
-// analyseScene() on the inputs; input errors name the DEM. Throws Canceled on a cancel.
-segmentation::SceneAnalysis analyseSceneForCommand(const SceneInputs& inputs,
-                                                   const segmentation::SceneParams& params,
-                                                   core::Progress* progress);
+// Reads the inputs (readSceneInputs) and runs analyseScene() on them, with the command's progress
+// ("reading", then the chain's stages, "writing" when it returns); input errors name the DEM.
+// Throws Canceled on a cancel.
+struct SceneRun {
+  SceneInputs inputs;
+  segmentation::SceneAnalysis analysis;
+};
+SceneRun runSceneAnalysis(const Options& opts, const segmentation::SceneParams& params);
 
 }  // namespace delineo::cli

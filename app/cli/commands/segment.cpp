@@ -77,18 +77,24 @@ SceneInputs readSceneInputs(const Options& opts) {
   return in;
 }
 
-segmentation::SceneAnalysis analyseSceneForCommand(const SceneInputs& inputs, const segmentation::SceneParams& params,
-                                                   core::Progress* progress) {
-  segmentation::SceneAnalysis analysis;
+SceneRun runSceneAnalysis(const Options& opts, const segmentation::SceneParams& params) {
+  auto& progress = commandProgress();
+  progress.setQuiet(opts.has("quiet"));
+  progress.setStage("reading");
+  SceneRun run{readSceneInputs(opts), {}};
+  throwIfCanceled(progress);
+  core::Progress::Range working(&progress, 0.0, 0.95);
   try {
-    analysis = segmentation::analyseScene(inputs.dem.data, inputs.image, inputs.gsd, params, inputs.disparity, progress);
+    run.analysis = segmentation::analyseScene(run.inputs.dem.data, run.inputs.image, run.inputs.gsd, params,
+                                              run.inputs.disparity, &working);
   } catch (const core::Error& e) {
     // The algorithms know no file names: input problems name the DEM.
     if (e.code() == core::ErrorCode::InvalidParameter) throw;
-    throw core::Error(e.code(), e.detail(), inputs.dem.path);
+    throw core::Error(e.code(), e.detail(), run.inputs.dem.path);
   }
-  if (analysis.status == core::RunStatus::Canceled) throw Canceled();
-  return analysis;
+  if (run.analysis.status == core::RunStatus::Canceled) throw Canceled();
+  progress.setStage("writing");
+  return run;
 }
 
 }  // namespace delineo::cli
@@ -119,23 +125,14 @@ int run(const std::vector<std::string>& args) {
                                             {(dir / "labels.tif").string(), io::OutputFormat::GeoTiff},
                                             {(dir / "objects.geojson").string(), io::OutputFormat::Vector}};
   io::checkOutputs(outputs, {opts.get("dem"), opts.get("image"), opts.has("disparity") ? opts.get("disparity") : ""});
-  auto& progress = cli::commandProgress();
-  progress.setQuiet(opts.has("quiet"));
-  progress.setStage("reading");
-  const cli::SceneInputs inputs = cli::readSceneInputs(opts);
-  cli::throwIfCanceled(progress);
-
-  core::Progress::Range working(&progress, 0.0, 0.95);
-  const segmentation::SceneAnalysis analysis = cli::analyseSceneForCommand(inputs, params, &working);
-
-  progress.setStage("writing");
+  const auto [inputs, analysis] = cli::runSceneAnalysis(opts, params);
   const io::GeoReference& geo = inputs.dem.geo;
   io::writeFloatGeoTiff(outputs[0].path, analysis.ground.dtm, geo);
   io::writeFloatGeoTiff(outputs[1].path, analysis.ground.ndsm, geo);
   io::writeGeoTiff(outputs[2].path, analysis.classes(), geo);
   io::writeFeatures(outputs[3].path, segmentation::objectFeatures(analysis.detection.objects.objects), geo, "objects");
-  progress.report(1.0);
-  progress.finish();
+  cli::commandProgress().report(1.0);
+  cli::commandProgress().finish();
 
   const cv::Mat& classes = analysis.classes();
   const double total = std::max(1, classes.rows * classes.cols);
