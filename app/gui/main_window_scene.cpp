@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "delineo/core/error.hpp"
+#include "delineo/io/raster.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "document.hpp"
@@ -192,13 +193,14 @@ widgets::JobId MainWindow::startSceneAnalysis() {
   }
   const project::Project projectCopy = document_->project();
   const cv::Mat heights = document_->dem();
-  const cv::Mat image = document_->leftDisplay();
   const cv::Mat disparity = document_->disparity();
   const SceneInputs inputs{heights.data, disparity.data, projectCopy.height.gsd};
   QPointer<Document> doc(document_.get());
   sceneJob_ = jobs_->run<project::SceneAnalysisOutcome>(
       tr("Scene analysis"),
-      [projectCopy, heights, image, disparity](core::Progress& p) {
+      [projectCopy, heights, disparity](core::Progress& p) {
+        // The left image as the command line reads it (8-bit grey or BGR), for the same classes.
+        const cv::Mat image = io::readImage8(projectCopy.left);
         return project::analyseScene(projectCopy, heights, image, disparity, &p);
       },
       [this, doc, inputs](project::SceneAnalysisOutcome outcome) {
