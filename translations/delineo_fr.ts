@@ -538,6 +538,106 @@
         <source>Ground refinements</source>
         <translation>Affinages du sol</translation>
     </message>
+    <message>
+        <source>Region step</source>
+        <translation>Saut dans une région</translation>
+    </message>
+    <message>
+        <source>Wall slope</source>
+        <translation>Pente des murs</translation>
+    </message>
+    <message>
+        <source>Smallest region</source>
+        <translation>Plus petite région</translation>
+    </message>
+    <message>
+        <source>Critical height</source>
+        <translation>Hauteur critique</translation>
+    </message>
+    <message>
+        <source>Data weight</source>
+        <translation>Poids des données</translation>
+    </message>
+    <message>
+        <source>DTM window</source>
+        <translation>Fenêtre du MNT</translation>
+    </message>
+    <message>
+        <source>Step band</source>
+        <translation>Bande des sauts</translation>
+    </message>
+    <message>
+        <source>Gap link length</source>
+        <translation>Longueur des liens à travers les lacunes</translation>
+    </message>
+    <message>
+        <source>Iterations</source>
+        <translation>Itérations</translation>
+    </message>
+    <message>
+        <source>Gap border spread</source>
+        <translation>Dispersion du bord des lacunes</translation>
+    </message>
+    <message>
+        <source>Gap border pixels</source>
+        <translation>Pixels du bord des lacunes</translation>
+    </message>
+    <message>
+        <source>Window</source>
+        <translation>Fenêtre</translation>
+    </message>
+    <message>
+        <source>Direction bins</source>
+        <translation>Classes de direction</translation>
+    </message>
+    <message>
+        <source>Minimum gradient</source>
+        <translation>Gradient minimal</translation>
+    </message>
+    <message>
+        <source>Entropy threshold</source>
+        <translation>Seuil d’entropie</translation>
+    </message>
+    <message>
+        <source>Texture variation</source>
+        <translation>Variation de texture</translation>
+    </message>
+    <message>
+        <source>Dark level</source>
+        <translation>Niveau sombre</translation>
+    </message>
+    <message>
+        <source>Greenness threshold</source>
+        <translation>Seuil de verdure</translation>
+    </message>
+    <message>
+        <source>Minimum piece area</source>
+        <translation>Aire minimale d’un morceau</translation>
+    </message>
+    <message>
+        <source>Minimum area</source>
+        <translation>Aire minimale</translation>
+    </message>
+    <message>
+        <source>Roof percentile</source>
+        <translation>Centile du toit</translation>
+    </message>
+    <message>
+        <source>Core shrink</source>
+        <translation>Rétrécissement du cœur</translation>
+    </message>
+    <message>
+        <source>Minimum building area</source>
+        <translation>Aire minimale d’un bâtiment</translation>
+    </message>
+    <message>
+        <source>Minimum height</source>
+        <translation>Hauteur minimale</translation>
+    </message>
+    <message>
+        <source>Growth</source>
+        <translation>Élargissement</translation>
+    </message>
 </context>
 <context>
     <name>Stages</name>
@@ -814,6 +914,13 @@
     <message>
         <source>Outline with the active polygon</source>
         <translation>Contourer par le polygone actif</translation>
+    </message>
+    <message numerus="yes">
+        <source>Detect %n building(s)</source>
+        <translation>
+            <numerusform>Détecter %n bâtiment</numerusform>
+            <numerusform>Détecter %n bâtiments</numerusform>
+        </translation>
     </message>
 </context>
 <context>
@@ -1625,6 +1732,184 @@
     <message>
         <source>The method that outlines a picked building; box-fitting needs the DEM.</source>
         <translation>La méthode qui contoure un bâtiment pointé ; l’ajustement de boîtes demande le MNE.</translation>
+    </message>
+    <message>
+        <source>DEM &amp;view shows</source>
+        <translation>La &amp;vue MNE montre</translation>
+    </message>
+    <message>
+        <source>DTM (ground)</source>
+        <translation>MNT (sol)</translation>
+    </message>
+    <message>
+        <source>nDSM (above ground)</source>
+        <translation>MNH (au-dessus du sol)</translation>
+    </message>
+    <message>
+        <source>The DEM, or the ground (DTM) and the height above it (nDSM) the scene analysis finds</source>
+        <translation>Le MNE, ou le sol (MNT) et la hauteur au-dessus du sol (MNH) que trouve l’analyse de la scène</translation>
+    </message>
+    <message>
+        <source>Ground</source>
+        <translation>Sol</translation>
+    </message>
+    <message>
+        <source>Processing → Analyse the scene: regions of even height, ground or above ground, and the DTM under them.</source>
+        <translation>Traitements → Analyser la scène : régions de hauteur régulière, au sol ou au-dessus, et le MNT sous elles.</translation>
+    </message>
+    <message>
+        <source>Classes</source>
+        <translation>Classes</translation>
+    </message>
+    <message>
+        <source>The above-ground pieces as building or vegetation, from the left image&apos;s texture and colour.</source>
+        <translation>Les morceaux au-dessus du sol classés en bâtiment ou végétation, d’après la texture et la couleur de l’image gauche.</translation>
+    </message>
+    <message>
+        <source>Objects</source>
+        <translation>Objets</translation>
+    </message>
+    <message>
+        <source>The above-ground objects of one class and their outlines (View → Objects).</source>
+        <translation>Les objets au-dessus du sol d’une même classe et leurs contours (Affichage → Objets).</translation>
+    </message>
+    <message>
+        <source>Detection</source>
+        <translation>Détection</translation>
+    </message>
+    <message>
+        <source>Building → Detect buildings: which building objects become pending buildings.</source>
+        <translation>Bâtiment → Détecter les bâtiments : quels objets bâtiments deviennent des bâtiments en attente.</translation>
+    </message>
+    <message>
+        <source>Analyse the &amp;scene</source>
+        <translation>Analyser la &amp;scène</translation>
+    </message>
+    <message>
+        <source>Ground, DTM, height above ground, buildings and vegetation of the whole image, from its heights</source>
+        <translation>Sol, MNT, hauteur au-dessus du sol, bâtiments et végétation de toute l’image, d’après ses hauteurs</translation>
+    </message>
+    <message>
+        <source>De&amp;tect buildings</source>
+        <translation>Dé&amp;tecter les bâtiments</translation>
+    </message>
+    <message>
+        <source>Add the buildings the scene analysis finds as pending buildings, to review and delineate</source>
+        <translation>Ajouter les bâtiments trouvés par l’analyse de la scène comme bâtiments en attente, à vérifier et délimiter</translation>
+    </message>
+    <message>
+        <source>&amp;Classes</source>
+        <translation>&amp;Classes</translation>
+    </message>
+    <message>
+        <source>Colour the left image by class: buildings blue, vegetation green</source>
+        <translation>Colorer l’image gauche par classe : bâtiments en bleu, végétation en vert</translation>
+    </message>
+    <message>
+        <source>O&amp;bjects</source>
+        <translation>O&amp;bjets</translation>
+    </message>
+    <message>
+        <source>Outline the above-ground objects on the left image: buildings blue, vegetation green</source>
+        <translation>Tracer les contours des objets au-dessus du sol sur l’image gauche : bâtiments en bleu, végétation en vert</translation>
+    </message>
+    <message>
+        <source>&amp;DEM</source>
+        <translation>&amp;MNE</translation>
+    </message>
+    <message>
+        <source>D&amp;TM (ground)</source>
+        <translation>M&amp;NT (sol)</translation>
+    </message>
+    <message>
+        <source>&amp;nDSM (height above ground)</source>
+        <translation>MN&amp;H (hauteur au-dessus du sol)</translation>
+    </message>
+    <message>
+        <source>What the DEM view shows</source>
+        <translation>Ce que montre la vue MNE</translation>
+    </message>
+    <message>
+        <source>building</source>
+        <translation>bâtiment</translation>
+    </message>
+    <message>
+        <source>vegetation</source>
+        <translation>végétation</translation>
+    </message>
+    <message>
+        <source>wall</source>
+        <translation>mur</translation>
+    </message>
+    <message>
+        <source>Objects:</source>
+        <translation>Objets :</translation>
+    </message>
+    <message>
+        <source>Open a project first.</source>
+        <translation>Ouvrez d’abord un projet.</translation>
+    </message>
+    <message>
+        <source>The scene analysis is not part of this build.</source>
+        <translation>L’analyse de la scène ne fait pas partie de cette version.</translation>
+    </message>
+    <message>
+        <source>The scene analysis needs heights: compute the disparity (Processing → Compute disparity) and set the height model (File → Project settings), or give the project a DEM.</source>
+        <translation>L’analyse de la scène a besoin des hauteurs : calculez la disparité (Traitements → Calculer la disparité) et définissez le modèle de hauteur (Fichier → Réglages du projet), ou donnez un MNE au projet.</translation>
+    </message>
+    <message>
+        <source>The scene analysis needs heights: set the height model of the pair (File → Project settings).</source>
+        <translation>L’analyse de la scène a besoin des hauteurs : définissez le modèle de hauteur du couple (Fichier → Réglages du projet).</translation>
+    </message>
+    <message>
+        <source>The scene analysis needs the ground sample distance: set it with the height model (File → Project settings).</source>
+        <translation>L’analyse de la scène a besoin de la taille du pixel au sol : définissez-la avec le modèle de hauteur (Fichier → Réglages du projet).</translation>
+    </message>
+    <message>
+        <source>Scene analysis</source>
+        <translation>Analyse de la scène</translation>
+    </message>
+    <message numerus="yes">
+        <source>Scene analysed: %n object(s).</source>
+        <translation>
+            <numerusform>Scène analysée : %n objet.</numerusform>
+            <numerusform>Scène analysée : %n objets.</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>%n building(s) proposed (%1 already present).</source>
+        <translation>
+            <numerusform>%n bâtiment proposé (%1 déjà présents).</numerusform>
+            <numerusform>%n bâtiments proposés (%1 déjà présents).</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Review them in the buildings list and delineate them.</source>
+        <translation>Vérifiez-les dans la liste des bâtiments et délimitez-les.</translation>
+    </message>
+    <message>
+        <source>Detect buildings</source>
+        <translation>Détecter les bâtiments</translation>
+    </message>
+    <message>
+        <source>Classes:</source>
+        <translation>Classes :</translation>
+    </message>
+    <message>
+        <source>Labels:</source>
+        <translation>Étiquettes :</translation>
+    </message>
+    <message>
+        <source>Ground height</source>
+        <translation>Hauteur du sol</translation>
+    </message>
+    <message>
+        <source>Height above ground</source>
+        <translation>Hauteur au-dessus du sol</translation>
+    </message>
+    <message>
+        <source>  above ground %1 m</source>
+        <translation>  au-dessus du sol %1 m</translation>
     </message>
 </context>
 <context>

@@ -23,6 +23,12 @@ bool BuildingCommand::mergeWith(const QUndoCommand* other) {
   return true;
 }
 
+BuildingsCommand::BuildingsCommand(Document* document, States before, States after, const QString& text)
+    : QUndoCommand(text), document_(document), before_(std::move(before)), after_(std::move(after)) {}
+
+void BuildingsCommand::undo() { document_->restoreBuildings(before_); }
+void BuildingsCommand::redo() { document_->restoreBuildings(after_); }
+
 ParametersCommand::ParametersCommand(Document* document, std::string group, nlohmann::json before,
                                      nlohmann::json after, const QString& text)
     : QUndoCommand(text),

@@ -2,6 +2,7 @@
 // Undo commands: every change of a document is one of these, so Ctrl+Z / Ctrl+Y cover manual
 // edits, status changes, parameter changes and algorithm results alike.
 #include <QUndoCommand>
+#include <map>
 #include <optional>
 
 #include <opencv2/core.hpp>
@@ -27,6 +28,19 @@ class BuildingCommand : public QUndoCommand {
   int buildingId_;
   std::optional<project::Building> before_, after_;
   int mergeKey_;
+};
+
+// Several buildings' states before and after as one step (the buildings Detect buildings adds).
+class BuildingsCommand : public QUndoCommand {
+ public:
+  using States = std::map<int, std::optional<project::Building>>;
+  BuildingsCommand(Document* document, States before, States after, const QString& text);
+  void undo() override;
+  void redo() override;
+
+ private:
+  Document* document_;
+  States before_, after_;
 };
 
 class ParametersCommand : public QUndoCommand {

@@ -143,6 +143,20 @@ int Document::addBuilding(const core::Polygon& initial) {
   return b.id;
 }
 
+std::vector<int> Document::addProposedBuildings(const std::vector<core::Feature>& proposals) {
+  project::Project after = project_;
+  const std::vector<int> ids = project::addProposedBuildings(after, proposals, "delineo");
+  if (ids.empty()) return ids;
+  BuildingsCommand::States before, added;
+  for (int id : ids) {
+    before[id] = std::nullopt;
+    added[id] = *after.find(id);
+  }
+  undo_.push(new BuildingsCommand(this, std::move(before), std::move(added),
+                                  tr("Detect %n building(s)", nullptr, static_cast<int>(ids.size()))));
+  return ids;
+}
+
 void Document::removeBuilding(int id) {
   const Building* b = project_.find(id);
   if (b == nullptr) return;
@@ -337,7 +351,7 @@ QString Document::dialogFolder() const {
   return !last.isEmpty() && QFileInfo(last).isDir() ? last : QDir::homePath();
 }
 
-void Document::restoreBuilding(int id, const std::optional<Building>& state) {
+void Document::placeBuilding(int id, const std::optional<Building>& state) {
   auto& list = project_.buildings;
   Building* existing = project_.find(id);
   if (state) {
@@ -347,7 +361,16 @@ void Document::restoreBuilding(int id, const std::optional<Building>& state) {
   } else if (existing != nullptr) {
     list.erase(list.begin() + (existing - list.data()));
   }
+}
+
+void Document::restoreBuilding(int id, const std::optional<Building>& state) {
+  placeBuilding(id, state);
   emit buildingChanged(id);
+}
+
+void Document::restoreBuildings(const std::map<int, std::optional<Building>>& states) {
+  for (const auto& [id, state] : states) placeBuilding(id, state);
+  emit buildingsReset();
 }
 
 void Document::restoreParameters(const std::string& group, const nlohmann::json& values) {

@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -61,6 +62,9 @@ class Document : public QObject {
   // active polygon's energy of its outline when it was scored.
   void setBoxFitResult(int id, const project::BoxFitOutcome& outcome,
                        const std::optional<project::EnergyOutcome>& energy);
+  // The scene analysis's building proposals that are not buildings yet, added as Pending
+  // buildings (project::addProposedBuildings) in one undoable step. Returns the new ids.
+  std::vector<int> addProposedBuildings(const std::vector<core::Feature>& proposals);
   void setStatus(int id, project::BuildingStatus status);
   void setRoofInterval(int id, project::DisparityInterval interval);
   void setParameters(const std::string& group, const nlohmann::json& values);
@@ -95,6 +99,7 @@ class Document : public QObject {
 
   // ---- used by the undo commands only ----
   void restoreBuilding(int id, const std::optional<project::Building>& state);
+  void restoreBuildings(const std::map<int, std::optional<project::Building>>& states);
   void restoreParameters(const std::string& group, const nlohmann::json& values);
   void restoreDisparity(const cv::Mat& disparity, const std::string& path);
   void restoreSettings(const Settings& settings);
@@ -118,6 +123,7 @@ class Document : public QObject {
  private:
   Document() = default;
   void loadRasters();
+  void placeBuilding(int id, const std::optional<project::Building>& state);
   void deriveDem();
   void setExtraDirty(bool dirty);
   void pushSettings(const Settings& after, const QString& description);

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -37,6 +38,7 @@ class DisparityHistogramWidget;
 class ParameterForm;
 class ColourLegend;
 class Terrain3DView;
+struct OverlayGuide;
 }  // namespace delineo::widgets
 
 namespace delineo::gui {
@@ -111,6 +113,24 @@ class MainWindow : public QMainWindow {
   // DEM enhancement with the current outlines (key "enhance"); returns the job id or 0.
   widgets::JobId startDemEnhancement();
 
+  // ---- scene analysis (main_window_scene.cpp) ----
+  // Processing → Analyse the scene (key "scene"): ground, DTM, nDSM, classes and objects of the
+  // current heights, kept until the heights or the analysis's parameters change. Returns the job
+  // id, or 0 with a message saying what is missing.
+  widgets::JobId startSceneAnalysis();
+  // Building → Detect buildings: the analysis's building proposals become pending buildings in
+  // one undoable step, after running the analysis when there is none. Returns the analysis's job
+  // id, or 0 when the proposals were added at once or nothing could be done (message shown).
+  widgets::JobId detectBuildings();
+  // The scene analysis of the current heights; null until computed and while stale.
+  const project::SceneAnalysisOutcome* sceneAnalysis() const { return scene_ ? &*scene_ : nullptr; }
+  // What the DEM view shows: the DEM, the DTM or the nDSM of the scene analysis.
+  enum class DemLayer { Dem = 0, Dtm = 1, Ndsm = 2 };
+  void setDemLayer(DemLayer layer);
+  DemLayer demLayer() const;
+  // The legend of the coloured layers over the left image (classes, labels, objects).
+  QWidget* layerLegend() const { return layerLegend_; }
+
   // ---- accessors for tests and the screenshot tour ----
   widgets::ImageView* leftView() const { return leftView_; }
   widgets::ImageView* rightView() const { return rightView_; }
@@ -172,6 +192,8 @@ class MainWindow : public QMainWindow {
   void regularizationFinished(int id);
   void boxFittingFinished(int id);  // a proposal is shown, or a message says why there is none
   void demEnhanced();
+  void sceneAnalysed();                         // a new scene analysis is shown
+  void buildingsDetected(int added, int present);  // Detect buildings has added its proposals
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -259,6 +281,24 @@ class MainWindow : public QMainWindow {
   void refreshBoxFitProposals();
   void onEnhancedDemToggled(bool on);
   void scheduleDemEnhancement();
+  std::vector<widgets::OverlayGuide> boxFitGuides() const;
+
+  // main_window_scene.cpp: the scene analysis, its layers and the detection of buildings.
+  void createSceneActions();
+  QWidget* createLayerLegend();
+  QString sceneInputsMissing() const;
+  bool ensureSceneAnalysis();
+  void onSceneJobEnded(widgets::JobId id, widgets::JobOutcome outcome);
+  void addDetectedBuildings();
+  void invalidateSceneAnalysis();
+  void onSceneLayerToggled(QAction* toggle, bool on);
+  void onDemLayerChosen(int index);
+  const cv::Mat& demViewRaster() const;
+  void refreshLabelOverlay();
+  void refreshLayerLegend();
+  void refreshGuides();
+  std::vector<widgets::OverlayGuide> sceneObjectGuides() const;
+  void showInformation(const QString& title, const QString& text);
 
   std::unique_ptr<Document> document_;
   widgets::JobRunner* jobs_ = nullptr;
@@ -322,6 +362,24 @@ class MainWindow : public QMainWindow {
   cv::Mat enhancedDem_;  // the enhanced DEM, empty until computed (or while stale)
   std::vector<core::Polygon> enhancedFrom_;  // the outlines it was made from
   QTimer enhanceTimer_;  // outlines changed while the enhanced DEM is shown: compute it again
+  // The scene analysis of the current heights and what it was computed from.
+  std::optional<project::SceneAnalysisOutcome> scene_;
+  struct SceneInputs {
+    const uchar* heights = nullptr;
+    const uchar* disparity = nullptr;
+    double gsd = 0.0;
+    bool operator==(const SceneInputs&) const = default;
+  };
+  SceneInputs sceneInputs_;
+  widgets::JobId sceneJob_ = 0;
+  bool detectAfterAnalysis_ = false;  // Detect buildings waits for the running analysis
+  QComboBox* demLayer_ = nullptr;
+  QWidget* layerLegend_ = nullptr;
+  QWidget* classesLegend_ = nullptr;
+  QLabel* classesLegendTitle_ = nullptr;
+  QWidget* wallLegend_ = nullptr;
+  QWidget* objectsLegend_ = nullptr;
+  const uchar* overlayShows_ = nullptr;  // the raster of the left view's overlay
   double rightShift_ = 0.0;
   bool linkingRight_ = false;
 };

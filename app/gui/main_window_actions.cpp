@@ -48,6 +48,7 @@ void MainWindow::createActions() {
   createBuildingActions();
   createEditActions();
   createViewActions();
+  createSceneActions();
 }
 
 void MainWindow::createFileActions() {
@@ -237,7 +238,7 @@ void MainWindow::createViewActions() {
   labels->setEnabled(false);
   labels->setStatusTip(tr("Overlay the project's label raster (only when the project has one)"));
   connect(labels, &QAction::toggled, this, [this](bool on) {
-    leftView_->setOverlayVisible(on);
+    refreshLabelOverlay();
     QSettings().setValue(QStringLiteral("view/showLabels"), on);
   });
   // The DEM sharpened with the current outlines (walls vertical, roofs median-filtered), in the
@@ -286,16 +287,28 @@ void MainWindow::createMenus() {
   building->addAction(action(QStringLiteral("actionReject")));
   building->addAction(action(QStringLiteral("actionReopen")));
   building->addAction(action(QStringLiteral("actionRemove")));
+  building->addSeparator();
+  building->addAction(action(QStringLiteral("actionDetectBuildings")));
 
   QMenu* process = menuBar()->addMenu(tr("&Processing"));
   process->addAction(action(QStringLiteral("actionMatch")));
   process->addAction(action(QStringLiteral("actionDelineate")));
   process->addAction(action(QStringLiteral("actionBoxFit")));
+  process->addSeparator();
+  process->addAction(action(QStringLiteral("actionAnalyseScene")));
+  process->addAction(action(QStringLiteral("actionDetectBuildings")));
+  process->addSeparator();
   process->addAction(action(QStringLiteral("actionCancelJobs")));
 
   QMenu* view = menuBar()->addMenu(tr("&View"));
   view->addAction(action(QStringLiteral("actionShowLabels")));
+  view->addAction(action(QStringLiteral("actionShowClasses")));
+  view->addAction(action(QStringLiteral("actionShowObjects")));
   view->addAction(action(QStringLiteral("actionEnhancedDem")));
+  QMenu* demLayers = view->addMenu(tr("DEM &view shows"));
+  for (const char* name : {"actionDemLayerDem", "actionDemLayerDtm", "actionDemLayerNdsm"}) {
+    demLayers->addAction(action(QString::fromLatin1(name)));
+  }
   view->addSeparator();
   for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
 
@@ -347,6 +360,11 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionKeepBoxFit"))->setEnabled(proposal);
   action(QStringLiteral("actionDiscardBoxFit"))->setEnabled(proposal);
   action(QStringLiteral("actionEnhancedDem"))->setEnabled(hasDoc && project::demEnhancementAvailable());
+  const bool scene = hasDoc && project::sceneAnalysisAvailable();
+  for (const char* name : {"actionAnalyseScene", "actionDetectBuildings", "actionShowClasses", "actionShowObjects",
+                           "actionDemLayerDtm", "actionDemLayerNdsm"}) {
+    action(QString::fromLatin1(name))->setEnabled(scene);
+  }
   action(QStringLiteral("actionAccept"))->setEnabled(b != nullptr && b->hasOutline() && b->status != BuildingStatus::Accepted);
   action(QStringLiteral("actionReject"))->setEnabled(b != nullptr && b->status != BuildingStatus::Rejected);
   action(QStringLiteral("actionReopen"))->setEnabled(

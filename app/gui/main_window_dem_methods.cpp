@@ -201,9 +201,8 @@ QWidget* MainWindow::createBoxFitPanel() {
   return boxFitPanel_;
 }
 
-// The proposals' boxes and outlines on the left view and the DEM view, and the panel for the
-// selected building.
-void MainWindow::refreshBoxFitProposals() {
+// The proposals' boxes and outlines, drawn on the left view and the DEM view.
+std::vector<widgets::OverlayGuide> MainWindow::boxFitGuides() const {
   std::vector<widgets::OverlayGuide> guides;
   for (const auto& [id, proposal] : boxFitProposals_) {
     for (const project::FittedBox& box : proposal.outcome.boxes) {
@@ -213,7 +212,12 @@ void MainWindow::refreshBoxFitProposals() {
     }
     guides.push_back({proposal.outcome.outline, kBoxFitOutlineColour, 2.5, Qt::DashLine});
   }
-  for (widgets::ImageView* v : {leftView_, demView_}) v->polygons().setGuides(guides);
+  return guides;
+}
+
+// The proposals on the views, and the panel for the selected building.
+void MainWindow::refreshBoxFitProposals() {
+  refreshGuides();
 
   const auto it = boxFitProposals_.find(selectedId_);
   const Building* b = document_ ? document_->project().find(selectedId_) : nullptr;

@@ -61,6 +61,12 @@ QDockWidget* MainWindow::createDemDock() {
   auto* demPage = new QWidget;
   auto* demLayout = new QGridLayout(demPage);
   demLayout->setContentsMargins(0, 0, 0, 0);
+  demLayer_ = new QComboBox;
+  demLayer_->setObjectName(QStringLiteral("demLayer"));
+  demLayer_->addItem(tr("DEM"));
+  demLayer_->addItem(tr("DTM (ground)"));
+  demLayer_->addItem(tr("nDSM (above ground)"));
+  demLayer_->setToolTip(tr("The DEM, or the ground (DTM) and the height above it (nDSM) the scene analysis finds"));
   demMode_ = new QComboBox;
   demMode_->setObjectName(QStringLiteral("demMode"));
   demMode_->addItem(tr("Hillshade"));
@@ -85,6 +91,7 @@ QDockWidget* MainWindow::createDemDock() {
   enhanced->setObjectName(QStringLiteral("enhancedDemButton"));
   enhanced->setToolButtonStyle(Qt::ToolButtonTextOnly);
   auto* demControls = new QHBoxLayout;
+  demControls->addWidget(demLayer_, 1);
   demControls->addWidget(demMode_, 1);
   demControls->addWidget(enhanced);
   demLayout->addLayout(demControls, 0, 0, 1, 2);

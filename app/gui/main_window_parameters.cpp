@@ -36,6 +36,12 @@
 #ifdef DELINEO_HAVE_STEREO
 #include "delineo/stereo/match.hpp"
 #endif
+#ifdef DELINEO_HAVE_SEGMENTATION
+#include "delineo/segmentation/classify.hpp"
+#include "delineo/segmentation/detect.hpp"
+#include "delineo/segmentation/ground.hpp"
+#include "delineo/segmentation/objects.hpp"
+#endif
 
 namespace delineo::gui {
 
@@ -101,6 +107,20 @@ QTabWidget* MainWindow::createParameterTabs() {
   addParameterGroup<delineation::AboveGroundParams>(
       tabs, "pick", tr("Object pick"),
       tr("Pick an above-ground object: the raised object under a click, above the ground beside it."));
+#endif
+#ifdef DELINEO_HAVE_SEGMENTATION
+  addParameterGroup<segmentation::GroundParams>(
+      tabs, project::kSegmentGroup, tr("Ground"),
+      tr("Processing → Analyse the scene: regions of even height, ground or above ground, and the DTM under them."));
+  addParameterGroup<segmentation::ClassifyParams>(
+      tabs, project::kClassifyGroup, tr("Classes"),
+      tr("The above-ground pieces as building or vegetation, from the left image's texture and colour."));
+  addParameterGroup<segmentation::ObjectParams>(
+      tabs, project::kObjectsGroup, tr("Objects"),
+      tr("The above-ground objects of one class and their outlines (View → Objects)."));
+  addParameterGroup<segmentation::DetectParams>(
+      tabs, project::kDetectGroup, tr("Detection"),
+      tr("Building → Detect buildings: which building objects become pending buildings."));
 #endif
   return tabs;
 }

@@ -131,14 +131,19 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   connectDocument(doc);
   leftView_->setImage(doc->leftDisplay());
   rightView_->setImage(doc->rightDisplay());
-  QAction* showLabels = action(QStringLiteral("actionShowLabels"));
-  showLabels->setEnabled(!doc->labels().empty());
-  if (!doc->labels().empty()) {
-    leftView_->setOverlay(doc->labels(), 0.25);
-    leftView_->setOverlayVisible(showLabels->isChecked());
-  } else {
-    leftView_->clearOverlay();
+  action(QStringLiteral("actionShowLabels"))->setEnabled(!doc->labels().empty());
+  // The scene analysis was of the previous document's heights.
+  scene_.reset();
+  sceneJob_ = 0;
+  detectAfterAnalysis_ = false;
+  overlayShows_ = nullptr;
+  leftView_->clearOverlay();
+  for (const char* name : {"actionShowClasses", "actionShowObjects"}) {
+    const QSignalBlocker block(action(QString::fromLatin1(name)));
+    action(QString::fromLatin1(name))->setChecked(false);
   }
+  setDemLayer(DemLayer::Dem);
+  refreshLabelOverlay();
   edgeMap_ = cv::Mat();
   leftView_->polygons().setEdgeMap(cv::Mat(), 128.0);
   rightShift_ = document_->project().height.groundDisparity;
@@ -223,9 +228,26 @@ void MainWindow::connectDocument(Document* doc) {
     refresh3D();
   });
   connect(doc, &Document::buildingsReset, this, [this] {
+    // Several buildings at once (detected ones, or their undo): the selection and the box-fitting
+    // proposals follow like for one.
+    std::erase_if(boxFitProposals_, [this](const auto& entry) { return document_->project().find(entry.first) == nullptr; });
     scheduleDemEnhancement();
     refreshOverlays();
+    refreshBoxFitProposals();
+    if (selectedId_ > 0 && document_->project().find(selectedId_) == nullptr) selectBuilding(-1);
     refresh3D();
+    updateActions();
+  });
+  // The scene analysis is of the heights, the disparity and its parameters.
+  connect(doc, &Document::disparityChanged, this, &MainWindow::invalidateSceneAnalysis);
+  connect(doc, &Document::settingsChanged, this, [this] {
+    const SceneInputs now{document_->dem().data, document_->disparity().data, document_->project().height.gsd};
+    if (!(now == sceneInputs_)) invalidateSceneAnalysis();
+  });
+  connect(doc, &Document::parametersChanged, this, [this](const QString& group) {
+    for (const char* g : {project::kSegmentGroup, project::kClassifyGroup, project::kObjectsGroup, project::kDetectGroup}) {
+      if (group == QLatin1String(g)) invalidateSceneAnalysis();
+    }
   });
   // A manual edit leaves the outline's energy unknown: it is scored again in the background.
   connect(doc, &Document::buildingChanged, this, [this](int id) { startEnergyUpdate(id); });

@@ -5,7 +5,9 @@
 #include <QLabel>
 #include <QScopedValueRollback>
 #include <QStatusBar>
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -105,6 +107,7 @@ void MainWindow::createViews() {
   readout_->setObjectName(QStringLiteral("readout"));
   readout_->setMinimumWidth(420);
   statusBar()->addWidget(readout_, 1);
+  statusBar()->addPermanentWidget(createLayerLegend());
   auto* progress = new widgets::JobProgressWidget(jobs_);
   progress->setObjectName(QStringLiteral("jobProgress"));
   statusBar()->addPermanentWidget(progress);
@@ -120,14 +123,19 @@ void MainWindow::refreshRasters() {
     disparityView_->setImage(disparity, {widgets::ColourMap::Viridis, lo, hi});
     disparityLegend_->setRange(lo, hi);
   }
-  const cv::Mat& dem = shownDem();
+  const cv::Mat& dem = demViewRaster();
   if (dem.empty()) {
     demView_->clearImage();
   } else if (demMode_->currentIndex() == 0) {
     demView_->setImage(widgets::hillshade(dem, document_->project().height.gsd));
     demLegend_->hide();
   } else {
-    const auto [lo, hi] = widgets::finiteRange(dem);
+    auto [lo, hi] = widgets::finiteRange(dem);
+    // Heights above ground from 0, so that the ground has one colour whatever the scene.
+    if (demLayer() == DemLayer::Ndsm) std::tie(lo, hi) = std::pair(0.0, std::max(hi, 1.0));
+    static const char* const titles[] = {QT_TR_NOOP("Height"), QT_TR_NOOP("Ground height"),
+                                         QT_TR_NOOP("Height above ground")};
+    demLegend_->setTitle(tr(titles[static_cast<int>(demLayer())]));
     demView_->setImage(dem, {widgets::ColourMap::Terrain, lo, hi});
     demLegend_->setRange(lo, hi);
     demLegend_->show();
@@ -216,6 +224,10 @@ void MainWindow::updateReadout(QPointF p, bool leftGeometry, const cv::Mat& ownG
     if (!dem.empty()) {
       const float h = dem.at<float>(y, x);
       text += std::isfinite(h) ? tr("  height %1 m").arg(h, 0, 'f', 2) : tr("  height –");
+    }
+    if (scene_ && !scene_->ndsm.empty()) {
+      const float above = scene_->ndsm.at<float>(y, x);
+      if (std::isfinite(above)) text += tr("  above ground %1 m").arg(above, 0, 'f', 2);
     }
   } else {
     text += tr("  (right image)");

@@ -136,5 +136,34 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Outline smoothing"),
     QT_TRANSLATE_NOOP("Parameters", "Outline simplification"),
     QT_TRANSLATE_NOOP("Parameters", "Ground refinements"),
+    // segmentation::GroundParams (with dem::GapParams)
+    QT_TRANSLATE_NOOP("Parameters", "Region step"),
+    QT_TRANSLATE_NOOP("Parameters", "Wall slope"),
+    QT_TRANSLATE_NOOP("Parameters", "Smallest region"),
+    QT_TRANSLATE_NOOP("Parameters", "Critical height"),
+    QT_TRANSLATE_NOOP("Parameters", "Data weight"),
+    QT_TRANSLATE_NOOP("Parameters", "DTM window"),
+    QT_TRANSLATE_NOOP("Parameters", "Step band"),
+    QT_TRANSLATE_NOOP("Parameters", "Gap link length"),
+    QT_TRANSLATE_NOOP("Parameters", "Iterations"),
+    QT_TRANSLATE_NOOP("Parameters", "Gap border spread"),
+    QT_TRANSLATE_NOOP("Parameters", "Gap border pixels"),
+    // segmentation::ClassifyParams
+    QT_TRANSLATE_NOOP("Parameters", "Window"),
+    QT_TRANSLATE_NOOP("Parameters", "Direction bins"),
+    QT_TRANSLATE_NOOP("Parameters", "Minimum gradient"),
+    QT_TRANSLATE_NOOP("Parameters", "Entropy threshold"),
+    QT_TRANSLATE_NOOP("Parameters", "Texture variation"),
+    QT_TRANSLATE_NOOP("Parameters", "Dark level"),
+    QT_TRANSLATE_NOOP("Parameters", "Greenness threshold"),
+    QT_TRANSLATE_NOOP("Parameters", "Minimum piece area"),
+    // segmentation::ObjectParams
+    QT_TRANSLATE_NOOP("Parameters", "Minimum area"),
+    QT_TRANSLATE_NOOP("Parameters", "Roof percentile"),
+    QT_TRANSLATE_NOOP("Parameters", "Core shrink"),
+    // segmentation::DetectParams
+    QT_TRANSLATE_NOOP("Parameters", "Minimum building area"),
+    QT_TRANSLATE_NOOP("Parameters", "Minimum height"),
+    QT_TRANSLATE_NOOP("Parameters", "Growth"),
 };
 }  // namespace

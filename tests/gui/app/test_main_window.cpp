@@ -41,6 +41,10 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/segmentation/classify.hpp"
+#include "delineo/segmentation/detect.hpp"
+#include "delineo/segmentation/ground.hpp"
+#include "delineo/segmentation/objects.hpp"
 #include "delineo/stereo/match.hpp"
 #include "delineo/widgets/disparity_histogram.hpp"
 #include "delineo/widgets/image_view.hpp"
@@ -803,6 +807,15 @@ class MainWindowTest : public QObject {
     enhance.visit(check);
     delineo::boxfit::BoxFitParams boxFit;
     boxFit.visit(check);
+    delineo::segmentation::GroundParams ground;
+    ground.visit(check);
+    delineo::segmentation::ClassifyParams classify;
+    classify.visit(check);
+    delineo::segmentation::ObjectParams objects;
+    objects.visit(check);
+    delineo::segmentation::DetectParams detect;
+    detect.visit(check);
+    QCOMPARE(translator.translate("delineo::gui::MainWindow", "De&tect buildings"), QStringLiteral("Dé&tecter les bâtiments"));
     QVERIFY2(untranslated.isEmpty(), qPrintable(untranslated.join(QStringLiteral(", "))));
     // The reusable widgets' strings are in the same translation.
     QCOMPARE(translator.translate("delineo::widgets::JobProgressWidget", "Idle"), QStringLiteral("Inactif"));
