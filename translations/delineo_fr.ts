@@ -571,6 +571,10 @@
         <translation>Longueur des liens à travers les lacunes</translation>
     </message>
     <message>
+        <source>Gap above share</source>
+        <translation>Part sursol du bord des lacunes</translation>
+    </message>
+    <message>
         <source>Iterations</source>
         <translation>Itérations</translation>
     </message>
@@ -585,18 +589,6 @@
     <message>
         <source>Window</source>
         <translation>Fenêtre</translation>
-    </message>
-    <message>
-        <source>Direction bins</source>
-        <translation>Classes de direction</translation>
-    </message>
-    <message>
-        <source>Minimum gradient</source>
-        <translation>Gradient minimal</translation>
-    </message>
-    <message>
-        <source>Entropy threshold</source>
-        <translation>Seuil d’entropie</translation>
     </message>
     <message>
         <source>Texture variation</source>
