@@ -6,9 +6,9 @@
 #include <limits>
 #include <sstream>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
 #include <opencv2/imgproc/detail/gcgraph.hpp>
 
 #include "delineo/core/error.hpp"
@@ -42,14 +42,14 @@ int toPixels(double metres, double gsd, int lo) {
 
 // The DTM from the pixels of the regions labelled ground.
 cv::Mat groundDtm(const RegionGraph& graph, const cv::Mat& dem, const Labels& labels, int windowPx,
-                  double binWidth, int* samples = nullptr) {
+                  const GroundParams& params, int* samples = nullptr) {
   cv::Mat ground(dem.size(), CV_8U);
   for (int y = 0; y < dem.rows; ++y) {
     const int* r = graph.labels.ptr<int>(y);
     unsigned char* g = ground.ptr<unsigned char>(y);
     for (int x = 0; x < dem.cols; ++x) g[x] = r[x] >= 0 && labels[static_cast<size_t>(r[x])] == GroundLabel::Ground;
   }
-  const std::vector<GroundSample> points = sampleGround(dem, ground, windowPx, binWidth);
+  const std::vector<GroundSample> points = sampleGround(dem, ground, windowPx, params.regionThreshold, params.dtmLevelShare);
   if (samples) *samples = static_cast<int>(points.size());
   return interpolateDtm(points, dem.size());
 }
@@ -156,7 +156,7 @@ Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundPar
   out.labels.assign(n, GroundLabel::Ground);
   out.oscillating.assign(n, false);
   std::vector<Labels> history{out.labels};
-  out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+  out.dtm = groundDtm(graph, dem, out.labels, windowPx, params, &out.samples);
   for (int round = 1; round <= params.maxIterations; ++round) {
     if (core::isCanceled(progress)) {
       out.canceled = true;
@@ -179,25 +179,40 @@ Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundPar
                                                : std::vector<Labels>{out.labels, next};
       out.labels = next;
       groundOscillating(states, out.labels, out.oscillating);
-      out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+      out.dtm = groundDtm(graph, dem, out.labels, windowPx, params, &out.samples);
       return out;
     }
     history.push_back(next);
     out.labels = std::move(next);
-    out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+    out.dtm = groundDtm(graph, dem, out.labels, windowPx, params, &out.samples);
     core::report(progress, static_cast<double>(round) / params.maxIterations);
   }
   return out;
 }
 
+// For every pixel without a region, the nearest pixel with one (Euclidean distance transform).
+cv::Mat nearestWithRegion(const cv::Mat& regions, std::vector<cv::Point>& pointOf) {
+  const cv::Mat noRegion = regions < 0;
+  cv::Mat distance, nearest;
+  cv::distanceTransform(noRegion, distance, nearest, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  pointOf.assign(regions.total() + 1, cv::Point(-1, -1));
+  for (int y = 0; y < regions.rows; ++y) {
+    for (int x = 0; x < regions.cols; ++x) {
+      if (!noRegion.at<uchar>(y, x)) pointOf[static_cast<size_t>(nearest.at<int>(y, x))] = cv::Point(x, y);
+    }
+  }
+  return nearest;
+}
+
 // Kept gaps (no height) inside above-ground objects: a gap whose 8-adjacent border pixels are
-// above-ground on more than `share` of them joins the above-ground mask and takes the region its
-// above-ground border meets most. An occlusion beside a wall borders the roof on one side and the
-// ground on the other and stays unlabelled; an unmatched patch of a roof or a crown joins it.
+// above-ground on more than `share` of them is labelled, each of its pixels with the label and
+// region of the nearest pixel with a height. An occlusion beside a wall borders the roof on one
+// side and the ground on the other and stays unlabelled; an unmatched patch of a roof or a crown
+// joins it; a gap that spans a roof and the shaded street beside it is split between the two
+// instead of joining the roof whole.
 void labelKeptGaps(const dem::GapResult& gaps, double share, cv::Mat& regions, cv::Mat& above) {
   const size_t n = gaps.gaps.size();
   std::vector<int> border(n, 0), aboveBorder(n, 0);
-  std::unordered_map<long long, int> regionVotes;  // (gap << 32 | region) -> border pixels
   const cv::Mat& g = gaps.gapLabels;
   for (int y = 0; y < g.rows; ++y) {
     for (int x = 0; x < g.cols; ++x) {
@@ -208,26 +223,26 @@ void labelKeptGaps(const dem::GapResult& gaps, double share, cv::Mat& regions, c
           const int yy = y + dy, xx = x + dx;
           if (yy < 0 || xx < 0 || yy >= g.rows || xx >= g.cols || g.at<int>(yy, xx) != 0) continue;
           ++border[static_cast<size_t>(gap)];
-          if (above.at<uchar>(yy, xx) == 0) continue;
-          ++aboveBorder[static_cast<size_t>(gap)];
-          ++regionVotes[(static_cast<long long>(gap) << 32) | static_cast<unsigned>(regions.at<int>(yy, xx))];
+          aboveBorder[static_cast<size_t>(gap)] += above.at<uchar>(yy, xx) != 0;
         }
       }
     }
   }
-  std::vector<int> regionOf(n, -1), best(n, 0);
-  for (const auto& [key, votes] : regionVotes) {
-    const auto gap = static_cast<size_t>(key >> 32);
-    if (votes > best[gap]) best[gap] = votes, regionOf[gap] = static_cast<int>(key & 0xffffffff);
-  }
+  const auto joins = [&](size_t i) { return border[i] > 0 && aboveBorder[i] > share * border[i]; };
+  bool any = false;
+  for (size_t i = 0; i < n; ++i) any = any || (!gaps.gaps[i].merged && joins(i));
+  if (!any) return;
+  std::vector<cv::Point> pointOf;
+  const cv::Mat nearest = nearestWithRegion(regions, pointOf);
+  const cv::Mat before = above.clone(), regionsBefore = regions.clone();
   for (int y = 0; y < g.rows; ++y) {
     for (int x = 0; x < g.cols; ++x) {
       const int gap = g.at<int>(y, x) - 1;
-      if (gap < 0 || gaps.gaps[static_cast<size_t>(gap)].merged) continue;
-      const auto i = static_cast<size_t>(gap);
-      if (border[i] == 0 || aboveBorder[i] <= share * border[i]) continue;
+      if (gap < 0 || gaps.gaps[static_cast<size_t>(gap)].merged || !joins(static_cast<size_t>(gap))) continue;
+      const cv::Point q = pointOf[static_cast<size_t>(nearest.at<int>(y, x))];
+      if (q.x < 0 || !before.at<uchar>(q)) continue;
       above.at<uchar>(y, x) = 255;
-      regions.at<int>(y, x) = regionOf[i];
+      regions.at<int>(y, x) = regionsBefore.at<int>(q);
     }
   }
 }

@@ -243,6 +243,20 @@ TEST(SegmentGround, UnmatchedPatchInsideARoofJoinsIt) {
   EXPECT_EQ(countAbove(kept, box), box.area() - hole.area());
 }
 
+TEST(SegmentGround, GapSpanningARoofAndTheGroundIsSplitAtTheNearestHeight) {
+  // One unmatched strip crosses the roof's right half and runs 20 px onto the ground beside it:
+  // most of its border is roof, so it is labelled, but its ground part stays ground.
+  const cv::Mat ground = terrain({240, 200}, 0.0);
+  cv::Mat dem = ground.clone();
+  const cv::Rect box(40, 40, 120, 120), hole(100, 85, 80, 30);
+  addBox(dem, ground, box, 10.0f);
+  dem(hole).setTo(kNaN);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  EXPECT_EQ(countAbove(r, box), box.area()) << "the roof's unmatched part joins it";
+  const cv::Rect street(box.br().x + 6, hole.y, hole.br().x - box.br().x - 6, hole.height);
+  EXPECT_EQ(cv::countNonZero(r.aboveGround(street)), 0) << "the part beyond the roof's edge is ground's";
+}
+
 TEST(SegmentGround, BoxSeparatedFromTheGroundOnlyByGapsIsFound) {
   // A box ringed by no data: only the links across the gaps make it the ground's neighbour.
   const cv::Mat ground = terrain({200, 200}, 0.0);
