@@ -209,8 +209,10 @@ cv::Mat nearestWithRegion(const cv::Mat& regions, std::vector<cv::Point>& pointO
 // region of the nearest pixel with a height. An occlusion beside a wall borders the roof on one
 // side and the ground on the other and stays unlabelled; an unmatched patch of a roof or a crown
 // joins it; a gap that spans a roof and the shaded street beside it is split between the two
-// instead of joining the roof whole.
-void labelKeptGaps(const dem::GapResult& gaps, double share, cv::Mat& regions, cv::Mat& above) {
+// instead of joining the roof whole. In left-image geometry (x_right = x_left - d) what the right
+// view cannot see lies left of a building: a run along a row that starts at the ground and ends
+// at a surface more than `occlusionStep` higher stays unlabelled (ground hidden by that surface).
+void labelKeptGaps(const dem::GapResult& gaps, double share, double occlusionStep, cv::Mat& regions, cv::Mat& above) {
   const size_t n = gaps.gaps.size();
   std::vector<int> border(n, 0), aboveBorder(n, 0);
   const cv::Mat& g = gaps.gapLabels;
@@ -236,9 +238,17 @@ void labelKeptGaps(const dem::GapResult& gaps, double share, cv::Mat& regions, c
   const cv::Mat nearest = nearestWithRegion(regions, pointOf);
   const cv::Mat before = above.clone(), regionsBefore = regions.clone();
   for (int y = 0; y < g.rows; ++y) {
+    int runStart = -1, runEnd = -1;  // the current run without region along the row: [runStart, runEnd)
+    bool hidden = false;             // that run is hidden by a building at its right end
     for (int x = 0; x < g.cols; ++x) {
       const int gap = g.at<int>(y, x) - 1;
       if (gap < 0 || gaps.gaps[static_cast<size_t>(gap)].merged || !joins(static_cast<size_t>(gap))) continue;
+      if (x >= runEnd) {
+        for (runStart = x, runEnd = x; runEnd < g.cols && regionsBefore.at<int>(y, runEnd) < 0;) ++runEnd;
+        hidden = runStart > 0 && runEnd < g.cols && !before.at<uchar>(y, runStart - 1) &&
+                 gaps.dem.at<float>(y, runEnd) - gaps.dem.at<float>(y, runStart - 1) > occlusionStep;
+      }
+      if (hidden) continue;  // the ground the right view cannot see beside a building
       const cv::Point q = pointOf[static_cast<size_t>(nearest.at<int>(y, x))];
       if (q.x < 0 || !before.at<uchar>(q)) continue;
       above.at<uchar>(y, x) = 255;
@@ -323,7 +333,7 @@ GroundResult segmentGround(const cv::Mat& dem, double gsd, const GroundParams& p
     }
   }
   // 8. Kept gaps inside above-ground objects (unmatched roof or crown patches) join them.
-  if (params.gapAboveShare < 1.0) labelKeptGaps(gaps, params.gapAboveShare, result.regions, result.aboveGround);
+  if (params.gapAboveShare < 1.0) labelKeptGaps(gaps, params.gapAboveShare, params.criticalHeight, result.regions, result.aboveGround);
   result.regionInfo.resize(static_cast<size_t>(count));
   for (size_t i = 0; i < result.regionInfo.size(); ++i) {
     GroundRegionInfo& info = result.regionInfo[i];

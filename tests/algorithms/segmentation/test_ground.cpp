@@ -257,6 +257,24 @@ TEST(SegmentGround, GapSpanningARoofAndTheGroundIsSplitAtTheNearestHeight) {
   EXPECT_EQ(cv::countNonZero(r.aboveGround(street)), 0) << "the part beyond the roof's edge is ground's";
 }
 
+TEST(SegmentGround, OcclusionLeftOfARoofStaysUnlabelledInAJoinedGap) {
+  // The strip left of a roof that the right view cannot see (x_right = x_left - d) is joined,
+  // through a slab of unmatched roof, to a gap mostly bordered by the roof. By nearest height its
+  // right half would be roof; along the rows it runs from the ground to a surface 10 m higher:
+  // hidden ground, left unlabelled.
+  const cv::Mat ground = terrain({240, 200}, 0.0);
+  cv::Mat dem = ground.clone();
+  const cv::Rect box(80, 50, 120, 100), strip(60, 50, 20, 100), slab(80, 60, 60, 20);
+  addBox(dem, ground, box, 10.0f);
+  dem(strip).setTo(kNaN);
+  dem(slab).setTo(kNaN);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  const cv::Rect stripBelowSlab(strip.x, slab.br().y, strip.width, strip.br().y - slab.br().y);
+  EXPECT_EQ(cv::countNonZero(r.aboveGround(stripBelowSlab)), 0) << "the occlusion is not the roof's";
+  EXPECT_EQ(cv::countNonZero(r.aboveGround(box)), box.area() - slab.area())
+      << "rows from the ground into the roof's gap stay unlabelled as a whole";
+}
+
 TEST(SegmentGround, BoxSeparatedFromTheGroundOnlyByGapsIsFound) {
   // A box ringed by no data: only the links across the gaps make it the ground's neighbour.
   const cv::Mat ground = terrain({200, 200}, 0.0);
