@@ -204,6 +204,88 @@ cv::Mat nearestWithRegion(const cv::Mat& regions, std::vector<cv::Point>& pointO
   return nearest;
 }
 
+// Per region: its mean height, whether it is above-ground, and its 4-adjacent regions (sorted).
+struct RegionContacts {
+  std::vector<double> mean;
+  std::vector<bool> above;
+  std::vector<std::vector<int>> neighbours;
+  bool adjacent(int a, int b) const {
+    const auto& n = neighbours[static_cast<size_t>(a)];
+    return std::binary_search(n.begin(), n.end(), b);
+  }
+  // Directly, or through one above-ground region between them (a wall between two roof levels).
+  bool joined(int a, int b) const {
+    if (adjacent(a, b)) return true;
+    for (const int w : neighbours[static_cast<size_t>(a)]) {
+      if (above[static_cast<size_t>(w)] && adjacent(w, b)) return true;
+    }
+    return false;
+  }
+};
+
+RegionContacts regionContacts(const cv::Mat& regions, const cv::Mat& dem, const cv::Mat& above) {
+  double maxLabel = -1;
+  cv::minMaxLoc(regions, nullptr, &maxLabel);
+  const size_t n = static_cast<size_t>(maxLabel + 1);
+  RegionContacts c{std::vector<double>(n, 0.0), std::vector<bool>(n, false), std::vector<std::vector<int>>(n)};
+  std::vector<int> count(n, 0);
+  for (int y = 0; y < regions.rows; ++y) {
+    for (int x = 0; x < regions.cols; ++x) {
+      const int r = regions.at<int>(y, x);
+      if (r < 0) continue;
+      c.mean[static_cast<size_t>(r)] += dem.at<float>(y, x);
+      ++count[static_cast<size_t>(r)];
+      c.above[static_cast<size_t>(r)] = above.at<uchar>(y, x) != 0;
+      const int right = x + 1 < regions.cols ? regions.at<int>(y, x + 1) : -1;
+      const int below = y + 1 < regions.rows ? regions.at<int>(y + 1, x) : -1;
+      for (const int o : {right, below}) {
+        if (o < 0 || o == r) continue;
+        c.neighbours[static_cast<size_t>(r)].push_back(o);
+        c.neighbours[static_cast<size_t>(o)].push_back(r);
+      }
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    c.mean[i] /= std::max(1, count[i]);
+    auto& nb = c.neighbours[i];
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  return c;
+}
+
+// Joined gap pixels next to a joined gap pixel of another region, when the two regions are not
+// joined (regionContacts) and their mean heights differ by more than `minStep`, go back to no
+// label: two buildings facing each other across an unmatched street stay two objects, while
+// the patches of one roof that the matcher left apart (one level) stay together.
+void unlabelSeams(const cv::Mat& regionsBefore, const cv::Mat& aboveBefore, const cv::Mat& dem, double minStep,
+                  cv::Mat& regions, cv::Mat& above) {
+  const RegionContacts contacts = regionContacts(regionsBefore, dem, aboveBefore);
+  const cv::Mat joined = (regionsBefore < 0) & (regions >= 0);
+  std::vector<cv::Point> seam;
+  const cv::Point steps[4] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  for (int y = 0; y < regions.rows; ++y) {
+    for (int x = 0; x < regions.cols; ++x) {
+      if (!joined.at<uchar>(y, x)) continue;
+      const int r = regions.at<int>(y, x);
+      for (const cv::Point& d : steps) {
+        const cv::Point q(x + d.x, y + d.y);
+        if (q.x < 0 || q.y < 0 || q.x >= regions.cols || q.y >= regions.rows || !joined.at<uchar>(q)) continue;
+        const int rq = regions.at<int>(q);
+        if (rq != r && std::abs(contacts.mean[static_cast<size_t>(r)] - contacts.mean[static_cast<size_t>(rq)]) > minStep &&
+            !contacts.joined(r, rq)) {
+          seam.emplace_back(x, y);
+          break;
+        }
+      }
+    }
+  }
+  for (const cv::Point& p : seam) {
+    regions.at<int>(p) = -1;
+    above.at<uchar>(p) = 0;
+  }
+}
+
 // Kept gaps (no height) inside above-ground objects: a gap whose 8-adjacent border pixels are
 // above-ground on more than `share` of them is labelled, each of its pixels with the label and
 // region of the nearest pixel with a height. An occlusion beside a wall borders the roof on one
@@ -212,7 +294,10 @@ cv::Mat nearestWithRegion(const cv::Mat& regions, std::vector<cv::Point>& pointO
 // instead of joining the roof whole. In left-image geometry (x_right = x_left - d) what the right
 // view cannot see lies left of a building: a run along a row that starts at the ground and ends
 // at a surface more than `occlusionStep` higher stays unlabelled (ground hidden by that surface).
-void labelKeptGaps(const dem::GapResult& gaps, double share, double occlusionStep, cv::Mat& regions, cv::Mat& above) {
+// Where the parts given to two separate regions of different heights meet, a seam stays
+// unlabelled (unlabelSeams).
+void labelKeptGaps(const dem::GapResult& gaps, double share, double occlusionStep, double seamStep, cv::Mat& regions,
+                   cv::Mat& above) {
   const size_t n = gaps.gaps.size();
   std::vector<int> border(n, 0), aboveBorder(n, 0);
   const cv::Mat& g = gaps.gapLabels;
@@ -255,6 +340,7 @@ void labelKeptGaps(const dem::GapResult& gaps, double share, double occlusionSte
       regions.at<int>(y, x) = regionsBefore.at<int>(q);
     }
   }
+  unlabelSeams(regionsBefore, before, gaps.dem, seamStep, regions, above);
 }
 
 GroundResult canceledResult(GroundResult result) {
@@ -333,7 +419,8 @@ GroundResult segmentGround(const cv::Mat& dem, double gsd, const GroundParams& p
     }
   }
   // 8. Kept gaps inside above-ground objects (unmatched roof or crown patches) join them.
-  if (params.gapAboveShare < 1.0) labelKeptGaps(gaps, params.gapAboveShare, params.criticalHeight, result.regions, result.aboveGround);
+  if (params.gapAboveShare < 1.0) labelKeptGaps(gaps, params.gapAboveShare, params.criticalHeight, params.regionThreshold, result.regions,
+                  result.aboveGround);
   result.regionInfo.resize(static_cast<size_t>(count));
   for (size_t i = 0; i < result.regionInfo.size(); ++i) {
     GroundRegionInfo& info = result.regionInfo[i];

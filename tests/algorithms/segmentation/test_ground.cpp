@@ -275,6 +275,23 @@ TEST(SegmentGround, OcclusionLeftOfARoofStaysUnlabelledInAJoinedGap) {
       << "rows from the ground into the roof's gap stay unlabelled as a whole";
 }
 
+TEST(SegmentGround, TwoBuildingsAcrossAnUnmatchedStreetStayApart) {
+  // Roofs at 10 m and 13 m face each other across a 20 px street without heights: the gap's
+  // border is mostly roof, so it is labelled from its nearest heights, but a seam stays
+  // unlabelled where the two roofs' parts meet, and the mask keeps two objects.
+  const cv::Mat ground = terrain({240, 200}, 0.0);
+  cv::Mat dem = ground.clone();
+  const cv::Rect left(40, 50, 60, 100), right(120, 50, 60, 100), street(100, 50, 20, 100);
+  addBox(dem, ground, left, 10.0f);
+  addBox(dem, ground, right, 13.0f);
+  dem(street).setTo(kNaN);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  EXPECT_EQ(countAbove(r, left) + countAbove(r, right), left.area() + right.area());
+  EXPECT_GT(countAbove(r, street), street.area() / 2) << "the street's gap is labelled";
+  cv::Mat components;
+  EXPECT_EQ(cv::connectedComponents(r.aboveGround, components, 8), 3) << "background and two objects";
+}
+
 TEST(SegmentGround, BoxSeparatedFromTheGroundOnlyByGapsIsFound) {
   // A box ringed by no data: only the links across the gaps make it the ground's neighbour.
   const cv::Mat ground = terrain({200, 200}, 0.0);

@@ -16,8 +16,9 @@
 //   8. kept gaps whose border is mostly above-ground (unmatched patches of a roof or a crown)
 //      join the above-ground mask, each pixel with the label and region of the nearest pixel
 //      with a height (a gap spanning a roof and the street beside it is split between them),
-//      except the runs along a row from the ground to a surface δ_0 higher: the ground hidden in
-//      the right view left of a building.
+//      except the runs along a row from the ground to a surface δ_0 higher (the ground hidden in
+//      the right view left of a building) and a seam where the parts of two separate regions of
+//      different heights meet (two buildings across an unmatched street stay apart).
 // No GUI interaction here: the CLI and the GUI call the same function.
 #include <vector>
 
