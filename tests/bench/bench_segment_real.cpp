@@ -188,9 +188,11 @@ int main(int argc, char** argv) {
                 a.detection.objects.objects.size() - static_cast<size_t>(buildings), a.detection.proposals.size(), ms);
     // Hand-labelled roofs: covered when one proposal holds at least half of the roof.
     int labelled = 0, covered = 0;
+    cv::Mat allRoofs(dem.size(), CV_8U, cv::Scalar(0));
     for (const auto& roof : roofs.at("roofs")) {
       if (roof.at("pair") != name) continue;
       const cv::Mat r = core::rasterize(bench::ringOf(roof.at("outline")), dem.size());
+      allRoofs |= r;
       double best = 0;
       for (const auto& f : a.detection.proposals) {
         best = std::max(best, cv::countNonZero(r & core::rasterize(f.polygon, dem.size())) /
@@ -200,6 +202,12 @@ int main(int argc, char** argv) {
       if (best < 0.5) std::printf("  roof %s not proposed (best cover %.2f)\n", roof.at("name").get<std::string>().c_str(), best);
     }
     std::printf("  hand-labelled roofs proposed: %d of %d\n", covered, labelled);
+    // Above-ground outside every labelled roof (shaded streets, alleys, trees, facades, and any
+    // building left unlabelled) against the labelled roofs' pixels found above-ground.
+    const cv::Mat above = a.ground.aboveGround != 0;
+    std::printf("  above-ground: %.1f %% of the labelled roofs' pixels; outside them %.1f %% of the tile\n",
+                100.0 * cv::countNonZero(above & allRoofs) / std::max(1, cv::countNonZero(allRoofs)),
+                100.0 * cv::countNonZero(above & ~allRoofs) / double(dem.total()));
     if (pair.contains("ground_truth_disparity")) {
       const fs::path gt = fs::path(data) / pair.at("ground_truth_disparity").get<std::string>();
       if (fs::exists(gt)) scoreAgainstLidar(gt.string(), a.ground.aboveGround, dem == dem, 2.0 / model.metresPerPixel);

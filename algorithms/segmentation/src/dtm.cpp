@@ -18,7 +18,7 @@ struct Point3 {
 
 // One window's sample, if any (see sampleGround()).
 bool sampleWindow(const cv::Mat& dem, const cv::Mat& ground, const cv::Rect& window, double binWidth,
-                  std::vector<Point3>& points, GroundSample& sample) {
+                  double levelShare, std::vector<Point3>& points, GroundSample& sample) {
   points.clear();
   int withHeight = 0;
   for (int y = window.y; y < window.br().y; ++y) {
@@ -40,7 +40,17 @@ bool sampleWindow(const cv::Mat& dem, const cv::Mat& ground, const cv::Rect& win
   std::vector<int> histogram(static_cast<size_t>(bins), 0);
   auto binOf = [&](float z) { return std::min(bins - 1, static_cast<int>((z - low) / width)); };
   for (const Point3& p : points) ++histogram[static_cast<size_t>(binOf(p.z))];
-  const int mode = static_cast<int>(std::max_element(histogram.begin(), histogram.end()) - histogram.begin());
+  // The lowest bin holding at least `levelShare` of the most populated one: in a window mostly
+  // covered by a roof (the street beside it in shadow, without heights) the most frequent
+  // "ground" height of the first round is the roof's, and the roof would stay ground.
+  const int peak = static_cast<int>(std::max_element(histogram.begin(), histogram.end()) - histogram.begin());
+  int mode = peak;
+  for (int b = 0; b < peak; ++b) {
+    if (histogram[static_cast<size_t>(b)] >= levelShare * histogram[static_cast<size_t>(peak)]) {
+      mode = b;
+      break;
+    }
+  }
   const float cx = window.x + 0.5f * window.width, cy = window.y + 0.5f * window.height;
   float best = std::numeric_limits<float>::infinity();
   for (const Point3& p : points) {
@@ -139,7 +149,8 @@ void extendOutsideHull(cv::Mat& dtm, const cv::Mat& done, const Plane& plane) {
 
 }  // namespace
 
-std::vector<GroundSample> sampleGround(const cv::Mat& dem, const cv::Mat& ground, int windowPx, double binWidth) {
+std::vector<GroundSample> sampleGround(const cv::Mat& dem, const cv::Mat& ground, int windowPx, double binWidth,
+                                       double levelShare) {
   std::vector<GroundSample> samples;
   std::vector<Point3> points;
   const int w = std::max(1, windowPx);
@@ -147,7 +158,7 @@ std::vector<GroundSample> sampleGround(const cv::Mat& dem, const cv::Mat& ground
     for (int x = 0; x < dem.cols; x += w) {
       const cv::Rect window = cv::Rect(x, y, w, w) & cv::Rect(0, 0, dem.cols, dem.rows);
       GroundSample sample;
-      if (sampleWindow(dem, ground, window, binWidth, points, sample)) samples.push_back(sample);
+      if (sampleWindow(dem, ground, window, binWidth, levelShare, points, sample)) samples.push_back(sample);
     }
   }
   return samples;

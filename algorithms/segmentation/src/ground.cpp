@@ -6,9 +6,9 @@
 #include <limits>
 #include <sstream>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
 #include <opencv2/imgproc/detail/gcgraph.hpp>
 
 #include "delineo/core/error.hpp"
@@ -42,14 +42,14 @@ int toPixels(double metres, double gsd, int lo) {
 
 // The DTM from the pixels of the regions labelled ground.
 cv::Mat groundDtm(const RegionGraph& graph, const cv::Mat& dem, const Labels& labels, int windowPx,
-                  double binWidth, int* samples = nullptr) {
+                  const GroundParams& params, int* samples = nullptr) {
   cv::Mat ground(dem.size(), CV_8U);
   for (int y = 0; y < dem.rows; ++y) {
     const int* r = graph.labels.ptr<int>(y);
     unsigned char* g = ground.ptr<unsigned char>(y);
     for (int x = 0; x < dem.cols; ++x) g[x] = r[x] >= 0 && labels[static_cast<size_t>(r[x])] == GroundLabel::Ground;
   }
-  const std::vector<GroundSample> points = sampleGround(dem, ground, windowPx, binWidth);
+  const std::vector<GroundSample> points = sampleGround(dem, ground, windowPx, params.regionThreshold, params.dtmLevelShare);
   if (samples) *samples = static_cast<int>(points.size());
   return interpolateDtm(points, dem.size());
 }
@@ -156,7 +156,7 @@ Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundPar
   out.labels.assign(n, GroundLabel::Ground);
   out.oscillating.assign(n, false);
   std::vector<Labels> history{out.labels};
-  out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+  out.dtm = groundDtm(graph, dem, out.labels, windowPx, params, &out.samples);
   for (int round = 1; round <= params.maxIterations; ++round) {
     if (core::isCanceled(progress)) {
       out.canceled = true;
@@ -179,25 +179,127 @@ Rounds labelAndDtm(const RegionGraph& graph, const cv::Mat& dem, const GroundPar
                                                : std::vector<Labels>{out.labels, next};
       out.labels = next;
       groundOscillating(states, out.labels, out.oscillating);
-      out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+      out.dtm = groundDtm(graph, dem, out.labels, windowPx, params, &out.samples);
       return out;
     }
     history.push_back(next);
     out.labels = std::move(next);
-    out.dtm = groundDtm(graph, dem, out.labels, windowPx, params.regionThreshold, &out.samples);
+    out.dtm = groundDtm(graph, dem, out.labels, windowPx, params, &out.samples);
     core::report(progress, static_cast<double>(round) / params.maxIterations);
   }
   return out;
 }
 
+// For every pixel without a region, the nearest pixel with one (Euclidean distance transform).
+cv::Mat nearestWithRegion(const cv::Mat& regions, std::vector<cv::Point>& pointOf) {
+  const cv::Mat noRegion = regions < 0;
+  cv::Mat distance, nearest;
+  cv::distanceTransform(noRegion, distance, nearest, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  pointOf.assign(regions.total() + 1, cv::Point(-1, -1));
+  for (int y = 0; y < regions.rows; ++y) {
+    for (int x = 0; x < regions.cols; ++x) {
+      if (!noRegion.at<uchar>(y, x)) pointOf[static_cast<size_t>(nearest.at<int>(y, x))] = cv::Point(x, y);
+    }
+  }
+  return nearest;
+}
+
+// Per region: its mean height, whether it is above-ground, and its 4-adjacent regions (sorted).
+struct RegionContacts {
+  std::vector<double> mean;
+  std::vector<bool> above;
+  std::vector<std::vector<int>> neighbours;
+  bool adjacent(int a, int b) const {
+    const auto& n = neighbours[static_cast<size_t>(a)];
+    return std::binary_search(n.begin(), n.end(), b);
+  }
+  // Directly, or through one above-ground region between them (a wall between two roof levels).
+  bool joined(int a, int b) const {
+    if (adjacent(a, b)) return true;
+    for (const int w : neighbours[static_cast<size_t>(a)]) {
+      if (above[static_cast<size_t>(w)] && adjacent(w, b)) return true;
+    }
+    return false;
+  }
+};
+
+RegionContacts regionContacts(const cv::Mat& regions, const cv::Mat& dem, const cv::Mat& above) {
+  double maxLabel = -1;
+  cv::minMaxLoc(regions, nullptr, &maxLabel);
+  const size_t n = static_cast<size_t>(maxLabel + 1);
+  RegionContacts c{std::vector<double>(n, 0.0), std::vector<bool>(n, false), std::vector<std::vector<int>>(n)};
+  std::vector<int> count(n, 0);
+  for (int y = 0; y < regions.rows; ++y) {
+    for (int x = 0; x < regions.cols; ++x) {
+      const int r = regions.at<int>(y, x);
+      if (r < 0) continue;
+      c.mean[static_cast<size_t>(r)] += dem.at<float>(y, x);
+      ++count[static_cast<size_t>(r)];
+      c.above[static_cast<size_t>(r)] = above.at<uchar>(y, x) != 0;
+      const int right = x + 1 < regions.cols ? regions.at<int>(y, x + 1) : -1;
+      const int below = y + 1 < regions.rows ? regions.at<int>(y + 1, x) : -1;
+      for (const int o : {right, below}) {
+        if (o < 0 || o == r) continue;
+        c.neighbours[static_cast<size_t>(r)].push_back(o);
+        c.neighbours[static_cast<size_t>(o)].push_back(r);
+      }
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    c.mean[i] /= std::max(1, count[i]);
+    auto& nb = c.neighbours[i];
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  return c;
+}
+
+// Joined gap pixels next to a joined gap pixel of another region, when the two regions are not
+// joined (regionContacts) and their mean heights differ by more than `minStep`, go back to no
+// label: two buildings facing each other across an unmatched street stay two objects, while
+// the patches of one roof that the matcher left apart (one level) stay together.
+void unlabelSeams(const cv::Mat& regionsBefore, const cv::Mat& aboveBefore, const cv::Mat& dem, double minStep,
+                  cv::Mat& regions, cv::Mat& above) {
+  const RegionContacts contacts = regionContacts(regionsBefore, dem, aboveBefore);
+  const cv::Mat joined = (regionsBefore < 0) & (regions >= 0);
+  std::vector<cv::Point> seam;
+  const cv::Point steps[4] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  for (int y = 0; y < regions.rows; ++y) {
+    for (int x = 0; x < regions.cols; ++x) {
+      if (!joined.at<uchar>(y, x)) continue;
+      const int r = regions.at<int>(y, x);
+      for (const cv::Point& d : steps) {
+        const cv::Point q(x + d.x, y + d.y);
+        if (q.x < 0 || q.y < 0 || q.x >= regions.cols || q.y >= regions.rows || !joined.at<uchar>(q)) continue;
+        const int rq = regions.at<int>(q);
+        if (rq != r && std::abs(contacts.mean[static_cast<size_t>(r)] - contacts.mean[static_cast<size_t>(rq)]) > minStep &&
+            !contacts.joined(r, rq)) {
+          seam.emplace_back(x, y);
+          break;
+        }
+      }
+    }
+  }
+  for (const cv::Point& p : seam) {
+    regions.at<int>(p) = -1;
+    above.at<uchar>(p) = 0;
+  }
+}
+
 // Kept gaps (no height) inside above-ground objects: a gap whose 8-adjacent border pixels are
-// above-ground on more than `share` of them joins the above-ground mask and takes the region its
-// above-ground border meets most. An occlusion beside a wall borders the roof on one side and the
-// ground on the other and stays unlabelled; an unmatched patch of a roof or a crown joins it.
-void labelKeptGaps(const dem::GapResult& gaps, double share, cv::Mat& regions, cv::Mat& above) {
+// above-ground on more than `share` of them is labelled, each of its pixels with the label and
+// region of the nearest pixel with a height. An occlusion beside a wall borders the roof on one
+// side and the ground on the other and stays unlabelled; an unmatched patch of a roof or a crown
+// joins it; a gap that spans a roof and the shaded street beside it is split between the two
+// instead of joining the roof whole. In left-image geometry (x_right = x_left - d) what the right
+// view cannot see lies left of a building: a run along a row that starts at the ground and ends
+// at a surface more than `occlusionStep` higher stays unlabelled (ground hidden by that surface).
+// Where the parts given to two separate regions of different heights meet, a seam stays
+// unlabelled (unlabelSeams).
+void labelKeptGaps(const dem::GapResult& gaps, double share, double occlusionStep, double seamStep, cv::Mat& regions,
+                   cv::Mat& above) {
   const size_t n = gaps.gaps.size();
   std::vector<int> border(n, 0), aboveBorder(n, 0);
-  std::unordered_map<long long, int> regionVotes;  // (gap << 32 | region) -> border pixels
   const cv::Mat& g = gaps.gapLabels;
   for (int y = 0; y < g.rows; ++y) {
     for (int x = 0; x < g.cols; ++x) {
@@ -208,28 +310,37 @@ void labelKeptGaps(const dem::GapResult& gaps, double share, cv::Mat& regions, c
           const int yy = y + dy, xx = x + dx;
           if (yy < 0 || xx < 0 || yy >= g.rows || xx >= g.cols || g.at<int>(yy, xx) != 0) continue;
           ++border[static_cast<size_t>(gap)];
-          if (above.at<uchar>(yy, xx) == 0) continue;
-          ++aboveBorder[static_cast<size_t>(gap)];
-          ++regionVotes[(static_cast<long long>(gap) << 32) | static_cast<unsigned>(regions.at<int>(yy, xx))];
+          aboveBorder[static_cast<size_t>(gap)] += above.at<uchar>(yy, xx) != 0;
         }
       }
     }
   }
-  std::vector<int> regionOf(n, -1), best(n, 0);
-  for (const auto& [key, votes] : regionVotes) {
-    const auto gap = static_cast<size_t>(key >> 32);
-    if (votes > best[gap]) best[gap] = votes, regionOf[gap] = static_cast<int>(key & 0xffffffff);
-  }
+  const auto joins = [&](size_t i) { return border[i] > 0 && aboveBorder[i] > share * border[i]; };
+  bool any = false;
+  for (size_t i = 0; i < n; ++i) any = any || (!gaps.gaps[i].merged && joins(i));
+  if (!any) return;
+  std::vector<cv::Point> pointOf;
+  const cv::Mat nearest = nearestWithRegion(regions, pointOf);
+  const cv::Mat before = above.clone(), regionsBefore = regions.clone();
   for (int y = 0; y < g.rows; ++y) {
+    int runStart = -1, runEnd = -1;  // the current run without region along the row: [runStart, runEnd)
+    bool hidden = false;             // that run is hidden by a building at its right end
     for (int x = 0; x < g.cols; ++x) {
       const int gap = g.at<int>(y, x) - 1;
-      if (gap < 0 || gaps.gaps[static_cast<size_t>(gap)].merged) continue;
-      const auto i = static_cast<size_t>(gap);
-      if (border[i] == 0 || aboveBorder[i] <= share * border[i]) continue;
+      if (gap < 0 || gaps.gaps[static_cast<size_t>(gap)].merged || !joins(static_cast<size_t>(gap))) continue;
+      if (x >= runEnd) {
+        for (runStart = x, runEnd = x; runEnd < g.cols && regionsBefore.at<int>(y, runEnd) < 0;) ++runEnd;
+        hidden = runStart > 0 && runEnd < g.cols && !before.at<uchar>(y, runStart - 1) &&
+                 gaps.dem.at<float>(y, runEnd) - gaps.dem.at<float>(y, runStart - 1) > occlusionStep;
+      }
+      if (hidden) continue;  // the ground the right view cannot see beside a building
+      const cv::Point q = pointOf[static_cast<size_t>(nearest.at<int>(y, x))];
+      if (q.x < 0 || !before.at<uchar>(q)) continue;
       above.at<uchar>(y, x) = 255;
-      regions.at<int>(y, x) = regionOf[i];
+      regions.at<int>(y, x) = regionsBefore.at<int>(q);
     }
   }
+  unlabelSeams(regionsBefore, before, gaps.dem, seamStep, regions, above);
 }
 
 GroundResult canceledResult(GroundResult result) {
@@ -308,7 +419,8 @@ GroundResult segmentGround(const cv::Mat& dem, double gsd, const GroundParams& p
     }
   }
   // 8. Kept gaps inside above-ground objects (unmatched roof or crown patches) join them.
-  if (params.gapAboveShare < 1.0) labelKeptGaps(gaps, params.gapAboveShare, result.regions, result.aboveGround);
+  if (params.gapAboveShare < 1.0) labelKeptGaps(gaps, params.gapAboveShare, params.criticalHeight, params.regionThreshold, result.regions,
+                  result.aboveGround);
   result.regionInfo.resize(static_cast<size_t>(count));
   for (size_t i = 0; i < result.regionInfo.size(); ++i) {
     GroundRegionInfo& info = result.regionInfo[i];

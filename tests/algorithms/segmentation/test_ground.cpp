@@ -243,6 +243,55 @@ TEST(SegmentGround, UnmatchedPatchInsideARoofJoinsIt) {
   EXPECT_EQ(countAbove(kept, box), box.area() - hole.area());
 }
 
+TEST(SegmentGround, GapSpanningARoofAndTheGroundIsSplitAtTheNearestHeight) {
+  // One unmatched strip crosses the roof's right half and runs 20 px onto the ground beside it:
+  // most of its border is roof, so it is labelled, but its ground part stays ground.
+  const cv::Mat ground = terrain({240, 200}, 0.0);
+  cv::Mat dem = ground.clone();
+  const cv::Rect box(40, 40, 120, 120), hole(100, 85, 80, 30);
+  addBox(dem, ground, box, 10.0f);
+  dem(hole).setTo(kNaN);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  EXPECT_EQ(countAbove(r, box), box.area()) << "the roof's unmatched part joins it";
+  const cv::Rect street(box.br().x + 6, hole.y, hole.br().x - box.br().x - 6, hole.height);
+  EXPECT_EQ(cv::countNonZero(r.aboveGround(street)), 0) << "the part beyond the roof's edge is ground's";
+}
+
+TEST(SegmentGround, OcclusionLeftOfARoofStaysUnlabelledInAJoinedGap) {
+  // The strip left of a roof that the right view cannot see (x_right = x_left - d) is joined,
+  // through a slab of unmatched roof, to a gap mostly bordered by the roof. By nearest height its
+  // right half would be roof; along the rows it runs from the ground to a surface 10 m higher:
+  // hidden ground, left unlabelled.
+  const cv::Mat ground = terrain({240, 200}, 0.0);
+  cv::Mat dem = ground.clone();
+  const cv::Rect box(80, 50, 120, 100), strip(60, 50, 20, 100), slab(80, 60, 60, 20);
+  addBox(dem, ground, box, 10.0f);
+  dem(strip).setTo(kNaN);
+  dem(slab).setTo(kNaN);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  const cv::Rect stripBelowSlab(strip.x, slab.br().y, strip.width, strip.br().y - slab.br().y);
+  EXPECT_EQ(cv::countNonZero(r.aboveGround(stripBelowSlab)), 0) << "the occlusion is not the roof's";
+  EXPECT_EQ(cv::countNonZero(r.aboveGround(box)), box.area() - slab.area())
+      << "rows from the ground into the roof's gap stay unlabelled as a whole";
+}
+
+TEST(SegmentGround, TwoBuildingsAcrossAnUnmatchedStreetStayApart) {
+  // Roofs at 10 m and 13 m face each other across a 20 px street without heights: the gap's
+  // border is mostly roof, so it is labelled from its nearest heights, but a seam stays
+  // unlabelled where the two roofs' parts meet, and the mask keeps two objects.
+  const cv::Mat ground = terrain({240, 200}, 0.0);
+  cv::Mat dem = ground.clone();
+  const cv::Rect left(40, 50, 60, 100), right(120, 50, 60, 100), street(100, 50, 20, 100);
+  addBox(dem, ground, left, 10.0f);
+  addBox(dem, ground, right, 13.0f);
+  dem(street).setTo(kNaN);
+  const GroundResult r = segmentGround(dem, kGsd, GroundParams{});
+  EXPECT_EQ(countAbove(r, left) + countAbove(r, right), left.area() + right.area());
+  EXPECT_GT(countAbove(r, street), street.area() / 2) << "the street's gap is labelled";
+  cv::Mat components;
+  EXPECT_EQ(cv::connectedComponents(r.aboveGround, components, 8), 3) << "background and two objects";
+}
+
 TEST(SegmentGround, BoxSeparatedFromTheGroundOnlyByGapsIsFound) {
   // A box ringed by no data: only the links across the gaps make it the ground's neighbour.
   const cv::Mat ground = terrain({200, 200}, 0.0);

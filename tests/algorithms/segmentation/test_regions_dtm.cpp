@@ -168,3 +168,21 @@ TEST(Potentials, DataPotentialCrossesAtH0) {
     previous = v;
   }
 }
+
+TEST(Dtm, SamplingTakesTheLowestWellPopulatedLevel) {
+  // A window mostly covered by a roof (9 m) with a strip of street (5 m) on a third of it: the
+  // most frequent height is the roof's, the lowest level holding 30 % of it is the street's.
+  cv::Mat dem(40, 40, CV_32F, cv::Scalar(9.0));
+  dem(cv::Rect(0, 0, 40, 12)).setTo(5.0);
+  const cv::Mat ground(dem.size(), CV_8U, cv::Scalar(255));
+  const auto low = sampleGround(dem, ground, 40, 1.0, 0.3);
+  ASSERT_EQ(low.size(), 1u);
+  EXPECT_FLOAT_EQ(low[0].height, 5.0f);
+  const auto frequent = sampleGround(dem, ground, 40, 1.0, 1.0);
+  ASSERT_EQ(frequent.size(), 1u);
+  EXPECT_FLOAT_EQ(frequent[0].height, 9.0f);
+  // A few low outliers (under 30 % of the peak) do not move it.
+  dem(cv::Rect(0, 0, 40, 12)).setTo(9.0);
+  dem(cv::Rect(0, 0, 10, 10)).setTo(2.0);
+  EXPECT_FLOAT_EQ(sampleGround(dem, ground, 40, 1.0, 0.3)[0].height, 9.0f);
+}

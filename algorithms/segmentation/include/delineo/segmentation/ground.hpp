@@ -14,7 +14,11 @@
 //   6. regions whose label oscillates become ground;
 //   7. above-ground mask and nDSM = DEM - DTM;
 //   8. kept gaps whose border is mostly above-ground (unmatched patches of a roof or a crown)
-//      join the above-ground mask and their border's region.
+//      join the above-ground mask, each pixel with the label and region of the nearest pixel
+//      with a height (a gap spanning a roof and the street beside it is split between them),
+//      except the runs along a row from the ground to a surface δ_0 higher (the ground hidden in
+//      the right view left of a building) and a seam where the parts of two separate regions of
+//      different heights meet (two buildings across an unmatched street stay apart).
 // No GUI interaction here: the CLI and the GUI call the same function.
 #include <vector>
 
@@ -35,6 +39,8 @@ struct GroundParams {
                                  // neighbourhood (δ_0 >= 2 δ_g)
   double dataWeight = 0.5;       // α_d, weight of the data potential (α_c = 1 - α_d)
   double dtmWindow = 20.0;       // m, side of the windows of the DTM's ground sampling
+  double dtmLevelShare = 0.3;    // a DTM window's ground point lies in the lowest height bin holding
+                                 // at least this share of its most populated bin (1: that bin)
   double stepBand = 2.0;         // m, how far inside two neighbouring regions their step is read
   double gapLinkLength = 40.0;   // m, longest kept-gap run along a row across which regions are
                                  // linked (0: no links across gaps)
@@ -68,6 +74,11 @@ struct GroundParams {
     v(ParamInfo{"dtm-window", "DTM window", "m",
                 "Side of the windows in which the DTM takes one ground point each", 0.001, 1e6},
       dtmWindow);
+    v(ParamInfo{"dtm-level-share", "DTM level share", "",
+                "A DTM window's ground point is at the lowest height holding this share of its most frequent one (1: "
+                "the most frequent)",
+                0.001, 1},
+      dtmLevelShare);
     v(ParamInfo{"step-band", "Step band", "m",
                 "How far inside two neighbouring regions the height step between them is read", 0, 1e4},
       stepBand);
