@@ -563,6 +563,10 @@
         <translation>Fenêtre du MNT</translation>
     </message>
     <message>
+        <source>DTM level share</source>
+        <translation>Part du niveau du MNT</translation>
+    </message>
+    <message>
         <source>Step band</source>
         <translation>Bande des sauts</translation>
     </message>

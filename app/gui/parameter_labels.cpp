@@ -143,6 +143,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Critical height"),
     QT_TRANSLATE_NOOP("Parameters", "Data weight"),
     QT_TRANSLATE_NOOP("Parameters", "DTM window"),
+    QT_TRANSLATE_NOOP("Parameters", "DTM level share"),
     QT_TRANSLATE_NOOP("Parameters", "Step band"),
     QT_TRANSLATE_NOOP("Parameters", "Gap link length"),
     QT_TRANSLATE_NOOP("Parameters", "Gap above share"),
