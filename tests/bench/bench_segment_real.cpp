@@ -2,7 +2,8 @@
 // real aerial pairs of the data folder (docs/dem.md, "Results on the real pairs"):
 //   - Dublin: above-ground vs the LiDAR disparity on the pixels where the LiDAR has a value;
 //   - every pair: how many hand-labelled roofs (tests/bench/data/real_roofs.json) a proposal
-//     covers, and an overlay PNG (building red, vegetation green, proposals yellow) to look at.
+//     covers, how many of them are alone in their proposal (touching buildings merged into one
+//     proposal share it), and an overlay PNG (building red, vegetation green, proposals yellow) to look at.
 // Heights come from the matcher's disparity (cached as in bench_real_outlines) through a linear
 // model; the pairs come without camera data, so metres per pixel of disparity is the stated
 // assumption below. Skips cleanly when the data folder is missing.
@@ -187,21 +188,36 @@ int main(int argc, char** argv) {
                 100.0 * cv::countNonZero(a.ground.aboveGround) / double(dem.total()), buildings,
                 a.detection.objects.objects.size() - static_cast<size_t>(buildings), a.detection.proposals.size(), ms);
     // Hand-labelled roofs: covered when one proposal holds at least half of the roof.
+    // Merges: the proposal holding a covered roof is shared when it holds another covered roof.
     int labelled = 0, covered = 0;
     cv::Mat allRoofs(dem.size(), CV_8U, cv::Scalar(0));
+    std::vector<cv::Mat> proposalMasks;
+    for (const auto& f : a.detection.proposals) proposalMasks.push_back(core::rasterize(f.polygon, dem.size()));
+    std::vector<int> holder;  // per covered roof, the proposal holding it
+    std::vector<std::string> holderRoof;
     for (const auto& roof : roofs.at("roofs")) {
       if (roof.at("pair") != name) continue;
       const cv::Mat r = core::rasterize(bench::ringOf(roof.at("outline")), dem.size());
       allRoofs |= r;
       double best = 0;
-      for (const auto& f : a.detection.proposals) {
-        best = std::max(best, cv::countNonZero(r & core::rasterize(f.polygon, dem.size())) /
-                                  std::max(1.0, double(cv::countNonZero(r))));
+      int bestProposal = -1;
+      for (size_t k = 0; k < proposalMasks.size(); ++k) {
+        const double cover = cv::countNonZero(r & proposalMasks[k]) / std::max(1.0, double(cv::countNonZero(r)));
+        if (cover > best) best = cover, bestProposal = static_cast<int>(k);
       }
       ++labelled, covered += best >= 0.5;
+      if (best >= 0.5) holder.push_back(bestProposal), holderRoof.push_back(roof.at("name").get<std::string>());
       if (best < 0.5) std::printf("  roof %s not proposed (best cover %.2f)\n", roof.at("name").get<std::string>().c_str(), best);
     }
+    int alone = 0;
+    for (size_t i = 0; i < holder.size(); ++i) {
+      const long sharing = std::count(holder.begin(), holder.end(), holder[i]);
+      alone += sharing == 1;
+      if (sharing > 1) std::printf("  roof %s shares proposal %d with %ld other roof(s)\n", holderRoof[i].c_str(),
+                                   holder[i], sharing - 1);
+    }
     std::printf("  hand-labelled roofs proposed: %d of %d\n", covered, labelled);
+    std::printf("  roofs alone in their proposal: %d of %d\n", alone, labelled);
     // Above-ground outside every labelled roof (shaded streets, alleys, trees, facades, and any
     // building left unlabelled) against the labelled roofs' pixels found above-ground.
     const cv::Mat above = a.ground.aboveGround != 0;
