@@ -68,7 +68,7 @@ std::vector<core::Feature> proposeBuildings(const std::vector<SceneObject>& obje
 Detection detectBuildings(const cv::Mat& image, const cv::Mat& aboveGround, const cv::Mat& ndsm, double gsd,
                           const cv::Mat& disparity, const cv::Mat& regions, const ClassifyParams& classifyParams,
                           const ObjectParams& objectParams, const DetectParams& detectParams,
-                          core::Progress* progress) {
+                          core::Progress* progress, const LevelSplit& split) {
   classifyParams.validate();
   objectParams.validate();
   detectParams.validate();
@@ -84,7 +84,7 @@ Detection detectBuildings(const cv::Mat& image, const cv::Mat& aboveGround, cons
   {
     core::Progress::Range range(progress, 0.7, 1.0);
     out.objects = extractObjects(out.classification.labels, ndsm, gsd, objectParams, disparity,
-                                 progress ? &range : nullptr);
+                                 progress ? &range : nullptr, regions, split);
   }
   if (out.objects.status == core::RunStatus::Canceled) {
     out.status = core::RunStatus::Canceled;

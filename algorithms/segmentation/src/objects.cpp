@@ -111,8 +111,45 @@ core::Polygon traceMask(const cv::Mat& mask, double simplification, double minHo
   return polygon;
 }
 
+namespace {
+
+// The object of the non-zero pixels of `mask` (the crop `box` of the scene), or false when it is
+// under `minArea` or smoothed away.
+bool makeObject(SceneObject& o, const cv::Mat& mask, const cv::Rect& box, const cv::Mat& ndsm, const cv::Mat& disparity,
+                double gsd, const ObjectParams& params) {
+  const double pixelArea = gsd * gsd;
+  o.pixels = cv::countNonZero(mask);
+  o.areaM2 = o.pixels * pixelArea;
+  if (o.areaM2 < params.minArea) return false;
+  measureHeights(o, ndsm(box), mask);
+  // Outline of the piece smoothed in a padded crop (closing then opening).
+  const int pad = params.smoothing + 1;
+  cv::Mat crop;
+  cv::copyMakeBorder(mask, crop, pad, pad, pad, pad, cv::BORDER_CONSTANT, 0);
+  if (params.smoothing > 1) {
+    const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {params.smoothing, params.smoothing});
+    cv::morphologyEx(crop, crop, cv::MORPH_CLOSE, kernel);
+    cv::morphologyEx(crop, crop, cv::MORPH_OPEN, kernel);
+  }
+  o.outline = traceMask(crop, params.simplification, params.minArea / pixelArea);
+  if (o.outline.outer.size() < 3) return false;  // smoothed away
+  const cv::Point2d shift(box.x - pad, box.y - pad);
+  for (auto& v : o.outline.outer) v += shift;
+  for (auto& hole : o.outline.holes) {
+    for (auto& v : hole) v += shift;
+  }
+  if (!disparity.empty()) {
+    measureDisparity(o, disparity(box), mask, params);
+    o.groundDisparity = delineation::estimateGroundLevel(disparity, o.outline);
+  }
+  return true;
+}
+
+}  // namespace
+
 ObjectSet extractObjects(const cv::Mat& labels, const cv::Mat& ndsm, double gsd, const ObjectParams& params,
-                         const cv::Mat& disparity, core::Progress* progress) {
+                         const cv::Mat& disparity, core::Progress* progress, const cv::Mat& regions,
+                         const LevelSplit& split) {
   params.validate();
   if (labels.empty() || labels.type() != CV_8UC1) {
     throw Error(ErrorCode::UnsupportedInput, "the class labels must be one band of 8 bits");
@@ -123,17 +160,19 @@ ObjectSet extractObjects(const cv::Mat& labels, const cv::Mat& ndsm, double gsd,
   if (!disparity.empty() && disparity.type() != CV_32FC1) {
     throw Error(ErrorCode::UnsupportedInput, "the disparity map must be one band of float32");
   }
-  if (ndsm.size() != labels.size() || (!disparity.empty() && disparity.size() != labels.size())) {
-    throw Error(ErrorCode::MismatchedInputs, "the class labels, the nDSM and the disparity map must have one size");
+  if (!regions.empty() && regions.type() != CV_32SC1) {
+    throw Error(ErrorCode::UnsupportedInput, "the region map must be one band of 32-bit integers");
+  }
+  if (ndsm.size() != labels.size() || (!disparity.empty() && disparity.size() != labels.size()) ||
+      (!regions.empty() && regions.size() != labels.size())) {
+    throw Error(ErrorCode::MismatchedInputs,
+                "the class labels, the nDSM, the disparity map and the region map must have one size");
   }
   if (!std::isfinite(gsd) || gsd <= 0.0) {
     throw Error(ErrorCode::InvalidParameter, "the ground sampling distance must be a positive number of metres");
   }
   ObjectSet out;
   out.index = cv::Mat::zeros(labels.size(), CV_32S);
-  const double pixelArea = gsd * gsd;
-  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, {params.smoothing, params.smoothing});
-  const int pad = params.smoothing + 1;
   int nextId = 1;
   for (const ClassLabel cls : {kClassBuilding, kClassVegetation}) {
     const double done = cls == kClassBuilding ? 0.0 : 0.5;
@@ -144,38 +183,22 @@ ObjectSet extractObjects(const cv::Mat& labels, const cv::Mat& ndsm, double gsd,
         out.status = core::RunStatus::Canceled;
         return out;
       }
-      const int pixels = stats.at<int>(c, cv::CC_STAT_AREA);
-      const int id = nextId++;
       const cv::Rect box(stats.at<int>(c, cv::CC_STAT_LEFT), stats.at<int>(c, cv::CC_STAT_TOP),
                          stats.at<int>(c, cv::CC_STAT_WIDTH), stats.at<int>(c, cv::CC_STAT_HEIGHT));
       const cv::Mat piece = pieces(box) == c;
-      out.index(box).setTo(id, piece);
-      if (pixels * pixelArea < params.minArea) continue;
-      SceneObject o;
-      o.id = id;
-      o.cls = cls;
-      o.pixels = pixels;
-      o.areaM2 = pixels * pixelArea;
-      measureHeights(o, ndsm(box), piece);
-      // Outline of the piece smoothed in a padded crop (closing then opening).
-      cv::Mat crop;
-      cv::copyMakeBorder(piece, crop, pad, pad, pad, pad, cv::BORDER_CONSTANT, 0);
-      if (params.smoothing > 1) {
-        cv::morphologyEx(crop, crop, cv::MORPH_CLOSE, kernel);
-        cv::morphologyEx(crop, crop, cv::MORPH_OPEN, kernel);
+      // Buildings: one part per height level (levels.hpp); vegetation and no region map: the piece.
+      int partCount = 1;
+      const cv::Mat parts = cls == kClassBuilding && !regions.empty()
+                                ? splitLevels(piece, regions(box), ndsm(box), gsd, split, partCount)
+                                : cv::Mat();
+      for (int part = 1; part <= partCount; ++part) {
+        const cv::Mat mask = partCount == 1 ? piece : cv::Mat(parts == part);
+        SceneObject o;
+        o.id = nextId++;
+        o.cls = cls;
+        out.index(box).setTo(o.id, mask);
+        if (makeObject(o, mask, box, ndsm, disparity, gsd, params)) out.objects.push_back(std::move(o));
       }
-      o.outline = traceMask(crop, params.simplification, params.minArea / pixelArea);
-      if (o.outline.outer.size() < 3) continue;  // smoothed away
-      const cv::Point2d shift(box.x - pad, box.y - pad);
-      for (auto& v : o.outline.outer) v += shift;
-      for (auto& hole : o.outline.holes) {
-        for (auto& v : hole) v += shift;
-      }
-      if (!disparity.empty()) {
-        measureDisparity(o, disparity(box), piece, params);
-        o.groundDisparity = delineation::estimateGroundLevel(disparity, o.outline);
-      }
-      out.objects.push_back(std::move(o));
       core::report(progress, done + 0.5 * c / n);
     }
   }

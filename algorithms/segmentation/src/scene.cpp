@@ -13,6 +13,20 @@ void SceneParams::validate() const {
   detect.validate();
 }
 
+namespace {
+
+// The height-level split of building objects reads the segmentation's and the proposals' thresholds.
+LevelSplit levelSplitOf(const SceneParams& params) {
+  LevelSplit split;
+  split.minStep = params.ground.criticalHeight;
+  split.stepBand = params.ground.stepBand;
+  split.wallSlope = params.ground.wallSlope;
+  split.minPartArea = params.detect.minBuildingArea;
+  return split;
+}
+
+}  // namespace
+
 SceneAnalysis analyseScene(const cv::Mat& dem, const cv::Mat& image, double gsd, const SceneParams& params,
                            const cv::Mat& disparity, core::Progress* progress) {
   params.validate();
@@ -43,7 +57,7 @@ SceneAnalysis analyseScene(const cv::Mat& dem, const cv::Mat& image, double gsd,
     range.setStage(core::StageId::DetectingObjects);
     out.detection = detectBuildings(image, out.ground.aboveGround, out.ground.ndsm, gsd, disparity,
                                     out.ground.regions, params.classify, params.objects, params.detect,
-                                    progress ? &range : nullptr);
+                                    progress ? &range : nullptr, levelSplitOf(params));
   }
   out.status = out.detection.status;
   core::report(progress, 1.0);

@@ -57,10 +57,12 @@ struct Detection {
 
 // The whole chain on one scene: classify(), extractObjects(), proposeBuildings(). Inputs as in
 // classify() plus the optional disparity map (CV_32F px, NaN no value) that gives the proposals
-// their intervals. Throws like the three steps; a cancel returns status Canceled.
+// their intervals; with `regions`, building pieces are split into height levels by `split`.
+// Throws like the three steps; a cancel returns status Canceled.
 Detection detectBuildings(const cv::Mat& image, const cv::Mat& aboveGround, const cv::Mat& ndsm, double gsd,
                           const cv::Mat& disparity = {}, const cv::Mat& regions = {},
                           const ClassifyParams& classifyParams = {}, const ObjectParams& objectParams = {},
-                          const DetectParams& detectParams = {}, core::Progress* progress = nullptr);
+                          const DetectParams& detectParams = {}, core::Progress* progress = nullptr,
+                          const LevelSplit& split = {});
 
 }  // namespace delineo::segmentation

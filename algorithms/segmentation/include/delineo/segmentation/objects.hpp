@@ -1,6 +1,6 @@
 #pragma once
 // Above-ground objects: the connected above-ground pieces of one class (building or vegetation)
-// of a classification, each with its outline, area, heights above the DTM and, with a disparity
+// of a classification, building pieces split into their height levels (levels.hpp), each with its outline, area, heights above the DTM and, with a disparity
 // map, its roof disparity interval and the ground disparity next to it (docs/dem.md, "Building vs
 // vegetation, objects and proposals"). Left-image pixel coordinates. No GUI interaction here.
 #include <limits>
@@ -12,6 +12,7 @@
 #include "delineo/core/params.hpp"
 #include "delineo/core/progress.hpp"
 #include "delineo/segmentation/classify.hpp"
+#include "delineo/segmentation/levels.hpp"
 
 namespace delineo::segmentation {
 
@@ -65,11 +66,15 @@ struct ObjectSet {
 };
 
 // The objects of `labels` (CV_8U ClassLabel). `ndsm`: CV_32F heights above the DTM (m, NaN no
-// data). `disparity`: optional CV_32F map (px, NaN no value). Throws core::Error: UnsupportedInput
-// for empty or wrongly typed rasters, MismatchedInputs for sizes that differ, InvalidParameter
-// for bad parameters or gsd. Polls `progress`; a cancel returns the objects found so far.
+// data). `disparity`: optional CV_32F map (px, NaN no value). `regions`: optional CV_32S region
+// map (the ground segmentation's, -1 none); with it every building piece is split into its
+// height levels by `split` (levels.hpp), each level an object. Throws core::Error:
+// UnsupportedInput for empty or wrongly typed rasters, MismatchedInputs for sizes that differ,
+// InvalidParameter for bad parameters or gsd. Polls `progress`; a cancel returns the objects
+// found so far.
 ObjectSet extractObjects(const cv::Mat& labels, const cv::Mat& ndsm, double gsd, const ObjectParams& params = {},
-                         const cv::Mat& disparity = {}, core::Progress* progress = nullptr);
+                         const cv::Mat& disparity = {}, core::Progress* progress = nullptr,
+                         const cv::Mat& regions = {}, const LevelSplit& split = {});
 
 // The outline of the non-zero pixels of `mask` (CV_8U, one connected piece expected; the largest
 // is taken): outer ring and the holes of at least `minHolePixels`, traced a quarter pixel inside

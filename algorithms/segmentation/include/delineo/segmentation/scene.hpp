@@ -31,7 +31,8 @@ struct SceneAnalysis {
 };
 
 // Stages: 1. ground / above-ground and DTM on `dem` (segmentGround); 2. building vs vegetation on
-// the above-ground regions of `image`; 3. objects (outline, area, heights, intervals read from
+// the above-ground regions of `image`; 3. objects (building pieces split where their regions
+// stand critical-height apart, levels.hpp; outline, area, heights, intervals read from
 // `disparity` when given); 4. building proposals. `dem`: CV_32F heights in metres (NaN = no
 // data) on the left image's grid; `image`: the left image, CV_8U grey or BGR, same size;
 // `gsd`: metres per pixel. Throws core::Error: InvalidParameter (parameters, gsd),
