@@ -94,6 +94,13 @@ std::uint64_t pairKey(int a, int b) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
 }
 
+// The q-quantile (0..1) of `v` (not empty), by partial sort.
+float quantile(std::vector<float>& v, double q) {
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
 float median(std::vector<float> v) {
   std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
   return v[v.size() / 2];
@@ -102,7 +109,7 @@ float median(std::vector<float> v) {
 // The parts after merging: every level smaller than `minPixels` or without contact off the piece
 // joins, smallest first, the neighbour it shares most border with. `partOf`: region -> level.
 void mergeSmallLevels(std::vector<int>& partOf, const std::vector<RegionStats>& stats,
-                      const std::map<std::uint64_t, Border>& borders, double minPixels) {
+                      const std::map<std::uint64_t, Border>& borders, double minPixels, const std::vector<bool>& ramp) {
   const size_t n = partOf.size();
   std::vector<long> pixels(n, 0), outside(n, 0);
   for (size_t r = 0; r < n; ++r) {
@@ -121,7 +128,7 @@ void mergeSmallLevels(std::vector<int>& partOf, const std::vector<RegionStats>& 
   for (;;) {
     int small = -1;
     for (size_t p = 0; p < n; ++p) {
-      if (shared[p].empty() || (pixels[p] >= minPixels && outside[p] > 0)) continue;
+      if (shared[p].empty() || (pixels[p] >= minPixels && outside[p] > 0 && !ramp[p])) continue;
       if (small < 0 || pixels[p] < pixels[static_cast<size_t>(small)]) small = static_cast<int>(p);
     }
     if (small < 0) break;
@@ -241,7 +248,22 @@ cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat&
   }
   std::vector<int> partOf(static_cast<size_t>(n));
   for (int r = 0; r < n; ++r) partOf[static_cast<size_t>(r)] = rootOf(parent, r);
-  mergeSmallLevels(partOf, stats, borders, rules.minPartArea / (gsd * gsd));
+  // Ramps: levels whose heights span more than 2 δ_0 from their 10th to their 90th percentile
+  // (a wall seen obliquely but less steep than the wall slope) are no roof of their own.
+  std::vector<std::vector<float>> levelHeights(static_cast<size_t>(n));
+  for (int y = 0; y < piece.rows; ++y) {
+    for (int x = 0; x < piece.cols; ++x) {
+      const int id = local.at<int>(y, x);
+      const float h = ndsm.at<float>(y, x);
+      if (id >= 0 && std::isfinite(h)) levelHeights[static_cast<size_t>(partOf[static_cast<size_t>(id)])].push_back(h);
+    }
+  }
+  std::vector<bool> ramp(static_cast<size_t>(n), false);
+  for (size_t l = 0; l < ramp.size(); ++l) {
+    std::vector<float>& h = levelHeights[l];
+    if (!h.empty()) ramp[l] = quantile(h, 0.9) - quantile(h, 0.1) > 2.0 * rules.minStep;
+  }
+  mergeSmallLevels(partOf, stats, borders, rules.minPartArea / (gsd * gsd), ramp);
   // Parts numbered 1..count in scan order.
   std::vector<int> number(static_cast<size_t>(n), 0);
   count = 0;

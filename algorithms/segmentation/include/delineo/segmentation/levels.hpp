@@ -6,9 +6,10 @@
 // Regions of the piece whose step along their common border (read `step-band` inside each side,
 // median over the border) is under the critical height δ_0 form one level; wall regions (steep
 // on most of their pixels: the ramps of walls in left-image geometry) join the level they touch
-// whose height is nearest their top (the roof they hang from); a level smaller than the least building area, or touching nothing outside the
-// piece (a superstructure or an atrium inside its roof), joins the neighbour it shares most
-// border with.
+// whose height is nearest their top (the roof they hang from); a level smaller than the least
+// building area, touching nothing outside the piece (a superstructure or an atrium inside its
+// roof), or spanning more than 2 δ_0 from its 10th to its 90th height percentile (a wall's ramp
+// less steep than the wall slope) joins the neighbour it shares most border with.
 #include <opencv2/core.hpp>
 
 namespace delineo::segmentation {
