@@ -75,8 +75,8 @@ struct EnergyWeights {
 };
 
 // Contour length unit of the edge terms: a full-contrast edge (normalised gradient 1) across the
-// contour is worth edgeUnit * λ per pixel of contour, i.e. 1.5 with λ = 5 (measured on the
-// simulator: 0.05 and 0.15 left a 1-2 px outward bias). docs/delineation.md explains the choice.
+// contour is worth edgeUnit * λ per pixel of contour, i.e. 0.75 with λ = 5. docs/delineation.md
+// explains the choice.
 inline constexpr double kEdgeUnit = 0.15;
 
 struct EnergyTerms {
