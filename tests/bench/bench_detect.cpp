@@ -30,6 +30,7 @@
 #include "delineo/segmentation/ground.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
+#include "simulated_match.hpp"
 
 using namespace delineo;
 using namespace delineo::segmentation;
@@ -75,23 +76,6 @@ GroundSegmentation demSegmentation(const cv::Mat& dem, double gsd) {
   return {g.aboveGround, g.dtm, g.ndsm, g.regions};
 }
 
-// The matcher's DEM of the scene: its disparity through the scene's height model.
-cv::Mat matcherDem(const sim::Scene& scene, const cv::Mat& disparity) {
-  dem::HeightModel model;
-  model.metresPerPixel = scene.metresPerDisparity;
-  model.groundDisparity = scene.groundDisparity;
-  return dem::heightsFromDisparity(disparity, model);
-}
-
-cv::Mat matchScene(const sim::Scene& scene) {
-  cv::Mat left, right;
-  scene.left.convertTo(left, CV_32F);
-  scene.right.convertTo(right, CV_32F);
-  stereo::MatchParams mp;
-  mp.dmin = scene.disparityMin;
-  mp.dmax = scene.disparityMax;
-  return stereo::matchStereo(left, right, mp).disparity;
-}
 
 double iouOf(const core::Polygon& a, const core::Polygon& b, cv::Size size) {
   const cv::Mat ma = core::rasterize(a, size), mb = core::rasterize(b, size);
@@ -306,9 +290,9 @@ int main(int argc, char** argv) {
     sp.seed = firstSeed + s;
     const sim::Scene scene = sim::simulateScene(sp);
     const bool needMap = chain || ground == "matcher";
-    const cv::Mat map = needMap ? matchScene(scene) : cv::Mat();
+    const cv::Mat map = needMap ? bench::matchScene(scene) : cv::Mat();
     const GroundSegmentation seg = ground == "truth"     ? truthSegmentation(scene)
-                                   : ground == "matcher" ? demSegmentation(matcherDem(scene, map), scene.gsd)
+                                   : ground == "matcher" ? demSegmentation(bench::sceneHeights(scene, map), scene.gsd)
                                                          : demSegmentation(scene.dem, scene.gsd);
     for (size_t v = 0; v < variants.size(); ++v) {
       const auto t0 = cv::getTickCount();

@@ -37,6 +37,7 @@
 #include "delineo/segmentation/ground.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
+#include "simulated_match.hpp"
 
 using namespace delineo;
 
@@ -119,18 +120,7 @@ void printScore(const char* scene, const char* demName, const Score& s) {
   if (std::getenv("BENCH_VERBOSE")) std::printf("       DEM error on the false pixels: %+.2f m\n", s.falseDemError);
 }
 
-cv::Mat matcherDem(const sim::Scene& scene) {
-  cv::Mat left, right;
-  scene.left.convertTo(left, CV_32F);
-  scene.right.convertTo(right, CV_32F);
-  stereo::MatchParams mp;
-  mp.dmin = scene.disparityMin;
-  mp.dmax = scene.disparityMax;
-  dem::HeightModel model;
-  model.metresPerPixel = scene.metresPerDisparity;
-  model.groundDisparity = scene.groundDisparity;
-  return dem::heightsFromDisparity(stereo::matchStereo(left, right, mp).disparity, model);
-}
+cv::Mat matcherDem(const sim::Scene& scene) { return bench::sceneHeights(scene, bench::matchScene(scene)); }
 
 int simulated(int scenes, int firstSeed, sim::SceneParams sceneParams, const segmentation::GroundParams& params,
               bool withMatcher, const std::string& dumpDir) {
