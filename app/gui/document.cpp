@@ -35,28 +35,11 @@ cv::Mat toDisplayGrey(const cv::Mat& grey) {
   return out;
 }
 
-// A BGR 8-bit copy of a colour raster (3 or more bands, read in file order R, G, B) for display;
-// empty for a grey one. Deeper integer bands are stretched from their range to 0..255.
+// A BGR 8-bit copy of a colour raster (io::readImage8: the first three bands as R, G, B, deeper
+// values stretched to 0..255) for display; empty for a grey one.
 cv::Mat toDisplayColour(const std::string& path) {
-  const io::Raster raster = io::readRaster(path);
-  if (raster.data.channels() < 3) return {};
-  cv::Mat rgb;
-  if (raster.data.channels() == 3) {
-    rgb = raster.data;
-  } else {
-    cv::Mat bands[CV_CN_MAX];
-    cv::split(raster.data, bands);
-    cv::merge(bands, 3, rgb);  // a fourth (alpha, infrared) band is not shown
-  }
-  if (rgb.depth() != CV_8U) {
-    double lo = 0, hi = 0;
-    cv::minMaxLoc(rgb.reshape(1), &lo, &hi);
-    const double scale = hi > lo ? 255.0 / (hi - lo) : 1.0;
-    rgb.convertTo(rgb, CV_8U, scale, -lo * scale);
-  }
-  cv::Mat bgr;
-  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-  return bgr;
+  cv::Mat image = io::readImage8(path);
+  return image.channels() == 3 ? image : cv::Mat();
 }
 }  // namespace
 
