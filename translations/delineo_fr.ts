@@ -291,8 +291,8 @@
         <translation>Garde des hauteurs intermédiaires</translation>
     </message>
     <message>
-        <source>Other height cost</source>
-        <translation>Coût d’une autre hauteur</translation>
+        <source>Disparity map cost</source>
+        <translation>Coût de la carte de disparité</translation>
     </message>
     <message>
         <source>Band best cost</source>

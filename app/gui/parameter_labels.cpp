@@ -48,7 +48,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Cost cap floor"),
     QT_TRANSLATE_NOOP("Parameters", "Intermediate height margin"),
     QT_TRANSLATE_NOOP("Parameters", "Intermediate height guard"),
-    QT_TRANSLATE_NOOP("Parameters", "Other height cost"),
+    QT_TRANSLATE_NOOP("Parameters", "Disparity map cost"),
     QT_TRANSLATE_NOOP("Parameters", "Band best cost"),
     // stereo::MatchParams
     QT_TRANSLATE_NOOP("Parameters", "Method"),

@@ -321,7 +321,7 @@ int real(const std::string& dataRoot, const std::string& labels, const std::stri
         dr.init = rect;
         dr.roof = {proposal.low, proposal.high};
         dr.searchRange = delineation::DisparityInterval{dmin, dmax};
-        dr.disparity = disparity;  // as the GUI and `run` give it (the other-height class)
+        dr.disparity = disparity;  // as the GUI and `run` give it (the map's costs and ground)
         try {
           const auto r = delineation::delineate(lefts[pairName], rights[pairName], dr, {});
           active = r.polygon;

@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
   std::string onlyInit;  // --init box+8|jit6: run one initialisation only
   bool oracleVegetation = false;  // --oracle-vegetation: true tree pixels given as excluded
   // --map: each scene matched (stereo::matchStereo over its ground - 8 .. highest roof + 8 px), the
-  // map and that range given with every request, as the GUI and `run` do (the other-height class).
+  // map and that range given with every request, as the GUI and `run` do (the map's costs and ground).
   bool withMap = false;
   bool diag = false;     // --diag: spatial decomposition of F(truth) - F(result) (implies BENCH_VERBOSE)
   std::map<std::string, DiagTable> diagTotals;  // by init

@@ -7,7 +7,7 @@
 // and `--montage FILE` all roofs in one picture (labelled
 // green, rectangle blue, naive cyan, raw yellow, regularized red). Skips cleanly (exit 0) when the
 // data folder is missing. Disparity maps are cached as in bench_roof_interval. The matcher's map is
-// also the request's disparity map (the other-height class); BENCH_NO_MAP=1 leaves it out.
+// also the request's disparity map (the map's costs and ground); BENCH_NO_MAP=1 leaves it out.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
+#include "delineo/delineation/roof_interval.hpp"
 #include "delineo/stereo/cost_service.hpp"
 
 namespace delineo::delineation {
@@ -207,33 +208,71 @@ std::vector<IntPolygon> regionStageCandidates(const EnergyImages& im, const cv::
   return candidates;
 }
 
-// c_other: Crit at the matcher's disparity (best of d_m - 1, d_m, d_m + 1) where the matcher's
-// map puts the pixel outside the operator's roof interval (widened by `intermediate-guard`) and the
-// ground's; the worst Crit (1) elsewhere, unmatched pixels included. Per pixel, before
-// aggregation. Not the cost volume's own minimum over the range: on a repeated texture (a
-// corrugated roof) a 5x5 window matches some other disparity better than its own, while the
-// matcher's validated map holds the roof's.
-cv::Mat otherHeightCost(const stereo::CorrelationCostService& costs, const cv::Mat& disparity,
-                        const DisparityInterval& roof, const DisparityInterval& ground,
-                        const DelineationParams& params) {
-  const cv::Rect roi = costs.roi();
-  const float r0 = static_cast<float>(roof.min - params.intermediateGuard) - 0.5f;
-  const float r1 = static_cast<float>(roof.max + params.intermediateGuard) + 0.5f;
-  const float g0 = static_cast<float>(ground.min) - 0.5f, g1 = static_cast<float>(ground.max) + 0.5f;
-  cv::Mat other(roi.size(), CV_32F, cv::Scalar(1.0f));
-  for (int y = 0; y < roi.height; ++y) {
-    const float* dm = disparity.ptr<float>(roi.y + y) + roi.x;
-    float* out = other.ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x) {
-      const float d = dm[x];
-      if (!std::isfinite(d) || (d >= r0 && d <= r1) || (d >= g0 && d <= g1)) continue;
-      const int c = static_cast<int>(std::lround(d));
-      for (int k = std::max(c - 1, costs.dmin()); k <= std::min(c + 1, costs.dmax()); ++k) {
-        out[x] = std::min(out[x], costs.cost(roi.x + x, roi.y + y, k));
+// The matcher's validated map as the class evidence where it has a value: a disparity in the roof
+// interval makes c_roof 0 and c_ground `map-cost`; one farther than `intermediate-guard` from it
+// (ground, a neighbour at another height, a crown) the reverse. Unmatched pixels and those within
+// the guard keep their correlation costs. Per pixel, before aggregation. The 5x5 correlation
+// window cannot tell a roof with a repeated or smooth texture from a shift of it, nor a neighbour
+// at another height from the roof; the matcher's adaptive windows, coarse-to-fine search and
+// left-right check can.
+void applyMapCosts(const cv::Mat& disparity, const DisparityInterval& roof, const DelineationParams& params,
+                   cv::Mat& roofCost, cv::Mat& groundCost) {
+  const float r0 = static_cast<float>(roof.min) - 0.5f, r1 = static_cast<float>(roof.max) + 0.5f;
+  const float guard = static_cast<float>(params.intermediateGuard);
+  const float high = static_cast<float>(params.mapCost);
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    float* roofRow = roofCost.ptr<float>(y);
+    float* groundRow = groundCost.ptr<float>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (!std::isfinite(d[x])) continue;
+      if (d[x] >= r0 && d[x] <= r1) {
+        roofRow[x] = 0.0f;
+        groundRow[x] = high;
+      } else if (d[x] < r0 - guard || d[x] > r1 + guard) {
+        roofRow[x] = high;
+        groundRow[x] = 0.0f;
       }
     }
   }
-  return other;
+}
+
+// The ground interval when the request gives none: with the matcher's map, the level of
+// estimateGroundLevel() (the one the GUI's pick and histogram show); without it, or when the map
+// has no ground around the init, the median best disparity of the cost volume in a ring
+// `ring-width` px wide outside the init. ± `ground-tolerance`, kept off the roof interval.
+// Returns the interval and the level.
+std::pair<DisparityInterval, double> estimateGroundInterval(const stereo::CorrelationCostService& costs,
+                                                            const DelineationRequest& request,
+                                                            const core::Polygon& init, const cv::Mat& initMask,
+                                                            float noMatchCost, const DelineationParams& params) {
+  double level = std::numeric_limits<double>::quiet_NaN();
+  if (!request.disparity.empty()) level = estimateGroundLevel(request.disparity, init);
+  if (!std::isfinite(level)) {
+    cv::Mat ring;
+    cv::dilate(initMask, ring, cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                                          {2 * params.ringWidth + 1, 2 * params.ringWidth + 1}));
+    ring &= ~initMask;
+    ring &= (costs.bestCost() <= noMatchCost);
+    cv::Mat bestDisparity;
+    costs.bestDisparity().convertTo(bestDisparity, CV_32F);
+    level = quantile(bestDisparity, 0.5, ring);
+  }
+  if (!std::isfinite(level)) {
+    throw Error(ErrorCode::ProcessingFailed,
+                "cannot estimate the ground disparity: no matched pixel around the initial polygon");
+  }
+  const int g = static_cast<int>(std::lround(level));
+  DisparityInterval ground{g - params.groundTolerance, g + params.groundTolerance};
+  // The ground interval must not overlap the roof's, or both costs would agree on the roof.
+  if (g < request.roof.min) ground.max = std::min(ground.max, request.roof.min - 1);
+  else if (g > request.roof.max) ground.min = std::max(ground.min, request.roof.max + 1);
+  if (ground.min > ground.max) {
+    throw Error(ErrorCode::ProcessingFailed, "the ground disparity estimated around the initial polygon (" +
+                                                 std::to_string(g) + ") falls inside the roof interval " +
+                                                 str(request.roof));
+  }
+  return {ground, g};
 }
 
 }  // namespace
@@ -379,55 +418,24 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   im.noMatchCost = static_cast<float>(quantile(bestCost, 1.0 - params.occlusionPercent / 100.0));
   if (!std::isfinite(im.noMatchCost)) im.noMatchCost = 1.0f;
 
-  // Ground interval: given, or the median best disparity in a ring outside the init.
+  // Ground interval: given, or estimated around the init.
   if (request.ground) {
     out.ground = *request.ground;
     out.groundDisparity = 0.5 * (out.ground.min + out.ground.max);
   } else {
-    cv::Mat ring;
-    cv::dilate(initMask, ring, cv::getStructuringElement(cv::MORPH_ELLIPSE,
-                                                          {2 * params.ringWidth + 1, 2 * params.ringWidth + 1}));
-    ring &= ~initMask;
-    ring &= (bestCost <= im.noMatchCost);
-    cv::Mat bestDisparity;
-    costs.bestDisparity().convertTo(bestDisparity, CV_32F);
-    const double median = quantile(bestDisparity, 0.5, ring);
-    if (!std::isfinite(median)) {
-      throw Error(ErrorCode::ProcessingFailed,
-                  "cannot estimate the ground disparity: no matched pixel around the initial polygon");
-    }
-    const int g = static_cast<int>(std::lround(median));
-    out.ground = {g - params.groundTolerance, g + params.groundTolerance};
-    // The ground interval must not overlap the roof's, or both costs would agree on the roof.
-    if (g < request.roof.min) out.ground.max = std::min(out.ground.max, request.roof.min - 1);
-    else if (g > request.roof.max) out.ground.min = std::max(out.ground.min, request.roof.max + 1);
-    if (out.ground.min > out.ground.max) {
-      throw Error(ErrorCode::ProcessingFailed,
-                  "the ground disparity estimated around the initial polygon (" +
-                      std::to_string(g) + ") falls inside the roof interval " + str(request.roof));
-    }
-    out.groundDisparity = g;
+    std::tie(out.ground, out.groundDisparity) = estimateGroundInterval(costs, request, init, initMask, im.noMatchCost, params);
   }
   std::tie(out.roofSearched, out.groundSearched) =
       costIntervals(request.roof, out.ground, params.balanceIntervals);
   im.roofCost = costs.minCost(out.roofSearched.min, out.roofSearched.max);
   im.groundCost = costs.minCost(out.groundSearched.min, out.groundSearched.max);
-  cv::Mat otherCost;
-  if (params.otherHeightCost < 1 && !request.disparity.empty()) {
-    otherCost = otherHeightCost(costs, request.disparity, request.roof, out.groundSearched, params);
+  if (params.mapCost > 0 && !request.disparity.empty()) {
+    applyMapCosts(request.disparity(roi), request.roof, params, im.roofCost, im.groundCost);
   }
   if (params.costAggregation > 1) {
     const cv::Size k(params.costAggregation, params.costAggregation);
     cv::blur(im.roofCost, im.roofCost, k, {-1, -1}, cv::BORDER_REPLICATE);
     cv::blur(im.groundCost, im.groundCost, k, {-1, -1}, cv::BORDER_REPLICATE);
-    if (!otherCost.empty()) cv::blur(otherCost, otherCost, k, {-1, -1}, cv::BORDER_REPLICATE);
-  }
-  if (!otherCost.empty()) {
-    // The outside class is a mixture: ground, or a surface at another height at a prior cost.
-    // A neighbour at another height than the roof matches the roof interval better than the
-    // ground's (NCC of a smooth texture degrades slowly with the shift), its own height better
-    // still.
-    im.groundCost = cv::min(im.groundCost, otherCost + static_cast<float>(params.otherHeightCost));
   }
 
   out.excluded = cv::Mat::zeros(size, CV_8U);

@@ -322,7 +322,7 @@ TEST(Delineate, LeavesANeighbourAtAnotherHeightOutside) {
   // A taller block along the roof's south side, as bright as the roof, with a smooth texture:
   // at the roof's disparities it matches better than at the ground's (5 px off against 15), so
   // c_roof < c_ground there, and the operator's rectangle takes in part of it. The matcher's
-  // map (here the true disparities) puts it at its own height, where it matches best.
+  // map (here the true disparities) puts it at its own height: outside the roof interval.
   const cv::Rect roof(50, 40, 60, 50), neighbour(40, 90, 80, 30);
   const cv::Size size(180, 160);
   const Pair pair = layeredPair(size, 4,
@@ -339,18 +339,48 @@ TEST(Delineate, LeavesANeighbourAtAnotherHeightOutside) {
   req.searchRange = DisparityInterval{0, 28};
   req.disparity = disparity;
   DelineationParams off;
-  off.otherHeightCost = 1;
+  off.mapCost = 0;
   const DelineationParams on;
   const double without = iou(delineate(pair.left, pair.right, req, off).polygon, truth, size);
   const double with = iou(delineate(pair.left, pair.right, req, on).polygon, truth, size);
   RecordProperty("iou_without", std::to_string(without));
   RecordProperty("iou_with", std::to_string(with));
-  EXPECT_LT(without, 0.85) << "without the other-height class the neighbour is taken as roof";
+  EXPECT_LT(without, 0.85) << "without the map's costs the neighbour is taken as roof";
   EXPECT_GT(with, 0.93) << "without " << without;
-  // Without a map the term has nothing to read: the outline is the ground-only one.
+  // Without a map there is nothing to read: the outline is the correlation costs' one.
   DelineationRequest noMap = req;
   noMap.disparity.release();
   EXPECT_NEAR(iou(delineate(pair.left, pair.right, noMap, on).polygon, truth, size), without, 1e-9);
+}
+
+TEST(Delineate, TakesTheGroundFromTheMatchersMapWhenATallerNeighbourRingsTheInit) {
+  // A taller block frames the roof just outside the operator's rectangle (a courtyard building):
+  // the ring around the rectangle lies on it. The matcher's map shows the ground beyond it, as
+  // the GUI's pick and histogram read it (estimateGroundLevel).
+  const cv::Rect roof(70, 60, 60, 50);
+  const cv::Size size(220, 190);
+  const cv::Mat frameTexture = texture(size + cv::Size(64, 0), 130, 25, 7);
+  const std::vector<cv::Rect> frame{{40, 30, 120, 22}, {40, 118, 120, 22}, {40, 52, 22, 66}, {138, 52, 22, 66}};
+  std::vector<Layer> layers{{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)}};
+  for (const cv::Rect& r : frame) layers.push_back({r, 22, frameTexture});
+  const Pair pair = layeredPair(size, 4, layers);
+  cv::Mat disparity(size, CV_32F, cv::Scalar(4.0f));
+  for (const cv::Rect& r : frame) disparity(r).setTo(22.0f);
+  disparity(roof).setTo(14.0f);
+  const core::Polygon truth{{{70, 60}, {130, 60}, {130, 110}, {70, 110}}, {}};
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.searchRange = DisparityInterval{0, 28};
+  req.disparity = disparity;
+  const auto withMap = delineate(pair.left, pair.right, req, DelineationParams{});
+  EXPECT_NEAR(0.5 * (withMap.ground.min + withMap.ground.max), 4.0, 1.0);
+  EXPECT_GT(iou(withMap.polygon, truth, size), 0.9);
+  // Without the map the ring's median is the frame's disparity, above the roof.
+  DelineationRequest noMap = req;
+  noMap.disparity.release();
+  const auto ring = delineate(pair.left, pair.right, noMap, DelineationParams{});
+  EXPECT_GT(ring.ground.min, req.roof.max);
 }
 
 TEST(Delineate, RejectsBadInputs) {

@@ -30,7 +30,7 @@ struct DelineationRequest {
   // largest connected component is used.
   cv::Mat initMask;
   DisparityInterval roof;                     // Δd_b, required
-  std::optional<DisparityInterval> ground;    // Δd_g; estimated from a ring around the init when unset
+  std::optional<DisparityInterval> ground;    // Δd_g; estimated around the init when unset
   std::optional<DisparityInterval> searchRange;  // full search range, when the caller knows it
   // Optional CV_8U mask of the left image's size, non-zero where a pixel is known not to belong
   // to the roof (vegetation from a classification or a near-infrared band, a neighbour's roof
@@ -39,8 +39,8 @@ struct DelineationRequest {
   // well as a roof does, and the correlation costs alone cannot keep them out.
   cv::Mat excludeMask;
   // Optional CV_32F of the left image's size: the matcher's disparity map (NaN = unmatched). Where
-  // it puts a pixel at another height than the roof and the ground, the pixel may be explained
-  // outside the outline as that surface (`other-height-cost`); empty = ground only.
+  // it has a value, c_roof and c_ground come from it (`map-cost`), and the ground interval, when
+  // not given, is estimateGroundLevel() on it; empty = the correlation costs alone.
   cv::Mat disparity;
 };
 

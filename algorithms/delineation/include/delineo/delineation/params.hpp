@@ -38,7 +38,7 @@ struct DelineationParams {
   double costCapFloor = 0.35;      // Crit units: the cap is never below this
   double intermediateMargin = 0.1; // Crit units: in-between match this much better: not roof (0 = off)
   int intermediateGuard = 1;       // disparities kept off each interval when looking between them
-  double otherHeightCost = 0.05;   // Crit units: prior cost of "another height" for a pixel outside (1 = off)
+  double mapCost = 0.6;            // Crit units: where the matcher's map has a value, cost of the class it rules out (0 = off)
   bool bandBestCost = false;       // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost, the paper)
   RegularizationParams regularization;  // the outline's last stage (its keys start with regularize)
   template <class V>
@@ -186,13 +186,11 @@ struct DelineationParams {
                       "window straddling a roof edge matches just inside the gap)",
                       0, 16},
       intermediateGuard);
-    v(core::ParamInfo{"other-height-cost", "Other height cost", "",
-                      "A pixel outside the outline is ground or a surface at another height (a "
-                      "neighbour, a lower wing): where the matcher's disparity map puts it off the "
-                      "roof and ground intervals, it costs the lower of c_ground and Crit at that "
-                      "disparity plus this (1 = ground only)",
+    v(core::ParamInfo{"map-cost", "Disparity map cost", "",
+                      "Where the matcher's disparity map has a value, c_roof and c_ground come from "
+                      "it: 0 for the class it shows, this for the other (0 = correlation costs only)",
                       0, 1},
-      otherHeightCost);
+      mapCost);
     v(core::ParamInfo{"band-best-cost", "Band best cost", "",
                       "A pixel of the occlusion band costs NoMatchCost or, when higher, the lower of "
                       "c_roof and c_ground there, so that the band is never cheaper than the pixel's "

@@ -38,7 +38,7 @@ struct StereoPair {
   io::GeoReference geo;  // of the left image
   cv::Mat exclude;  // CV_8U, 255 on pixels that are not roof (project's images.exclude), or empty
   // CV_32F, the matcher's disparity map when there is one (NaN = unmatched), or empty: the active
-  // polygon's other-height class reads it. Not read by readStereoPair: set by whoever holds it.
+  // polygon's costs and ground estimate read it. Not read by readStereoPair: set by whoever holds it.
   cv::Mat disparity;
 };
 StereoPair readStereoPair(const Project& project);
