@@ -338,12 +338,14 @@ class Optimiser {
   }
 
   // After convergence, an interior region where the ground interval matches clearly better
-  // than the roof interval is tried as a courtyard: a hole ring is initialised on it and
-  // optimised with the rest; it is kept only when the final energy is lower.
+  // than the roof interval, and that the matcher's map does not put above the roof, is tried as
+  // a courtyard: a hole ring is initialised on it and optimised with the rest; it is kept only
+  // when the final energy is lower.
   void addCourtyards() {
     const IntPolygon before = energy_.polygon();
     const cv::Mat inside = core::rasterize(toPolygon(before), energy_.size());
     cv::Mat groundLike = groundLeaning(inside);
+    if (!images_.aboveRoof.empty()) groundLike &= (images_.aboveRoof == 0);
     // Keep away from the outer ring so that the hole starts strictly inside it.
     cv::Mat interior;
     cv::erode(inside, interior, cv::getStructuringElement(cv::MORPH_RECT, {7, 7}));

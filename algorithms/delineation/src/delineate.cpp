@@ -431,6 +431,7 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   im.groundCost = costs.minCost(out.groundSearched.min, out.groundSearched.max);
   if (params.mapCost > 0 && !request.disparity.empty()) {
     applyMapCosts(request.disparity(roi), request.roof, params, im.roofCost, im.groundCost);
+    im.aboveRoof = request.disparity(roi) > static_cast<float>(request.roof.max + params.intermediateGuard) + 0.5f;
   }
   if (params.costAggregation > 1) {
     const cv::Size k(params.costAggregation, params.costAggregation);

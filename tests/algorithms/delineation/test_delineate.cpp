@@ -383,6 +383,29 @@ TEST(Delineate, TakesTheGroundFromTheMatchersMapWhenATallerNeighbourRingsTheInit
   EXPECT_GT(ring.ground.min, req.roof.max);
 }
 
+TEST(Delineate, ASuperstructureAboveTheRoofIsNoCourtyard) {
+  // A plant room 4 px above a flat roof: the map puts it off the roof interval, as it does a
+  // courtyard floor, but above the roof. The footprint keeps it.
+  const cv::Rect roof(50, 40, 80, 60), plant(80, 60, 22, 22);
+  const cv::Size size(190, 150);
+  const Pair pair = layeredPair(size, 4,
+                                {{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
+                                 {plant, 18, texture(size + cv::Size(64, 0), 120, 25, 3)}});
+  cv::Mat disparity(size, CV_32F, cv::Scalar(4.0f));
+  disparity(roof).setTo(14.0f);
+  disparity(plant).setTo(18.0f);
+  const core::Polygon truth{{{50, 40}, {130, 40}, {130, 100}, {50, 100}}, {}};
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  req.searchRange = DisparityInterval{0, 28};
+  req.disparity = disparity;
+  const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
+  EXPECT_TRUE(r.polygon.holes.empty()) << r.polygon.holes.size() << " holes";
+  EXPECT_GT(iou(r.polygon, truth, size), 0.93);
+}
+
 TEST(Delineate, RejectsBadInputs) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);

@@ -55,6 +55,10 @@ struct EnergyImages {
   // CV_8U, same size, optional: non-zero where a vertex may go (a vertex at pixel corner (x, y)
   // is allowed when one of the four pixels around it is). Empty = anywhere in the ROI.
   cv::Mat allowed;
+  // CV_8U, same size, optional: non-zero where the matcher's map puts the pixel above the roof
+  // interval (a plant room, a taller neighbour). No courtyard starts there: a courtyard is lower
+  // than its roof. Empty = no map.
+  cv::Mat aboveRoof;
 };
 
 struct EnergyWeights {
