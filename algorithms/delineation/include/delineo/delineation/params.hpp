@@ -18,7 +18,7 @@ struct DelineationParams {
   double costBrightness = 20.0;    // × noise sigma: Crit's mean grey term for flat windows (0 = NCC only)
   int groundTolerance = 3;         // px, half width of the ground interval estimated from the ring
   int groundSearch = 64;           // px searched below the roof interval when ground is unknown
-  int ringWidth = 8;               // px, width of the band outside the init used to estimate ground
+  int ringWidth = 8;               // px, width of the band outside the init used to estimate ground without a map
   bool edgeMoves = true;           // also translate whole edges (two vertices at once)
   bool courtyards = true;          // look for inner courtyards after convergence (holes)
   bool notches = true;             // carve ground regions reaching the outline after convergence
@@ -88,7 +88,7 @@ struct DelineationParams {
                       1024},
       groundSearch);
     v(core::ParamInfo{"ring-width", "Ring width", "px",
-                      "Width of the band outside the init where ground disparity is estimated", 2,
+                      "Width of the band outside the init where ground disparity is estimated when there is no disparity map", 2,
                       200},
       ringWidth);
     v(core::ParamInfo{"edge-moves", "Edge moves", "",
