@@ -191,8 +191,8 @@ int run(const std::vector<std::string>& args) {
              "mask of the left image's size, non-zero where a pixel is known not to be roof "
              "(vegetation, a neighbour's roof); kept outside every outline")
       .value("disparity", "FILE",
-             "the matcher's disparity map (float, the left image's size, NaN = none): pixels it "
-             "puts at another height than the roof and the ground may stay outside as that surface")
+             "the matcher's disparity map (float, the left image's size, NaN = none): where it has a "
+             "value it says roof or not (map-cost), and it gives the ground when none is given")
       .required("out", "FILE", "output polygons (GeoJSON/GeoPackage) with energies and status")
       .flag("quiet", "no progress and no range estimate on stderr")
       .params(delineation::DelineationParams{});
