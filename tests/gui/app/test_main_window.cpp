@@ -14,7 +14,6 @@
 #include <QSettings>
 #include <QSignalSpy>
 #include <QSpinBox>
-#include <QStandardPaths>
 #include <QTabWidget>
 #include <QTableView>
 #include <QTableWidget>
@@ -29,7 +28,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
@@ -53,6 +51,7 @@
 #include "delineo/widgets/stage_text.hpp"
 #include "document.hpp"
 #include "main_window.hpp"
+#include "sample_window.hpp"
 
 using namespace delineo;
 using gui::MainWindow;
@@ -169,24 +168,12 @@ class MainWindowTest : public QObject {
 
  private slots:
   void initTestCase() {
-    QStandardPaths::setTestModeEnabled(true);
-    QCoreApplication::setOrganizationName(QStringLiteral("DelineoTest"));
-    QSettings().clear();
-    QSettings().setValue(QStringLiteral("autoMatch"), false);
     // Each step is driven by the test (the automatic run on pick is tested on its own).
-    QSettings().setValue(QStringLiteral("delineateOnPick"), false);
+    guitest::isolateSettings(QStringLiteral("DelineoTest"), false);
     QVERIFY(dir_.isValid());
     if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
-    // Made on a worker thread, as the application does (its job runner).
-    const std::string sampleDir = dir_.filePath(QStringLiteral("sample")).toStdString();
-    std::string made;
-    std::thread maker([&] { made = project::ensureSampleProject(sampleDir); });
-    maker.join();
-    projectPath_ = QString::fromStdString(made);
-    window_ = std::make_unique<MainWindow>();
-    window_->setInteractive(false);
-    window_->resize(1300, 850);
-    window_->show();
+    projectPath_ = guitest::makeSampleProject(dir_);
+    window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
   }
 

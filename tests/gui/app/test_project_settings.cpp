@@ -7,16 +7,13 @@
 #include <QDoubleSpinBox>
 #include <QLabel>
 #include <QLineEdit>
-#include <QSettings>
 #include <QSignalSpy>
 #include <QSpinBox>
-#include <QStandardPaths>
 #include <QTabWidget>
 #include <QTemporaryDir>
 #include <QTest>
 #include <QUndoStack>
 #include <filesystem>
-#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
@@ -30,6 +27,7 @@
 #include "document.hpp"
 #include "main_window.hpp"
 #include "project_settings_dialog.hpp"
+#include "sample_window.hpp"
 
 using namespace delineo;
 using gui::MainWindow;
@@ -58,21 +56,12 @@ class ProjectSettingsTest : public QObject {
 
  private slots:
   void initTestCase() {
-    QStandardPaths::setTestModeEnabled(true);
-    QCoreApplication::setOrganizationName(QStringLiteral("DelineoSettingsTest"));
-    QSettings().clear();
-    QSettings().setValue(QStringLiteral("autoMatch"), false);
+    // A pick starts the active polygon here, as it does for the operator.
+    guitest::isolateSettings(QStringLiteral("DelineoSettingsTest"), true);
     QVERIFY(dir_.isValid());
     if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
-    const std::string sampleDir = dir_.filePath(QStringLiteral("sample")).toStdString();
-    std::string made;
-    std::thread maker([&] { made = project::ensureSampleProject(sampleDir); });
-    maker.join();
-    projectPath_ = QString::fromStdString(made);
-    window_ = std::make_unique<MainWindow>();
-    window_->setInteractive(false);
-    window_->resize(1300, 850);
-    window_->show();
+    projectPath_ = guitest::makeSampleProject(dir_);
+    window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
   }
 

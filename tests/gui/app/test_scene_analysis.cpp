@@ -4,14 +4,11 @@
 // analysis changing nothing, the message when heights are missing, the parameter tabs.
 #include <QAction>
 #include <QComboBox>
-#include <QSettings>
 #include <QSignalSpy>
-#include <QStandardPaths>
 #include <QTableView>
 #include <QTemporaryDir>
 #include <QTest>
 #include <QUndoStack>
-#include <thread>
 
 #include <opencv2/core.hpp>
 
@@ -22,6 +19,7 @@
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "document.hpp"
 #include "main_window.hpp"
+#include "sample_window.hpp"
 
 using namespace delineo;
 using gui::MainWindow;
@@ -67,22 +65,12 @@ class SceneAnalysisTest : public QObject {
 
  private slots:
   void initTestCase() {
-    QStandardPaths::setTestModeEnabled(true);
-    QCoreApplication::setOrganizationName(QStringLiteral("DelineoSceneTest"));
-    QSettings().clear();
-    QSettings().setValue(QStringLiteral("autoMatch"), false);
-    QSettings().setValue(QStringLiteral("delineateOnPick"), false);
+    guitest::isolateSettings(QStringLiteral("DelineoSceneTest"), false);
     QVERIFY(dir_.isValid());
     if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
     if (!project::sceneAnalysisAvailable()) QSKIP("no scene analysis in this build");
-    std::string made;
-    std::thread maker([&] { made = project::ensureSampleProject(dir_.filePath(QStringLiteral("sample")).toStdString()); });
-    maker.join();
-    projectPath_ = QString::fromStdString(made);
-    window_ = std::make_unique<MainWindow>();
-    window_->setInteractive(false);
-    window_->resize(1300, 850);
-    window_->show();
+    projectPath_ = guitest::makeSampleProject(dir_);
+    window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
   }
 
