@@ -30,6 +30,7 @@
 #include "delineo/segmentation/ground.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
+#include "proposal_request.hpp"
 #include "simulated_match.hpp"
 
 using namespace delineo;
@@ -108,14 +109,6 @@ struct Tally {
                 100.0 * vegAsBuilding / std::max(1L, vegetation));
   }
 };
-
-double number(const core::Feature& f, const char* key) {
-  const auto it = f.attributes.find(key);
-  if (it == f.attributes.end()) return std::nan("");
-  if (const auto* i = std::get_if<long long>(&it->second)) return static_cast<double>(*i);
-  if (const auto* d = std::get_if<double>(&it->second)) return *d;
-  return std::nan("");
-}
 
 struct ProposalScore {
   int targets = 0, found = 0, proposals = 0, falses = 0;
@@ -318,22 +311,12 @@ int main(int argc, char** argv) {
     std::vector<core::Polygon> outlines;
     delineation::DelineationParams params;
     for (const auto& f : dm.proposals) {
-      if (!std::isfinite(number(f, "roof_disparity_min"))) continue;
-      delineation::DelineationRequest req;
-      req.init = f.polygon;
-      req.init.holes.clear();
-      req.roof = {static_cast<int>(number(f, "roof_disparity_min")), static_cast<int>(number(f, "roof_disparity_max"))};
-      const double g = number(f, "ground_disparity");
-      if (std::isfinite(g)) {
-        req.ground = delineation::DisparityInterval{static_cast<int>(g) - params.groundTolerance,
-                                                    static_cast<int>(g) + params.groundTolerance};
-      }
-      req.disparity = map;
-      req.searchRange = delineation::DisparityInterval{scene.disparityMin, scene.disparityMax};
+      const auto req = bench::proposalRequest(f, map, {scene.disparityMin, scene.disparityMax}, params.groundTolerance);
+      if (!req) continue;
       try {
-        outlines.push_back(delineation::delineate(left, right, req, params).polygon);
+        outlines.push_back(delineation::delineate(left, right, *req, params).polygon);
       } catch (const std::exception& e) {
-        std::printf("  scene %d proposal %lld failed: %s\n", sp.seed, static_cast<long long>(number(f, "id")), e.what());
+        std::printf("  scene %d proposal %lld failed: %s\n", sp.seed, static_cast<long long>(bench::numberAttribute(f, "id")), e.what());
       }
     }
     scoreProposals(outlines, scene, 100.0, chainScore);

@@ -3,7 +3,10 @@
 //   - Dublin: above-ground vs the LiDAR disparity on the pixels where the LiDAR has a value;
 //   - every pair: how many hand-labelled roofs (tests/bench/data/real_roofs.json) a proposal
 //     covers, how many of them are alone in their proposal (touching buildings merged into one
-//     proposal share it), and an overlay PNG (building red, vegetation green, proposals yellow) to look at.
+//     proposal share it), and an overlay PNG (building red, vegetation green, proposals yellow) to look at;
+//   - with --delineate, the whole automatic chain: the active polygon run from every proposal (its
+//     roof interval and ground, the matcher's map), each labelled roof scored by the best IoU of
+//     the outlines.
 // Heights come from the matcher's disparity (cached as in bench_real_outlines) through a linear
 // model; the pairs come without camera data, so metres per pixel of disparity is the stated
 // assumption below. Skips cleanly when the data folder is missing.
@@ -23,8 +26,11 @@
 
 #include "delineo/core/allocator.hpp"
 #include "delineo/core/params.hpp"
+#include "delineo/delineation/delineate.hpp"
+#include "delineo/eval/polygon_measures.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/segmentation/scene.hpp"
+#include "proposal_request.hpp"
 #include "real_roofs.hpp"
 
 using namespace delineo;
@@ -130,18 +136,56 @@ void drawOverlay(const std::string& path, const cv::Mat& bgr, const segmentation
   cv::imwrite(path, out);
 }
 
+// The active polygon from every proposal; per labelled roof of the pair, the best IoU of the
+// outlines (0 when none overlaps it), and the mean over the roofs reached (IoU >= 0.5).
+void delineateProposals(const std::string& name, const nlohmann::json& pair, const nlohmann::json& roofs,
+                        const fs::path& left, const fs::path& right, const cv::Mat& disparity,
+                        const std::vector<core::Feature>& proposals) {
+  const cv::Mat l = io::readGreyFloat(left.string()), r = io::readGreyFloat(right.string());
+  const delineation::DisparityInterval range{pair.at("disparity_range").at(0).get<int>(),
+                                             pair.at("disparity_range").at(1).get<int>()};
+  const delineation::DelineationParams params;
+  std::vector<core::Polygon> outlines;
+  for (const auto& f : proposals) {
+    const auto req = bench::proposalRequest(f, disparity, range, params.groundTolerance);
+    if (!req) continue;
+    try {
+      outlines.push_back(delineation::delineate(l, r, *req, params).polygon);
+    } catch (const std::exception& e) {
+      std::printf("  proposal %.0f failed: %s\n", bench::numberAttribute(f, "id"), e.what());
+    }
+  }
+  double sum = 0;
+  int reached = 0, labelled = 0;
+  std::printf("  automatic outlines (%zu from %zu proposals), best IoU per labelled roof:", outlines.size(),
+              proposals.size());
+  for (const auto& roof : roofs.at("roofs")) {
+    if (roof.at("pair") != name) continue;
+    const core::Polygon truth = bench::ringOf(roof.at("outline"));
+    double best = 0;
+    for (const auto& o : outlines) best = std::max(best, eval::intersectionOverUnion(o, truth));
+    std::printf(" %s %.3f", roof.at("name").get<std::string>().c_str(), best);
+    ++labelled;
+    if (best >= 0.5) sum += best, ++reached;
+  }
+  std::printf("\n  reached (IoU >= 0.5): %d of %d labelled roofs, mean IoU %.3f\n", reached, labelled,
+              reached > 0 ? sum / reached : std::nan(""));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   std::string data = "../shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json", out = "/tmp";
   std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  bool delineate = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) data = argv[++i];
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
     else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
+    else if (!std::strcmp(argv[i], "--delineate")) delineate = true;
     else {
-      std::fprintf(stderr, "usage: bench_segment_real [--data DIR] [--out DIR] [--cache DIR]\n");
+      std::fprintf(stderr, "usage: bench_segment_real [--data DIR] [--out DIR] [--cache DIR] [--delineate]\n");
       return 2;
     }
   }
@@ -228,6 +272,7 @@ int main(int argc, char** argv) {
       const fs::path gt = fs::path(data) / pair.at("ground_truth_disparity").get<std::string>();
       if (fs::exists(gt)) scoreAgainstLidar(gt.string(), a.ground.aboveGround, dem == dem, 2.0 / model.metresPerPixel);
     }
+    if (delineate) delineateProposals(name, pair, roofs, left, right, disparity, a.detection.proposals);
     const std::string png = (fs::path(out) / ("scene_" + name + ".png")).string();
     cv::Mat bgr = image;
     if (bgr.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
