@@ -268,6 +268,15 @@ Pair layeredPair(cv::Size size, int groundDisparity, std::vector<Layer> layers) 
   return p;
 }
 
+// The true disparity map of layeredPair's scene, as a perfect matcher would give it (the nearest
+// layer, the largest disparity, in front).
+cv::Mat layeredMap(cv::Size size, int groundDisparity, std::vector<Layer> layers) {
+  std::sort(layers.begin(), layers.end(), [](const Layer& a, const Layer& b) { return a.disparity < b.disparity; });
+  cv::Mat map(size, CV_32F, cv::Scalar(static_cast<float>(groundDisparity)));
+  for (const Layer& l : layers) map(l.area & cv::Rect({}, size)).setTo(static_cast<float>(l.disparity));
+  return map;
+}
+
 TEST(Delineate, KeepsWhatMatchesBetweenTheGroundAndTheRoofOut) {
   // A crown lower than the roof along its south side, as bright as the roof and textured like
   // it: the edge between them is weak, the crown's edge on the ground strong. Its pixels match
@@ -325,12 +334,10 @@ TEST(Delineate, LeavesANeighbourAtAnotherHeightOutside) {
   // map (here the true disparities) puts it at its own height: outside the roof interval.
   const cv::Rect roof(50, 40, 60, 50), neighbour(40, 90, 80, 30);
   const cv::Size size(180, 160);
-  const Pair pair = layeredPair(size, 4,
-                                {{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
-                                 {neighbour, 19, smoothTexture(size + cv::Size(64, 0), 160, 25, 5)}});
-  cv::Mat disparity(size, CV_32F, cv::Scalar(4.0f));
-  disparity(neighbour).setTo(19.0f);
-  disparity(roof).setTo(14.0f);
+  const std::vector<Layer> layers{{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
+                                  {neighbour, 19, smoothTexture(size + cv::Size(64, 0), 160, 25, 5)}};
+  const Pair pair = layeredPair(size, 4, layers);
+  const cv::Mat disparity = layeredMap(size, 4, layers);
   const core::Polygon truth{{{50, 40}, {110, 40}, {110, 90}, {50, 90}}, {}};
   DelineationRequest req;
   req.init = grownBox(cv::Rect(roof.x, roof.y, roof.width, roof.height + 20), 8);
@@ -364,9 +371,7 @@ TEST(Delineate, TakesTheGroundFromTheMatchersMapWhenATallerNeighbourRingsTheInit
   std::vector<Layer> layers{{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)}};
   for (const cv::Rect& r : frame) layers.push_back({r, 22, frameTexture});
   const Pair pair = layeredPair(size, 4, layers);
-  cv::Mat disparity(size, CV_32F, cv::Scalar(4.0f));
-  for (const cv::Rect& r : frame) disparity(r).setTo(22.0f);
-  disparity(roof).setTo(14.0f);
+  const cv::Mat disparity = layeredMap(size, 4, layers);
   const core::Polygon truth{{{70, 60}, {130, 60}, {130, 110}, {70, 110}}, {}};
   DelineationRequest req;
   req.init = grownBox(roof, 8);
@@ -388,12 +393,10 @@ TEST(Delineate, ASuperstructureAboveTheRoofIsNoCourtyard) {
   // courtyard floor, but above the roof. The footprint keeps it.
   const cv::Rect roof(50, 40, 80, 60), plant(80, 60, 22, 22);
   const cv::Size size(190, 150);
-  const Pair pair = layeredPair(size, 4,
-                                {{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
-                                 {plant, 18, texture(size + cv::Size(64, 0), 120, 25, 3)}});
-  cv::Mat disparity(size, CV_32F, cv::Scalar(4.0f));
-  disparity(roof).setTo(14.0f);
-  disparity(plant).setTo(18.0f);
+  const std::vector<Layer> layers{{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
+                                  {plant, 18, texture(size + cv::Size(64, 0), 120, 25, 3)}};
+  const Pair pair = layeredPair(size, 4, layers);
+  const cv::Mat disparity = layeredMap(size, 4, layers);
   const core::Polygon truth{{{50, 40}, {130, 40}, {130, 100}, {50, 100}}, {}};
   DelineationRequest req;
   req.init = grownBox(roof, 8);
