@@ -1289,6 +1289,10 @@
         <translation>Calculez la disparité pour voir l’histogramme.</translation>
     </message>
     <message>
+        <source>Select a building to see the disparities around it.</source>
+        <translation>Sélectionnez un bâtiment pour voir les disparités autour de lui.</translation>
+    </message>
+    <message>
         <source>The 3D view needs a display (X server).</source>
         <translation>La vue 3D a besoin d’un affichage (serveur X).</translation>
     </message>

@@ -198,8 +198,8 @@ void MainWindow::refreshHistogram() {
   histogram_->clearGroundLevel();
   intervalLabel_->clear();
   leftView_->polygons().setRoi({});
-  if (!document_ || selectedId_ <= 0) return;
-  const Building* b = document_->project().find(selectedId_);
+  const Building* b = document_ && selectedId_ > 0 ? document_->project().find(selectedId_) : nullptr;
+  histogram_->setPlaceholder(b == nullptr ? tr("Select a building to see the disparities around it.") : QString());
   if (b == nullptr) return;
   const cv::Rect2d box = core::boundingBox(b->initial.outer);
   int margin = 24;

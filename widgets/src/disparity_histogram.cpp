@@ -144,8 +144,15 @@ void DisparityHistogramWidget::flushPendingSignal() {
   emit intervalChanged(a_, b_);
 }
 
+void DisparityHistogramWidget::setPlaceholder(const QString& text) {
+  if (text == placeholder_) return;
+  placeholder_ = text;
+  drag_ = DragPart::None;
+  update();
+}
+
 void DisparityHistogramWidget::mousePressEvent(QMouseEvent* event) {
-  if (event->button() != Qt::LeftButton) return;
+  if (event->button() != Qt::LeftButton || !placeholder_.isEmpty()) return;
   const double x = event->position().x();
   const double xa = xOfDisparity(a_ - 0.5);
   const double xb = xOfDisparity(b_ + 0.5);
@@ -173,6 +180,7 @@ void DisparityHistogramWidget::mousePressEvent(QMouseEvent* event) {
 }
 
 void DisparityHistogramWidget::mouseMoveEvent(QMouseEvent* event) {
+  if (!placeholder_.isEmpty()) return;
   const double x = event->position().x();
   if (drag_ == DragPart::None) {
     const bool nearHandle = std::abs(x - xOfDisparity(a_ - 0.5)) <= kHandleGrabPx ||
@@ -206,6 +214,10 @@ void DisparityHistogramWidget::mouseReleaseEvent(QMouseEvent* event) {
 }
 
 void DisparityHistogramWidget::keyPressEvent(QKeyEvent* event) {
+  if (!placeholder_.isEmpty()) {
+    QWidget::keyPressEvent(event);
+    return;
+  }
   int step = 0;
   if (event->key() == Qt::Key_Left) step = -1;
   if (event->key() == Qt::Key_Right) step = 1;
@@ -255,6 +267,11 @@ QRectF DisparityHistogramWidget::intervalLabelRect() const {
 void DisparityHistogramWidget::paintEvent(QPaintEvent*) {
   QPainter painter(this);
   painter.fillRect(rect(), palette().color(QPalette::Base));
+  if (!placeholder_.isEmpty()) {
+    painter.setPen(palette().color(QPalette::PlaceholderText));
+    painter.drawText(rect().adjusted(8, 8, -8, -8), Qt::AlignCenter | Qt::TextWordWrap, placeholder_);
+    return;
+  }
   const QRectF plot = plotRect();
   const QFontMetrics fm(font());
   const QColor text = palette().color(QPalette::Text);

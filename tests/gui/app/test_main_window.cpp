@@ -224,6 +224,9 @@ class MainWindowTest : public QObject {
     const cv::Rect truth = largestBuilding(doc->labels());
     widgets::ImageView* view = window_->leftView();
     view->setView(QPointF(truth.x + truth.width / 2.0, truth.y + truth.height / 2.0), 1.5);
+    // Nothing selected yet: the histogram asks for a building instead of showing an interval.
+    QVERIFY(window_->selectedBuilding() <= 0);
+    QVERIFY(!window_->histogram()->placeholder().isEmpty());
     window_->action(QStringLiteral("actionPickRectangle"))->trigger();
     QCOMPARE(view->interactionMode(), widgets::InteractionMode::PickRectangle);
     const QPoint a = view->imageToWidget(QPointF(truth.x - 6, truth.y - 6)).toPoint();
@@ -242,6 +245,7 @@ class MainWindowTest : public QObject {
     // The table shows it selected, the histogram is filled and has a roof interval.
     QCOMPARE(window_->buildingsTable()->selectionModel()->selectedRows().size(), 1);
     QVERIFY(window_->histogram()->sampleCount() > 100);
+    QVERIFY(window_->histogram()->placeholder().isEmpty());
     QVERIFY(building->roofInterval.has_value());
     QVERIFY(window_->histogram()->groundLevel().has_value());
     QVERIFY(building->roofInterval->low > *window_->histogram()->groundLevel());
@@ -773,6 +777,8 @@ class MainWindowTest : public QObject {
     QCOMPARE(translator.translate("delineo::gui::BuildingsModel", "accepted"), QStringLiteral("accepté"));
     QCOMPARE(translator.translate("delineo::gui::MainWindow", "Bo&x-fitting"), QStringLiteral("Ajustement de &boîtes"));
     QCOMPARE(translator.translate("delineo::gui::MainWindow", "En&hanced DEM"), QStringLiteral("MNE a&mélioré"));
+    QCOMPARE(translator.translate("delineo::gui::MainWindow", "Select a building to see the disparities around it."),
+             QStringLiteral("Sélectionnez un bâtiment pour voir les disparités autour de lui."));
     QCOMPARE(translator.translate("ErrorText", "The input files do not match each other."),
              QStringLiteral("Les fichiers d’entrée ne correspondent pas entre eux."));
     // Every label of the parameter forms (their strings come from the structs' visit(),

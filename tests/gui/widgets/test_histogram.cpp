@@ -91,6 +91,28 @@ TEST(DisparityHistogram, DraggingHandlesAndBandChangesTheInterval) {
   delineo::widgets::test::saveScreenshot(h, QStringLiteral("disparity_histogram"));
 }
 
+TEST(DisparityHistogram, APlaceholderTakesNoEdits) {
+  DisparityHistogramWidget h;
+  h.resize(420, 160);
+  h.setDisparities(roiDisparities());
+  h.setInterval(24, 31);
+  h.setPlaceholder(QStringLiteral("Select a building"));
+  h.show();
+  QSignalSpy changed(&h, &DisparityHistogramWidget::intervalChanged);
+  QTest::mousePress(&h, Qt::LeftButton, {}, at(h, 31.5));
+  QTest::mouseMove(&h, at(h, 34.0));
+  QTest::mouseRelease(&h, Qt::LeftButton, {}, at(h, 34.0));
+  QTest::keyClick(&h, Qt::Key_Right);
+  EXPECT_EQ(changed.count(), 0);
+  EXPECT_EQ(h.upperBound(), 31);
+  // Back to the plot, the same drag moves the bound.
+  h.setPlaceholder({});
+  QTest::mousePress(&h, Qt::LeftButton, {}, at(h, 31.5));
+  QTest::mouseMove(&h, at(h, 34.0));
+  QTest::mouseRelease(&h, Qt::LeftButton, {}, at(h, 34.0));
+  EXPECT_EQ(h.upperBound(), 34);
+}
+
 TEST(DisparityHistogram, DragSignalsAreThrottled) {
   DisparityHistogramWidget h;
   h.resize(420, 160);

@@ -6,6 +6,7 @@
 // the band to move the nearest bound there; keyboard: Left/Right move the whole band by 1,
 // Shift+Left/Right move the upper bound, Ctrl+Left/Right move the lower bound.
 #include <QElapsedTimer>
+#include <QString>
 #include <QTimer>
 #include <QWidget>
 #include <optional>
@@ -37,6 +38,11 @@ class DisparityHistogramWidget : public QWidget {
   void setGroundLevel(double disparity);
   void clearGroundLevel();
   std::optional<double> groundLevel() const { return ground_; }
+
+  // A text shown instead of the plot, the band and its label, which take no mouse or key input
+  // meanwhile (nothing to show: no building selected); empty = the plot.
+  void setPlaceholder(const QString& text);
+  const QString& placeholder() const { return placeholder_; }
 
   // Horizontal range shown (defaults to the data range plus a margin).
   int displayMin() const;
@@ -78,6 +84,7 @@ class DisparityHistogramWidget : public QWidget {
   int a_ = 0;
   int b_ = 0;
   std::optional<double> ground_;
+  QString placeholder_;
   DragPart drag_ = DragPart::None;
   double dragStartD_ = 0.0;
   int dragStartA_ = 0;
