@@ -214,16 +214,19 @@ std::vector<IntPolygon> regionStageCandidates(const EnergyImages& im, const cv::
 // the guard keep their correlation costs. Per pixel, before aggregation. The 5x5 correlation
 // window cannot tell a roof with a repeated or smooth texture from a shift of it, nor a neighbour
 // at another height from the roof; the matcher's adaptive windows, coarse-to-fine search and
-// left-right check can.
-void applyMapCosts(const cv::Mat& disparity, const DisparityInterval& roof, const DelineationParams& params,
-                   cv::Mat& roofCost, cv::Mat& groundCost) {
+// left-right check can. Returns the mask of the pixels the map puts above the roof interval
+// (beyond the guard), where no courtyard starts.
+cv::Mat applyMapCosts(const cv::Mat& disparity, const DisparityInterval& roof, const DelineationParams& params,
+                      cv::Mat& roofCost, cv::Mat& groundCost) {
   const float r0 = static_cast<float>(roof.min) - 0.5f, r1 = static_cast<float>(roof.max) + 0.5f;
   const float guard = static_cast<float>(params.intermediateGuard);
   const float high = static_cast<float>(params.mapCost);
+  cv::Mat aboveRoof = cv::Mat::zeros(disparity.size(), CV_8U);
   for (int y = 0; y < disparity.rows; ++y) {
     const float* d = disparity.ptr<float>(y);
     float* roofRow = roofCost.ptr<float>(y);
     float* groundRow = groundCost.ptr<float>(y);
+    uchar* aboveRow = aboveRoof.ptr<uchar>(y);
     for (int x = 0; x < disparity.cols; ++x) {
       if (!std::isfinite(d[x])) continue;
       if (d[x] >= r0 && d[x] <= r1) {
@@ -232,9 +235,11 @@ void applyMapCosts(const cv::Mat& disparity, const DisparityInterval& roof, cons
       } else if (d[x] < r0 - guard || d[x] > r1 + guard) {
         roofRow[x] = high;
         groundRow[x] = 0.0f;
+        if (d[x] > r1 + guard) aboveRow[x] = 255;
       }
     }
   }
+  return aboveRoof;
 }
 
 // The ground interval when the request gives none: with the matcher's map, the level of
@@ -430,8 +435,7 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   im.roofCost = costs.minCost(out.roofSearched.min, out.roofSearched.max);
   im.groundCost = costs.minCost(out.groundSearched.min, out.groundSearched.max);
   if (params.mapCost > 0 && !request.disparity.empty()) {
-    applyMapCosts(request.disparity(roi), request.roof, params, im.roofCost, im.groundCost);
-    im.aboveRoof = request.disparity(roi) > static_cast<float>(request.roof.max + params.intermediateGuard) + 0.5f;
+    im.aboveRoof = applyMapCosts(request.disparity(roi), request.roof, params, im.roofCost, im.groundCost);
   }
   if (params.costAggregation > 1) {
     const cv::Size k(params.costAggregation, params.costAggregation);

@@ -16,7 +16,7 @@ struct DelineationParams {
   int roiMargin = 24;              // px added around the initial polygon to make the ROI
   int costWindow = 5;              // px, side of the correlation window of Crit
   double costBrightness = 20.0;    // × noise sigma: Crit's mean grey term for flat windows (0 = NCC only)
-  int groundTolerance = 3;         // px, half width of the ground interval estimated from the ring
+  int groundTolerance = 3;         // px, half width of a ground interval estimated around the init or given as one value
   int groundSearch = 64;           // px searched below the roof interval when ground is unknown
   int ringWidth = 8;               // px, width of the band outside the init used to estimate ground without a map
   bool edgeMoves = true;           // also translate whole edges (two vertices at once)
