@@ -25,12 +25,12 @@
 #include "delineo/core/allocator.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/delineation/delineate.hpp"
+#include "delineo/delineation/feature_request.hpp"
 #include "delineo/dem/heights.hpp"
 #include "delineo/segmentation/detect.hpp"
 #include "delineo/segmentation/ground.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
-#include "proposal_request.hpp"
 #include "simulated_match.hpp"
 
 using namespace delineo;
@@ -311,12 +311,15 @@ int main(int argc, char** argv) {
     std::vector<core::Polygon> outlines;
     delineation::DelineationParams params;
     for (const auto& f : dm.proposals) {
-      const auto req = bench::proposalRequest(f, map, {scene.disparityMin, scene.disparityMax}, params.groundTolerance);
-      if (!req) continue;
       try {
+        auto req = delineation::featureRequest(f, params.groundTolerance);
+        if (!req) continue;
+        req->disparity = map;
+        req->searchRange = delineation::DisparityInterval{scene.disparityMin, scene.disparityMax};
         outlines.push_back(delineation::delineate(left, right, *req, params).polygon);
       } catch (const std::exception& e) {
-        std::printf("  scene %d proposal %lld failed: %s\n", sp.seed, static_cast<long long>(bench::numberAttribute(f, "id")), e.what());
+        std::printf("  scene %d proposal %.0f failed: %s\n", sp.seed, core::numberProperty(f, "id", 9e15).value_or(-1),
+                    e.what());
       }
     }
     scoreProposals(outlines, scene, 100.0, chainScore);

@@ -27,10 +27,10 @@
 #include "delineo/core/allocator.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/delineation/delineate.hpp"
+#include "delineo/delineation/feature_request.hpp"
 #include "delineo/eval/polygon_measures.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/segmentation/scene.hpp"
-#include "proposal_request.hpp"
 #include "real_roofs.hpp"
 
 using namespace delineo;
@@ -147,12 +147,14 @@ void delineateProposals(const std::string& name, const nlohmann::json& pair, con
   const delineation::DelineationParams params;
   std::vector<core::Polygon> outlines;
   for (const auto& f : proposals) {
-    const auto req = bench::proposalRequest(f, disparity, range, params.groundTolerance);
-    if (!req) continue;
     try {
+      auto req = delineation::featureRequest(f, params.groundTolerance);
+      if (!req) continue;
+      req->disparity = disparity;
+      req->searchRange = range;
       outlines.push_back(delineation::delineate(l, r, *req, params).polygon);
     } catch (const std::exception& e) {
-      std::printf("  proposal %.0f failed: %s\n", bench::numberAttribute(f, "id"), e.what());
+      std::printf("  proposal %.0f failed: %s\n", core::numberProperty(f, "id", 9e15).value_or(-1), e.what());
     }
   }
   double sum = 0;

@@ -12,6 +12,27 @@
 
 namespace delineo::core {
 
+std::optional<double> numberProperty(const Feature& feature, const std::string& key, double limit) {
+  const auto it = feature.attributes.find(key);
+  if (it == feature.attributes.end() || std::holds_alternative<std::monostate>(it->second)) return std::nullopt;
+  std::optional<double> value;
+  if (const auto* i = std::get_if<long long>(&it->second)) value = static_cast<double>(*i);
+  if (const auto* d = std::get_if<double>(&it->second)) value = *d;
+  if (const auto* s = std::get_if<std::string>(&it->second)) {
+    try {
+      size_t used = 0;
+      value = std::stod(*s, &used);
+      if (used != s->size()) value.reset();
+    } catch (const std::exception&) {
+    }
+  }
+  if (!value || !std::isfinite(*value) || std::abs(*value) > limit) {
+    throw Error(ErrorCode::InvalidParameter, "property " + key + " must be a finite number within +-" +
+                                                 std::to_string(static_cast<long long>(limit)));
+  }
+  return value;
+}
+
 double signedArea(const Ring& ring) {
   double a = 0.0;
   const size_t n = ring.size();

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <optional>
 #include <string>
-#include <variant>
 
 #include <opencv2/core.hpp>
 
@@ -93,12 +92,17 @@ double coveredShare(const core::Polygon& polygon, const core::Polygon& other) {
   return inside > 0 ? static_cast<double>(cv::countNonZero(ma & mb)) / inside : 0.0;
 }
 
-std::optional<int> intAttribute(const core::Feature& feature, const char* key) {
-  const auto it = feature.attributes.find(key);
-  if (it == feature.attributes.end()) return std::nullopt;
-  if (const auto* v = std::get_if<long long>(&it->second)) return static_cast<int>(*v);
-  if (const auto* d = std::get_if<double>(&it->second)) return static_cast<int>(std::lround(*d));
-  return std::nullopt;
+// The proposal's roof interval (detect's roof_disparity_min/max, integers); none when either is
+// missing or malformed: the operator then sets it, as for a drawn building.
+std::optional<DisparityInterval> roofInterval(const core::Feature& proposal) {
+  try {
+    const auto low = core::numberProperty(proposal, "roof_disparity_min", 1e5);
+    const auto high = core::numberProperty(proposal, "roof_disparity_max", 1e5);
+    if (!low || !high || *low > *high) return std::nullopt;
+    return DisparityInterval{static_cast<int>(std::floor(*low)), static_cast<int>(std::ceil(*high))};
+  } catch (const core::Error&) {
+    return std::nullopt;
+  }
 }
 }  // namespace
 
@@ -116,9 +120,7 @@ std::vector<int> addProposedBuildings(Project& project, const std::vector<core::
     Building b;
     b.id = project.nextBuildingId();
     b.initial = proposal.polygon;
-    const auto low = intAttribute(proposal, "roof_disparity_min");
-    const auto high = intAttribute(proposal, "roof_disparity_max");
-    if (low && high && *low <= *high) b.roofInterval = DisparityInterval{*low, *high};
+    b.roofInterval = roofInterval(proposal);
     b.addHistory("detected", origin.empty() ? std::string("building proposal") : origin + ": building proposal");
     project.buildings.push_back(b);
     added.push_back(b.id);

@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <optional>
 #include <string>
-#include <variant>
 
 #include "cli_support.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/delineation/delineate.hpp"
+#include "delineo/delineation/feature_request.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "range_support.hpp"
@@ -18,46 +18,28 @@
 namespace {
 using namespace delineo;
 using delineation::DisparityInterval;
-
-// Disparities beyond this many pixels are no disparity of a real pair: a sign of a bad value.
-constexpr double kMaxDisparity = 100000;
+using delineation::kMaxFeatureDisparity;
 
 DisparityInterval intervalFlag(const cli::Options& opts, const std::string& key) {
   const auto [a, b] = opts.getPair(key);
   if (a != std::floor(a) || b != std::floor(b)) {
     throw cli::UsageError("--" + key + " expects integer disparities A:B");
   }
-  if (std::abs(a) > kMaxDisparity || std::abs(b) > kMaxDisparity || a > b) {
+  if (std::abs(a) > kMaxFeatureDisparity || std::abs(b) > kMaxFeatureDisparity || a > b) {
     throw cli::UsageError("--" + key + " expects A:B with A <= B, both within +-" +
-                          std::to_string(static_cast<int>(kMaxDisparity)) + " px");
+                          std::to_string(static_cast<int>(kMaxFeatureDisparity)) + " px");
   }
   return {static_cast<int>(a), static_cast<int>(b)};
 }
 
-// A numeric property of an initial polygon: absent, or a finite number of magnitude at most
-// `limit`; anything else is an error naming the feature and the file.
-std::optional<double> numberAttribute(const core::Feature& f, const std::string& key, double limit,
-                                      const std::string& feature, const std::string& file) {
-  const auto it = f.attributes.find(key);
-  if (it == f.attributes.end() || std::holds_alternative<std::monostate>(it->second)) return std::nullopt;
-  std::optional<double> value;
-  if (const auto* i = std::get_if<long long>(&it->second)) value = static_cast<double>(*i);
-  if (const auto* d = std::get_if<double>(&it->second)) value = *d;
-  if (const auto* s = std::get_if<std::string>(&it->second)) {
-    try {
-      size_t used = 0;
-      value = std::stod(*s, &used);
-      if (used != s->size()) value.reset();
-    } catch (const std::exception&) {
-    }
+// Reads `read(feature)`; a malformed property becomes an error naming the building and the file.
+template <class Read>
+auto readProperties(Read&& read, const std::string& building, const std::string& file) {
+  try {
+    return read();
+  } catch (const core::Error& e) {
+    throw core::Error(e.code(), building + ": " + e.detail(), file);
   }
-  if (!value || !std::isfinite(*value) || std::abs(*value) > limit) {
-    throw core::Error(core::ErrorCode::InvalidParameter,
-                      feature + ": property " + key + " must be a finite number within +-" +
-                          std::to_string(static_cast<long long>(limit)),
-                      file);
-  }
-  return value;
 }
 
 // The estimated search range widened to hold the building's intervals: the operator's (or the
@@ -98,20 +80,14 @@ std::vector<BuildingJob> buildingJobs(const std::vector<core::Feature>& inits, c
     const core::Feature& init = inits[i];
     const std::string position = "feature " + std::to_string(i + 1);
     BuildingJob job;
-    const auto id = numberAttribute(init, "id", 9e15, position, file);
+    const auto id = readProperties([&] { return core::numberProperty(init, "id", 9e15); }, position, file);
     job.id = id ? static_cast<long long>(*id) : static_cast<long long>(i + 1);
     const std::string name = "building id " + std::to_string(job.id);
+    const auto intervals = readProperties([&] { return delineation::readFeatureIntervals(init); }, name, file);
     auto& req = job.request;
-    req.init = init.polygon;
-    req.init.holes.clear();
-    const auto rmin = numberAttribute(init, "roof_disparity_min", kMaxDisparity, name, file);
-    const auto rmax = numberAttribute(init, "roof_disparity_max", kMaxDisparity, name, file);
-    if (rmin && rmax) {
-      req.roof = {static_cast<int>(std::floor(*rmin)), static_cast<int>(std::ceil(*rmax))};
-      if (req.roof.min > req.roof.max) {
-        throw core::Error(core::ErrorCode::InvalidParameter,
-                          name + ": roof_disparity_min is above roof_disparity_max", file);
-      }
+    req.init.outer = init.polygon.outer;
+    if (intervals.roof) {
+      req.roof = *intervals.roof;
     } else if (flags.roof) {
       req.roof = *flags.roof;
     } else {
@@ -119,8 +95,8 @@ std::vector<BuildingJob> buildingJobs(const std::vector<core::Feature>& inits, c
       job.missing = "no roof disparity interval: give --roof-disparity or the feature's "
                     "roof_disparity_min/max";
     }
-    if (const auto g = numberAttribute(init, "ground_disparity", kMaxDisparity, name, file)) {
-      const int c = static_cast<int>(std::lround(*g));
+    if (intervals.groundDisparity) {
+      const int c = *intervals.groundDisparity;
       req.ground = DisparityInterval{c - params.groundTolerance, c + params.groundTolerance};
     } else {
       req.ground = flags.ground;

@@ -3,6 +3,7 @@
 // says otherwise: x to the right, y down, pixel (i, j) covers [i, i+1) x [j, j+1), so the centre
 // of pixel (i, j) is (i + 0.5, j + 0.5).
 #include <map>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -24,6 +25,11 @@ struct Feature {
   Polygon polygon;
   std::map<std::string, AttributeValue> attributes;
 };
+
+// A numeric property of `feature`: nullopt when absent or null; else a finite number of magnitude
+// at most `limit` (a string holding one whole is read too). Anything else throws
+// core::Error(InvalidParameter) naming the property.
+std::optional<double> numberProperty(const Feature& feature, const std::string& key, double limit);
 
 // Signed area (shoelace): positive for counter-clockwise in a y-up frame, i.e. clockwise on
 // screen with y down.
