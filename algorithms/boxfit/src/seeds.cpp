@@ -17,6 +17,27 @@ const cv::Point kSteps[8] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}, {1, 1}, {-1, 1}, 
 
 bool inside(const cv::Mat& m, cv::Point p) { return p.x >= 0 && p.y >= 0 && p.x < m.cols && p.y < m.rows; }
 
+// Distance of each mask pixel to the nearest pixel outside the mask, the outside of the ROI
+// counted as outside: where a building runs past the image's border, its depth there is the
+// distance to that border (OpenCV's transform takes the outside of the array as infinitely far,
+// and a box grown from a seed on the border would start as a square reaching past the image).
+cv::Mat depthInside(const cv::Mat& mask) {
+  cv::Mat padded, depth;
+  cv::copyMakeBorder(mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  cv::distanceTransform(padded, depth, cv::DIST_L2, 5);
+  return depth(cv::Rect(1, 1, mask.cols, mask.rows)).clone();
+}
+
+// Zhang-Suen skeleton with the outside of the ROI as background: the thinning leaves the
+// array's outer rows and columns alone, so a segment touching the image's border would keep
+// that whole border in its skeleton (a line of seeds along it).
+cv::Mat skeletonOf(const cv::Mat& mask) {
+  cv::Mat padded, skeleton;
+  cv::copyMakeBorder(mask, padded, 2, 2, 2, 2, cv::BORDER_CONSTANT, 0);
+  cv::ximgproc::thinning(padded, skeleton, cv::ximgproc::THINNING_ZHANGSUEN);
+  return skeleton(cv::Rect(2, 2, mask.cols, mask.rows)).clone();
+}
+
 // The pixels of one branch (label `id` in `labels`) in walking order, from an end when it has
 // one. Pixels a walk cannot reach without going back are appended last. `visited` is shared by
 // the branches (they do not overlap).
@@ -63,9 +84,8 @@ std::vector<cv::Point> walk(const cv::Mat& labels, int id, const std::vector<cv:
 
 SkeletonSeeds skeletonSeeds(const cv::Mat& segment, const BoxFitParams& params) {
   SkeletonSeeds out;
-  cv::Mat depth;
-  cv::distanceTransform(segment, depth, cv::DIST_L2, 5);
-  cv::ximgproc::thinning(segment, out.skeleton, cv::ximgproc::THINNING_ZHANGSUEN);
+  const cv::Mat depth = depthInside(segment);
+  out.skeleton = skeletonOf(segment);
 
   // Junctions: skeleton pixels with more than two skeleton neighbours.
   cv::Mat skeleton01 = out.skeleton / 255, count;
@@ -153,11 +173,10 @@ std::vector<Seed> uncoveredSeeds(const cv::Mat& segment, const std::vector<Box>&
   const int r = std::max(1, params.erosionRadius);
   cv::morphologyEx(residual, residual, cv::MORPH_OPEN,
                    cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
-  cv::Mat labels, stats, centroids, depth, segmentDepth;
+  cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(residual, labels, stats, centroids, 8, CV_32S);
   if (n <= 1) return {};
-  cv::distanceTransform(residual, depth, cv::DIST_L2, 5);
-  cv::distanceTransform(segment, segmentDepth, cv::DIST_L2, 5);
+  const cv::Mat depth = depthInside(residual), segmentDepth = depthInside(segment);
   const int minArea = std::max(1, params.minArea / 5);
   std::vector<Seed> seeds;
   for (int i = 1; i < n; ++i) {

@@ -374,3 +374,17 @@ TEST(BoxFitStages, ABoxIsClippedToTheImage) {
   box.centre = {-100, -100};
   EXPECT_TRUE(box.cornersWithin({200, 100}).empty());
 }
+
+TEST(BoxFitStages, SeedsOfASegmentCutByTheBorderAreNoDeeperThanTheirDistanceToIt) {
+  // A segment running past the ROI's right side: the border is the segment's edge there, so no
+  // skeleton along it and no seed deeper than its distance to it.
+  cv::Mat segment = cv::Mat::zeros(120, 160, CV_8U);
+  segment(cv::Rect(30, 20, 130, 80)).setTo(255);
+  const SkeletonSeeds s = skeletonSeeds(segment, BoxFitParams{});
+  EXPECT_EQ(cv::countNonZero(s.skeleton.col(segment.cols - 1)), 0);
+  ASSERT_FALSE(s.seeds.empty());
+  for (const Seed& seed : s.seeds) {
+    EXPECT_LE(seed.depth, segment.cols - seed.point.x + 1.0) << seed.point;
+    EXPECT_LE(seed.depth, 41.0) << seed.point;
+  }
+}
