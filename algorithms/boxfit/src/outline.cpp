@@ -143,6 +143,20 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
       lines.push_back(fitLine(pts, first, last));
     }
   }
+  // The closing rounds concave corners and the slopes of small jogs; such a rounding, cut off as
+  // a side of its own, would be a short slanted line. A line fitted to no more than the
+  // rounding's extent is dropped: its neighbours then meet at the corner itself, or, parallel,
+  // make a jog square to them.
+  const double rounding = 2.0 * params.closingRadius + 2.0;
+  for (bool dropped = true; dropped && lines.size() > 3;) {
+    dropped = false;
+    for (size_t i = 0; i < lines.size() && lines.size() > 3; ++i) {
+      if (static_cast<double>(lines[i].last - lines[i].first) * pointSpacing > rounding) continue;
+      lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(i));
+      dropped = true;
+      break;
+    }
+  }
   // Neighbouring lines within 10° whose points lie within the tolerance of one line are merged.
   const double cosMerge = std::cos(10.0 * 3.14159265358979323846 / 180.0);
   for (bool merged = true; merged && lines.size() > 3;) {
@@ -285,9 +299,11 @@ core::Polygon mergeBoxes(const std::vector<Box>& boxes, cv::Size roiSize, const 
   }
   if (!segment.empty()) bridgeWithSegment(mask, segment);
   if (params.closingRadius > 0) {
+    // The border replicated: boxes reaching the ROI's side (the image's border, for a building
+    // the image cuts) keep reaching it instead of being eroded by the radius there.
     const int r = params.closingRadius * kScale;
     cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}),
-                     {-1, -1}, 1, cv::BORDER_CONSTANT, 0);
+                     {-1, -1}, 1, cv::BORDER_REPLICATE);
   }
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;

@@ -375,6 +375,37 @@ TEST(BoxFitStages, ABoxIsClippedToTheImage) {
   EXPECT_TRUE(box.cornersWithin({200, 100}).empty());
 }
 
+// The largest deviation from a right angle (degrees) among the ring's corners.
+double worstCornerDeviation(const core::Ring& ring) {
+  double worst = 0;
+  for (size_t i = 0; i < ring.size(); ++i) {
+    const cv::Point2d a = ring[(i + ring.size() - 1) % ring.size()] - ring[i];
+    const cv::Point2d b = ring[(i + 1) % ring.size()] - ring[i];
+    const double angle = std::acos(std::clamp(a.dot(b) / (cv::norm(a) * cv::norm(b)), -1.0, 1.0)) * 180.0 / kPi;
+    worst = std::max(worst, std::abs(angle - 90.0));
+  }
+  return worst;
+}
+
+TEST(BoxFitting, ABuildingCutByTheImageBorderStaysRectilinear) {
+  // An L-shaped flat roof whose east part runs past the image's right border, and an operator's
+  // rectangle up to that border: the outline stops at the border with right angles only, and
+  // no box leans (seeds along the border once grew boxes reaching past it at a slant).
+  const core::Polygon truth{{{70, 40}, {260, 40}, {260, 120}, {130, 120}, {130, 160}, {70, 160}}, {}};
+  const Scene s = makeScene(kSize, {truth});
+  const core::Polygon init = rectangle(60, 30, kSize.width - 60, 140);
+  const BoxFitBuilding b = fitOne(s, init);
+  const core::Polygon visible{{{70, 40}, {220, 40}, {220, 120}, {130, 120}, {130, 160}, {70, 160}}, {}};
+  EXPECT_GT(iou(b.outline, visible, kSize), 0.95);
+  EXPECT_EQ(b.outline.outer.size(), 6u);
+  EXPECT_LT(worstCornerDeviation(b.outline.outer), 2.0);
+  for (const auto& box : b.boxes) {
+    const double a = std::fmod(box.angleDeg, 90.0);
+    EXPECT_LT(std::min(a, 90.0 - a), 1.5) << box.angleDeg;
+    for (const auto& c : box.corners()) EXPECT_LE(c.x, kSize.width + 1.0) << "a box reaches past the image";
+  }
+}
+
 TEST(BoxFitStages, SeedsOfASegmentCutByTheBorderAreNoDeeperThanTheirDistanceToIt) {
   // A segment running past the ROI's right side: the border is the segment's edge there, so no
   // skeleton along it and no seed deeper than its distance to it.
