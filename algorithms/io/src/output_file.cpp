@@ -25,11 +25,13 @@ const std::vector<std::string>& extensionsOf(OutputFormat format) {
   static const std::vector<std::string> geotiff{".tif", ".tiff"};
   static const std::vector<std::string> vector{".geojson", ".json", ".gpkg"};
   static const std::vector<std::string> json{".json"};
+  static const std::vector<std::string> cityJson{".json", ".cityjson"};
   static const std::vector<std::string> any;
   switch (format) {
     case OutputFormat::GeoTiff: return geotiff;
     case OutputFormat::Vector: return vector;
     case OutputFormat::Json: return json;
+    case OutputFormat::CityJson: return cityJson;
     case OutputFormat::Text: return any;
   }
   return json;
@@ -40,6 +42,7 @@ std::string formatName(OutputFormat format) {
     case OutputFormat::GeoTiff: return "a GeoTIFF";
     case OutputFormat::Vector: return "a vector file";
     case OutputFormat::Json: return "a JSON file";
+    case OutputFormat::CityJson: return "a CityJSON file";
     case OutputFormat::Text: return "a text file";
   }
   return "a file";

@@ -15,6 +15,7 @@ namespace delineo::io {
 enum class OutputFormat {
   GeoTiff,  // .tif / .tiff
   Vector,   // .geojson / .json / .gpkg
+  CityJson, // .city.json / .cityjson (3D blocks, io/cityjson.hpp)
   Json,     // .json (reports)
   Text,     // any name (project files and their autosave copies)
 };
