@@ -1050,8 +1050,8 @@
         <translation>Exporter les bâtiments acceptés</translation>
     </message>
     <message>
-        <source>GeoJSON (*.geojson);;GeoPackage (*.gpkg)</source>
-        <translation>GeoJSON (*.geojson);;GeoPackage (*.gpkg)</translation>
+        <source>GeoJSON (*.geojson);;GeoPackage (*.gpkg);;CityJSON 3D blocks (*.city.json *.cityjson)</source>
+        <translation>GeoJSON (*.geojson);;GeoPackage (*.gpkg);;Blocs 3D CityJSON (*.city.json *.cityjson)</translation>
     </message>
     <message>
         <source>&amp;Quit</source>
@@ -1266,6 +1266,13 @@
         <translation>
             <numerusform>%n bâtiment accepté exporté vers %1</numerusform>
             <numerusform>%n bâtiments acceptés exportés vers %1</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>%n left out: no roof height above the ground.</source>
+        <translation>
+            <numerusform>%n laissé de côté : pas de hauteur de toit au-dessus du sol.</numerusform>
+            <numerusform>%n laissés de côté : pas de hauteur de toit au-dessus du sol.</numerusform>
         </translation>
     </message>
     <message>

@@ -398,7 +398,7 @@ void Document::autosave() {
   project::saveProject(project_, project::autosavePath(path_.toStdString()));
 }
 
-int Document::exportAccepted(const QString& path) const {
+project::ExportSummary Document::exportAccepted(const QString& path) const {
   return project::exportBuildings(project_, path.toStdString());
 }
 

@@ -98,7 +98,7 @@ void MainWindow::createFileActions() {
             if (start.isEmpty() && document_) start = document_->dialogFolder();
             const QString path = QFileDialog::getSaveFileName(
                 this, tr("Export accepted buildings"), start + QStringLiteral("/buildings.geojson"),
-                tr("GeoJSON (*.geojson);;GeoPackage (*.gpkg)"));
+                tr("GeoJSON (*.geojson);;GeoPackage (*.gpkg);;CityJSON 3D blocks (*.city.json *.cityjson)"));
             if (!path.isEmpty()) exportAccepted(path);
           });
   connect(makeAction(this, QStringLiteral("actionQuit"), tr("&Quit"), QKeySequence::Quit),

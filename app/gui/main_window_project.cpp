@@ -298,9 +298,14 @@ bool MainWindow::saveAs(const QString& path) {
 int MainWindow::exportAccepted(const QString& path) {
   if (!document_) return -1;
   try {
-    const int n = document_->exportAccepted(path);
-    statusBar()->showMessage(tr("%n accepted building(s) exported to %1", nullptr, n).arg(path), 8000);
-    return n;
+    const project::ExportSummary exported = document_->exportAccepted(path);
+    QString text = tr("%n accepted building(s) exported to %1", nullptr, exported.written).arg(path);
+    if (!exported.leftOut.empty()) {
+      text += QStringLiteral(" ") + tr("%n left out: no roof height above the ground.", nullptr,
+                                       static_cast<int>(exported.leftOut.size()));
+    }
+    statusBar()->showMessage(text, 8000);
+    return exported.written;
   } catch (const core::Error& e) {
     showMessage(tr("Cannot export"), errorMessage(e));
     return -1;

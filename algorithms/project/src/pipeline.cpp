@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "delineo/core/error.hpp"
+#include "delineo/io/cityjson.hpp"
 #include "delineo/io/output_file.hpp"
 #include "delineo/io/vector.hpp"
 
@@ -349,22 +350,39 @@ std::vector<core::Feature> buildingFeatures(const Project& project,
   return features;
 }
 
-int exportBuildings(const Project& project, const std::string& path,
-                    const std::vector<BuildingStatus>& statuses) {
-  const auto features = buildingFeatures(project, statuses);
-  io::GeoReference geo;
+namespace {
+// The left image's georeferencing; none when it is missing or unreadable (pixel coordinates
+// then; the image problem is reported where it is read).
+io::GeoReference leftGeoReference(const Project& project) {
   std::error_code ec;
-  if (!project.left.empty() && fs::exists(project.left, ec)) {
-    try {
-      geo = io::readRaster(project.left).geo;
-    } catch (const Error&) {
-      geo = {};  // pixel coordinates then; the image problem is reported where it is read
-    }
+  if (project.left.empty() || !fs::exists(project.left, ec)) return {};
+  try {
+    return io::readRaster(project.left).geo;
+  } catch (const Error&) {
+    return {};
   }
+}
+}  // namespace
+
+ExportSummary exportBuildings(const Project& project, const std::string& path,
+                              const std::vector<BuildingStatus>& statuses) {
+  const auto features = buildingFeatures(project, statuses);
+  const io::GeoReference geo = leftGeoReference(project);
   std::error_code mk;
   fs::create_directories(fs::absolute(path).parent_path(), mk);
+  ExportSummary summary;
+  if (io::isCityJsonPath(path)) {
+    io::CityJsonOptions options;
+    options.geo = geo;
+    options.localPixelSize = project.height.gsd;
+    const io::CityJsonSummary blocks = io::writeCityJson(path, features, options);
+    summary.written = blocks.written;
+    summary.leftOut = blocks.leftOut;
+    return summary;
+  }
   io::writeFeatures(path, features, geo);
-  return static_cast<int>(features.size());
+  summary.written = static_cast<int>(features.size());
+  return summary;
 }
 
 namespace {
@@ -416,6 +434,33 @@ bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& di
 }
 }  // namespace
 
+namespace {
+// run's exports: the outlines to buildings.geojson, and the LoD1 blocks to buildings.city.json
+// when any building has a roof height. A degenerate outline stops the blocks only: the outlines
+// and the project's work are kept, the problem is in the summary.
+void exportRunOutputs(const Project& project, const std::string& outputDir, RunSummary& summary) {
+  const std::vector<BuildingStatus> statuses{BuildingStatus::Automatic, BuildingStatus::Corrected,
+                                             BuildingStatus::Accepted};
+  const auto features = buildingFeatures(project, statuses);
+  if (features.empty()) return;
+  summary.exported = (fs::path(outputDir) / "buildings.geojson").string();
+  exportBuildings(project, summary.exported, statuses);
+  const bool anyHeight = std::any_of(features.begin(), features.end(),
+                                     [](const core::Feature& f) { return f.attributes.count("roof_height_m") > 0; });
+  if (!anyHeight) return;
+  const std::string blocksPath = (fs::path(outputDir) / "buildings.city.json").string();
+  try {
+    const ExportSummary blocks = exportBuildings(project, blocksPath, statuses);
+    summary.exportedBlocks = blocksPath;
+    for (const auto& line : blocks.leftOut) summary.messages.push_back("not in buildings.city.json: " + line);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::InvalidParameter) throw;
+    summary.blocksFailed = true;
+    summary.messages.push_back("buildings.city.json not written: " + e.detail());
+  }
+}
+}  // namespace
+
 RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress,
                            const RunOptions& options) {
   RunSummary summary;
@@ -423,7 +468,8 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
   std::error_code mk;
   fs::create_directories(outputDir, mk);
   const fs::path out(outputDir);
-  std::vector<io::OutputFile> outputs{{(out / "buildings.geojson").string(), io::OutputFormat::Vector}};
+  std::vector<io::OutputFile> outputs{{(out / "buildings.geojson").string(), io::OutputFormat::Vector},
+                                      {(out / "buildings.city.json").string(), io::OutputFormat::CityJson}};
   if (project.disparity.empty()) {
     outputs.push_back({(out / "disparity.tif").string(), io::OutputFormat::GeoTiff});
   }
@@ -515,13 +561,7 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
       }
     }
   }
-  const auto features = buildingFeatures(
-      project, {BuildingStatus::Automatic, BuildingStatus::Corrected, BuildingStatus::Accepted});
-  if (!features.empty()) {
-    summary.exported = (fs::path(outputDir) / "buildings.geojson").string();
-    exportBuildings(project, summary.exported,
-                    {BuildingStatus::Automatic, BuildingStatus::Corrected, BuildingStatus::Accepted});
-  }
+  exportRunOutputs(project, outputDir, summary);
   core::report(progress, 1.0);
   return summary;
 }

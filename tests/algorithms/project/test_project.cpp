@@ -1,6 +1,7 @@
-// Project file model: round trips, relative paths, atomic save, corrupt files, autosave.
+// Project file model: round trips, relative paths, atomic save, corrupt files, autosave; export.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -10,6 +11,8 @@
 #include <unistd.h>
 
 #include "delineo/core/error.hpp"
+#include "delineo/io/vector.hpp"
+#include "delineo/project/pipeline.hpp"
 #include "delineo/project/project.hpp"
 
 namespace fs = std::filesystem;
@@ -324,4 +327,32 @@ TEST(ProjectAutosave, NewerAutosaveIsDetected) {
   EXPECT_TRUE(project::hasNewerAutosave(path));
   fs::last_write_time(autosave, fs::last_write_time(path) - std::chrono::seconds(5));
   EXPECT_FALSE(project::hasNewerAutosave(path));
+}
+
+TEST(ProjectExport, ACityJsonNameWritesLod1BlocksInTheHeightModelsMetres) {
+  TempDir dir;
+  Project p = sampleProject(dir);  // building 3 corrected with a 9.5 m roof, 4 pending; no images
+  p.buildings[0].status = BuildingStatus::Accepted;
+  Building noHeight = p.buildings[0];
+  noHeight.id = 5;
+  noHeight.roofHeight = std::nan("");
+  p.buildings.push_back(noHeight);
+
+  const project::ExportSummary outlines = project::exportBuildings(p, dir.file("out/accepted.geojson"));
+  EXPECT_EQ(outlines.written, 2);
+  EXPECT_TRUE(outlines.leftOut.empty());
+  EXPECT_EQ(io::readFeatures(dir.file("out/accepted.geojson")).size(), 2u);
+
+  const project::ExportSummary blocks = project::exportBuildings(p, dir.file("out/accepted.city.json"));
+  EXPECT_EQ(blocks.written, 1);
+  EXPECT_EQ(blocks.leftOut, std::vector<std::string>{"building 5: no roof height"});
+  std::ifstream in(dir.file("out/accepted.city.json"));
+  const nlohmann::json city = nlohmann::json::parse(in);
+  EXPECT_EQ(city["type"], "CityJSON");
+  ASSERT_EQ(city["CityObjects"].size(), 1u);
+  EXPECT_EQ(city["CityObjects"]["building-3"]["attributes"]["roof_height_m"], 9.5);
+  // Not georeferenced: x = column x gsd (0.25 m), so the outline's 12.5 .. 48 px span 8.875 m.
+  const auto& extent = city["metadata"]["geographicalExtent"];
+  EXPECT_NEAR(extent[3].get<double>() - extent[0].get<double>(), (48 - 12.5) * 0.25, 1e-9);
+  EXPECT_NEAR(extent[5].get<double>(), 9.5, 1e-9);
 }

@@ -2,7 +2,7 @@
 # End-to-end check of `delineo-cli run PROJECT` on a project with pending buildings: a simulated
 # pair, a project file written here with two rough rectangles (one with a roof interval, one
 # without, so the proposed interval is used), then: the run computes the disparity, delineates
-# both buildings, exports them and saves the project; a second run changes nothing; box-fitting as
+# both buildings, exports them (outlines and LoD1 blocks) and saves the project; a second run changes nothing; box-fitting as
 # the project's method (a building's own method wins); a corrupt project, an unknown method and a
 # missing image give exit code 3 naming the file.
 # Usage: e2e_run.sh PATH/TO/delineo-cli WORKDIR      (needs jq)
@@ -87,6 +87,14 @@ grep -q '%$' "$work/run_first.err" && fail "--quiet still printed progress" || p
 [ -s "$site/output/buildings.geojson" ] && pass "outlines exported" || fail "no output/buildings.geojson"
 expect export_has_all "(.features | length) == $count" "$site/output/buildings.geojson"
 expect export_statuses '[.features[].properties.status] | all(. == "automatic")' "$site/output/buildings.geojson"
+# The LoD1 blocks beside the outlines: one Building per exported outline with a roof height.
+blocks="$site/output/buildings.city.json"
+with_height=$(jq '[.features[] | select(.properties.roof_height_m != null)] | length' "$site/output/buildings.geojson")
+grep -q "LoD1 blocks written to .*buildings.city.json" "$work/run_first.err" && pass "run_first reports the blocks" \
+  || fail "run_first does not report buildings.city.json"
+expect blocks_cityjson '.type == "CityJSON" and .version == "1.1"' "$blocks"
+expect blocks_one_per_height "$with_height > 0 and ([.CityObjects[] | select(.type == \"Building\")] | length) == $with_height" "$blocks"
+expect blocks_lod1_solids '[.CityObjects[].geometry[0] | .type == "Solid" and .lod == "1"] | all' "$blocks"
 expect saved_disparity '.images.disparity == "output/disparity.tif"' "$project"
 expect saved_statuses '[.buildings[].status] | all(. == "automatic")' "$project"
 expect saved_outlines '[.buildings[].outline[0] | length] | all(. >= 4)' "$project"

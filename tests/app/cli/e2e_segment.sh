@@ -2,10 +2,10 @@
 # End-to-end check of the scene analysis commands on a small simulated scene with a 10 % slope:
 # `dem` from the true disparity, `segment` (its four outputs, the classes against the truth),
 # `detect` (one proposal per building, attributes `delineate --init` reads), then `delineate`
-# from the proposals scored by eval-footprints; `run --detect` on the sample project; and the
-# usage, input and output errors with their exit codes.
+# from the proposals scored by eval-footprints; `run --detect` on the sample project (its outlines
+# and LoD1 blocks); and the usage, input and output errors with their exit codes.
 #
-# Usage: e2e_segment.sh DELINEO_CLI WORK_DIR
+# Usage: e2e_segment.sh DELINEO_CLI WORK_DIR      (needs jq)
 # Exit status 0 when every check passes; otherwise 1, with one line per failed check on stderr.
 set -u
 E2E_NAME=e2e_segment
@@ -55,9 +55,14 @@ above "$IOU" 0.7 || fail "mean IoU $IOU of the outlines from the proposals is no
 # 3. run --detect on the sample project: proposals become buildings, outlined and exported.
 expect_rc run_detect 0 "$CLI" run --sample "$WORK/sample" --detect --quiet
 expect_in "$WORK/run_detect.err" "new building\(s\) proposed" "run reports the proposals"
-for f in dtm.tif ndsm.tif labels.tif objects.geojson buildings.geojson; do
+for f in dtm.tif ndsm.tif labels.tif objects.geojson buildings.geojson buildings.city.json; do
   [[ -s $WORK/sample/output/$f ]] || fail "run --detect wrote no $f"
 done
+# The sample's LoD1 blocks: one Building per exported outline with a roof height.
+WITH_HEIGHT=$(jq '[.features[] | select(.properties.roof_height_m != null)] | length' "$WORK/sample/output/buildings.geojson")
+BLOCKS=$(jq '[.CityObjects[] | select(.type == "Building")] | length' "$WORK/sample/output/buildings.city.json")
+[[ $WITH_HEIGHT -gt 0 && $BLOCKS == "$WITH_HEIGHT" ]] \
+  || fail "buildings.city.json has $BLOCKS Building(s) for $WITH_HEIGHT outline(s) with a roof height"
 expect_in "$WORK/sample/sample.delineo.json" '"detected"' "the proposals' history says where they come from"
 # A second run proposes nothing new: the buildings are already there.
 expect_rc run_again 0 "$CLI" run "$WORK/sample/sample.delineo.json" --detect --quiet

@@ -246,7 +246,8 @@ std::vector<int> addProposedBuildings(Project& project, const std::vector<core::
 // `outputDir`/disparity.tif and recorded in the project), then the outline of every Pending
 // building with its method (Project::methodOf: the active polygon, or box-fitting on
 // projectHeights(); status becomes Automatic, method and history updated), then export of accepted +
-// automatic + corrected outlines to `outputDir`/buildings.geojson. `outputDir` is the resolved
+// automatic + corrected outlines to `outputDir`/buildings.geojson, and when any of them has a
+// roof height their LoD1 blocks to `outputDir`/buildings.city.json. `outputDir` is the resolved
 // folder (outputDirectory()). The caller saves the project.
 struct RunSummary {
   std::optional<RangeOutcome> rangeEstimated;  // set when the range was estimated
@@ -258,6 +259,8 @@ struct RunSummary {
   int objects = 0;     // above-ground objects the scene analysis found
   std::vector<std::string> messages;
   std::string exported;  // path of the written GeoJSON, empty when nothing was written
+  std::string exportedBlocks;  // path of the written CityJSON, empty when nothing was written
+  bool blocksFailed = false;   // the CityJSON was not written: a building's outline is degenerate (in `messages`)
   core::RunStatus status = core::RunStatus::Completed;
 };
 // With `detect`, the scene analysis runs after matching on projectHeights() (analyseScene(),
@@ -273,10 +276,17 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
 // roof_height_m, energy), in left-image pixels.
 std::vector<core::Feature> buildingFeatures(const Project& project,
                                             const std::vector<BuildingStatus>& statuses);
-// Writes the accepted buildings (GeoJSON or GeoPackage by extension), georeferenced like the
-// left image when it has a geotransform. Returns the number written. Throws WriteFailed.
-int exportBuildings(const Project& project, const std::string& path,
-                    const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted});
+struct ExportSummary {
+  int written = 0;                   // buildings written
+  std::vector<std::string> leftOut;  // CityJSON: "building 3: no roof height", one per building left out
+};
+// Writes the accepted buildings, georeferenced like the left image when it has a geotransform:
+// their outlines as GeoJSON or GeoPackage by extension, or for "*.city.json" / "*.cityjson"
+// CityJSON LoD1 blocks from the ground to the roof height (io/cityjson.hpp; local metres of the
+// height model's gsd without georeferencing), leaving out the buildings without a roof height
+// above 0. Throws WriteFailed, and InvalidParameter naming a building whose outline is degenerate.
+ExportSummary exportBuildings(const Project& project, const std::string& path,
+                              const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted});
 
 // The bundled sample: a deterministic simulated scene written into `directory` (left, right,
 // ground-truth DEM and labels) and a project file "sample.delineo.json" referencing them, with
