@@ -2,9 +2,11 @@
 # End-to-end check of `delineo-cli run PROJECT` on a project with pending buildings: a simulated
 # pair, a project file written here with two rough rectangles (one with a roof interval, one
 # without, so the proposed interval is used), then: the run computes the disparity, delineates
-# both buildings, exports them (outlines and LoD1 blocks) and saves the project; a second run changes nothing; box-fitting as
-# the project's method (a building's own method wins); a corrupt project, an unknown method and a
-# missing image give exit code 3 naming the file.
+# both buildings, exports them (outlines and LoD1 blocks) and saves the project; a second run
+# changes nothing; box-fitting as the project's method (a building's own method wins); a
+# building without a roof height is left out of the blocks, a degenerate outline stops them
+# (exit 4); a corrupt project, an unknown method and a missing image give exit code 3 naming
+# the file.
 # Usage: e2e_run.sh PATH/TO/delineo-cli WORKDIR      (needs jq)
 set -uo pipefail
 cli="$1"
@@ -206,6 +208,22 @@ jq '.buildings[0].status = "pending" | .buildings[0].outline = []' "$work/after_
 chmod 444 "$site/locked.delineo.json"
 run_cli run_read_only 3 "read-only" -- "$cli" run --quiet "$site/locked.delineo.json"
 expect read_only_untouched '.buildings[0].status == "pending"' "$site/locked.delineo.json"
+# The blocks leave out a building without a roof height, naming it; a degenerate outline stops
+# the blocks only (exit 4, named), the outlines and the project are still written.
+jq '.outputDir = "blocks-out" | .buildings[0].roofHeight = null | .buildings[0].status = "accepted"' \
+  "$work/after_first.json" >"$site/noroof.delineo.json"
+run_cli run_block_left_out 0 "not in buildings.city.json: building 1: no roof height" -- \
+  "$cli" run "$site/noroof.delineo.json" --quiet
+expect blocks_left_out "(.CityObjects | length) == $((count - 1)) and (.CityObjects | has(\"building-1\") | not)" \
+  "$site/blocks-out/buildings.city.json"
+jq '.outputDir = "degenerate-out" | .buildings[0].outline = [[[10,10],[20,20],[30,30]]] | .buildings[0].status = "accepted"' \
+  "$work/after_first.json" >"$site/degenerate.delineo.json"
+run_cli run_degenerate_block 4 "buildings.city.json not written: building 1's outline is degenerate" -- \
+  "$cli" run "$site/degenerate.delineo.json" --quiet
+[ -s "$site/degenerate-out/buildings.geojson" ] && [ ! -e "$site/degenerate-out/buildings.city.json" ] \
+  && pass "a degenerate outline stops the blocks only" || fail "degenerate outline: wrong outputs"
+expect degenerate_project_saved '.buildings[0].status == "accepted"' "$site/degenerate.delineo.json"
+
 # --sample never replaces someone else's images; a relative folder works.
 mkdir -p "$work/mine"
 echo "my image" >"$work/mine/left.tif"
