@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -158,6 +159,23 @@ void expectOutwardSurfaces(const nlohmann::json& shell, const std::vector<Vec3>&
   }
 }
 
+// The shell is closed and consistently oriented: every directed edge of a ring is walked once,
+// and once in the opposite direction by the neighbouring surface.
+void expectClosedShell(const nlohmann::json& shell) {
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& surface : shell) {
+    for (const auto& ring : surface) {
+      for (size_t i = 0; i < ring.size(); ++i) ++edges[{ring[i].get<int>(), ring[(i + 1) % ring.size()].get<int>()}];
+    }
+  }
+  for (const auto& [edge, count] : edges) {
+    EXPECT_EQ(count, 1) << "edge " << edge.first << "-" << edge.second << " walked " << count << " times";
+    const auto reverse = edges.find({edge.second, edge.first});
+    EXPECT_TRUE(reverse != edges.end() && reverse->second == 1)
+        << "edge " << edge.first << "-" << edge.second << " has no opposite";
+  }
+}
+
 // The checks every written file passes, whatever the frame.
 void expectBlocks(const nlohmann::json& city, const std::function<cv::Point2d(cv::Point2d)>& toFrame) {
   ASSERT_EQ(city["type"], "CityJSON");
@@ -201,6 +219,7 @@ void expectBlocks(const nlohmann::json& city, const std::function<cv::Point2d(cv
     EXPECT_DOUBLE_EQ(object["attributes"]["roof_height_m"].get<double>(), c.roof);
     EXPECT_EQ(object["attributes"]["status"], "accepted");
     EXPECT_EQ(object["attributes"]["method"], "active-polygon");
+    expectClosedShell(shell);
     expectOutwardSurfaces(shell, vertices, expectedBlock(c.polygon, c.roof, toFrame));
   }
 }
