@@ -25,6 +25,7 @@
 #include <QTranslator>
 #include <QUndoStack>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -613,6 +614,13 @@ class MainWindowTest : public QObject {
     const auto features = io::readFeatures(exported.toStdString());
     QCOMPARE(features.size(), size_t(1));
     QCOMPARE(std::get<long long>(features[0].attributes.at("id")), static_cast<long long>(buildingId_));
+    // The same building as a CityJSON LoD1 block, up to its roof height.
+    QVERIFY(std::isfinite(loaded.buildings[0].roofHeight));
+    const QString blocks = dir_.filePath(QStringLiteral("sample/accepted.city.json"));
+    QCOMPARE(reopened.exportAccepted(blocks), 1);
+    QFile blocksFile(blocks);
+    QVERIFY(blocksFile.open(QIODevice::ReadOnly));
+    QVERIFY(blocksFile.readAll().contains("\"type\":\"CityJSON\""));
   }
 
   void badInputsShowAMessageAndChangeNothing() {
