@@ -77,6 +77,12 @@ struct Block {
   double height = 0.0;                    // m above the ground
 };
 
+std::string formatNumber(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
 std::string buildingNumber(const core::Feature& feature, size_t index) {
   const auto it = feature.attributes.find("id");
   if (it != feature.attributes.end()) {
@@ -107,7 +113,7 @@ std::optional<Block> blockOf(const core::Feature& feature, size_t index, const O
     return std::nullopt;
   }
   if (!(std::llround(*height / kMetreScale) > 0)) {
-    leftOutBecause = block.name + ": roof height " + std::to_string(*height) + " m is not above the ground";
+    leftOutBecause = block.name + ": roof height " + formatNumber(*height) + " m is not above the ground";
     return std::nullopt;
   }
   block.height = *height;
@@ -269,12 +275,6 @@ Grid gridFor(const std::vector<Block>& blocks, bool geographic) {
   if (std::isfinite(minX)) grid.translate[0] = std::floor(minX);
   if (std::isfinite(minY)) grid.translate[1] = std::floor(minY);
   return grid;
-}
-
-std::string formatNumber(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
 }
 
 std::string titleFor(const OutputFrame& frame, const CrsDescription& crs) {
