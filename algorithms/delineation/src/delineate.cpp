@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -685,6 +686,25 @@ EnergyTerms gateByEnergy(RegularizationOutcome& reg, const core::Polygon& raw, c
   return terms;
 }
 
+// The regularization stage: the outline regularized at the parameter's tolerance, then at half
+// and a quarter of it, until a result passes the outline gates and `energyGate` (which refuses a
+// result by setting KeptRaw). A looser tolerance merges more, but on a ragged outline it can cut
+// across a notch that a gate refuses where a tighter one passes. None passing, the first try's
+// outcome: the raw outline, with the reason the whole tolerance failed.
+template <class EnergyGate>
+RegularizationOutcome regularizeWithinTolerance(const core::Polygon& raw, const RegularizationParams& params,
+                                                const cv::Mat& left, EnergyGate&& energyGate) {
+  RegularizationParams tried = params;
+  std::optional<RegularizationOutcome> first;
+  for (int k = 0; k < 3 && tried.tolerance >= RegularizationParams::kMinTolerance; ++k, tried.tolerance /= 2) {
+    RegularizationOutcome outcome = regularizeOutline(raw, tried, left);
+    if (outcome.status == RegularizationStatus::Regularized) energyGate(outcome);
+    if (outcome.status != RegularizationStatus::KeptRaw) return outcome;  // regularized, or off
+    if (!first) first = std::move(outcome);
+  }
+  return *first;
+}
+
 }  // namespace
 
 OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
@@ -711,25 +731,31 @@ OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const D
 RegularizationOutcome regularizeBuildingOutline(const cv::Mat& left, const cv::Mat& right,
                                                 const DelineationRequest& request, const DelineationParams& params,
                                                 const core::Polygon& outline, core::Progress* progress) {
-  RegularizationOutcome reg = regularizeOutline(outline, params.regularization, left);
-  if (reg.status != RegularizationStatus::Regularized) return reg;
-  const cv::Rect roi = regionOfInterest(left, right, request, params);
-  const auto costs = costsOver(left, right, roi, request, params, progress);
-  if (!costs || core::isCanceled(progress)) {
-    reg.status = RegularizationStatus::Off;
-    reg.polygon = outline;
-    reg.outputVertices = reg.inputVertices;
-    return reg;
-  }
-  const IntPolygon raw = toRoiPolygon(outline, roi);
-  if (!isValidPolygon(raw)) {
-    throw Error(ErrorCode::InvalidParameter,
-                "the outline is not a valid polygon on the pixel grid of its region of interest "
-                "(a ring with fewer than 3 distinct corners, crossing itself or another ring)");
-  }
-  const PreparedEnergy prepared = prepareEnergy(*costs, left, right, request, params);
-  gateByEnergy(reg, outline, referenceEnergy(prepared.images, weightsOf(params), raw), prepared, params);
-  return reg;
+  // The costs only once a result needs the energy gate.
+  std::optional<PreparedEnergy> prepared;
+  EnergyTerms rawTerms;
+  auto energyGate = [&](RegularizationOutcome& outcome) {
+    if (!prepared) {
+      const cv::Rect roi = regionOfInterest(left, right, request, params);
+      const auto costs = costsOver(left, right, roi, request, params, progress);
+      if (!costs || core::isCanceled(progress)) {
+        outcome.status = RegularizationStatus::Off;
+        outcome.polygon = outline;
+        outcome.outputVertices = outcome.inputVertices;
+        return;
+      }
+      const IntPolygon raw = toRoiPolygon(outline, roi);
+      if (!isValidPolygon(raw)) {
+        throw Error(ErrorCode::InvalidParameter,
+                    "the outline is not a valid polygon on the pixel grid of its region of interest "
+                    "(a ring with fewer than 3 distinct corners, crossing itself or another ring)");
+      }
+      prepared = prepareEnergy(*costs, left, right, request, params);
+      rawTerms = referenceEnergy(prepared->images, weightsOf(params), raw);
+    }
+    gateByEnergy(outcome, outline, rawTerms, *prepared, params);
+  };
+  return regularizeWithinTolerance(outline, params.regularization, left, energyGate);
 }
 
 DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
@@ -772,8 +798,12 @@ DelineationResult delineate(const cv::Mat& left, const cv::Mat& right,
   result.status = r.status;
   result.regularization.polygon = result.polygon;
   if (r.status == core::RunStatus::Completed) {
-    result.regularization = regularizeOutline(result.rawPolygon, params.regularization, left);
-    result.terms = gateByEnergy(result.regularization, result.rawPolygon, r.terms, prepared, params);
+    EnergyTerms regularizedTerms = r.terms;
+    result.regularization = regularizeWithinTolerance(
+        result.rawPolygon, params.regularization, left, [&](RegularizationOutcome& outcome) {
+          regularizedTerms = gateByEnergy(outcome, result.rawPolygon, r.terms, prepared, params);
+        });
+    result.terms = result.regularization.status == RegularizationStatus::Regularized ? regularizedTerms : r.terms;
     result.polygon = result.regularization.polygon;
   }
   result.vertexCount = static_cast<int>(result.polygon.outer.size());

@@ -1149,6 +1149,7 @@ RegularizationOutcome regularizeOutline(const core::Polygon& outline,
   out.polygon = outline;
   out.inputVertices = out.outputVertices = vertexCount(outline);
   if (mode == RegularizationMode::None) return out;
+  out.tolerance = params.tolerance;
 
   RingContext ctx{mode,
                   dominantOrientation(input, image, params.imageEdgeWeight,

@@ -602,6 +602,29 @@ TEST(Delineate, RegularizesTheOutlineAsItsLastStage) {
   EXPECT_EQ(raw.rawPolygon.outer, r.rawPolygon.outer);
 }
 
+TEST(Delineate, RegularizationTriesTighterTolerancesWhenAGateRefuses) {
+  // A 20 px square roof: at 12 px its square lies within the round test's reach of a circle
+  // (0.4 x tolerance), so the whole tolerance keeps the input; half of it squares the outline.
+  const cv::Rect roof(60, 50, 20, 20);
+  const Pair pair = raisedRoof({140, 120}, roof, 14, 4);
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  core::Polygon outline;
+  outline.outer = {{60, 50}, {80, 50}, {80, 60}, {81, 60}, {81, 70}, {60, 70}};
+  DelineationParams params;
+  params.regularization.tolerance = 12;
+  EXPECT_EQ(regularizeOutline(outline, params.regularization, pair.left).status, RegularizationStatus::KeptRaw);
+  const RegularizationOutcome r = regularizeBuildingOutline(pair.left, pair.right, req, params, outline);
+  EXPECT_EQ(r.status, RegularizationStatus::Regularized) << r.reason;
+  EXPECT_LT(r.tolerance, 12.0);
+  EXPECT_EQ(r.polygon.outer.size(), 4u);
+  // The smallest tolerance has no tighter tries, and runs.
+  params.regularization.tolerance = RegularizationParams::kMinTolerance;
+  EXPECT_NO_THROW(regularizeBuildingOutline(pair.left, pair.right, req, params, outline));
+}
+
 TEST(Delineate, TheEnergyGateKeepsAnOutlineWhoseRegularizationLeavesTheRoofEdge) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);

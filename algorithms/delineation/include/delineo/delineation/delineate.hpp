@@ -115,8 +115,9 @@ OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const D
 // The regularization stage of delineate() on any outline of the building of `request` (an
 // operator's edit, a box-fitting outline): regularizeOutline() with params.regularization, then
 // the energy gate: the regularized outline's F(C), on the same costs as delineate() would use,
-// may exceed the input's by at most regularize-energy-margin per px of the input's length, else
-// the input is kept (status KeptRaw, reason "energy ..."). Throws like evaluateOutline(); cancel
+// may exceed the input's by at most regularize-energy-margin per px of the input's length. The
+// tolerance is tried whole, then halved twice; the first result that passes both gates is kept,
+// else the input (status KeptRaw, with the reason the whole tolerance failed). Throws like evaluateOutline(); cancel
 // returns the input with status Off.
 RegularizationOutcome regularizeBuildingOutline(const cv::Mat& left, const cv::Mat& right,
                                                 const DelineationRequest& request, const DelineationParams& params,

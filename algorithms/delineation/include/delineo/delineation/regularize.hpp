@@ -14,9 +14,12 @@
 namespace delineo::delineation {
 
 struct RegularizationParams {
+  static constexpr double kMinTolerance = 0.5;  // px, the smallest tolerance
   // right-angles | right-angles-and-diagonals | any-angle | none
   std::string mode = "right-angles";
-  double tolerance = 3.0;  // px: farthest any point of the result may lie from the input outline
+  // px: farthest any point of the result may lie from the input outline. delineate() also tries
+  // half and a quarter of it when a gate refuses the result.
+  double tolerance = 12.0;
   double minEdge = 4.0;    // px: edges shorter than this are merged away when the tolerance allows
   double minWidth = 4.0;   // px: spikes, fingers and slits narrower than this are cut off first
   double maxAreaChange = 8.0;  // %: largest change of the enclosed area
@@ -30,8 +33,9 @@ struct RegularizationParams {
                       0, 0, "right-angles|right-angles-and-diagonals|any-angle|none"},
       mode);
     v(core::ParamInfo{"regularize-tolerance", "Regularize tolerance", "px",
-                      "Farthest any point of the regularized outline may lie from the raw outline",
-                      0.5, 50},
+                      "Farthest any point of the regularized outline may lie from the raw outline "
+                      "(half and a quarter of it are tried when the result is refused)",
+                      kMinTolerance, 50},
       tolerance);
     v(core::ParamInfo{"regularize-min-edge", "Regularize min edge", "px",
                       "Edges shorter than this are merged into their neighbours when the tolerance "
@@ -83,6 +87,7 @@ struct RegularizationOutcome {
   RegularizationStatus status = RegularizationStatus::Off;
   std::string reason;         // why the input was kept (empty when regularized or off)
   double orientationDeg = 0;  // dominant orientation, degrees in [0, 90)
+  double tolerance = 0;       // px: the tolerance this outcome was regularized within
   double deviation = 0;       // px: farthest point of the result from the input outline
   double areaRatio = 1;       // area(result) / area(input)
   double energyChange = 0;    // F(result) - F(input) when the energy gate ran (delineate)
