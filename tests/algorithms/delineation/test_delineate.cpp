@@ -86,15 +86,22 @@ core::Polygon grownBox(cv::Rect r, int g) {
                        {}};
 }
 
+// The request for a raisedRoof(…, 14, 4) pair: the roof's box grown by 8 px, the roof interval
+// around 14 px and the ground around 4 px.
+DelineationRequest raisedRoofRequest(const cv::Rect& roof) {
+  DelineationRequest req;
+  req.init = grownBox(roof, 8);
+  req.roof = {13, 15};
+  req.ground = DisparityInterval{3, 5};
+  return req;
+}
+
 }  // namespace
 
 TEST(Delineate, ConvergesOnASyntheticPairWithGivenGround) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   int reports = 0;
   const auto r = delineate(pair.left, pair.right, req, DelineationParams{},
                            [&](const IterationReport&) { ++reports; });
@@ -122,10 +129,7 @@ TEST(Delineate, DoesNotFollowAStrongLineLeavingTheRoof) {
   const cv::Rect roof(50, 40, 60, 50);
   // The line crosses the ROI 10 px above the roof (2 px beyond the init's top edge).
   const Pair pair = raisedRoof({200, 140}, roof, 14, 4, roof.y - 10);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
   EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.9);
   EXPECT_LT(farthestOutside(r.polygon, roof), 4.0);
@@ -157,10 +161,7 @@ TEST(Delineate, CarvesTheNotchOfAnLShapedRoofFromABox) {
   const cv::Rect roof(50, 40, 90, 80);
   const cv::Rect notch(75, 40, 65, 60);  // leaves a 25 px wide arm and a 20 px wide base
   const Pair pair = raisedRoof({210, 170}, roof, 14, 4, -1, notch);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
   EXPECT_GT(iou(r.polygon, pair.truth, pair.left.size()), 0.93);
 }
@@ -179,10 +180,7 @@ TEST(Delineate, EstimatesTheGroundFromTheRing) {
 TEST(Delineate, OcclusionBandLiesOnTheMinusXSideForRaisedRoofs) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   const DelineationParams params;
   const cv::Rect roi = regionOfInterest(pair.left, pair.right, req, params);
   const auto costs = stereo::CorrelationCostService::compute(pair.left, pair.right, roi, 3, 15);
@@ -203,10 +201,7 @@ TEST(Delineate, OcclusionBandLiesOnTheMinusXSideForRaisedRoofs) {
 TEST(Delineate, CancelReturnsThePolygonSoFar) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   core::Progress counting;
   delineate(pair.left, pair.right, req, DelineationParams{}, {}, &counting);
   ASSERT_GT(counting.reportCount(), 4);
@@ -398,10 +393,7 @@ TEST(Delineate, ASuperstructureAboveTheRoofIsNoCourtyard) {
   const Pair pair = layeredPair(size, 4, layers);
   const cv::Mat disparity = layeredMap(size, 4, layers);
   const core::Polygon truth{{{50, 40}, {130, 40}, {130, 100}, {50, 100}}, {}};
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   req.searchRange = DisparityInterval{0, 28};
   req.disparity = disparity;
   const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
@@ -581,10 +573,7 @@ TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
 TEST(Delineate, RegularizesTheOutlineAsItsLastStage) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   const auto r = delineate(pair.left, pair.right, req, DelineationParams{});
   ASSERT_EQ(r.status, core::RunStatus::Completed);
   EXPECT_EQ(r.regularization.status, RegularizationStatus::Regularized) << r.regularization.reason;
@@ -607,10 +596,7 @@ TEST(Delineate, RegularizationTriesTighterTolerancesWhenAGateRefuses) {
   // (0.4 x tolerance), so the whole tolerance keeps the input; half of it squares the outline.
   const cv::Rect roof(60, 50, 20, 20);
   const Pair pair = raisedRoof({140, 120}, roof, 14, 4);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   core::Polygon outline;
   outline.outer = {{60, 50}, {80, 50}, {80, 60}, {81, 60}, {81, 70}, {60, 70}};
   DelineationParams params;
@@ -628,10 +614,7 @@ TEST(Delineate, RegularizationTriesTighterTolerancesWhenAGateRefuses) {
 TEST(Delineate, TheEnergyGateKeepsAnOutlineWhoseRegularizationLeavesTheRoofEdge) {
   const cv::Rect roof(50, 40, 60, 50);
   const Pair pair = raisedRoof({170, 140}, roof, 14, 4);
-  DelineationRequest req;
-  req.init = grownBox(roof, 8);
-  req.roof = {13, 15};
-  req.ground = DisparityInterval{3, 5};
+  DelineationRequest req = raisedRoofRequest(roof);
   // The true outline except a 3 px bulge over the middle 30 px of the east side: its jogs are
   // shorter than min-edge, and regularizing merges the side into one line about 2 px out, off
   // the image edge over its whole length.
