@@ -705,26 +705,42 @@ RegularizationOutcome regularizeWithinTolerance(const core::Polygon& raw, const 
   return *first;
 }
 
-}  // namespace
-
-OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
-                              const DelineationParams& params, const core::Polygon& outline,
-                              core::Progress* progress) {
-  OutlineEnergy result;
+// An outline's energy on the costs delineate() would use for `request`, with those costs;
+// nullopt when canceled. Throws InvalidParameter when the outline, on the pixel grid of its
+// region of interest, is not a valid polygon.
+struct OutlineOnCosts {
+  PreparedEnergy prepared;
+  EnergyTerms terms;
+};
+std::optional<OutlineOnCosts> energyOnCosts(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
+                                            const DelineationParams& params, const core::Polygon& outline,
+                                            core::Progress* progress) {
   const cv::Rect roi = regionOfInterest(left, right, request, params);
   const auto costs = costsOver(left, right, roi, request, params, progress);
-  if (!costs || core::isCanceled(progress)) {
-    result.status = core::RunStatus::Canceled;
-    return result;
-  }
+  if (!costs || core::isCanceled(progress)) return std::nullopt;
   const IntPolygon polygon = toRoiPolygon(outline, roi);
   if (!isValidPolygon(polygon)) {
     throw Error(ErrorCode::InvalidParameter,
                 "the outline is not a valid polygon on the pixel grid of its region of interest "
                 "(a ring with fewer than 3 distinct corners, crossing itself or another ring)");
   }
-  const PreparedEnergy prepared = prepareEnergy(*costs, left, right, request, params);
-  result.terms = referenceEnergy(prepared.images, weightsOf(params), polygon);
+  OutlineOnCosts out{prepareEnergy(*costs, left, right, request, params), {}};
+  out.terms = referenceEnergy(out.prepared.images, weightsOf(params), polygon);
+  return out;
+}
+
+}  // namespace
+
+OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const DelineationRequest& request,
+                              const DelineationParams& params, const core::Polygon& outline,
+                              core::Progress* progress) {
+  OutlineEnergy result;
+  const auto evaluated = energyOnCosts(left, right, request, params, outline, progress);
+  if (!evaluated) {
+    result.status = core::RunStatus::Canceled;
+    return result;
+  }
+  result.terms = evaluated->terms;
   return result;
 }
 
@@ -732,28 +748,16 @@ RegularizationOutcome regularizeBuildingOutline(const cv::Mat& left, const cv::M
                                                 const DelineationRequest& request, const DelineationParams& params,
                                                 const core::Polygon& outline, core::Progress* progress) {
   // The costs only once a result needs the energy gate.
-  std::optional<PreparedEnergy> prepared;
-  EnergyTerms rawTerms;
+  std::optional<OutlineOnCosts> raw;
   auto energyGate = [&](RegularizationOutcome& outcome) {
-    if (!prepared) {
-      const cv::Rect roi = regionOfInterest(left, right, request, params);
-      const auto costs = costsOver(left, right, roi, request, params, progress);
-      if (!costs || core::isCanceled(progress)) {
-        outcome.status = RegularizationStatus::Off;
-        outcome.polygon = outline;
-        outcome.outputVertices = outcome.inputVertices;
-        return;
-      }
-      const IntPolygon raw = toRoiPolygon(outline, roi);
-      if (!isValidPolygon(raw)) {
-        throw Error(ErrorCode::InvalidParameter,
-                    "the outline is not a valid polygon on the pixel grid of its region of interest "
-                    "(a ring with fewer than 3 distinct corners, crossing itself or another ring)");
-      }
-      prepared = prepareEnergy(*costs, left, right, request, params);
-      rawTerms = referenceEnergy(prepared->images, weightsOf(params), raw);
+    if (!raw) raw = energyOnCosts(left, right, request, params, outline, progress);
+    if (!raw) {  // canceled
+      outcome.status = RegularizationStatus::Off;
+      outcome.polygon = outline;
+      outcome.outputVertices = outcome.inputVertices;
+      return;
     }
-    gateByEnergy(outcome, outline, rawTerms, *prepared, params);
+    gateByEnergy(outcome, outline, raw->terms, raw->prepared, params);
   };
   return regularizeWithinTolerance(outline, params.regularization, left, energyGate);
 }

@@ -117,8 +117,8 @@ OutlineEnergy evaluateOutline(const cv::Mat& left, const cv::Mat& right, const D
 // the energy gate: the regularized outline's F(C), on the same costs as delineate() would use,
 // may exceed the input's by at most regularize-energy-margin per px of the input's length. The
 // tolerance is tried whole, then halved twice; the first result that passes both gates is kept,
-// else the input (status KeptRaw, with the reason the whole tolerance failed). Throws like evaluateOutline(); cancel
-// returns the input with status Off.
+// else the input (status KeptRaw, with the reason the whole tolerance failed). Throws like
+// evaluateOutline(); cancel returns the input with status Off.
 RegularizationOutcome regularizeBuildingOutline(const cv::Mat& left, const cv::Mat& right,
                                                 const DelineationRequest& request, const DelineationParams& params,
                                                 const core::Polygon& outline, core::Progress* progress = nullptr);
