@@ -17,6 +17,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -133,7 +134,7 @@ void drawOverlay(const std::string& path, const cv::Mat& bgr, const segmentation
     for (const auto& p : f.polygon.outer) ring.emplace_back(cvRound(p.x), cvRound(p.y));
     cv::polylines(out, ring, true, cv::Scalar(0, 230, 255), 3);
   }
-  cv::imwrite(path, out);
+  if (!cv::imwrite(path, out)) throw std::runtime_error(path + ": cannot write the overlay");
 }
 
 // The active polygon from every proposal; per labelled roof of the pair, the best IoU of the
@@ -195,6 +196,7 @@ int main(int argc, char** argv) {
     std::printf("skipped: data folder %s missing\n", data.c_str());
     return 0;
   }
+  fs::create_directories(out);
   const nlohmann::json roofs = nlohmann::json::parse(std::ifstream(labels));
   // BENCH_PARAMS='{"segment": {...}, "classify": {...}, "objects": {...}, "detect": {...}}' overrides.
   segmentation::SceneParams params;

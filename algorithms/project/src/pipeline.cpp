@@ -362,11 +362,10 @@ io::GeoReference leftGeoReference(const Project& project) {
     return {};
   }
 }
-}  // namespace
 
-ExportSummary exportBuildings(const Project& project, const std::string& path,
-                              const std::vector<BuildingStatus>& statuses) {
-  const auto features = buildingFeatures(project, statuses);
+// Writes `features` (the project's buildings) to `path` in the format its name says.
+ExportSummary writeBuildingFeatures(const Project& project, const std::string& path,
+                                    const std::vector<core::Feature>& features) {
   const io::GeoReference geo = leftGeoReference(project);
   std::error_code mk;
   fs::create_directories(fs::absolute(path).parent_path(), mk);
@@ -383,6 +382,12 @@ ExportSummary exportBuildings(const Project& project, const std::string& path,
   io::writeFeatures(path, features, geo);
   summary.written = static_cast<int>(features.size());
   return summary;
+}
+}  // namespace
+
+ExportSummary exportBuildings(const Project& project, const std::string& path,
+                              const std::vector<BuildingStatus>& statuses) {
+  return writeBuildingFeatures(project, path, buildingFeatures(project, statuses));
 }
 
 namespace {
@@ -444,13 +449,13 @@ void exportRunOutputs(const Project& project, const std::string& outputDir, RunS
   const auto features = buildingFeatures(project, statuses);
   if (features.empty()) return;
   summary.exported = (fs::path(outputDir) / "buildings.geojson").string();
-  exportBuildings(project, summary.exported, statuses);
+  writeBuildingFeatures(project, summary.exported, features);
   const bool anyHeight = std::any_of(features.begin(), features.end(),
                                      [](const core::Feature& f) { return f.attributes.count("roof_height_m") > 0; });
   if (!anyHeight) return;
   const std::string blocksPath = (fs::path(outputDir) / "buildings.city.json").string();
   try {
-    const ExportSummary blocks = exportBuildings(project, blocksPath, statuses);
+    const ExportSummary blocks = writeBuildingFeatures(project, blocksPath, features);
     summary.exportedBlocks = blocksPath;
     for (const auto& line : blocks.leftOut) summary.messages.push_back("not in buildings.city.json: " + line);
   } catch (const Error& e) {

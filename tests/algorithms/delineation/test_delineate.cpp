@@ -240,7 +240,13 @@ struct Layer {
   int disparity;
   cv::Mat texture;  // image size + 64 columns
 };
-Pair layeredPair(cv::Size size, int groundDisparity, std::vector<Layer> layers) {
+// The pair of a layered scene, and its true disparity map as a perfect matcher would give it
+// (the nearest layer, the largest disparity, in front).
+struct LayeredScene {
+  Pair pair;
+  cv::Mat disparity;
+};
+LayeredScene layeredScene(cv::Size size, int groundDisparity, std::vector<Layer> layers) {
   const cv::Mat ground = texture(size + cv::Size(64, 0), 100, 25, 1);
   std::sort(layers.begin(), layers.end(),
             [](const Layer& a, const Layer& b) { return a.disparity > b.disparity; });
@@ -260,16 +266,11 @@ Pair layeredPair(cv::Size size, int groundDisparity, std::vector<Layer> layers) 
       p.right.at<float>(y, x) = 0.95f * sample(x, y, 1) + 4.0f;
     }
   }
-  return p;
-}
-
-// The true disparity map of layeredPair's scene, as a perfect matcher would give it (the nearest
-// layer, the largest disparity, in front).
-cv::Mat layeredMap(cv::Size size, int groundDisparity, std::vector<Layer> layers) {
-  std::sort(layers.begin(), layers.end(), [](const Layer& a, const Layer& b) { return a.disparity < b.disparity; });
   cv::Mat map(size, CV_32F, cv::Scalar(static_cast<float>(groundDisparity)));
-  for (const Layer& l : layers) map(l.area & cv::Rect({}, size)).setTo(static_cast<float>(l.disparity));
-  return map;
+  for (auto l = layers.rbegin(); l != layers.rend(); ++l) {
+    map(l->area & cv::Rect({}, size)).setTo(static_cast<float>(l->disparity));
+  }
+  return {p, map};
 }
 
 TEST(Delineate, KeepsWhatMatchesBetweenTheGroundAndTheRoofOut) {
@@ -278,9 +279,10 @@ TEST(Delineate, KeepsWhatMatchesBetweenTheGroundAndTheRoofOut) {
   // neither interval (the cost cap makes them neutral) but match a disparity between the two.
   const cv::Rect roof(50, 40, 60, 50), crown(50, 90, 60, 12);
   const cv::Size size(170, 150);
-  const Pair pair = layeredPair(size, 4,
+  const Pair pair = layeredScene(size, 4,
                                 {{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
-                                 {crown, 9, texture(size + cv::Size(64, 0), 160, 25, 5)}});
+                                 {crown, 9, texture(size + cv::Size(64, 0), 160, 25, 5)}})
+                        .pair;
   const core::Polygon truth{{{50, 40}, {110, 40}, {110, 90}, {50, 90}}, {}};
   DelineationRequest req;
   req.init = grownBox(roof | crown, 6);
@@ -331,8 +333,7 @@ TEST(Delineate, LeavesANeighbourAtAnotherHeightOutside) {
   const cv::Size size(180, 160);
   const std::vector<Layer> layers{{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
                                   {neighbour, 19, smoothTexture(size + cv::Size(64, 0), 160, 25, 5)}};
-  const Pair pair = layeredPair(size, 4, layers);
-  const cv::Mat disparity = layeredMap(size, 4, layers);
+  const auto [pair, disparity] = layeredScene(size, 4, layers);
   const core::Polygon truth{{{50, 40}, {110, 40}, {110, 90}, {50, 90}}, {}};
   DelineationRequest req;
   req.init = grownBox(cv::Rect(roof.x, roof.y, roof.width, roof.height + 20), 8);
@@ -365,8 +366,7 @@ TEST(Delineate, TakesTheGroundFromTheMatchersMapWhenATallerNeighbourRingsTheInit
   const std::vector<cv::Rect> frame{{40, 30, 120, 22}, {40, 118, 120, 22}, {40, 52, 22, 66}, {138, 52, 22, 66}};
   std::vector<Layer> layers{{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)}};
   for (const cv::Rect& r : frame) layers.push_back({r, 22, frameTexture});
-  const Pair pair = layeredPair(size, 4, layers);
-  const cv::Mat disparity = layeredMap(size, 4, layers);
+  const auto [pair, disparity] = layeredScene(size, 4, layers);
   const core::Polygon truth{{{70, 60}, {130, 60}, {130, 110}, {70, 110}}, {}};
   DelineationRequest req;
   req.init = grownBox(roof, 8);
@@ -390,8 +390,7 @@ TEST(Delineate, ASuperstructureAboveTheRoofIsNoCourtyard) {
   const cv::Size size(190, 150);
   const std::vector<Layer> layers{{roof, 14, texture(size + cv::Size(64, 0), 160, 25, 2)},
                                   {plant, 18, texture(size + cv::Size(64, 0), 120, 25, 3)}};
-  const Pair pair = layeredPair(size, 4, layers);
-  const cv::Mat disparity = layeredMap(size, 4, layers);
+  const auto [pair, disparity] = layeredScene(size, 4, layers);
   const core::Polygon truth{{{50, 40}, {130, 40}, {130, 100}, {50, 100}}, {}};
   DelineationRequest req = raisedRoofRequest(roof);
   req.searchRange = DisparityInterval{0, 28};
