@@ -1883,13 +1883,6 @@
             <numerusform>Scène analysée : %n objets.</numerusform>
         </translation>
     </message>
-    <message numerus="yes">
-        <source>%n building(s) proposed (%1 already present).</source>
-        <translation>
-            <numerusform>%n bâtiment proposé (%1 déjà présents).</numerusform>
-            <numerusform>%n bâtiments proposés (%1 déjà présents).</numerusform>
-        </translation>
-    </message>
     <message>
         <source>Review them in the buildings list and delineate them.</source>
         <translation>Vérifiez-les dans la liste des bâtiments et délimitez-les.</translation>
@@ -1917,6 +1910,58 @@
     <message>
         <source>  above ground %1 m</source>
         <translation>  au-dessus du sol %1 m</translation>
+    </message>
+    <message>
+        <source>&amp;Outline the pending buildings</source>
+        <translation>&amp;Délimiter les bâtiments en attente</translation>
+    </message>
+    <message>
+        <source>Outline every pending building in turn with its method; a cancel keeps those done</source>
+        <translation>Délimiter chaque bâtiment en attente à tour de rôle avec sa méthode ; une annulation garde ceux qui sont faits</translation>
+    </message>
+    <message>
+        <source>Outline the pending buildings</source>
+        <translation>Délimiter les bâtiments en attente</translation>
+    </message>
+    <message>
+        <source>No building is pending.</source>
+        <translation>Aucun bâtiment n’est en attente.</translation>
+    </message>
+    <message>
+        <source>Compute the disparity first: it gives the buildings their roof intervals.</source>
+        <translation>Calculez d’abord la disparité : elle donne aux bâtiments leurs intervalles de toit.</translation>
+    </message>
+    <message>
+        <source>Building %1: %2</source>
+        <translation>Bâtiment %1 : %2</translation>
+    </message>
+    <message>
+        <source>These buildings could not be outlined and stay pending:</source>
+        <translation>Ces bâtiments n’ont pas pu être délimités et restent en attente :</translation>
+    </message>
+    <message>
+        <source>%1 building proposed (%2 already present).</source>
+        <translation>%1 bâtiment proposé (%2 déjà présents).</translation>
+    </message>
+    <message>
+        <source>%1 buildings proposed (%2 already present).</source>
+        <translation>%1 bâtiments proposés (%2 déjà présents).</translation>
+    </message>
+    <message>
+        <source>1 building outlined.</source>
+        <translation>1 bâtiment délimité.</translation>
+    </message>
+    <message>
+        <source>%1 buildings outlined.</source>
+        <translation>%1 bâtiments délimités.</translation>
+    </message>
+    <message>
+        <source>1 stays pending.</source>
+        <translation>1 reste en attente.</translation>
+    </message>
+    <message>
+        <source>%1 stay pending.</source>
+        <translation>%1 restent en attente.</translation>
     </message>
 </context>
 <context>

@@ -191,6 +191,17 @@ void Document::setDelineationResult(int id, const project::DelineationOutcome& o
   undo_.push(new BuildingCommand(this, id, *current, after, tr("Delineate building %1").arg(id)));
 }
 
+bool Document::setOutlinedPending(const Building& after) {
+  const Building* current = project_.find(after.id);
+  if (current == nullptr || current->status != BuildingStatus::Pending) return false;
+  if (!(current->initial.outer == after.initial.outer && current->initial.holes == after.initial.holes)) return false;
+  if (current->roofInterval && current->roofInterval != after.roofInterval) return false;
+  const QString text = after.method == project::kBoxFitting ? tr("Box-fitting outline for building %1").arg(after.id)
+                                                            : tr("Delineate building %1").arg(after.id);
+  undo_.push(new BuildingCommand(this, after.id, *current, after, text));
+  return true;
+}
+
 void Document::setBoxFitResult(int id, const project::BoxFitOutcome& outcome,
                                const std::optional<project::EnergyOutcome>& energy) {
   const Building* current = project_.find(id);

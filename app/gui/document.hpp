@@ -62,6 +62,10 @@ class Document : public QObject {
   // active polygon's energy of its outline when it was scored.
   void setBoxFitResult(int id, const project::BoxFitOutcome& outcome,
                        const std::optional<project::EnergyOutcome>& energy);
+  // A pending building as project::outlinePendingBuilding() outlined it, applied only while the
+  // building is still pending with the initial polygon it was outlined from (the operator may
+  // have changed it meanwhile); returns whether it was applied.
+  bool setOutlinedPending(const project::Building& after);
   // The scene analysis's building proposals that are not buildings yet, added as Pending
   // buildings (project::addProposedBuildings) in one undoable step. Returns the new ids.
   std::vector<int> addProposedBuildings(const std::vector<core::Feature>& proposals);

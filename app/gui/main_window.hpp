@@ -84,6 +84,11 @@ class MainWindow : public QMainWindow {
   widgets::JobId startDelineation(int id);
   // Outlines a building with its method (Project::methodOf): the active polygon or box-fitting.
   widgets::JobId outlineBuilding(int id);
+  // Building → Outline the pending buildings (key "outline-pending"): every pending building in
+  // turn with its method, as `delineo-cli run` does; each result is applied as it comes (one
+  // undoable step per building), so a cancel keeps those done. Returns the job id, or 0 with a
+  // message saying why nothing started.
+  widgets::JobId outlinePendingBuildings();
   void acceptSelected();
   void rejectSelected();
   void autosaveNow();
@@ -194,6 +199,7 @@ class MainWindow : public QMainWindow {
   void demEnhanced();
   void sceneAnalysed();                         // a new scene analysis is shown
   void buildingsDetected(int added, int present);  // Detect buildings has added its proposals
+  void pendingOutlined(int outlined, int skipped);  // Outline the pending buildings has ended
 
  protected:
   void closeEvent(QCloseEvent* event) override;

@@ -152,6 +152,9 @@ void MainWindow::createBuildingActions() {
   action(QStringLiteral("actionRegularize"))
       ->setStatusTip(tr(
           "Square the selected outline: right angles, few vertices, within the tolerance of it"));
+  QAction* outlinePending = makeAction(this, QStringLiteral("actionOutlinePending"), tr("&Outline the pending buildings"));
+  outlinePending->setStatusTip(tr("Outline every pending building in turn with its method; a cancel keeps those done"));
+  connect(outlinePending, &QAction::triggered, this, &MainWindow::outlinePendingBuildings);
   QAction* boxFit = makeAction(this, QStringLiteral("actionBoxFit"), tr("Bo&x-fitting"));
   boxFit->setStatusTip(tr("Fit boxes to the selected building from its DEM and the left image's edges, and show "
                           "their outline beside the building's outline"));
@@ -289,6 +292,7 @@ void MainWindow::createMenus() {
   building->addAction(action(QStringLiteral("actionRemove")));
   building->addSeparator();
   building->addAction(action(QStringLiteral("actionDetectBuildings")));
+  building->addAction(action(QStringLiteral("actionOutlinePending")));
 
   QMenu* process = menuBar()->addMenu(tr("&Processing"));
   process->addAction(action(QStringLiteral("actionMatch")));
@@ -297,6 +301,7 @@ void MainWindow::createMenus() {
   process->addSeparator();
   process->addAction(action(QStringLiteral("actionAnalyseScene")));
   process->addAction(action(QStringLiteral("actionDetectBuildings")));
+  process->addAction(action(QStringLiteral("actionOutlinePending")));
   process->addSeparator();
   process->addAction(action(QStringLiteral("actionCancelJobs")));
 
@@ -356,6 +361,8 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionRegularize"))
       ->setEnabled(b != nullptr && b->hasOutline() && project::delineationAvailable());
   action(QStringLiteral("actionBoxFit"))->setEnabled(b != nullptr && project::boxFittingAvailable());
+  action(QStringLiteral("actionOutlinePending"))
+      ->setEnabled(hasDoc && project::delineationAvailable() && !document_->project().pendingBuildings().empty());
   const bool proposal = b != nullptr && hasBoxFitProposal(b->id);
   action(QStringLiteral("actionKeepBoxFit"))->setEnabled(proposal);
   action(QStringLiteral("actionDiscardBoxFit"))->setEnabled(proposal);

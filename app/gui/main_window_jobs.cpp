@@ -1,11 +1,12 @@
 // MainWindow's background jobs: the disparity range, dense matching, the active polygon, the
-// energy and the regularization of an outline, the edge map. Each copies its inputs into a
-// job of the window's JobRunner and applies the result on the GUI thread, provided the document
-// it was started on is still the open one.
+// pending buildings outlined in turn, the energy and the regularization of an outline, the edge
+// map. Each copies its inputs into a job of the window's JobRunner and applies the result on the
+// GUI thread, provided the document it was started on is still the open one.
 #include <QLabel>
 #include <QMetaObject>
 #include <QPointer>
 #include <QStatusBar>
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -18,6 +19,7 @@
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "document.hpp"
+#include "error_text.hpp"
 #include "main_window.hpp"
 
 namespace delineo::gui {
@@ -148,6 +150,76 @@ widgets::JobId MainWindow::startDelineation(int id) {
       },
       QStringLiteral("delineate-%1").arg(id));
   return job;
+}
+
+widgets::JobId MainWindow::outlinePendingBuildings() {
+  if (!document_ || !project::delineationAvailable()) return 0;
+  const QString title = tr("Outline the pending buildings");
+  const std::vector<int> pending = document_->project().pendingBuildings();
+  if (pending.empty()) {
+    showMessage(title, tr("No building is pending."));
+    return 0;
+  }
+  const bool withoutInterval = std::any_of(pending.begin(), pending.end(), [this](int id) {
+    return !document_->project().find(id)->roofInterval;
+  });
+  if (document_->disparity().empty() && withoutInterval) {
+    showMessage(title, tr("Compute the disparity first: it gives the buildings their roof intervals."));
+    return 0;
+  }
+  const project::Project projectCopy = document_->project();
+  const project::StereoPair pair = document_->pair();
+  QPointer<Document> doc(document_.get());
+  QPointer<MainWindow> self(this);
+  struct Batch {
+    int outlined = 0;
+    std::vector<std::pair<int, core::Error>> skipped;  // building id, why
+  };
+  // Each result goes to the GUI thread as soon as it is there: a cancel loses none of them.
+  auto deliver = [self, doc](const Building& after) {
+    QMetaObject::invokeMethod(self.data(), [self, doc, after] {
+      if (self && doc && doc == self->document_.get()) doc->setOutlinedPending(after);
+    }, Qt::QueuedConnection);
+  };
+  return jobs_->run<Batch>(
+      title,
+      [projectCopy, pair, pending, deliver](core::Progress& p) {
+        Batch batch;
+        cv::Mat heights;  // read once, by the first building outlined by box-fitting
+        const double n = static_cast<double>(pending.size());
+        for (size_t i = 0; i < pending.size(); ++i) {
+          core::Progress::Range range(&p, static_cast<double>(i) / n, static_cast<double>(i + 1) / n);
+          const Building& building = *projectCopy.find(pending[i]);
+          try {
+            const std::optional<Building> after =
+                project::outlinePendingBuilding(projectCopy, building, pair, heights, &range, "all pending");
+            if (!after) return batch;  // canceled
+            deliver(*after);
+            ++batch.outlined;
+          } catch (const core::Error& e) {
+            // This building cannot be outlined (a degenerate proposal, no heights for box-fitting):
+            // the others still are. Anything else ends the job as failed.
+            if (core::isInputError(e.code()) && e.code() != core::ErrorCode::InvalidParameter) throw;
+            batch.skipped.emplace_back(building.id, e);
+          }
+        }
+        return batch;
+      },
+      [this, doc, title](Batch batch) {
+        if (!doc || doc != document_.get()) return;
+        const int skipped = static_cast<int>(batch.skipped.size());
+        QString text = batch.outlined == 1 ? tr("1 building outlined.") : tr("%1 buildings outlined.").arg(batch.outlined);
+        if (skipped > 0) text += QLatin1Char(' ') + (skipped == 1 ? tr("1 stays pending.") : tr("%1 stay pending.").arg(skipped));
+        statusBar()->showMessage(text, 8000);
+        if (skipped > 0) {
+          QStringList lines;
+          for (const auto& [id, error] : batch.skipped) lines << tr("Building %1: %2").arg(id).arg(errorMessage(error));
+          showMessage(title, tr("These buildings could not be outlined and stay pending:") + QLatin1Char('\n') +
+                                 lines.join(QLatin1Char('\n')));
+        }
+        emit pendingOutlined(batch.outlined, skipped);
+      },
+      QStringLiteral("outline-pending"));
 }
 
 widgets::JobId MainWindow::startEnergyUpdate(int id) {

@@ -391,27 +391,44 @@ ExportSummary exportBuildings(const Project& project, const std::string& path,
 }
 
 namespace {
-
-// The active polygon on one pending building of `delineo-cli run`; false when canceled.
-bool delineateOne(const Project& project, Building& b, const StereoPair& pair, const cv::Mat& disparity,
-                  core::Progress* progress) {
-  if (!b.roofInterval) b.roofInterval = suggestRoofInterval(disparity, b.initial);
+// The active polygon on one pending building; nullopt when canceled.
+std::optional<Building> delineatePending(const Project& project, Building b, const StereoPair& pair,
+                                         core::Progress* progress, const std::string& origin) {
+  if (!b.roofInterval) b.roofInterval = suggestRoofInterval(pair.disparity, b.initial);
   DelineationOutcome outcome = delineateBuilding(project, b, pair, progress);
-  if (outcome.status == core::RunStatus::Canceled) return false;
+  if (outcome.status == core::RunStatus::Canceled) return std::nullopt;
   b.outline = outcome.outline;
   b.energy = outcome.energy;
   b.energyTerms = outcome.terms;
-  b.roofHeight = roofHeight(project, disparity, b.outline);
+  b.roofHeight = roofHeight(project, pair.disparity, b.outline);
   b.status = BuildingStatus::Automatic;
   b.method = kActivePolygon;
-  std::string detail = "delineo-cli run, " + std::to_string(b.outline.outer.size()) + " vertices";
+  std::string detail = origin + ", " + std::to_string(b.outline.outer.size()) + " vertices";
   if (!outcome.regularization.empty()) detail += ", " + outcome.regularization;
   if (!outcome.regularizationNote.empty()) detail += " (" + outcome.regularizationNote + ")";
   b.addHistory("delineated", detail);
-  return true;
+  return b;
 }
-
 }  // namespace
+
+std::optional<Building> outlinePendingBuilding(const Project& project, const Building& building,
+                                               const StereoPair& pair, cv::Mat& heights,
+                                               core::Progress* progress, const std::string& origin) {
+  if (project.methodOf(building) != kBoxFitting) {
+    core::setStage(progress, core::StageId::DelineatingBuilding, building.id);
+    return delineatePending(project, building, pair, progress, origin);
+  }
+  core::setStage(progress, core::StageId::BoxFittingBuilding, building.id);
+  if (heights.empty()) heights = projectHeights(project, pair.disparity);
+  if (heights.empty()) {
+    throw Error(ErrorCode::InvalidParameter,
+                "box-fitting needs heights: the project names no DEM and has no height model");
+  }
+  const BoxFitOutcome outcome = fitBuildingBoxes(project, building, heights, pair.left, progress);
+  if (outcome.status == core::RunStatus::Canceled) return std::nullopt;
+  if (!outcome.hasOutline()) throw Error(ErrorCode::ProcessingFailed, "box-fitting: " + outcome.message);
+  return withBoxFitOutline(project, building, outcome, pair.disparity, origin);
+}
 
 namespace {
 // run --detect: the scene analysis on `heights`, its rasters and objects written into
@@ -533,29 +550,14 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
     core::Progress::Range range(progress, begin, end);
     Building& b = *project.find(pending[i]);
     try {
-      const bool boxFitting = project.methodOf(b) == kBoxFitting;
-      if (boxFitting) {
-        range.setStage(core::StageId::BoxFittingBuilding, b.id);
-        if (heights.empty()) heights = projectHeights(project, disparity);
-        if (heights.empty()) {
-          throw Error(ErrorCode::InvalidParameter,
-                      "box-fitting needs heights: the project names no DEM and has no height model");
-        }
-        const BoxFitOutcome outcome = fitBuildingBoxes(project, b, heights, pair.left, &range);
-        if (outcome.status == core::RunStatus::Canceled) {
-          summary.status = core::RunStatus::Canceled;
-          return summary;
-        }
-        if (!outcome.hasOutline()) throw Error(ErrorCode::ProcessingFailed, "box-fitting: " + outcome.message);
-        b = withBoxFitOutline(project, b, outcome, disparity, "delineo-cli run");
-        ++summary.boxFitted;
-      } else {
-        range.setStage(core::StageId::DelineatingBuilding, b.id);
-        if (!delineateOne(project, b, pair, disparity, &range)) {
-          summary.status = core::RunStatus::Canceled;
-          return summary;
-        }
+      const std::optional<Building> outlined =
+          outlinePendingBuilding(project, b, pair, heights, &range, "delineo-cli run");
+      if (!outlined) {
+        summary.status = core::RunStatus::Canceled;
+        return summary;
       }
+      if (outlined->method == kBoxFitting) ++summary.boxFitted;
+      b = *outlined;
       ++summary.delineated;
     } catch (const Error& e) {
       if (!core::isInputError(e.code()) || e.code() == ErrorCode::InvalidParameter) {

@@ -6,8 +6,8 @@
 // again with "Pick an above-ground object" (a click in its middle). Checks the range
 // against the roof, the outline against a hand-drawn one (tests/bench/data/real_roofs.json),
 // that nothing is written beside the images, and counts the operator's actions; then box-fitting
-// beside the active polygon and the enhanced DEM; last, the scene analysis's layers and Detect
-// buildings on the whole tile.
+// beside the active polygon and the enhanced DEM; last, the scene analysis's layers, Detect
+// buildings on the whole tile and Outline the pending buildings.
 //
 // DELINEO_DATA_DIR overrides the data folder; DELINEO_SCREENSHOT_DIR keeps a screenshot of each
 // step (the user guide's images: scripts/screenshots.sh).
@@ -462,6 +462,44 @@ class RealPairTest : public QObject {
     QCOMPARE(window_->document()->project().buildings.size(), before + static_cast<size_t>(added));
     QCOMPARE(window_->document()->undoStack()->index(), undoIndex + 1);
     shot(QStringLiteral("14-detected"));
+  }
+
+  // Outline the pending buildings: the detected proposals outlined in turn by the active polygon,
+  // as `delineo-cli run --detect` does, then scored against the hand-drawn roofs they cover.
+  void outlinesTheProposals() {
+    if (!project::sceneAnalysisAvailable() || !project::delineationAvailable()) QSKIP("no scene analysis");
+    gui::Document* doc = window_->document();
+    const std::vector<int> pending = doc->project().pendingBuildings();
+    QVERIFY(!pending.empty());
+    QSignalSpy outlined(window_.get(), &MainWindow::pendingOutlined);
+    window_->action(QStringLiteral("actionOutlinePending"))->trigger();
+    QTRY_VERIFY_WITH_TIMEOUT(!outlined.isEmpty(), 600000);
+    QCOMPARE(outlined.first().at(0).toInt(), static_cast<int>(pending.size()));
+    QVERIFY(doc->project().pendingBuildings().empty());
+    // Each hand-drawn roof whose most overlapping outline is one of these.
+    std::ifstream in(DELINEO_REAL_ROOFS);
+    const nlohmann::json labelled = nlohmann::json::parse(in);
+    double sum = 0;
+    int reached = 0;
+    for (const auto& roof : labelled["roofs"]) {
+      if (roof["pair"] != "toulouse_0051") continue;
+      const core::Polygon hand = handOutline(roof["name"].get<std::string>());
+      double best = 0;
+      int bestId = -1;
+      for (const project::Building& b : doc->project().buildings) {
+        if (!b.hasOutline()) continue;
+        const double iou = eval::intersectionOverUnion(b.outline, hand);
+        if (iou > best) best = iou, bestId = b.id;
+      }
+      if (std::find(pending.begin(), pending.end(), bestId) == pending.end() || best < 0.5) continue;
+      qInfo("%s: IoU %.3f (building %d)", roof["name"].get<std::string>().c_str(), best, bestId);
+      sum += best;
+      ++reached;
+    }
+    QVERIFY(reached >= 2);
+    qInfo("outlined proposals: %d roofs reached, mean IoU %.3f", reached, sum / reached);
+    QVERIFY(sum / reached > 0.8);
+    shot(QStringLiteral("15-proposals-outlined"));
   }
 
   void cleanupTestCase() { window_.reset(); }

@@ -1,7 +1,8 @@
 // The scene analysis in the real main window, on the generated sample project (its DEM and gsd,
 // its ground-truth labels): Analyse the scene and its layers (classes against the truth, objects'
-// outlines, DTM / nDSM in the DEM view), Detect buildings as one undoable step, a canceled
-// analysis changing nothing, the message when heights are missing, the parameter tabs.
+// outlines, DTM / nDSM in the DEM view), Detect buildings as one undoable step, Outline the
+// pending buildings (one undo step each, a cancel keeping those done), a canceled analysis
+// changing nothing, the message when heights are missing, the parameter tabs.
 #include <QAction>
 #include <QComboBox>
 #include <QSignalSpy>
@@ -194,6 +195,62 @@ class SceneAnalysisTest : public QObject {
     QVERIFY(window_->startDelineation(first) != 0);
     QVERIFY(delineated.wait(120000));
     QVERIFY(doc()->project().find(first)->hasOutline());
+  }
+
+  // Building → Outline the pending buildings: every proposal outlined in turn, one undo step
+  // each; a cancel keeps the buildings outlined before it and leaves the others pending.
+  void pendingBuildingsAreOutlinedInTurn() {
+    if (!project::matchingAvailable() || !project::delineationAvailable()) QSKIP("no matcher or active polygon");
+    QVERIFY(window_->openProject(projectPath_));
+    QVERIFY(!act("actionOutlinePending")->isEnabled());
+    QCOMPARE(window_->outlinePendingBuildings(), widgets::JobId(0));  // nothing pending
+    QSignalSpy matched(window_.get(), &MainWindow::matchingFinished);
+    QVERIFY(window_->startMatching() != 0);
+    QVERIFY(matched.wait(60000));
+    QSignalSpy detected(window_.get(), &MainWindow::buildingsDetected);
+    QVERIFY(window_->detectBuildings() != 0);
+    QVERIFY(detected.wait(60000));
+    const int added = detected.at(0).at(0).toInt();
+    QVERIFY(added >= 3);
+    QVERIFY(act("actionOutlinePending")->isEnabled());
+
+    // Canceled once the first building is outlined: that one is kept, the others stay pending.
+    const int undoBefore = doc()->undoStack()->count();
+    QMetaObject::Connection cancelOnFirst =
+        connect(doc(), &gui::Document::buildingChanged, window_->jobs(), &widgets::JobRunner::cancelAll);
+    QVERIFY(window_->outlinePendingBuildings() != 0);
+    QVERIFY(window_->jobs()->waitForIdle(120000));
+    QTest::qWait(50);
+    disconnect(cancelOnFirst);
+    const int keptAfterCancel = added - static_cast<int>(doc()->project().pendingBuildings().size());
+    QVERIFY2(keptAfterCancel >= 1 && keptAfterCancel < added, qPrintable(QString::number(keptAfterCancel)));
+    QCOMPARE(doc()->undoStack()->count(), undoBefore + keptAfterCancel);
+
+    // Run again: the rest are outlined, each by the active polygon, with a roof height.
+    QSignalSpy outlined(window_.get(), &MainWindow::pendingOutlined);
+    act("actionOutlinePending")->trigger();
+    QVERIFY(outlined.wait(240000));
+    QCOMPARE(outlined.at(0).at(0).toInt() + outlined.at(0).at(1).toInt(), added - keptAfterCancel);
+    QCOMPARE(outlined.at(0).at(1).toInt(), 0);
+    QVERIFY(doc()->project().pendingBuildings().empty());
+    QVERIFY(!act("actionOutlinePending")->isEnabled());
+    const cv::Mat& truth = doc()->labels();
+    for (const project::Building& b : doc()->project().buildings) {
+      QVERIFY(b.status == project::BuildingStatus::Automatic);
+      QCOMPARE(QString::fromStdString(b.method), QString::fromLatin1(project::kActivePolygon));
+      QVERIFY(b.hasOutline());
+      QVERIFY(std::isfinite(b.roofHeight) && b.roofHeight > 2.0);
+      // Most of each outline is on the sample's buildings (label 1).
+      const cv::Mat inside = core::rasterize(b.outline, truth.size());
+      const double onBuildings = cv::countNonZero(inside & (truth == 1)) / double(cv::countNonZero(inside));
+      QVERIFY2(onBuildings > 0.8, qPrintable(QStringLiteral("building %1: %2").arg(b.id).arg(onBuildings)));
+    }
+    QCOMPARE(doc()->undoStack()->count(), undoBefore + added);
+    QVERIFY(window_->buildingsTable()->model()->rowCount() == added);
+    // One undo puts the last one back to pending.
+    act("actionUndo")->trigger();
+    QCOMPARE(static_cast<int>(doc()->project().pendingBuildings().size()), 1);
+    QVERIFY(act("actionOutlinePending")->isEnabled());
   }
 
   void canceledAnalysisChangesNothing() {

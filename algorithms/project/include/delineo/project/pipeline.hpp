@@ -241,6 +241,17 @@ SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights
 std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
                                       const std::string& origin = {});
 
+// One pending building outlined with its method (Project::methodOf), as `run` and the GUI's
+// "Outline the pending buildings" do it: the active polygon on `pair` (whose disparity map gives
+// the roof interval when the building has none), or box-fitting on `heights` (projectHeights(),
+// read here when empty). Returns the building after: status Automatic, method, outline, energy,
+// roof height and a "delineated" history entry starting with `origin`; nullopt when canceled.
+// Throws core::Error when the method cannot outline it (InvalidParameter without heights for
+// box-fitting, ProcessingFailed when box-fitting finds no building).
+std::optional<Building> outlinePendingBuilding(const Project& project, const Building& building,
+                                               const StereoPair& pair, cv::Mat& heights,
+                                               core::Progress* progress, const std::string& origin);
+
 // `delineo-cli run`: the disparity range estimated when the project has none, matching when
 // the disparity is missing (written to
 // `outputDir`/disparity.tif and recorded in the project), then the outline of every Pending
