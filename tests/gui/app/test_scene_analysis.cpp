@@ -53,6 +53,15 @@ class SceneAnalysisTest : public QObject {
     return analysed.wait(60000);
   }
 
+  // Computes the disparity, then Detect buildings; the number of buildings added, -1 on a timeout.
+  int matchAndDetect() {
+    QSignalSpy matched(window_.get(), &MainWindow::matchingFinished);
+    QSignalSpy detected(window_.get(), &MainWindow::buildingsDetected);
+    if (window_->startMatching() == 0 || !matched.wait(60000)) return -1;
+    if (window_->detectBuildings() == 0 || !detected.wait(60000)) return -1;
+    return detected.at(0).at(0).toInt();
+  }
+
   // A project with no DEM, no disparity and no height model: no heights at all.
   bool openPairWithoutHeights() {
     cv::Mat left(120, 160, CV_8U);
@@ -150,14 +159,8 @@ class SceneAnalysisTest : public QObject {
     QVERIFY(doc()->project().buildings.empty());
     // With the disparity, each proposal comes with its roof interval.
     if (!project::matchingAvailable()) QSKIP("no matcher in this build");
-    QSignalSpy matched(window_.get(), &MainWindow::matchingFinished);
-    QVERIFY(window_->startMatching() != 0);
-    QVERIFY(matched.wait(60000));
     QSignalSpy detected(window_.get(), &MainWindow::buildingsDetected);
-    // No analysis yet: Detect buildings runs it first.
-    QVERIFY(window_->detectBuildings() != 0);
-    QVERIFY(detected.wait(60000));
-    const int added = detected.at(0).at(0).toInt();
+    const int added = matchAndDetect();  // no analysis yet: Detect buildings runs it first
     QVERIFY(added >= 3);
     QCOMPARE(detected.at(0).at(1).toInt(), 0);
     QVERIFY2(window_->lastMessage().contains(QStringLiteral("%1 buildings proposed (0 already present)").arg(added)),
@@ -204,13 +207,7 @@ class SceneAnalysisTest : public QObject {
     QVERIFY(window_->openProject(projectPath_));
     QVERIFY(!act("actionOutlinePending")->isEnabled());
     QCOMPARE(window_->outlinePendingBuildings(), widgets::JobId(0));  // nothing pending
-    QSignalSpy matched(window_.get(), &MainWindow::matchingFinished);
-    QVERIFY(window_->startMatching() != 0);
-    QVERIFY(matched.wait(60000));
-    QSignalSpy detected(window_.get(), &MainWindow::buildingsDetected);
-    QVERIFY(window_->detectBuildings() != 0);
-    QVERIFY(detected.wait(60000));
-    const int added = detected.at(0).at(0).toInt();
+    const int added = matchAndDetect();
     QVERIFY(added >= 3);
     QVERIFY(act("actionOutlinePending")->isEnabled());
 
