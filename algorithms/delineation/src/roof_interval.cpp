@@ -322,6 +322,70 @@ size_t roofLevel(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat
   return bestKept >= bar ? best : first;
 }
 
+// How many of the core's pixels within `halfWindow` of `level` lie in regions (8-connected pixels
+// within that window) that stay inside the polygon (none `reach` px outside it, unlike
+// enteringCount's) and touch the roof: pixels within [low, high] lie 2 px or less from them.
+int attachedCount(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, double level,
+                  double halfWindow, double reach, int low, int high) {
+  cv::Mat atLevel, roofLevel;
+  cv::inRange(disparity(n.roi), level - halfWindow, level + halfWindow, atLevel);
+  atLevel &= n.outerDistance <= static_cast<float>(reach + 1.0);
+  cv::inRange(disparity(n.roi), low, high, roofLevel);
+  cv::dilate(roofLevel, roofLevel, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
+  cv::Mat labels;
+  const int count = cv::connectedComponents(atLevel, labels, 8, CV_32S);
+  std::vector<char> out(static_cast<size_t>(count), 0), touches(static_cast<size_t>(count), 0);
+  for (int y = 0; y < atLevel.rows; ++y) {
+    const uchar* a = atLevel.ptr<uchar>(y);
+    const uchar* r = roofLevel.ptr<uchar>(y);
+    const float* o = n.outerDistance.ptr<float>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < atLevel.cols; ++x) {
+      if (a[x] == 0) continue;
+      if (o[x] >= static_cast<float>(reach)) out[static_cast<size_t>(l[x])] = 1;
+      if (r[x] != 0) touches[static_cast<size_t>(l[x])] = 1;
+    }
+  }
+  int attached = 0;
+  for (int y = 0; y < atLevel.rows; ++y) {
+    const uchar* a = atLevel.ptr<uchar>(y);
+    const uchar* c = core.ptr<uchar>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < atLevel.cols; ++x) {
+      const auto k = static_cast<size_t>(l[x]);
+      if (a[x] != 0 && c[x] != 0 && out[k] == 0 && touches[k] != 0) ++attached;
+    }
+  }
+  return attached;
+}
+
+// The lowest disparity of a lower roof of the building, as the recessed roof inside a raised ring:
+// the most populated level of the core's pixels between the floor and `low` (above the ground:
+// not a courtyard or the street), when its regions that stay inside the polygon and touch the
+// roof [low, high] (attachedCount: not a neighbour crossing a rough outline, nor a separate
+// structure beside the building) hold at least a tenth of the core's matched pixels; that level
+// down to `peakFraction` of its smoothed peak. NaN when there is none.
+double lowerRoofLow(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, const std::vector<float>& roof,
+                    int low, int high, double floorLevel, const RoofIntervalParams& params) {
+  if (!std::isfinite(floorLevel)) return std::numeric_limits<double>::quiet_NaN();
+  std::vector<float> lower;
+  for (float d : roof) {
+    if (d >= floorLevel && d < static_cast<float>(low)) lower.push_back(d);
+  }
+  if (lower.size() < 10 || 10 * lower.size() < roof.size()) return std::numeric_limits<double>::quiet_NaN();
+  const Histogram h = histogram(lower, params.binWidth);
+  const int windowBins = std::max(1, static_cast<int>(std::lround(1.0 / params.binWidth)));
+  const std::vector<double> mass = windowSums(h.counts, windowBins);
+  const size_t mode = static_cast<size_t>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  const double halfWindow = (windowBins + 0.5) * h.width;
+  const int attached = attachedCount(disparity, n, core, h.centre(mode), halfWindow, params.entryReach, low, high);
+  if (10 * static_cast<size_t>(attached) < roof.size()) return std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> smooth = smoothed(h.counts, params.smoothing / params.binWidth);
+  size_t lo = mode;
+  while (lo > 0 && smooth[lo - 1] >= params.peakFraction * smooth[mode]) --lo;
+  return h.centre(lo) - 0.5 * h.width;
+}
+
 }  // namespace
 
 double estimateGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon, const RoofIntervalParams& params) {
@@ -375,6 +439,8 @@ RoofIntervalProposal proposeRoofInterval(const cv::Mat& disparity, const core::P
   while (hi + 1 < smooth.size() && smooth[hi + 1] >= threshold) ++hi;
   out.low = static_cast<int>(std::floor(h.centre(lo) - 0.5 * h.width)) - params.padding;
   out.high = static_cast<int>(std::ceil(h.centre(hi) + 0.5 * h.width)) + params.padding;
+  const double lowerLow = lowerRoofLow(disparity, n, core, roof, out.low, out.high, floorLevel, params);
+  if (std::isfinite(lowerLow)) out.low = static_cast<int>(std::floor(lowerLow)) - params.padding;
   if (std::isfinite(floorLevel)) {
     // Never down to the ground itself, or the roof and ground costs would agree there.
     out.low = std::max(out.low, static_cast<int>(std::floor(out.groundLevel)) + 1);

@@ -133,6 +133,44 @@ TEST(RoofInterval, ADelineatedRingRoofKeepsItsRingNotTheLowerPartAtItsCentre) {
   EXPECT_NEAR(p.peak, 80.0, 0.5);
 }
 
+TEST(RoofInterval, ALowerRoofOfTheBuildingJoinsTheIntervalButACourtyardOrAStructureBesideItDoesNot) {
+  // Toulouse's raised block from a rough rectangle: the ring (80 px) is the roof peak, the inner
+  // roof (72 px) it encloses is part of the building: the interval reaches down to it.
+  cv::Mat map(360, 440, CV_32F, cv::Scalar(6.0f));
+  map(cv::Rect(100, 100, 200, 160)).setTo(80.0f);
+  map(cv::Rect(140, 140, 120, 80)).setTo(72.0f);
+  cv::Mat recessed = map.clone();
+  addNoise(recessed);
+  const Polygon rough = rectangle(70, 70, 330, 290);
+  const auto p = proposeRoofInterval(recessed, rough);
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.peak, 80.0, 0.5);
+  EXPECT_LE(p.low, 71);
+  EXPECT_GE(p.high, 81);
+  // A courtyard at the ground inside the ring is not roof.
+  cv::Mat courtyard = map.clone();
+  courtyard(cv::Rect(140, 140, 120, 80)).setTo(6.0f);
+  addNoise(courtyard);
+  const auto c = proposeRoofInterval(courtyard, rough);
+  ASSERT_TRUE(c.found);
+  EXPECT_GE(c.low, 76);
+  // Neither is a lower structure of the same size beside the building, inside the rectangle but
+  // apart from the roof (the street between them), nor one crossing the rectangle's side.
+  cv::Mat beside(360, 440, CV_32F, cv::Scalar(6.0f));
+  beside(cv::Rect(100, 100, 150, 160)).setTo(80.0f);
+  beside(cv::Rect(260, 110, 60, 140)).setTo(72.0f);
+  cv::Mat crossing = beside.clone();
+  crossing(cv::Rect(260, 110, 60, 140)).setTo(6.0f);
+  crossing(cv::Rect(250, 110, 190, 140)).setTo(72.0f);
+  for (cv::Mat* m : {&beside, &crossing}) {
+    addNoise(*m);
+    const auto b = proposeRoofInterval(*m, rough);
+    ASSERT_TRUE(b.found);
+    EXPECT_NEAR(b.peak, 80.0, 0.5);
+    EXPECT_GE(b.low, 76);
+  }
+}
+
 TEST(RoofInterval, APolygonDrawnInsideItsRoofKeepsTheRoofNotASmallStructureOnIt) {
   // Every level of the polygon enters it from outside except a plant room (46 px, 30 x 30 px).
   cv::Mat map(300, 400, CV_32F, cv::Scalar(6.0f));
