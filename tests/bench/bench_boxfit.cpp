@@ -41,6 +41,7 @@
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
 #include "real_roofs.hpp"
+#include "bench_image.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
@@ -155,7 +156,7 @@ void dump(const std::string& path, const cv::Mat& left, const boxfit::BoxFitBuil
     cv::drawContours(heights, contours, -1, {255, 255, 255}, 1);
     cv::hconcat(both, heights, both);
   }
-  cv::imwrite(path, both);
+  bench::writeImage(path, both);
 }
 
 struct Tally {

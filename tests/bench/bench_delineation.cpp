@@ -25,6 +25,7 @@
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/cost_service.hpp"
 #include "delineo/stereo/match.hpp"
+#include "bench_image.hpp"
 #include "energy_diag.hpp"
 #ifdef DELINEO_HAVE_EVAL
 #include "delineo/eval/footprint_metrics.hpp"
@@ -148,7 +149,7 @@ void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& ri
       cv::hconcat(cr, cg, grey);
       grey.convertTo(grey, CV_8U, 255.0);
       cv::resize(grey, grey, {}, k, k, cv::INTER_NEAREST);
-      cv::imwrite(path.substr(0, path.size() - 4) + "_costs.png", grey);
+      bench::writeImage(path.substr(0, path.size() - 4) + "_costs.png", grey);
     }
     cv::resize(roofBetter, roofBetter, {}, k, k, cv::INTER_NEAREST);
     cv::cvtColor(roofBetter, roofBetter, cv::COLOR_GRAY2BGR);
@@ -172,7 +173,7 @@ void dumpPicture(const std::string& path, const cv::Mat& left, const cv::Mat& ri
   }
   cv::Mat both = crop;
   if (!roofBetter.empty()) cv::hconcat(crop, roofBetter, both);
-  cv::imwrite(path, both);
+  bench::writeImage(path, both);
 }
 
 
@@ -449,7 +450,7 @@ int main(int argc, char** argv) {
                 std::vector<cv::Point> pts;
                 for (const auto& v : truthLocal.outer) pts.emplace_back(v.x * 3, v.y * 3);
                 cv::polylines(picture, pts, true, {255, 255, 255}, 1);
-                cv::imwrite(dumpDir + "/s" + std::to_string(sceneParams.seed) + "_b" + std::to_string(id) + "_" +
+                bench::writeImage(dumpDir + "/s" + std::to_string(sceneParams.seed) + "_b" + std::to_string(id) + "_" +
                                 initName + "_diag.png",
                             picture);
               }

@@ -32,6 +32,7 @@
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
 #include "simulated_match.hpp"
+#include "bench_image.hpp"
 
 using namespace delineo;
 using namespace delineo::segmentation;
@@ -152,7 +153,7 @@ void overlay(const std::string& path, const cv::Mat& bgr, const cv::Mat& labels)
   cv::addWeighted(bgr, 0.6, tint, 0.4, 0, out);
   cv::Mat dim = bgr * 0.5;
   dim.copyTo(out, labels == kClassGround);
-  cv::imwrite(path, out);
+  bench::writeImage(path, out);
 }
 
 // The real tiles: on Dublin an above-ground mask from the LiDAR disparity; on Toulouse (no

@@ -49,6 +49,7 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/disparity_range.hpp"
+#include "bench_image.hpp"
 
 namespace {
 using namespace delineo;
@@ -199,7 +200,7 @@ void drawMatches(const fs::path& file, const Case& c, const stereo::RangeEstimat
     const cv::Scalar colour(255 * (1 - t), 255 * (1 - std::abs(2 * t - 1)), 255 * t);
     cv::circle(bgr, {cvRound(p.x), cvRound(p.y)}, 3, colour, -1, cv::LINE_AA);
   }
-  cv::imwrite(file.string(), bgr);
+  bench::writeImage(file.string(), bgr);
 }
 
 struct Row {

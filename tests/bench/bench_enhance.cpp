@@ -35,6 +35,7 @@
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
 #include "real_roofs.hpp"
+#include "bench_image.hpp"
 
 using namespace delineo;
 namespace fs = std::filesystem;
@@ -311,10 +312,10 @@ void writeScenePng(const std::string& dir, int seed, const cv::Mat& truthDem,
     }
     cv::Mat row;
     cv::hconcat(crops, row);
-    cv::imwrite((fs::path(dir) / ("sim_seed" + std::to_string(seed) + "_b" + std::to_string(k) + ".png")).string(), row);
+    bench::writeImage((fs::path(dir) / ("sim_seed" + std::to_string(seed) + "_b" + std::to_string(k) + ".png")).string(), row);
   }
   const std::string path = (fs::path(dir) / ("sim_seed" + std::to_string(seed) + ".png")).string();
-  cv::imwrite(path, all);
+  bench::writeImage(path, all);
   std::printf("wrote %s (before, after with true, after with active-polygon outlines)\n", path.c_str());
 }
 
@@ -502,7 +503,7 @@ void runReal(const std::string& dataRoot, const std::string& labels, const std::
       cv::Mat both;
       cv::hconcat(a, b, both);
       const std::string path = (fs::path(pngDir) / (pairName + "_dem_before_after.png")).string();
-      cv::imwrite(path, both);
+      bench::writeImage(path, both);
       std::printf("wrote %s (left: before, right: after)\n", path.c_str());
     }
   }

@@ -33,6 +33,7 @@
 #include "delineo/stereo/cost_service.hpp"
 #include "energy_diag.hpp"
 #include "real_roofs.hpp"
+#include "bench_image.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
@@ -256,7 +257,7 @@ void diagnoseRoof(const std::string& name, const cv::Mat& left, const cv::Mat& r
     draw(truthLocal, {255, 255, 255});
     draw(rawLocal, {0, 220, 255});
   }
-  cv::imwrite((fs::path(dumpDir) / (name + "_diag.png")).string(), both);
+  bench::writeImage((fs::path(dumpDir) / (name + "_diag.png")).string(), both);
 }
 }  // namespace
 
@@ -473,7 +474,7 @@ int main(int argc, char** argv) {
                                             {r.polygon, {0, 0, 255}}});
         if (!dumpDir.empty()) {
           fs::create_directories(dumpDir);
-          cv::imwrite((fs::path(dumpDir) / (name + ".png")).string(), panel);
+          bench::writeImage((fs::path(dumpDir) / (name + ".png")).string(), panel);
         }
         panels.emplace_back(name, panel);
       }
@@ -497,7 +498,7 @@ int main(int argc, char** argv) {
                 mean(set.regIou), median(set.naiveV), median(set.rawV), median(set.regV), set.regularized);
   }
   if (!montagePath.empty()) {
-    cv::imwrite(montagePath, montage(panels, 260, 5));
+    bench::writeImage(montagePath, montage(panels, 260, 5));
     std::printf("\nwrote %s\n", montagePath.c_str());
   }
   std::printf("\nregularization time median %.2f ms, max %.2f ms\n", median(regMs),

@@ -38,6 +38,7 @@
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
 #include "simulated_match.hpp"
+#include "bench_image.hpp"
 
 using namespace delineo;
 
@@ -111,7 +112,7 @@ void dump(const std::string& dir, const std::string& name, const segmentation::G
       else if (!above && truth) p = cv::Vec3b(230, p[1] / 2, 0);               // missed: blue
     }
   }
-  cv::imwrite(dir + "/" + name + ".png", view);
+  bench::writeImage(dir + "/" + name + ".png", view);
 }
 
 void printScore(const char* scene, const char* demName, const Score& s) {

@@ -17,7 +17,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -33,6 +32,7 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/segmentation/scene.hpp"
 #include "real_roofs.hpp"
+#include "bench_image.hpp"
 
 using namespace delineo;
 namespace fs = std::filesystem;
@@ -134,7 +134,7 @@ void drawOverlay(const std::string& path, const cv::Mat& bgr, const segmentation
     for (const auto& p : f.polygon.outer) ring.emplace_back(cvRound(p.x), cvRound(p.y));
     cv::polylines(out, ring, true, cv::Scalar(0, 230, 255), 3);
   }
-  if (!cv::imwrite(path, out)) throw std::runtime_error(path + ": cannot write the overlay");
+  bench::writeImage(path, out);
 }
 
 // The active polygon from every proposal; per labelled roof of the pair, the best IoU of the
@@ -196,7 +196,6 @@ int main(int argc, char** argv) {
     std::printf("skipped: data folder %s missing\n", data.c_str());
     return 0;
   }
-  fs::create_directories(out);
   const nlohmann::json roofs = nlohmann::json::parse(std::ifstream(labels));
   // BENCH_PARAMS='{"segment": {...}, "classify": {...}, "objects": {...}, "detect": {...}}' overrides.
   segmentation::SceneParams params;

@@ -57,6 +57,7 @@
 #include "delineo/core/progress.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
+#include "bench_image.hpp"
 #ifdef DELINEO_BENCH_HAVE_SIM
 #include "delineo/sim/scene.hpp"
 #endif
@@ -229,7 +230,7 @@ void dumpErrors(const cv::Mat& disparity, const Case& c, const std::string& path
                                    : off > 1            ? cv::Vec3b(255, 255, 0)
                                                         : cv::Vec3b(255, 0, 255);
   }
-  cv::imwrite(path, img);
+  bench::writeImage(path, img);
 }
 
 // Every scored outline pixel with its outcome, for analysis outside the bench: y, xb, dir,
@@ -430,17 +431,17 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
     if (!dump.empty() && !c.outline.empty()) {
       cv::Mat grey;
       c.left.convertTo(grey, CV_8U);
-      cv::imwrite(dump + "/left.png", grey);
+      bench::writeImage(dump + "/left.png", grey);
       dumpErrors(disparity[i], c, dump + "/errors_" + m + ".png");
       dumpOutline(disparity[i], c, dump + "/outline_" + m + ".csv");
-      cv::imwrite(dump + "/disparity_" + m + ".tif", disparity[i]);
-      if (!scores[i].empty()) cv::imwrite(dump + "/score_" + m + ".tif", scores[i]);
+      bench::writeImage(dump + "/disparity_" + m + ".tif", disparity[i]);
+      if (!scores[i].empty()) bench::writeImage(dump + "/score_" + m + ".tif", scores[i]);
       if (i == 0) {
-        cv::imwrite(dump + "/truth.tif", c.truth);
-        if (!c.roof.empty()) cv::imwrite(dump + "/roof.png", c.roof * 255);
-        if (!c.slopedRoof.empty()) cv::imwrite(dump + "/sloped_roof.png", c.slopedRoof * 255);
-        cv::imwrite(dump + "/left.tif", c.left);
-        cv::imwrite(dump + "/right.tif", c.right);
+        bench::writeImage(dump + "/truth.tif", c.truth);
+        if (!c.roof.empty()) bench::writeImage(dump + "/roof.png", c.roof * 255);
+        if (!c.slopedRoof.empty()) bench::writeImage(dump + "/sloped_roof.png", c.slopedRoof * 255);
+        bench::writeImage(dump + "/left.tif", c.left);
+        bench::writeImage(dump + "/right.tif", c.right);
       }
     }
   }
