@@ -172,13 +172,14 @@ widgets::JobId MainWindow::outlinePendingBuildings() {
   QPointer<Document> doc(document_.get());
   QPointer<MainWindow> self(this);
   struct Batch {
-    int outlined = 0;
     std::vector<std::pair<int, core::Error>> skipped;  // building id, why
   };
-  // Each result goes to the GUI thread as soon as it is there: a cancel loses none of them.
-  auto deliver = [self, doc](const Building& after) {
-    QMetaObject::invokeMethod(self.data(), [self, doc, after] {
-      if (self && doc && doc == self->document_.get()) doc->setOutlinedPending(after);
+  // Each result goes to the GUI thread as soon as it is there: a cancel loses none of them. A
+  // building the operator changed meanwhile keeps the change (Document::setOutlinedPending).
+  auto applied = std::make_shared<int>(0);  // read and written on the GUI thread only
+  auto deliver = [self, doc, applied](const Building& after) {
+    QMetaObject::invokeMethod(self.data(), [self, doc, applied, after] {
+      if (self && doc && doc == self->document_.get() && doc->setOutlinedPending(after)) ++*applied;
     }, Qt::QueuedConnection);
   };
   return jobs_->run<Batch>(
@@ -195,7 +196,6 @@ widgets::JobId MainWindow::outlinePendingBuildings() {
                 project::outlinePendingBuilding(projectCopy, building, pair, heights, &range, "all pending");
             if (!after) return batch;  // canceled
             deliver(*after);
-            ++batch.outlined;
           } catch (const core::Error& e) {
             // This building cannot be outlined (a degenerate proposal, no heights for box-fitting):
             // the others still are. Anything else ends the job as failed.
@@ -205,10 +205,11 @@ widgets::JobId MainWindow::outlinePendingBuildings() {
         }
         return batch;
       },
-      [this, doc, title](Batch batch) {
+      [this, doc, title, applied](Batch batch) {
+        // The results were queued before this: every one of them has been applied or refused.
         if (!doc || doc != document_.get()) return;
         const int skipped = static_cast<int>(batch.skipped.size());
-        QString text = batch.outlined == 1 ? tr("1 building outlined.") : tr("%1 buildings outlined.").arg(batch.outlined);
+        QString text = *applied == 1 ? tr("1 building outlined.") : tr("%1 buildings outlined.").arg(*applied);
         if (skipped > 0) text += QLatin1Char(' ') + (skipped == 1 ? tr("1 stays pending.") : tr("%1 stay pending.").arg(skipped));
         statusBar()->showMessage(text, 8000);
         if (skipped > 0) {
@@ -217,7 +218,7 @@ widgets::JobId MainWindow::outlinePendingBuildings() {
           showMessage(title, tr("These buildings could not be outlined and stay pending:") + QLatin1Char('\n') +
                                  lines.join(QLatin1Char('\n')));
         }
-        emit pendingOutlined(batch.outlined, skipped);
+        emit pendingOutlined(*applied, skipped);
       },
       QStringLiteral("outline-pending"));
 }

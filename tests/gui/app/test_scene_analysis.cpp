@@ -223,16 +223,22 @@ class SceneAnalysisTest : public QObject {
     QVERIFY2(keptAfterCancel >= 1 && keptAfterCancel < added, qPrintable(QString::number(keptAfterCancel)));
     QCOMPARE(doc()->undoStack()->count(), undoBefore + keptAfterCancel);
 
-    // Run again: the rest are outlined, each by the active polygon, with a roof height.
+    // Run again: the rest are outlined, each by the active polygon, with a roof height, except the
+    // last one, which the operator rejects while the job runs: it stays rejected.
     QSignalSpy outlined(window_.get(), &MainWindow::pendingOutlined);
     act("actionOutlinePending")->trigger();
+    const int rejected = doc()->project().pendingBuildings().back();
+    doc()->setStatus(rejected, project::BuildingStatus::Rejected);
     QVERIFY(outlined.wait(240000));
-    QCOMPARE(outlined.at(0).at(0).toInt() + outlined.at(0).at(1).toInt(), added - keptAfterCancel);
+    QCOMPARE(outlined.at(0).at(0).toInt(), added - keptAfterCancel - 1);
     QCOMPARE(outlined.at(0).at(1).toInt(), 0);
     QVERIFY(doc()->project().pendingBuildings().empty());
     QVERIFY(!act("actionOutlinePending")->isEnabled());
+    QVERIFY(doc()->project().find(rejected)->status == project::BuildingStatus::Rejected);
+    QVERIFY(!doc()->project().find(rejected)->hasOutline());
     const cv::Mat& truth = doc()->labels();
     for (const project::Building& b : doc()->project().buildings) {
+      if (b.id == rejected) continue;
       QVERIFY(b.status == project::BuildingStatus::Automatic);
       QCOMPARE(QString::fromStdString(b.method), QString::fromLatin1(project::kActivePolygon));
       QVERIFY(b.hasOutline());
