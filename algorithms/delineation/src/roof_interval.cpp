@@ -249,36 +249,59 @@ double groundLevelAround(const cv::Mat& disparity, const Neighbourhood& n, const
   return groundNextTo(n, band, groundLevelOf(values, params), params);
 }
 
+// The regions at `level`: 8-connected pixels within `halfWindow` of it, over the polygon and a
+// band `reach` + 1 px around it; for each, whether it reaches `reach` px outside the polygon
+// (courtyards, holes, are not outside) and whether it touches a non-zero pixel of `touch` (CV_8U
+// over the neighbourhood, may be empty).
+struct LevelRegions {
+  cv::Mat atLevel, labels;
+  std::vector<char> reachesOut, touches;
+};
+
+LevelRegions levelRegions(const cv::Mat& disparity, const Neighbourhood& n, double level, double halfWindow,
+                          double reach, const cv::Mat& touch = {}) {
+  LevelRegions r;
+  cv::inRange(disparity(n.roi), level - halfWindow, level + halfWindow, r.atLevel);  // NaN is out of range
+  r.atLevel &= n.outerDistance <= static_cast<float>(reach + 1.0);
+  const int count = cv::connectedComponents(r.atLevel, r.labels, 8, CV_32S);
+  r.reachesOut.assign(static_cast<size_t>(count), 0);
+  r.touches.assign(static_cast<size_t>(count), 0);
+  for (int y = 0; y < r.atLevel.rows; ++y) {
+    const uchar* a = r.atLevel.ptr<uchar>(y);
+    const uchar* t = touch.empty() ? nullptr : touch.ptr<uchar>(y);
+    const float* o = n.outerDistance.ptr<float>(y);
+    const int* l = r.labels.ptr<int>(y);
+    for (int x = 0; x < r.atLevel.cols; ++x) {
+      if (a[x] == 0) continue;
+      if (o[x] >= static_cast<float>(reach)) r.reachesOut[static_cast<size_t>(l[x])] = 1;
+      if (t != nullptr && t[x] != 0) r.touches[static_cast<size_t>(l[x])] = 1;
+    }
+  }
+  return r;
+}
+
+// How many of the core's pixels lie in the regions for which `keep(region index)` holds.
+template <class Keep>
+int corePixelsOf(const LevelRegions& r, const cv::Mat& core, Keep keep) {
+  int pixels = 0;
+  for (int y = 0; y < r.atLevel.rows; ++y) {
+    const uchar* a = r.atLevel.ptr<uchar>(y);
+    const uchar* c = core.ptr<uchar>(y);
+    const int* l = r.labels.ptr<int>(y);
+    for (int x = 0; x < r.atLevel.cols; ++x) {
+      if (a[x] != 0 && c[x] != 0 && keep(static_cast<size_t>(l[x]))) ++pixels;
+    }
+  }
+  return pixels;
+}
+
 // How many of the core's pixels within `halfWindow` of `level` belong to regions that enter the
-// polygon from outside, as a neighbour's roof crossing a rough outline does: 8-connected pixels
-// within that window, over the polygon and a band around it, that reach `reach` px outside the
-// polygon. Courtyards (holes) are not outside.
+// polygon from outside, as a neighbour's roof crossing a rough outline does (they reach `reach`
+// px outside the polygon).
 int enteringCount(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, double level,
                   double halfWindow, double reach) {
-  cv::Mat atLevel;
-  cv::inRange(disparity(n.roi), level - halfWindow, level + halfWindow, atLevel);  // NaN is out of range
-  atLevel &= n.outerDistance <= static_cast<float>(reach + 1.0);
-  cv::Mat labels;
-  const int count = cv::connectedComponents(atLevel, labels, 8, CV_32S);
-  std::vector<char> reachesOut(static_cast<size_t>(count), 0);
-  const cv::Mat farOut = atLevel & (n.outerDistance >= static_cast<float>(reach));
-  for (int y = 0; y < farOut.rows; ++y) {
-    const uchar* f = farOut.ptr<uchar>(y);
-    const int* l = labels.ptr<int>(y);
-    for (int x = 0; x < farOut.cols; ++x) {
-      if (f[x] != 0) reachesOut[static_cast<size_t>(l[x])] = 1;
-    }
-  }
-  int entering = 0;
-  for (int y = 0; y < atLevel.rows; ++y) {
-    const uchar* a = atLevel.ptr<uchar>(y);
-    const uchar* c = core.ptr<uchar>(y);
-    const int* l = labels.ptr<int>(y);
-    for (int x = 0; x < atLevel.cols; ++x) {
-      if (a[x] != 0 && c[x] != 0) entering += reachesOut[static_cast<size_t>(l[x])];
-    }
-  }
-  return entering;
+  const LevelRegions r = levelRegions(disparity, n, level, halfWindow, reach);
+  return corePixelsOf(r, core, [&r](size_t k) { return r.reachesOut[k] != 0; });
 }
 
 // The roof level (bin): the most populated level above the floor, its pixels in regions that
@@ -322,41 +345,16 @@ size_t roofLevel(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat
   return bestKept >= bar ? best : first;
 }
 
-// How many of the core's pixels within `halfWindow` of `level` lie in regions (8-connected pixels
-// within that window) that stay inside the polygon (none `reach` px outside it, unlike
-// enteringCount's) and touch the roof: pixels within [low, high] lie 2 px or less from them.
+// How many of the core's pixels within `halfWindow` of `level` lie in regions that stay inside
+// the polygon (none reaches `reach` px outside it) and touch the roof: pixels within [low, high]
+// lie 2 px or less from them.
 int attachedCount(const cv::Mat& disparity, const Neighbourhood& n, const cv::Mat& core, double level,
                   double halfWindow, double reach, int low, int high) {
-  cv::Mat atLevel, roofLevel;
-  cv::inRange(disparity(n.roi), level - halfWindow, level + halfWindow, atLevel);
-  atLevel &= n.outerDistance <= static_cast<float>(reach + 1.0);
+  cv::Mat roofLevel;
   cv::inRange(disparity(n.roi), low, high, roofLevel);
   cv::dilate(roofLevel, roofLevel, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
-  cv::Mat labels;
-  const int count = cv::connectedComponents(atLevel, labels, 8, CV_32S);
-  std::vector<char> out(static_cast<size_t>(count), 0), touches(static_cast<size_t>(count), 0);
-  for (int y = 0; y < atLevel.rows; ++y) {
-    const uchar* a = atLevel.ptr<uchar>(y);
-    const uchar* r = roofLevel.ptr<uchar>(y);
-    const float* o = n.outerDistance.ptr<float>(y);
-    const int* l = labels.ptr<int>(y);
-    for (int x = 0; x < atLevel.cols; ++x) {
-      if (a[x] == 0) continue;
-      if (o[x] >= static_cast<float>(reach)) out[static_cast<size_t>(l[x])] = 1;
-      if (r[x] != 0) touches[static_cast<size_t>(l[x])] = 1;
-    }
-  }
-  int attached = 0;
-  for (int y = 0; y < atLevel.rows; ++y) {
-    const uchar* a = atLevel.ptr<uchar>(y);
-    const uchar* c = core.ptr<uchar>(y);
-    const int* l = labels.ptr<int>(y);
-    for (int x = 0; x < atLevel.cols; ++x) {
-      const auto k = static_cast<size_t>(l[x]);
-      if (a[x] != 0 && c[x] != 0 && out[k] == 0 && touches[k] != 0) ++attached;
-    }
-  }
-  return attached;
+  const LevelRegions r = levelRegions(disparity, n, level, halfWindow, reach, roofLevel);
+  return corePixelsOf(r, core, [&r](size_t k) { return r.reachesOut[k] == 0 && r.touches[k] != 0; });
 }
 
 // The lowest disparity of a lower roof of the building, as the recessed roof inside a raised ring:
