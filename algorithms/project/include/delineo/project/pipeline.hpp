@@ -241,6 +241,8 @@ SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights
 std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
                                       const std::string& origin = {});
 
+// ---- run and export (src/run_and_export.cpp) ----
+
 // One pending building outlined with its method (Project::methodOf), as `run` and the GUI's
 // "Outline the pending buildings" do it: the active polygon on `pair` (whose disparity map gives
 // the roof interval when the building has none), or box-fitting on `heights` (projectHeights(),

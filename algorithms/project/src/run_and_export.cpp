@@ -1,0 +1,264 @@
+// `delineo-cli run`'s steps and the export of the buildings: the outline of one pending building
+// with its method, the scene analysis's proposals, the exports to GeoJSON / GeoPackage and
+// CityJSON blocks (declared in pipeline.hpp).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "delineo/core/error.hpp"
+#include "delineo/io/cityjson.hpp"
+#include "delineo/io/output_file.hpp"
+#include "delineo/io/raster.hpp"
+#include "delineo/io/vector.hpp"
+#include "delineo/project/pipeline.hpp"
+
+namespace delineo::project {
+
+namespace fs = std::filesystem;
+using core::Error;
+using core::ErrorCode;
+
+std::vector<core::Feature> buildingFeatures(const Project& project,
+                                            const std::vector<BuildingStatus>& statuses) {
+  std::vector<core::Feature> features;
+  for (const auto& b : project.buildings) {
+    if (std::find(statuses.begin(), statuses.end(), b.status) == statuses.end()) continue;
+    core::Feature f;
+    f.polygon = b.currentPolygon();
+    f.attributes["id"] = static_cast<long long>(b.id);
+    f.attributes["status"] = toString(b.status);
+    if (b.hasOutline()) f.attributes["method"] = b.method.empty() ? std::string(kActivePolygon) : b.method;
+    long long vertices = static_cast<long long>(f.polygon.outer.size());
+    for (const auto& hole : f.polygon.holes) vertices += static_cast<long long>(hole.size());
+    f.attributes["vertices"] = vertices;
+    if (std::isfinite(b.roofHeight)) f.attributes["roof_height_m"] = b.roofHeight;
+    if (std::isfinite(b.energy)) f.attributes["energy"] = b.energy;
+    features.push_back(std::move(f));
+  }
+  return features;
+}
+
+namespace {
+// The left image's georeferencing; none when it is missing or unreadable (pixel coordinates
+// then; the image problem is reported where it is read).
+io::GeoReference leftGeoReference(const Project& project) {
+  std::error_code ec;
+  if (project.left.empty() || !fs::exists(project.left, ec)) return {};
+  try {
+    return io::readRaster(project.left).geo;
+  } catch (const Error&) {
+    return {};
+  }
+}
+
+// Writes `features` (the project's buildings) to `path` in the format its name says.
+ExportSummary writeBuildingFeatures(const Project& project, const std::string& path,
+                                    const std::vector<core::Feature>& features) {
+  const io::GeoReference geo = leftGeoReference(project);
+  std::error_code mk;
+  fs::create_directories(fs::absolute(path).parent_path(), mk);
+  ExportSummary summary;
+  if (io::isCityJsonPath(path)) {
+    io::CityJsonOptions options;
+    options.geo = geo;
+    options.localPixelSize = project.height.gsd;
+    const io::CityJsonSummary blocks = io::writeCityJson(path, features, options);
+    summary.written = blocks.written;
+    summary.leftOut = blocks.leftOut;
+    return summary;
+  }
+  io::writeFeatures(path, features, geo);
+  summary.written = static_cast<int>(features.size());
+  return summary;
+}
+}  // namespace
+
+ExportSummary exportBuildings(const Project& project, const std::string& path,
+                              const std::vector<BuildingStatus>& statuses) {
+  return writeBuildingFeatures(project, path, buildingFeatures(project, statuses));
+}
+
+namespace {
+// The active polygon on one pending building; nullopt when canceled.
+std::optional<Building> delineatePending(const Project& project, Building b, const StereoPair& pair,
+                                         core::Progress* progress, const std::string& origin) {
+  if (!b.roofInterval) b.roofInterval = suggestRoofInterval(pair.disparity, b.initial);
+  DelineationOutcome outcome = delineateBuilding(project, b, pair, progress);
+  if (outcome.status == core::RunStatus::Canceled) return std::nullopt;
+  b.outline = outcome.outline;
+  b.energy = outcome.energy;
+  b.energyTerms = outcome.terms;
+  b.roofHeight = roofHeight(project, pair.disparity, b.outline);
+  b.status = BuildingStatus::Automatic;
+  b.method = kActivePolygon;
+  std::string detail = origin + ", " + std::to_string(b.outline.outer.size()) + " vertices";
+  if (!outcome.regularization.empty()) detail += ", " + outcome.regularization;
+  if (!outcome.regularizationNote.empty()) detail += " (" + outcome.regularizationNote + ")";
+  b.addHistory("delineated", detail);
+  return b;
+}
+}  // namespace
+
+std::optional<Building> outlinePendingBuilding(const Project& project, const Building& building,
+                                               const StereoPair& pair, cv::Mat& heights,
+                                               core::Progress* progress, const std::string& origin) {
+  if (project.methodOf(building) != kBoxFitting) {
+    core::setStage(progress, core::StageId::DelineatingBuilding, building.id);
+    return delineatePending(project, building, pair, progress, origin);
+  }
+  core::setStage(progress, core::StageId::BoxFittingBuilding, building.id);
+  if (heights.empty()) heights = projectHeights(project, pair.disparity);
+  if (heights.empty()) {
+    throw Error(ErrorCode::InvalidParameter,
+                "box-fitting needs heights: the project names no DEM and has no height model");
+  }
+  const BoxFitOutcome outcome = fitBuildingBoxes(project, building, heights, pair.left, progress);
+  if (outcome.status == core::RunStatus::Canceled) return std::nullopt;
+  if (!outcome.hasOutline()) throw Error(ErrorCode::ProcessingFailed, "box-fitting: " + outcome.message);
+  return withBoxFitOutline(project, building, outcome, pair.disparity, origin);
+}
+
+namespace {
+// run --detect: the scene analysis on `heights`, its rasters and objects written into
+// `outputDir`, its proposals added as pending buildings. False when canceled.
+bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& disparity, const io::GeoReference& geo,
+                     const std::string& outputDir, core::Progress* progress, RunSummary& summary) {
+  if (heights.empty()) {
+    throw Error(ErrorCode::InvalidParameter,
+                "detecting buildings needs heights: the project names no DEM and has no height model");
+  }
+  const cv::Mat image = io::readImage8(project.left);
+  const SceneAnalysisOutcome analysis = analyseScene(project, heights, image, disparity, progress);
+  if (analysis.status == core::RunStatus::Canceled) {
+    summary.status = core::RunStatus::Canceled;
+    return false;
+  }
+  const fs::path out(outputDir);
+  io::writeFloatGeoTiff((out / "dtm.tif").string(), analysis.dtm, geo);
+  io::writeFloatGeoTiff((out / "ndsm.tif").string(), analysis.ndsm, geo);
+  io::writeGeoTiff((out / "labels.tif").string(), analysis.classes, geo);
+  io::writeFeatures((out / "objects.geojson").string(), analysis.objects, geo, "objects");
+  summary.objects = static_cast<int>(analysis.objects.size());
+  summary.proposed = static_cast<int>(addProposedBuildings(project, analysis.proposals, "delineo-cli run").size());
+  return true;
+}
+}  // namespace
+
+namespace {
+// run's exports: the outlines to buildings.geojson, and the LoD1 blocks to buildings.city.json
+// when any building has a roof height. A degenerate outline stops the blocks only: the outlines
+// and the project's work are kept, the problem is in the summary.
+void exportRunOutputs(const Project& project, const std::string& outputDir, RunSummary& summary) {
+  const std::vector<BuildingStatus> statuses{BuildingStatus::Automatic, BuildingStatus::Corrected,
+                                             BuildingStatus::Accepted};
+  const auto features = buildingFeatures(project, statuses);
+  if (features.empty()) return;
+  summary.exported = (fs::path(outputDir) / "buildings.geojson").string();
+  writeBuildingFeatures(project, summary.exported, features);
+  const bool anyHeight = std::any_of(features.begin(), features.end(),
+                                     [](const core::Feature& f) { return f.attributes.count("roof_height_m") > 0; });
+  if (!anyHeight) return;
+  const std::string blocksPath = (fs::path(outputDir) / "buildings.city.json").string();
+  try {
+    const ExportSummary blocks = writeBuildingFeatures(project, blocksPath, features);
+    summary.exportedBlocks = blocksPath;
+    for (const auto& line : blocks.leftOut) summary.messages.push_back("not in buildings.city.json: " + line);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::InvalidParameter) throw;
+    summary.blocksFailed = true;
+    summary.messages.push_back("buildings.city.json not written: " + e.detail());
+  }
+}
+}  // namespace
+
+RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress,
+                           const RunOptions& options) {
+  RunSummary summary;
+  // The outputs are checked before any work: never over an input of the project.
+  std::error_code mk;
+  fs::create_directories(outputDir, mk);
+  const fs::path out(outputDir);
+  std::vector<io::OutputFile> outputs{{(out / "buildings.geojson").string(), io::OutputFormat::Vector},
+                                      {(out / "buildings.city.json").string(), io::OutputFormat::CityJson}};
+  if (project.disparity.empty()) {
+    outputs.push_back({(out / "disparity.tif").string(), io::OutputFormat::GeoTiff});
+  }
+  if (options.detect) {
+    for (const char* name : {"dtm.tif", "ndsm.tif", "labels.tif"}) {
+      outputs.push_back({(out / name).string(), io::OutputFormat::GeoTiff});
+    }
+    outputs.push_back({(out / "objects.geojson").string(), io::OutputFormat::Vector});
+  }
+  io::checkOutputs(outputs, {project.left, project.right, project.disparity, project.dem, project.labels,
+                             project.exclude});
+  StereoPair pair = readStereoPair(project);
+  const bool work = !project.pendingBuildings().empty() || options.detect;
+  double matchShare = project.disparity.empty() ? (work ? 0.5 : 1.0) : 0.0;
+  cv::Mat disparity;
+  if (project.disparity.empty() && !project.disparityRange) {
+    core::Progress::Range range(progress, 0.0, 0.1 * matchShare);
+    const RangeOutcome estimated = estimateDisparityRange(project, pair, &range);
+    if (estimated.status == core::RunStatus::Canceled) {
+      summary.status = core::RunStatus::Canceled;
+      return summary;
+    }
+    project.disparityRange = estimated.range;
+    summary.rangeEstimated = estimated;
+  }
+  if (project.disparity.empty()) {
+    core::Progress::Range range(progress, 0.1 * matchShare, matchShare);
+    range.setStage(core::StageId::DenseMatching);
+    MatchingOutcome matched = computeDisparity(project, pair.left, pair.right, &range);
+    if (matched.status == core::RunStatus::Canceled) {
+      summary.status = core::RunStatus::Canceled;
+      return summary;
+    }
+    const std::string written = (out / "disparity.tif").string();
+    fs::create_directories(outputDir);
+    io::writeFloatGeoTiff(written, matched.disparity, pair.geo);
+    project.disparity = written;
+    disparity = matched.disparity;
+    summary.matched = true;
+  } else {
+    disparity = readDisparity(project, pair.left.size());
+  }
+  pair.disparity = disparity;
+  cv::Mat heights;  // for box-fitting and the scene analysis, read when asked for
+  std::vector<int> pending = project.pendingBuildings();
+  if (options.detect) {
+    core::Progress::Range range(progress, matchShare, matchShare + 0.3 * (1.0 - matchShare));
+    heights = projectHeights(project, disparity);
+    if (!detectBuildings(project, heights, disparity, pair.geo, outputDir, &range, summary)) return summary;
+    pending = project.pendingBuildings();
+    matchShare += 0.3 * (1.0 - matchShare);
+  }
+  for (size_t i = 0; i < pending.size(); ++i) {
+    const double begin = matchShare + (1.0 - matchShare) * static_cast<double>(i) / static_cast<double>(pending.size());
+    const double end = matchShare + (1.0 - matchShare) * static_cast<double>(i + 1) / static_cast<double>(pending.size());
+    core::Progress::Range range(progress, begin, end);
+    Building& b = *project.find(pending[i]);
+    try {
+      const std::optional<Building> outlined =
+          outlinePendingBuilding(project, b, pair, heights, &range, "delineo-cli run");
+      if (!outlined) {
+        summary.status = core::RunStatus::Canceled;
+        return summary;
+      }
+      if (outlined->method == kBoxFitting) ++summary.boxFitted;
+      b = *outlined;
+      ++summary.delineated;
+    } catch (const Error& e) {
+      if (!core::isInputError(e.code()) || e.code() == ErrorCode::InvalidParameter) {
+        ++summary.skipped;
+        summary.messages.push_back("building " + std::to_string(b.id) + ": " + e.what());
+      } else {
+        throw;
+      }
+    }
+  }
+  exportRunOutputs(project, outputDir, summary);
+  core::report(progress, 1.0);
+  return summary;
+}
+
+}  // namespace delineo::project
