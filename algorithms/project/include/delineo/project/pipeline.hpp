@@ -301,6 +301,8 @@ struct ExportSummary {
 ExportSummary exportBuildings(const Project& project, const std::string& path,
                               const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted});
 
+// ---- the bundled sample (src/pipeline.cpp) ----
+
 // The bundled sample: a deterministic simulated scene written into `directory` (left, right,
 // ground-truth DEM and labels) and a project file "sample.delineo.json" referencing them, with
 // no disparity yet so the first step of the workflow is there to run. Reuses an existing
