@@ -577,8 +577,18 @@ std::vector<core::Polygon> lidarFootprints(const cv::Mat& truth, const cv::Mat& 
 // enhancement with `footprints`, scored on the LiDAR's valid pixels in the wall band (wallBand px
 // on both sides of the outlines), the roofs' cores and everywhere else.
 void scoreAgainstLidar(const char* what, const cv::Mat& disparity, const cv::Mat& truth, const cv::Mat& lidar,
-                       const std::vector<core::Polygon>& footprints, const dem::EnhanceParams& params) {
+                       const std::vector<core::Polygon>& footprints, const dem::EnhanceParams& params,
+                       const std::string& png) {
   const dem::EnhanceResult r = dem::enhanceDem(disparity, footprints, params);
+  if (!png.empty()) {
+    // Heights in px of disparity: 0.2 px of image per px of disparity (0.034 / 0.17 m) shades them.
+    cv::Mat a = render(disparity, 0, 150, 0.2), b = render(r.dem, 0, 150, 0.2), both;
+    drawOutlines(a, footprints);
+    drawOutlines(b, footprints);
+    cv::hconcat(a, b, both);
+    bench::writeImage(png, both);
+    std::printf("wrote %s (left: before, right: after)\n", png.c_str());
+  }
   cv::Mat inside = cv::Mat::zeros(disparity.size(), CV_8U);
   for (const auto& f : footprints) inside |= core::rasterize(f, disparity.size());
   cv::Mat depth, away;
@@ -622,7 +632,7 @@ void scoreAgainstLidar(const char* what, const cv::Mat& disparity, const cv::Mat
 // Dublin against its LiDAR, enhanced with the hand outline of the one labelled roof, then with the
 // building footprints the LiDAR itself gives (margin 2 m: 11.8 px of disparity at 0.17 m per px).
 void runDublin(const std::string& dataRoot, const nlohmann::json& data, const std::string& cache,
-               const dem::EnhanceParams& params) {
+               const std::string& pngDir, const dem::EnhanceParams& params) {
   const auto pairIt = data.at("pairs").find("dublin_0004");
   if (pairIt == data.at("pairs").end()) return;
   const nlohmann::json& pair = *pairIt;
@@ -642,8 +652,12 @@ void runDublin(const std::string& dataRoot, const nlohmann::json& data, const st
   for (const auto& roof : data.at("roofs")) {
     if (roof.at("pair") == "dublin_0004") roofs.push_back(bench::ringOf(roof.at("outline")));
   }
-  scoreAgainstLidar("hand outline", disparity, truth, lidar, roofs, params);
-  scoreAgainstLidar("LiDAR footprints", disparity, truth, lidar, lidarFootprints(truth, lidar, 2.0 / 0.17), params);
+  const auto png = [&pngDir](const char* name) {
+    return pngDir.empty() ? std::string() : (fs::path(pngDir) / name).string();
+  };
+  scoreAgainstLidar("hand outline", disparity, truth, lidar, roofs, params, png("dublin_0004_hand_dem_before_after.png"));
+  scoreAgainstLidar("LiDAR footprints", disparity, truth, lidar, lidarFootprints(truth, lidar, 2.0 / 0.17), params,
+                    png("dublin_0004_lidar_dem_before_after.png"));
 }
 
 }  // namespace
@@ -697,6 +711,6 @@ int main(int argc, char** argv) {
   }
   runReal(dataRoot, labels, cache, pngDir, params);
   std::ifstream in(labels);
-  runDublin(dataRoot, nlohmann::json::parse(in), cache, params);
+  runDublin(dataRoot, nlohmann::json::parse(in), cache, pngDir, params);
   return 0;
 }
