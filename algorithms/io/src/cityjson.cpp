@@ -47,16 +47,11 @@ struct CrsDescription {
   bool geographic = false;      // x, y in degrees
 };
 
-struct SpatialReferenceDeleter {
-  void operator()(OGRSpatialReferenceH srs) const { OSRDestroySpatialReference(srs); }
-};
-
 CrsDescription describeCrs(const std::string& wkt) {
   CrsDescription crs;
   if (wkt.empty()) return crs;
   detail::ScopedGdalErrors quiet;
-  std::unique_ptr<std::remove_pointer_t<OGRSpatialReferenceH>, SpatialReferenceDeleter> srs(
-      OSRNewSpatialReference(nullptr));
+  const detail::SpatialReferencePtr srs(OSRNewSpatialReference(nullptr));
   if (OSRSetFromUserInput(srs.get(), wkt.c_str()) != OGRERR_NONE) return crs;
   crs.geographic = OSRIsGeographic(srs.get()) != 0;
   if (OSRGetAuthorityCode(srs.get(), nullptr) == nullptr) OSRAutoIdentifyEPSG(srs.get());

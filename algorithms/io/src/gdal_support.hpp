@@ -1,8 +1,11 @@
 #pragma once
 // Internal GDAL helpers shared by raster and vector I/O (not part of the public API).
+#include <memory>
 #include <string>
+#include <type_traits>
 
 #include <gdal.h>
+#include <ogr_srs_api.h>
 
 namespace delineo::io::detail {
 
@@ -31,6 +34,12 @@ bool isVirtualPath(const std::string& path);
 
 // Lower-case file extension with its dot (".tif"), empty when none.
 std::string lowerExtension(const std::string& path);
+
+// An OGR spatial reference, destroyed on scope exit.
+struct SpatialReferenceDeleter {
+  void operator()(OGRSpatialReferenceH srs) const { OSRDestroySpatialReference(srs); }
+};
+using SpatialReferencePtr = std::unique_ptr<std::remove_pointer_t<OGRSpatialReferenceH>, SpatialReferenceDeleter>;
 
 // Closes a GDAL dataset handle on scope exit.
 struct DatasetCloser {

@@ -28,11 +28,6 @@ struct FeatureDeleter {
 };
 using FeaturePtr = std::unique_ptr<std::remove_pointer_t<OGRFeatureH>, FeatureDeleter>;
 
-struct SpatialReferenceDeleter {
-  void operator()(OGRSpatialReferenceH srs) const { OSRDestroySpatialReference(srs); }
-};
-using SpatialReferencePtr = std::unique_ptr<std::remove_pointer_t<OGRSpatialReferenceH>, SpatialReferenceDeleter>;
-
 // OGR driver for a file extension, empty when the extension is not one of ours.
 std::string driverForExtension(const std::string& path) {
   const std::string ext = detail::lowerExtension(path);
@@ -269,7 +264,7 @@ void writeFeaturesAt(const std::string& path, const std::vector<core::Feature>& 
     throw Error(ErrorCode::WriteFailed, message, path);
   };
 
-  SpatialReferencePtr srs;
+  detail::SpatialReferencePtr srs;
   if (geo.valid() && !geo.crsWkt.empty()) {
     srs.reset(OSRNewSpatialReference(nullptr));
     if (OSRSetFromUserInput(srs.get(), geo.crsWkt.c_str()) != OGRERR_NONE) fail("the CRS is not valid WKT");
