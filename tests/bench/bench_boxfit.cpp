@@ -40,8 +40,8 @@
 #include "delineo/eval/footprint_metrics.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
-#include "real_roofs.hpp"
 #include "bench_image.hpp"
+#include "real_roofs.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
@@ -238,7 +238,6 @@ int simulated(int scenes, int firstSeed, sim::SceneParams sceneParams, const box
                       d.segmentMs, d.seedsMs, d.boxesMs, d.outlineMs);
         }
         if (!dumpDir.empty()) {
-          fs::create_directories(dumpDir);
           dump(dumpDir + "/s" + std::to_string(sceneParams.seed) + "_b" + std::to_string(id) + "_" + demName + ".png", left, b,
                grownBox(fp.polygon, 24, left.size()).outer.empty() ? cv::Rect() : cv::Rect(core::boundingBox(grownBox(fp.polygon, 24, left.size()).outer)),
                fp.polygon, request.init, params);
@@ -338,7 +337,6 @@ int real(const std::string& dataRoot, const std::string& labels, const std::stri
     std::printf("%-18s %-9s | %7.3f %5d %5zu %6.0f | %7.3f %5d | %s\n", name.c_str(), set.c_str(), bi,
                 b ? b->diagnostics.vertices : 0, b ? b->boxes.size() : 0, ms, ai, av, b ? "" : result.message.c_str());
     if (!dumpDir.empty()) {
-      fs::create_directories(dumpDir);
       dump((fs::path(dumpDir) / (name + ".png")).string(), lefts[pairName], b, cv::Rect(core::boundingBox(rect.outer)), truth,
            rect, params, withActive ? &active : nullptr);
     }

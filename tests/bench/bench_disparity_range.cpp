@@ -278,7 +278,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_disparity_range: %s\n", e.what());
     return 2;
   }
-  if (!draw.empty()) fs::create_directories(draw);
 
   std::vector<Case> cases;
   if (useData && !tiny) {

@@ -33,10 +33,12 @@
 #include "delineo/delineation/delineate.hpp"
 #include "delineo/dem/enhance.hpp"
 #include "delineo/project/project.hpp"
+#include "delineo/segmentation/objects.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
-#include "real_roofs.hpp"
 #include "bench_image.hpp"
+#include "lidar.hpp"
+#include "real_roofs.hpp"
 
 using namespace delineo;
 namespace fs = std::filesystem;
@@ -298,7 +300,6 @@ void writeScenePng(const std::string& dir, int seed, const cv::Mat& truthDem,
   panels.push_back(changes);
   cv::Mat all;
   cv::hconcat(panels, all);
-  fs::create_directories(dir);
   // One zoomed crop per building, the three panels side by side.
   for (size_t k = 0; k < truth.size(); ++k) {
     const cv::Rect2d b = core::boundingBox(truth[k].outer);
@@ -495,7 +496,6 @@ void runReal(const std::string& dataRoot, const std::string& labels, const std::
     std::printf("%s: gradient threshold %.3f m/px, enhancement %.0f ms (CPU)\n", pairName.c_str(),
                 r.gradientThreshold, ms);
     if (!pngDir.empty()) {
-      fs::create_directories(pngDir);
       const auto all = valuesIn(before, core::numberMask(before));
       const double lo = percentileOf(all, 0.01), hi = percentileOf(all, 0.99);
       cv::Mat a = render(before, lo, hi, model.gsd), b = render(r.dem, lo, hi, model.gsd);
@@ -511,46 +511,26 @@ void runReal(const std::string& dataRoot, const std::string& labels, const std::
 }
 
 // The building footprints the LiDAR gives, as the simulated scenes' true footprints: the sparse
-// LiDAR disparity filled from its nearest value, a plane fitted to its ground (refitted eight
-// times to the points up to 2 px above its lowest 30 %), the pixels more than `margin` px of
-// disparity above that plane, opened 7x7; each component of at least 2000 px traced (1 px
-// simplification). Trees standing at building height join their building.
-std::vector<core::Polygon> lidarFootprints(const cv::Mat& truth, const cv::Mat& lidar, double margin) {
+// LiDAR disparity (NaN where none) filled from its nearest value, the pixels more than `margin`
+// px of disparity above its ground plane (bench::lidarGround), opened 7x7; each component of at
+// least 2000 px traced (segmentation::traceMask, 1 px simplification, holes of 2000 px kept).
+// Trees standing at building height join their building.
+std::vector<core::Polygon> lidarFootprints(const cv::Mat& lidar, double margin) {
   cv::Mat distance, nearest;
-  cv::distanceTransform(lidar == 0, distance, nearest, cv::DIST_L2, 5, cv::DIST_LABEL_PIXEL);
-  std::vector<float> valueOf(static_cast<size_t>(cv::countNonZero(lidar)) + 2, 0.0f);
-  std::vector<cv::Point3d> points;
-  for (int y = 0; y < truth.rows; ++y) {
-    for (int x = 0; x < truth.cols; ++x) {
-      if (lidar.at<uchar>(y, x) == 0) continue;
-      valueOf[static_cast<size_t>(nearest.at<int>(y, x))] = truth.at<float>(y, x);
-      if (x % 4 == 0 && y % 4 == 0) points.emplace_back(x, y, truth.at<float>(y, x));
+  const cv::Mat valid = lidar == lidar;
+  cv::distanceTransform(valid == 0, distance, nearest, cv::DIST_L2, 5, cv::DIST_LABEL_PIXEL);
+  std::vector<float> valueOf(static_cast<size_t>(cv::countNonZero(valid)) + 2, 0.0f);
+  for (int y = 0; y < lidar.rows; ++y) {
+    for (int x = 0; x < lidar.cols; ++x) {
+      if (valid.at<uchar>(y, x) != 0) valueOf[static_cast<size_t>(nearest.at<int>(y, x))] = lidar.at<float>(y, x);
     }
   }
-  cv::Vec3d plane(0, 0, 0);  // d = a x + b y + c
-  std::vector<char> use(points.size(), 1);
-  for (int round = 0; round < 8; ++round) {
-    cv::Mat A(0, 3, CV_64F), B(0, 1, CV_64F);
-    for (size_t i = 0; i < points.size(); ++i) {
-      if (!use[i]) continue;
-      A.push_back(cv::Mat(cv::Matx13d(points[i].x, points[i].y, 1.0)));
-      B.push_back(points[i].z);
-    }
-    cv::Mat solution;
-    cv::solve(A, B, solution, cv::DECOMP_SVD);
-    plane = cv::Vec3d(solution.at<double>(0), solution.at<double>(1), solution.at<double>(2));
-    std::vector<double> residual;
-    for (const auto& p : points) residual.push_back(p.z - (plane[0] * p.x + plane[1] * p.y + plane[2]));
-    std::vector<double> sorted = residual;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() * 3 / 10), sorted.end());
-    const double low = sorted[sorted.size() * 3 / 10];
-    for (size_t i = 0; i < points.size(); ++i) use[i] = residual[i] <= low + 2.0;
-  }
-  cv::Mat above(truth.size(), CV_8U);
-  for (int y = 0; y < truth.rows; ++y) {
-    for (int x = 0; x < truth.cols; ++x) {
-      const double d = valueOf[static_cast<size_t>(nearest.at<int>(y, x))];
-      above.at<uchar>(y, x) = d - (plane[0] * x + plane[1] * y + plane[2]) > margin ? 255 : 0;
+  const cv::Mat ground = bench::lidarGround(lidar);
+  cv::Mat above(lidar.size(), CV_8U);
+  for (int y = 0; y < lidar.rows; ++y) {
+    for (int x = 0; x < lidar.cols; ++x) {
+      const float d = valueOf[static_cast<size_t>(nearest.at<int>(y, x))];
+      above.at<uchar>(y, x) = d - ground.at<float>(y, x) > margin ? 255 : 0;
     }
   }
   cv::morphologyEx(above, above, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {7, 7}));
@@ -560,15 +540,8 @@ std::vector<core::Polygon> lidarFootprints(const cv::Mat& truth, const cv::Mat& 
   for (int k = 1; k < count; ++k) {
     const cv::Mat component = labels == k;
     if (cv::countNonZero(component) < 2000) continue;
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(component, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-    for (const auto& c : contours) {
-      std::vector<cv::Point> simple;
-      cv::approxPolyDP(c, simple, 1.0, true);
-      core::Polygon p;
-      for (const auto& v : simple) p.outer.emplace_back(v.x + 0.5, v.y + 0.5);
-      if (p.outer.size() >= 3) footprints.push_back(p);
-    }
+    core::Polygon footprint = segmentation::traceMask(component, 1.0, 2000.0);
+    if (footprint.outer.size() >= 3) footprints.push_back(std::move(footprint));
   }
   return footprints;
 }
@@ -645,9 +618,8 @@ void runDublin(const std::string& dataRoot, const nlohmann::json& data, const st
   }
   const cv::Mat disparity = bench::disparityFor("dublin_0004", left, right, pair.at("disparity_range").at(0),
                                                 pair.at("disparity_range").at(1), cache);
-  cv::Mat truth = cv::imread(truthPath, cv::IMREAD_UNCHANGED);
-  truth.convertTo(truth, CV_32F, 1.0 / 256.0);
-  const cv::Mat lidar = truth > 0;
+  const cv::Mat truth = bench::readLidarDisparity(truthPath);
+  const cv::Mat lidar = truth == truth;  // NaN: no LiDAR value
   std::vector<core::Polygon> roofs;
   for (const auto& roof : data.at("roofs")) {
     if (roof.at("pair") == "dublin_0004") roofs.push_back(bench::ringOf(roof.at("outline")));
@@ -656,7 +628,7 @@ void runDublin(const std::string& dataRoot, const nlohmann::json& data, const st
     return pngDir.empty() ? std::string() : (fs::path(pngDir) / name).string();
   };
   scoreAgainstLidar("hand outline", disparity, truth, lidar, roofs, params, png("dublin_0004_hand_dem_before_after.png"));
-  scoreAgainstLidar("LiDAR footprints", disparity, truth, lidar, lidarFootprints(truth, lidar, 2.0 / 0.17), params,
+  scoreAgainstLidar("LiDAR footprints", disparity, truth, lidar, lidarFootprints(truth, 2.0 / 0.17), params,
                     png("dublin_0004_lidar_dem_before_after.png"));
 }
 

@@ -31,9 +31,9 @@
 #include "delineo/delineation/roof_interval.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/cost_service.hpp"
+#include "bench_image.hpp"
 #include "energy_diag.hpp"
 #include "real_roofs.hpp"
-#include "bench_image.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
@@ -201,7 +201,6 @@ void diagnoseRoof(const std::string& name, const cv::Mat& left, const cv::Mat& r
   bench::diagnose(pe.images, pe.excluded, truthLocal, rawLocal, table, dumpDir.empty() ? nullptr : &picture);
   bench::printDiag(table, "    ", false);
   if (picture.empty()) return;
-  fs::create_directories(dumpDir);
   cv::Mat img;
   cv::normalize(left(r.roi), img, 0, 255, cv::NORM_MINMAX, CV_8U);
   cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
@@ -473,7 +472,6 @@ int main(int argc, char** argv) {
                                             {r.rawPolygon, {0, 220, 255}},
                                             {r.polygon, {0, 0, 255}}});
         if (!dumpDir.empty()) {
-          fs::create_directories(dumpDir);
           bench::writeImage((fs::path(dumpDir) / (name + ".png")).string(), panel);
         }
         panels.emplace_back(name, panel);

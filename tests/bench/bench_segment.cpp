@@ -37,8 +37,8 @@
 #include "delineo/segmentation/ground.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
-#include "simulated_match.hpp"
 #include "bench_image.hpp"
+#include "simulated_match.hpp"
 
 using namespace delineo;
 

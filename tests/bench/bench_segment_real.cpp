@@ -31,8 +31,9 @@
 #include "delineo/eval/polygon_measures.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/segmentation/scene.hpp"
-#include "real_roofs.hpp"
 #include "bench_image.hpp"
+#include "lidar.hpp"
+#include "real_roofs.hpp"
 
 using namespace delineo;
 namespace fs = std::filesystem;
@@ -57,52 +58,12 @@ double percentile(std::vector<float> v, double q) {
   return v[static_cast<size_t>(k)];
 }
 
-// The LiDAR's ground as a plane of disparity: the 10th percentile of each 128 px window, fitted
-// by least squares, windows more than 3 px above the fit dropped and the fit repeated.
-cv::Mat lidarGround(const cv::Mat& lidar) {
-  std::vector<cv::Vec3d> samples;
-  const int w = 128;
-  for (int y = 0; y + w <= lidar.rows; y += w / 2) {
-    for (int x = 0; x + w <= lidar.cols; x += w / 2) {
-      std::vector<float> v;
-      const cv::Mat win = lidar(cv::Rect(x, y, w, w));
-      for (int r = 0; r < w; ++r) {
-        for (int c = 0; c < w; ++c) {
-          if (std::isfinite(win.at<float>(r, c))) v.push_back(win.at<float>(r, c));
-        }
-      }
-      if (v.size() > 200) samples.push_back({x + w / 2.0, y + w / 2.0, percentile(v, 0.1)});
-    }
-  }
-  cv::Vec3d plane(0, 0, 0);  // d = a x + b y + c
-  for (int round = 0; round < 5 && samples.size() >= 3; ++round) {
-    cv::Mat A(static_cast<int>(samples.size()), 3, CV_64F), b(static_cast<int>(samples.size()), 1, CV_64F);
-    for (size_t i = 0; i < samples.size(); ++i) {
-      A.at<double>(static_cast<int>(i), 0) = samples[i][0];
-      A.at<double>(static_cast<int>(i), 1) = samples[i][1];
-      A.at<double>(static_cast<int>(i), 2) = 1.0;
-      b.at<double>(static_cast<int>(i)) = samples[i][2];
-    }
-    cv::Mat p;
-    cv::solve(A, b, p, cv::DECOMP_SVD);
-    plane = {p.at<double>(0), p.at<double>(1), p.at<double>(2)};
-    std::erase_if(samples, [&](const cv::Vec3d& s) { return s[2] > plane[0] * s[0] + plane[1] * s[1] + plane[2] + 3.0; });
-  }
-  cv::Mat ground(lidar.size(), CV_32F);
-  for (int y = 0; y < lidar.rows; ++y) {
-    for (int x = 0; x < lidar.cols; ++x) ground.at<float>(y, x) = static_cast<float>(plane[0] * x + plane[1] * y + plane[2]);
-  }
-  return ground;
-}
-
 // Above-ground vs the LiDAR: on its valid pixels, above when its disparity exceeds its ground by
 // `margin` px. Pixels within half a margin of that threshold are left out (low walls, cars,
 // kerbs: neither class is wrong there).
 void scoreAgainstLidar(const std::string& gtPath, const cv::Mat& above, const cv::Mat& demValid, double margin) {
-  cv::Mat raw = cv::imread(gtPath, cv::IMREAD_UNCHANGED), lidar;
-  raw.convertTo(lidar, CV_32F, 1.0 / 256.0);
-  lidar.setTo(std::nanf(""), raw == 0);
-  const cv::Mat ground = lidarGround(lidar);
+  const cv::Mat lidar = bench::readLidarDisparity(gtPath);
+  const cv::Mat ground = bench::lidarGround(lidar);
   long right = 0, total = 0, rightH = 0, totalH = 0, tp = 0, fp = 0, fn = 0;
   for (int y = 0; y < lidar.rows; ++y) {
     for (int x = 0; x < lidar.cols; ++x) {
