@@ -1230,10 +1230,6 @@
         <translation>Projet d’exemple</translation>
     </message>
     <message>
-        <source>This build has no scene simulator to make the sample project.</source>
-        <translation>Cette version ne contient pas le simulateur de scène nécessaire au projet d’exemple.</translation>
-    </message>
-    <message>
         <source>Preparing the sample project…</source>
         <translation>Préparation du projet d’exemple…</translation>
     </message>
@@ -1362,10 +1358,6 @@
     <message>
         <source>No above-ground object under the cursor.</source>
         <translation>Aucun objet sursol sous le curseur.</translation>
-    </message>
-    <message>
-        <source>Picking an above-ground object is not part of this build.</source>
-        <translation>La sélection d&apos;un objet sursol ne fait pas partie de cette version.</translation>
     </message>
     <message>
         <source>Edit outline</source>
@@ -1855,10 +1847,6 @@
     <message>
         <source>Open a project first.</source>
         <translation>Ouvrez d’abord un projet.</translation>
-    </message>
-    <message>
-        <source>The scene analysis is not part of this build.</source>
-        <translation>L’analyse de la scène ne fait pas partie de cette version.</translation>
     </message>
     <message>
         <source>The scene analysis needs heights: compute the disparity (Processing → Compute disparity) and set the height model (File → Project settings), or give the project a DEM.</source>

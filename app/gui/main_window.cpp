@@ -188,9 +188,6 @@ void MainWindow::onObjectPicked(QPointF imagePos) {
     case Outcome::NoHeights:
       showMessage(tr("Pick an object"), tr("Picking an above-ground object needs a DEM or a disparity map."));
       return;
-    case Outcome::Unavailable:
-      showMessage(tr("Pick an object"), tr("Picking an above-ground object is not part of this build."));
-      return;
     case Outcome::NoGround:
     case Outcome::NotAboveGround:
       showMessage(tr("Pick an object"), tr("No above-ground object under the cursor."));

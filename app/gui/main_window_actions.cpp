@@ -356,21 +356,18 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionSave"))->setEnabled(hasDoc);
   action(QStringLiteral("actionSaveAs"))->setEnabled(hasDoc);
   action(QStringLiteral("actionExport"))->setEnabled(hasDoc);
-  action(QStringLiteral("actionMatch"))->setEnabled(hasDoc && project::matchingAvailable());
-  action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr && project::delineationAvailable());
-  action(QStringLiteral("actionRegularize"))
-      ->setEnabled(b != nullptr && b->hasOutline() && project::delineationAvailable());
-  action(QStringLiteral("actionBoxFit"))->setEnabled(b != nullptr && project::boxFittingAvailable());
-  action(QStringLiteral("actionOutlinePending"))
-      ->setEnabled(hasDoc && project::delineationAvailable() && !document_->project().pendingBuildings().empty());
+  action(QStringLiteral("actionMatch"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr);
+  action(QStringLiteral("actionRegularize"))->setEnabled(b != nullptr && b->hasOutline());
+  action(QStringLiteral("actionBoxFit"))->setEnabled(b != nullptr);
+  action(QStringLiteral("actionOutlinePending"))->setEnabled(hasDoc && !document_->project().pendingBuildings().empty());
   const bool proposal = b != nullptr && hasBoxFitProposal(b->id);
   action(QStringLiteral("actionKeepBoxFit"))->setEnabled(proposal);
   action(QStringLiteral("actionDiscardBoxFit"))->setEnabled(proposal);
-  action(QStringLiteral("actionEnhancedDem"))->setEnabled(hasDoc && project::demEnhancementAvailable());
-  const bool scene = hasDoc && project::sceneAnalysisAvailable();
+  action(QStringLiteral("actionEnhancedDem"))->setEnabled(hasDoc);
   for (const char* name : {"actionAnalyseScene", "actionDetectBuildings", "actionShowClasses", "actionShowObjects",
                            "actionDemLayerDtm", "actionDemLayerNdsm"}) {
-    action(QString::fromLatin1(name))->setEnabled(scene);
+    action(QString::fromLatin1(name))->setEnabled(hasDoc);
   }
   action(QStringLiteral("actionAccept"))->setEnabled(b != nullptr && b->hasOutline() && b->status != BuildingStatus::Accepted);
   action(QStringLiteral("actionReject"))->setEnabled(b != nullptr && b->status != BuildingStatus::Rejected);

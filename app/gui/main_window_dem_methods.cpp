@@ -84,7 +84,7 @@ bool sameFootprints(const std::vector<core::Polygon>& a, const std::vector<core:
 // box-fitting
 
 widgets::JobId MainWindow::startBoxFitting(int id) {
-  if (!document_ || !project::boxFittingAvailable()) return 0;
+  if (!document_) return 0;
   const Building* current = document_->project().find(id);
   if (current == nullptr) {
     showMessage(tr("Box-fitting"), tr("Select a building first."));
@@ -110,9 +110,7 @@ widgets::JobId MainWindow::startBoxFitting(int id) {
         BoxFitProposal proposal;
         core::Progress::Range fitting(&p, 0.0, 0.8);
         proposal.outcome = project::fitBuildingBoxes(projectCopy, building, heights, pair.left, &fitting);
-        if (!proposal.outcome.hasOutline() || !building.roofInterval || !project::delineationAvailable()) {
-          return proposal;
-        }
+        if (!proposal.outcome.hasOutline() || !building.roofInterval) return proposal;
         core::Progress::Range scoring(&p, 0.8, 1.0);
         try {
           proposal.activeEnergy =
@@ -280,7 +278,7 @@ void MainWindow::onEnhancedDemToggled(bool on) {
 
 widgets::JobId MainWindow::startDemEnhancement() {
   QAction* toggle = action(QStringLiteral("actionEnhancedDem"));
-  if (!document_ || !project::demEnhancementAvailable()) return 0;
+  if (!document_) return 0;
   const auto refuse = [&](const QString& reason) -> widgets::JobId {
     const QSignalBlocker block(toggle);
     toggle->setChecked(false);

@@ -60,7 +60,7 @@ project::ContourListener evolvingContourListener(MainWindow* window) {
 }  // namespace
 
 widgets::JobId MainWindow::startRangeEstimate(bool thenMatch) {
-  if (!document_ || !project::matchingAvailable()) return 0;
+  if (!document_) return 0;
   const project::Project projectCopy = document_->project();
   const project::StereoPair pair = document_->pair();
   QPointer<Document> doc(document_.get());
@@ -86,7 +86,7 @@ widgets::JobId MainWindow::startRangeEstimate(bool thenMatch) {
 }
 
 widgets::JobId MainWindow::startMatching() {
-  if (!document_ || !project::matchingAvailable()) return 0;
+  if (!document_) return 0;
   // The range comes first: estimated from the images when the project has none.
   if (!document_->project().disparityRange) return startRangeEstimate(true);
   const project::Project projectCopy = document_->project();
@@ -111,7 +111,7 @@ widgets::JobId MainWindow::startMatching() {
 }
 
 widgets::JobId MainWindow::startDelineation(int id) {
-  if (!document_ || !project::delineationAvailable()) return 0;
+  if (!document_) return 0;
   const Building* current = document_->project().find(id);
   if (current == nullptr) {
     showMessage(tr("Active polygon"), tr("Select a building first."));
@@ -153,7 +153,7 @@ widgets::JobId MainWindow::startDelineation(int id) {
 }
 
 widgets::JobId MainWindow::outlinePendingBuildings() {
-  if (!document_ || !project::delineationAvailable()) return 0;
+  if (!document_) return 0;
   const QString title = tr("Outline the pending buildings");
   const std::vector<int> pending = document_->project().pendingBuildings();
   if (pending.empty()) {
@@ -224,7 +224,7 @@ widgets::JobId MainWindow::outlinePendingBuildings() {
 }
 
 widgets::JobId MainWindow::startEnergyUpdate(int id) {
-  if (!document_ || !project::delineationAvailable()) return 0;
+  if (!document_) return 0;
   const Building* b = document_->project().find(id);
   if (b == nullptr || !b->hasOutline() || std::isfinite(b->energy) || !b->roofInterval) return 0;
   const auto asked = energyAsked_.find(id);
@@ -261,7 +261,7 @@ widgets::JobId MainWindow::startEnergyUpdate(int id) {
 }
 
 widgets::JobId MainWindow::startRegularization(int id) {
-  if (!document_ || !project::delineationAvailable()) return 0;
+  if (!document_) return 0;
   const Building* b = document_->project().find(id);
   if (b == nullptr || !b->hasOutline()) return 0;
   if (!b->roofInterval) {

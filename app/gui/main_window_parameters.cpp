@@ -181,7 +181,6 @@ QWidget* MainWindow::createMethodChoice() {
   methodChoice_->setObjectName(QStringLiteral("methodChoice"));
   methodChoice_->addItem(tr("active polygon"), QString::fromLatin1(project::kActivePolygon));
   methodChoice_->addItem(tr("box-fitting"), QString::fromLatin1(project::kBoxFitting));
-  if (!project::boxFittingAvailable()) methodChoice_->setEnabled(false);
   methodChoice_->setToolTip(tr("The method that outlines a picked building; box-fitting needs the DEM."));
   label->setBuddy(methodChoice_);
   layout->addWidget(label);

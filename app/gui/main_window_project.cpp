@@ -102,10 +102,6 @@ QString MainWindow::sampleDirectory() {
 }
 
 bool MainWindow::openSample() {
-  if (!project::simulationAvailable()) {
-    showMessage(tr("Sample project"), tr("This build has no scene simulator to make the sample project."));
-    return false;
-  }
   const QString dir = sampleDirectory();
   statusBar()->showMessage(tr("Preparing the sample project…"));
   jobs_->run<std::string>(
@@ -173,8 +169,7 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   updateActions();
   emit documentOpened();
   startEdgeMap();
-  if (doc->disparity().empty() && project::matchingAvailable() &&
-      QSettings().value(QStringLiteral("autoMatch"), true).toBool()) {
+  if (doc->disparity().empty() && QSettings().value(QStringLiteral("autoMatch"), true).toBool()) {
     statusBar()->showMessage(tr("No disparity yet: computing it in the background."), 8000);
     startMatching();
   }

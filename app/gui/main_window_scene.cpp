@@ -170,7 +170,6 @@ QWidget* MainWindow::createLayerLegend() {
 // Why the analysis cannot run on the open document; empty when it can.
 QString MainWindow::sceneInputsMissing() const {
   if (!document_) return tr("Open a project first.");
-  if (!project::sceneAnalysisAvailable()) return tr("The scene analysis is not part of this build.");
   if (document_->dem().empty()) {
     return document_->disparity().empty()
                ? tr("The scene analysis needs heights: compute the disparity (Processing → Compute disparity) "

@@ -1,40 +1,18 @@
 // The project's steps that work on heights: box-fitting of one building and the enhancement of
-// the DEM with the buildings' outlines. Each library is optional at build time
-// (DELINEO_HAVE_BOXFIT, DELINEO_HAVE_DEM).
+// the DEM with the buildings' outlines.
 #include <cstdio>
 #include <string>
 #include <vector>
 
-#include "delineo/core/error.hpp"
-#include "delineo/project/pipeline.hpp"
-
-#ifdef DELINEO_HAVE_BOXFIT
 #include "delineo/boxfit/box_fitting.hpp"
-#endif
-#ifdef DELINEO_HAVE_DEM
+#include "delineo/core/error.hpp"
 #include "delineo/dem/enhance.hpp"
-#endif
+#include "delineo/project/pipeline.hpp"
 
 namespace delineo::project {
 
 using core::Error;
 using core::ErrorCode;
-
-bool boxFittingAvailable() {
-#ifdef DELINEO_HAVE_BOXFIT
-  return true;
-#else
-  return false;
-#endif
-}
-
-bool demEnhancementAvailable() {
-#ifdef DELINEO_HAVE_DEM
-  return true;
-#else
-  return false;
-#endif
-}
 
 cv::Mat projectHeights(const Project& project, const cv::Mat& disparity) {
   if (!project.dem.empty()) {
@@ -49,7 +27,6 @@ cv::Mat projectHeights(const Project& project, const cv::Mat& disparity) {
 
 BoxFitOutcome fitBuildingBoxes(const Project& project, const Building& building, const cv::Mat& heights,
                                const cv::Mat& left, core::Progress* progress) {
-#ifdef DELINEO_HAVE_BOXFIT
   if (heights.empty()) {
     throw Error(ErrorCode::InvalidParameter,
                 "box-fitting needs heights: a DEM, or the disparity and the height model");
@@ -72,10 +49,6 @@ BoxFitOutcome fitBuildingBoxes(const Project& project, const Building& building,
     }
   }
   return outcome;
-#else
-  (void)project, (void)building, (void)heights, (void)left, (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "box-fitting is not part of this build");
-#endif
 }
 
 Building withBoxFitOutline(const Project& project, const Building& building, const BoxFitOutcome& outcome,
@@ -99,7 +72,6 @@ Building withBoxFitOutline(const Project& project, const Building& building, con
 }
 
 EnhancedDemOutcome enhanceHeights(const Project& project, const cv::Mat& heights, core::Progress* progress) {
-#ifdef DELINEO_HAVE_DEM
   std::vector<core::Polygon> footprints;
   for (const Building& b : project.buildings) {
     if (b.hasOutline() && b.status != BuildingStatus::Rejected) footprints.push_back(b.outline);
@@ -117,10 +89,6 @@ EnhancedDemOutcome enhanceHeights(const Project& project, const cv::Mat& heights
   outcome.dem = result.dem;
   outcome.status = result.status;
   return outcome;
-#else
-  (void)project, (void)heights, (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "DEM enhancement is not part of this build");
-#endif
 }
 
 }  // namespace delineo::project

@@ -6,60 +6,23 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "delineo/core/error.hpp"
-
-#ifdef DELINEO_HAVE_STEREO
-#include "delineo/stereo/disparity_range.hpp"
-#include "delineo/stereo/match.hpp"
-#endif
-#ifdef DELINEO_HAVE_SIM
-#include "delineo/sim/scene.hpp"
-#endif
-#ifdef DELINEO_HAVE_BOXFIT
-#include "delineo/boxfit/params.hpp"
-#endif
-#ifdef DELINEO_HAVE_DEM
-#include "delineo/dem/enhance.hpp"
-#endif
-#ifdef DELINEO_HAVE_SEGMENTATION
-#include "delineo/segmentation/scene.hpp"
-#endif
-#ifdef DELINEO_HAVE_DELINEATION
 #include "delineation_bridge.hpp"
+#include "delineo/boxfit/params.hpp"
+#include "delineo/core/error.hpp"
 #include "delineo/delineation/above_ground.hpp"
 #include "delineo/delineation/params.hpp"
 #include "delineo/delineation/roof_interval.hpp"
-#endif
+#include "delineo/dem/enhance.hpp"
+#include "delineo/segmentation/scene.hpp"
+#include "delineo/sim/scene.hpp"
+#include "delineo/stereo/disparity_range.hpp"
+#include "delineo/stereo/match.hpp"
 
 namespace delineo::project {
 
 namespace fs = std::filesystem;
 using core::Error;
 using core::ErrorCode;
-
-bool matchingAvailable() {
-#ifdef DELINEO_HAVE_STEREO
-  return true;
-#else
-  return false;
-#endif
-}
-
-bool delineationAvailable() {
-#ifdef DELINEO_HAVE_DELINEATION
-  return true;
-#else
-  return false;
-#endif
-}
-
-bool simulationAvailable() {
-#ifdef DELINEO_HAVE_SIM
-  return true;
-#else
-  return false;
-#endif
-}
 
 namespace {
 template <class Params>
@@ -73,26 +36,15 @@ void validateGroup(const Project& project, const std::string& group) {
 }  // namespace
 
 void validateParameters(const Project& project) {
-#ifdef DELINEO_HAVE_STEREO
   validateGroup<stereo::RangeEstimateParams>(project, "range");
   validateGroup<stereo::MatchParams>(project, "matching");
-#endif
-#ifdef DELINEO_HAVE_DELINEATION
   validateGroup<delineation::DelineationParams>(project, "delineation");
-#endif
-#ifdef DELINEO_HAVE_BOXFIT
   validateGroup<boxfit::BoxFitParams>(project, "boxfit");
-#endif
-#ifdef DELINEO_HAVE_DEM
   validateGroup<dem::EnhanceParams>(project, "enhance");
-#endif
-#ifdef DELINEO_HAVE_SEGMENTATION
   validateGroup<segmentation::GroundParams>(project, kSegmentGroup);
   validateGroup<segmentation::ClassifyParams>(project, kClassifyGroup);
   validateGroup<segmentation::ObjectParams>(project, kObjectsGroup);
   validateGroup<segmentation::DetectParams>(project, kDetectGroup);
-#endif
-  (void)project;
 }
 
 StereoPair readStereoPair(const Project& project) {
@@ -128,7 +80,6 @@ cv::Mat readDisparity(const Project& project, cv::Size size) {
 }
 
 RangeOutcome estimateDisparityRange(const Project& project, const StereoPair& pair, core::Progress* progress) {
-#ifdef DELINEO_HAVE_STEREO
   const auto params = parameters<stereo::RangeEstimateParams>(project, "range");
   const stereo::RangeEstimate estimate = stereo::estimateDisparityRange(pair.left, pair.right, params, progress);
   RangeOutcome outcome;
@@ -136,15 +87,10 @@ RangeOutcome estimateDisparityRange(const Project& project, const StereoPair& pa
   outcome.range = DisparityInterval{estimate.dmin, estimate.dmax};
   outcome.matches = estimate.matches;
   return outcome;
-#else
-  (void)project, (void)pair, (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "dense matching is not part of this build");
-#endif
 }
 
 MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, const cv::Mat& right,
                                  core::Progress* progress) {
-#ifdef DELINEO_HAVE_STEREO
   if (!project.disparityRange) {
     throw Error(ErrorCode::InvalidParameter, "the project has no disparity range: estimate or give it first");
   }
@@ -157,10 +103,6 @@ MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, co
   outcome.status = result.status;
   if (result.status == core::RunStatus::Completed) outcome.disparity = result.disparity;
   return outcome;
-#else
-  (void)project, (void)left, (void)right, (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "dense matching is not part of this build");
-#endif
 }
 
 namespace {
@@ -186,31 +128,20 @@ float percentile(std::vector<float>& values, double q) {
 }  // namespace
 
 std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon) {
-#ifdef DELINEO_HAVE_DELINEATION
   if (disparity.empty()) return std::nullopt;
   const delineation::RoofIntervalProposal p = delineation::proposeRoofInterval(disparity, polygon);
   if (!p.found) return std::nullopt;
   return DisparityInterval{p.low, p.high};
-#else
-  (void)disparity, (void)polygon;
-  return std::nullopt;
-#endif
 }
 
 std::optional<double> suggestGroundLevel(const cv::Mat& disparity, const core::Polygon& polygon) {
-#ifdef DELINEO_HAVE_DELINEATION
   if (disparity.empty()) return std::nullopt;
   const double level = delineation::estimateGroundLevel(disparity, polygon);
   if (!std::isfinite(level)) return std::nullopt;
   return level;
-#else
-  (void)disparity, (void)polygon;
-  return std::nullopt;
-#endif
 }
 
 std::optional<double> suggestSceneGroundLevel(const cv::Mat& disparity) {
-#ifdef DELINEO_HAVE_DELINEATION
   if (disparity.empty()) return std::nullopt;
   // The same estimate with a band that covers the whole map, around its centre pixel.
   delineation::RoofIntervalParams params;
@@ -221,10 +152,6 @@ std::optional<double> suggestSceneGroundLevel(const cv::Mat& disparity) {
   const double level = delineation::estimateGroundLevel(disparity, centre, params);
   if (!std::isfinite(level)) return std::nullopt;
   return level;
-#else
-  (void)disparity;
-  return std::nullopt;
-#endif
 }
 
 dem::HeightModel demHeightModel(const HeightModel& model) {
@@ -259,7 +186,6 @@ ObjectPick pickAboveGroundObject(const Project& project, const cv::Mat& disparit
   } else {
     return pick;  // NoHeights
   }
-#ifdef DELINEO_HAVE_DELINEATION
   const auto params = parameters<delineation::AboveGroundParams>(project, "pick");
   const delineation::AboveGroundObject object =
       delineation::aboveGroundObjectAt(map, click, metresPerPixelOf(project), params);
@@ -274,11 +200,6 @@ ObjectPick pickAboveGroundObject(const Project& project, const cv::Mat& disparit
     pick.groundHeight = project.height.heightAt(object.groundLevel);
   }
   return pick;
-#else
-  (void)click;
-  pick.outcome = ObjectPick::Outcome::Unavailable;
-  return pick;
-#endif
 }
 
 std::optional<double> groundHeightNextTo(const Project& project, const cv::Mat& dem, const core::Polygon& polygon) {
@@ -298,33 +219,18 @@ double roofHeight(const Project& project, const cv::Mat& disparity, const core::
 DelineationOutcome delineateBuilding(const Project& project, const Building& building,
                                      const StereoPair& pair, core::Progress* progress,
                                      const ContourListener& onContour) {
-#ifdef DELINEO_HAVE_DELINEATION
   return runActivePolygon(project, building, pair, progress, onContour);
-#else
-  (void)project, (void)building, (void)pair, (void)progress, (void)onContour;
-  throw Error(ErrorCode::ProcessingFailed, "the active polygon is not part of this build");
-#endif
 }
 
 EnergyOutcome outlineEnergy(const Project& project, const Building& building, const StereoPair& pair,
                             const core::Polygon& outline, core::Progress* progress) {
-#ifdef DELINEO_HAVE_DELINEATION
   return evaluateBuildingOutline(project, building, pair, outline, progress);
-#else
-  (void)project, (void)building, (void)pair, (void)outline, (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "the active polygon is not part of this build");
-#endif
 }
 
 RegularizationOutcome regularizeOutline(const Project& project, const Building& building,
                                         const StereoPair& pair, const core::Polygon& outline,
                                         core::Progress* progress) {
-#ifdef DELINEO_HAVE_DELINEATION
   return regularizeBuilding(project, building, pair, outline, progress);
-#else
-  (void)project, (void)building, (void)pair, (void)outline, (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "the active polygon is not part of this build");
-#endif
 }
 
 std::string ensureSampleProject(const std::string& directory, core::Progress* progress) {
@@ -343,7 +249,6 @@ std::string ensureSampleProject(const std::string& directory, core::Progress* pr
                   directory);
     }
   }
-#ifdef DELINEO_HAVE_SIM
   sim::SceneParams params;
   params.seed = 2024;
   params.width = 512;
@@ -370,10 +275,6 @@ std::string ensureSampleProject(const std::string& directory, core::Progress* pr
   p.height = {scene.groundDisparity, scene.metresPerDisparity, scene.gsd};
   saveProject(p, projectPath.string());
   return projectPath.string();
-#else
-  (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "the scene simulator is not part of this build", directory);
-#endif
 }
 
 }  // namespace delineo::project

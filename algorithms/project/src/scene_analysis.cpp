@@ -1,6 +1,6 @@
-// The project's scene analysis (segmentation library, optional at build time:
-// DELINEO_HAVE_SEGMENTATION): ground / above-ground, DTM, nDSM, classes, objects and building
-// proposals with the project's parameter groups, and proposals turned into pending buildings.
+// The project's scene analysis (segmentation library): ground / above-ground, DTM, nDSM, classes,
+// objects and building proposals with the project's parameter groups, and proposals turned into
+// pending buildings.
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -10,25 +10,14 @@
 
 #include "delineo/core/error.hpp"
 #include "delineo/project/pipeline.hpp"
-
-#ifdef DELINEO_HAVE_SEGMENTATION
 #include "delineo/segmentation/scene.hpp"
-#endif
 
 namespace delineo::project {
 
 using core::Error;
 using core::ErrorCode;
 
-bool sceneAnalysisAvailable() {
-#ifdef DELINEO_HAVE_SEGMENTATION
-  return true;
-#else
-  return false;
-#endif
-}
-
-#ifdef DELINEO_HAVE_SEGMENTATION
+namespace {
 segmentation::SceneParams sceneParameters(const Project& project) {
   segmentation::SceneParams params;
   params.ground = parameters<segmentation::GroundParams>(project, kSegmentGroup);
@@ -37,11 +26,10 @@ segmentation::SceneParams sceneParameters(const Project& project) {
   params.detect = parameters<segmentation::DetectParams>(project, kDetectGroup);
   return params;
 }
-#endif
+}  // namespace
 
 SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights, const cv::Mat& image,
                                   const cv::Mat& disparity, core::Progress* progress) {
-#ifdef DELINEO_HAVE_SEGMENTATION
   if (heights.empty()) {
     throw Error(ErrorCode::InvalidParameter,
                 "the scene analysis needs heights: a DEM, or the disparity and the height model");
@@ -64,10 +52,6 @@ SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights
   out.rounds = analysis.ground.iterations;
   out.converged = analysis.ground.converged;
   return out;
-#else
-  (void)project, (void)heights, (void)image, (void)disparity, (void)progress;
-  throw Error(ErrorCode::ProcessingFailed, "the scene analysis is not part of this build");
-#endif
 }
 
 namespace {

@@ -168,7 +168,6 @@ TEST(Pipeline, HeightsComeFromTheDemFileOrTheDisparityThroughTheHeightModel) {
 }
 
 TEST(Pipeline, BoxFittingOutlinesTheBuildingAndRecordsItsMethod) {
-  if (!project::boxFittingAvailable()) GTEST_SKIP() << "no box-fitting in this build";
   SceneProject s = makeSceneProject();
   s.project.height = {s.scene.groundDisparity, s.scene.metresPerDisparity, 0.25};
   const cv::Mat heights = project::projectHeights(s.project, s.scene.disparity);
@@ -200,7 +199,6 @@ TEST(Pipeline, BoxFittingOutlinesTheBuildingAndRecordsItsMethod) {
 }
 
 TEST(Pipeline, EnhancedHeightsFollowTheOutlinesAndLeaveTheGroundAlone) {
-  if (!project::demEnhancementAvailable()) GTEST_SKIP() << "no DEM enhancement in this build";
   SceneProject s = makeSceneProject();
   s.project.height = {s.scene.groundDisparity, s.scene.metresPerDisparity, 0.25};
   const cv::Mat heights = project::projectHeights(s.project, s.scene.disparity);
@@ -231,38 +229,36 @@ TEST(Pipeline, APendingBuildingIsOutlinedWithItsMethod) {
   s.project.height = {s.scene.groundDisparity, s.scene.metresPerDisparity, 0.25};
   s.pair.disparity = s.scene.disparity;
   cv::Mat heights;
-  if (project::delineationAvailable()) {
-    const auto polygon = project::outlinePendingBuilding(s.project, s.building, s.pair, heights, nullptr, "test");
-    ASSERT_TRUE(polygon.has_value());
-    EXPECT_EQ(polygon->status, project::BuildingStatus::Automatic);
-    EXPECT_EQ(polygon->method, project::kActivePolygon);
-    EXPECT_TRUE(std::isfinite(polygon->energy));
-    EXPECT_GT(polygon->roofHeight, 2.0);
-    EXPECT_GT(iou(polygon->outline, s.truth, s.pair.left.size()), 0.85);
-    EXPECT_EQ(polygon->history.back().detail.rfind("test, ", 0), 0u) << polygon->history.back().detail;
-    EXPECT_TRUE(heights.empty()) << "the active polygon reads no heights";
-    // Without a roof interval the disparity map gives one.
-    project::Building open = s.building;
-    open.roofInterval.reset();
-    const auto suggested = project::outlinePendingBuilding(s.project, open, s.pair, heights, nullptr, "test");
-    ASSERT_TRUE(suggested.has_value());
-    EXPECT_TRUE(suggested->roofInterval.has_value());
-    EXPECT_GT(iou(suggested->outline, s.truth, s.pair.left.size()), 0.85);
-    // A canceled progress outlines nothing.
-    core::Progress canceled;
-    canceled.cancel();
-    EXPECT_FALSE(project::outlinePendingBuilding(s.project, s.building, s.pair, heights, &canceled, "test"));
-  }
-  if (project::boxFittingAvailable()) {
-    s.building.method = project::kBoxFitting;
-    const auto boxes = project::outlinePendingBuilding(s.project, s.building, s.pair, heights, nullptr, "test");
-    ASSERT_TRUE(boxes.has_value());
-    EXPECT_EQ(boxes->method, project::kBoxFitting);
-    EXPECT_FALSE(heights.empty()) << "the heights are read once and handed back for the next building";
-    EXPECT_GT(iou(boxes->outline, s.truth, s.pair.left.size()), 0.8);
-    // Without a height model there are no heights: box-fitting is refused with a reason.
-    cv::Mat none;
-    s.project.height = {};
-    EXPECT_THROW(project::outlinePendingBuilding(s.project, s.building, s.pair, none, nullptr, "test"), core::Error);
-  }
+  const auto polygon = project::outlinePendingBuilding(s.project, s.building, s.pair, heights, nullptr, "test");
+  ASSERT_TRUE(polygon.has_value());
+  EXPECT_EQ(polygon->status, project::BuildingStatus::Automatic);
+  EXPECT_EQ(polygon->method, project::kActivePolygon);
+  EXPECT_TRUE(std::isfinite(polygon->energy));
+  EXPECT_GT(polygon->roofHeight, 2.0);
+  EXPECT_GT(iou(polygon->outline, s.truth, s.pair.left.size()), 0.85);
+  EXPECT_EQ(polygon->history.back().detail.rfind("test, ", 0), 0u) << polygon->history.back().detail;
+  EXPECT_TRUE(heights.empty()) << "the active polygon reads no heights";
+  // Without a roof interval the disparity map gives one.
+  project::Building open = s.building;
+  open.roofInterval.reset();
+  const auto suggested = project::outlinePendingBuilding(s.project, open, s.pair, heights, nullptr, "test");
+  ASSERT_TRUE(suggested.has_value());
+  EXPECT_TRUE(suggested->roofInterval.has_value());
+  EXPECT_GT(iou(suggested->outline, s.truth, s.pair.left.size()), 0.85);
+  // A canceled progress outlines nothing.
+  core::Progress canceled;
+  canceled.cancel();
+  EXPECT_FALSE(project::outlinePendingBuilding(s.project, s.building, s.pair, heights, &canceled, "test"));
+
+  // Box-fitting reads the heights.
+  s.building.method = project::kBoxFitting;
+  const auto boxes = project::outlinePendingBuilding(s.project, s.building, s.pair, heights, nullptr, "test");
+  ASSERT_TRUE(boxes.has_value());
+  EXPECT_EQ(boxes->method, project::kBoxFitting);
+  EXPECT_FALSE(heights.empty()) << "the heights are read once and handed back for the next building";
+  EXPECT_GT(iou(boxes->outline, s.truth, s.pair.left.size()), 0.8);
+  // Without a height model there are no heights: box-fitting is refused with a reason.
+  cv::Mat none;
+  s.project.height = {};
+  EXPECT_THROW(project::outlinePendingBuilding(s.project, s.building, s.pair, none, nullptr, "test"), core::Error);
 }

@@ -45,7 +45,6 @@ TEST(SceneAnalysisStep, ProposalsBecomePendingBuildingsOnce) {
 }
 
 TEST(SceneAnalysisStep, TheChainRunsWithTheProjectsParametersAndGsd) {
-  if (!project::sceneAnalysisAvailable()) GTEST_SKIP() << "segmentation not in this build";
   sim::SceneParams sp;
   sp.width = 320;
   sp.height = 240;

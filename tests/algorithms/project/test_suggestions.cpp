@@ -32,7 +32,6 @@ cv::Mat roofScene() {
 }  // namespace
 
 TEST(Suggestions, RoofIntervalHoldsTheRoofPeakAndGroundLevelIsTheStreet) {
-  if (!project::delineationAvailable()) GTEST_SKIP() << "the active polygon is not part of this build";
   const cv::Mat map = roofScene();
   const core::Polygon picked = rectangle(96, 100, 324, 304);
   const auto interval = project::suggestRoofInterval(map, picked);
@@ -50,7 +49,6 @@ TEST(Suggestions, NothingWithoutADisparityMap) {
 }
 
 TEST(Suggestions, TheScenesGroundLevelIsTheStreetNotTheBiggestRoof) {
-  if (!project::delineationAvailable()) GTEST_SKIP() << "the active polygon is not part of this build";
   const auto ground = project::suggestSceneGroundLevel(roofScene());
   ASSERT_TRUE(ground.has_value());
   EXPECT_NEAR(*ground, 8.0, 1.0);
@@ -60,7 +58,6 @@ TEST(Suggestions, TheScenesGroundLevelIsTheStreetNotTheBiggestRoof) {
 // The GUI's "Pick an above-ground object" and the 3D view's block base read the same ground as
 // the histogram's line: suggestGroundLevel of the picked outline, in px or in metres.
 TEST(Suggestions, ThePickedObjectsGroundIsTheHistogramsGround) {
-  if (!project::delineationAvailable()) GTEST_SKIP() << "the active polygon is not part of this build";
   const cv::Mat map = roofScene();
   project::Project p;
   p.height = {8.0, 0.25, 0.05};

@@ -172,7 +172,6 @@ class MainWindowTest : public QObject {
     // Each step is driven by the test (the automatic run on pick is tested on its own).
     guitest::isolateSettings(QStringLiteral("DelineoTest"), false);
     QVERIFY(dir_.isValid());
-    if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
     projectPath_ = guitest::makeSampleProject(dir_);
     window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
@@ -184,7 +183,6 @@ class MainWindowTest : public QObject {
     QCOMPARE(opened.count(), 1);
     QVERIFY(window_->document()->disparity().empty());
     QVERIFY(window_->leftView()->hasImage());
-    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
     // Every tick is taken while a matching job runs; the sample's matching now takes about
     // 0.1 s, so it is run again until the ticks are enough for a 99th percentile.
     std::vector<double> lateness;
@@ -268,7 +266,6 @@ class MainWindowTest : public QObject {
   }
 
   void runsTheActivePolygonInTheBackground() {
-    if (!project::delineationAvailable()) QSKIP("no active polygon in this build");
     gui::Document* doc = window_->document();
     QSignalSpy finished(window_.get(), &MainWindow::delineationFinished);
     const widgets::JobId job = window_->startDelineation(buildingId_);
@@ -398,7 +395,6 @@ class MainWindowTest : public QObject {
   }
 
   void regularizesAnEditedOutlineAsOneStep() {
-    if (!project::delineationAvailable()) QSKIP("no active polygon in this build");
     gui::Document* doc = window_->document();
     window_->selectBuilding(buildingId_);
     // A hand-drawn outline of the building that zigzags by a pixel along its sides.
@@ -428,7 +424,6 @@ class MainWindowTest : public QObject {
   }
 
   void boxFittingIsShownBesideTheOutlineAndKeptAsOneStep() {
-    if (!project::boxFittingAvailable()) QSKIP("no box-fitting in this build");
     gui::Document* doc = window_->document();
     window_->selectBuilding(buildingId_);
     const project::Building before = *doc->project().find(buildingId_);
@@ -511,7 +506,6 @@ class MainWindowTest : public QObject {
   }
 
   void canceledBoxFittingKeepsTheOutline() {
-    if (!project::boxFittingAvailable()) QSKIP("no box-fitting in this build");
     gui::Document* doc = window_->document();
     window_->selectBuilding(buildingId_);
     window_->discardBoxFitProposal();  // one a test before may have left
@@ -545,7 +539,6 @@ class MainWindowTest : public QObject {
   }
 
   void enhancedDemToggleChangesTheDemView() {
-    if (!project::demEnhancementAvailable()) QSKIP("no DEM enhancement in this build");
     gui::Document* doc = window_->document();
     QVERIFY(doc->project().find(buildingId_)->hasOutline());
     window_->showDock(QStringLiteral("demDock"));
@@ -840,7 +833,6 @@ class MainWindowTest : public QObject {
   }
 
   void orderingCheckIsAMatchingParameterOfTheProject() {
-    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
     if (!window_->document()) QVERIFY(window_->openProject(projectPath_));
     auto* box = window_->matchingForm()->findChild<QCheckBox*>(QStringLiteral("ordering-check"));
     QVERIFY(box);
@@ -881,7 +873,6 @@ class MainWindowTest : public QObject {
   }
 
   void roofPlanesAreMatchingParametersOfTheProject() {
-    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
     if (!window_->document()) QVERIFY(window_->openProject(projectPath_));
     auto* residual = window_->matchingForm()->findChild<QDoubleSpinBox*>(QStringLiteral("plane-residual"));
     auto* area = window_->matchingForm()->findChild<QSpinBox*>(QStringLiteral("plane-min-area"));
@@ -905,7 +896,6 @@ class MainWindowTest : public QObject {
   }
 
   void squareWindowsOnOneSurfaceIsAMatchingParameterOfTheProject() {
-    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
     if (!window_->document()) QVERIFY(window_->openProject(projectPath_));
     auto* box =
         window_->matchingForm()->findChild<QCheckBox*>(QStringLiteral("square-on-one-surface"));
@@ -981,7 +971,7 @@ class MainWindowTest : public QObject {
                                            .arg(view->height())));
       QVERIFY(view->isFitted());
       // A disparity arriving later (its dock's view gets its first image) leaves it fitted.
-      if (asProject && project::matchingAvailable()) {
+      if (asProject) {
         const widgets::JobId job = fresh.startMatching();
         QTRY_VERIFY_WITH_TIMEOUT(!fresh.jobs()->isActive(job), 60000);
         QVERIFY(fresh.disparityView()->hasImage());

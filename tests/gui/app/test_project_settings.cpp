@@ -59,7 +59,6 @@ class ProjectSettingsTest : public QObject {
     // A pick starts the active polygon here, as it does for the operator.
     guitest::isolateSettings(QStringLiteral("DelineoSettingsTest"), true);
     QVERIFY(dir_.isValid());
-    if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
     projectPath_ = guitest::makeSampleProject(dir_);
     window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
@@ -189,7 +188,6 @@ class ProjectSettingsTest : public QObject {
   }
 
   void anEditedOutlineGetsItsEnergyBack() {
-    if (!project::delineationAvailable()) QSKIP("no active polygon in this build");
     QVERIFY(window_->openProject(projectPath_));
     gui::Document* doc = window_->document();
     const int id = addRoofBuilding();
@@ -216,7 +214,6 @@ class ProjectSettingsTest : public QObject {
   }
 
   void aPickStartsTheActivePolygonOnceTheDisparityIsThere() {
-    if (!project::delineationAvailable() || !project::matchingAvailable()) QSKIP("needs the matcher and the active polygon");
     QVERIFY(window_->openProject(projectPath_));  // no disparity yet, automatic matching off
     QVERIFY(window_->action(QStringLiteral("actionDelineateOnPick"))->isChecked());
     gui::Document* doc = window_->document();
@@ -240,7 +237,6 @@ class ProjectSettingsTest : public QObject {
   }
 
   void aPickIsOutlinedWithTheProjectsMethod() {
-    if (!project::boxFittingAvailable() || !project::matchingAvailable()) QSKIP("needs the matcher and box-fitting");
     QVERIFY(window_->openProject(projectPath_));
     gui::Document* doc = window_->document();
     QSignalSpy matched(window_.get(), &MainWindow::matchingFinished);
@@ -294,7 +290,6 @@ class ProjectSettingsTest : public QObject {
     const std::vector<std::pair<std::string, std::string>> groups = {
         {"boxfit", "min-height"}, {"enhance", "wall-band"}, {"pick", "height-margin"}};
     for (const auto& [group, key] : groups) {
-      if (group == "boxfit" && !project::boxFittingAvailable()) continue;
       widgets::ParameterForm* form = window_->parameterForm(group);
       QVERIFY2(form != nullptr, group.c_str());
       auto* spin = form->findChild<QAbstractSpinBox*>(QString::fromStdString(key));

@@ -316,7 +316,6 @@ class RealPairTest : public QObject {
   // Box-fitting beside the active polygon on the big roof (accepted above), then the choice to keep
   // the active polygon's outline; the enhanced DEM from the two outlines.
   void boxFittingBesideTheActivePolygon() {
-    if (!project::boxFittingAvailable()) QSKIP("no box-fitting in this build");
     const core::Polygon hand = handOutline("t51_right_big");
     window_->selectBuilding(bigRoof_);
     const project::Building before = *window_->document()->project().find(bigRoof_);
@@ -340,7 +339,6 @@ class RealPairTest : public QObject {
   }
 
   void enhancedDemFromTheOutlines() {
-    if (!project::demEnhancementAvailable()) QSKIP("no DEM enhancement in this build");
     window_->selectBuilding(-1);
     window_->showDock(QStringLiteral("demDock"));
     window_->findChild<QComboBox*>(QStringLiteral("demMode"))->setCurrentIndex(0);  // hillshade
@@ -414,7 +412,6 @@ class RealPairTest : public QObject {
   // Detect buildings adds the building objects that are not buildings yet as pending buildings, in
   // one undoable step; the buildings delineated above are not proposed again.
   void detectsTheTilesBuildings() {
-    if (!project::sceneAnalysisAvailable()) QSKIP("no scene analysis in this build");
     window_->selectBuilding(-1);
     window_->activateWindow();
     window_->leftView()->fitToWindow();
@@ -454,7 +451,6 @@ class RealPairTest : public QObject {
   // Outline the pending buildings: the detected proposals outlined in turn by the active polygon,
   // as `delineo-cli run --detect` does, then scored against the hand-drawn roofs they cover.
   void outlinesTheProposals() {
-    if (!project::sceneAnalysisAvailable() || !project::delineationAvailable()) QSKIP("no scene analysis");
     gui::Document* doc = window_->document();
     const std::vector<int> pending = doc->project().pendingBuildings();
     QVERIFY(!pending.empty());

@@ -77,8 +77,6 @@ class SceneAnalysisTest : public QObject {
   void initTestCase() {
     guitest::isolateSettings(QStringLiteral("DelineoSceneTest"), false);
     QVERIFY(dir_.isValid());
-    if (!project::simulationAvailable()) QSKIP("no scene simulator in this build");
-    if (!project::sceneAnalysisAvailable()) QSKIP("no scene analysis in this build");
     projectPath_ = guitest::makeSampleProject(dir_);
     window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
@@ -158,7 +156,6 @@ class SceneAnalysisTest : public QObject {
     QVERIFY(window_->openProject(projectPath_));
     QVERIFY(doc()->project().buildings.empty());
     // With the disparity, each proposal comes with its roof interval.
-    if (!project::matchingAvailable()) QSKIP("no matcher in this build");
     QSignalSpy detected(window_.get(), &MainWindow::buildingsDetected);
     const int added = matchAndDetect();  // no analysis yet: Detect buildings runs it first
     QVERIFY(added >= 3);
@@ -191,7 +188,6 @@ class SceneAnalysisTest : public QObject {
     QCOMPARE(doc()->undoStack()->count(), undoCount);
     QVERIFY(window_->lastMessage().contains(QStringLiteral("already present")));
     // The active polygon takes a proposed building as it is.
-    if (!project::delineationAvailable()) return;
     const int first = doc()->project().buildings.front().id;
     window_->selectBuilding(first);
     QSignalSpy delineated(window_.get(), &MainWindow::delineationFinished);
@@ -203,7 +199,6 @@ class SceneAnalysisTest : public QObject {
   // Building → Outline the pending buildings: every proposal outlined in turn, one undo step
   // each; a cancel keeps the buildings outlined before it and leaves the others pending.
   void pendingBuildingsAreOutlinedInTurn() {
-    if (!project::matchingAvailable() || !project::delineationAvailable()) QSKIP("no matcher or active polygon");
     QVERIFY(window_->openProject(projectPath_));
     QVERIFY(!act("actionOutlinePending")->isEnabled());
     QCOMPARE(window_->outlinePendingBuildings(), widgets::JobId(0));  // nothing pending

@@ -2,9 +2,6 @@
 // The project's processing steps, shared by the GUI (run in its job runner) and by
 // `delineo-cli run PROJECT`: reading the pair, dense matching, the active polygon for one
 // building, roof height, export of accepted buildings and the bundled sample project.
-//
-// Each algorithm library is optional at build time: a step whose library is absent throws
-// core::Error(ProcessingFailed) saying so, and the *Available() functions tell callers first.
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -20,14 +17,8 @@
 
 namespace delineo::project {
 
-bool matchingAvailable();
-bool delineationAvailable();
-bool simulationAvailable();
-bool boxFittingAvailable();
-bool demEnhancementAvailable();
-
-// Checks every parameter group the steps of this build read ("range", "matching",
-// "delineation", "boxfit", "enhance"): a bad value is found when the project is loaded, not after matching.
+// Checks every parameter group the steps read ("range", "matching", "delineation", "boxfit",
+// "enhance", and the scene analysis's): a bad value is found when the project is loaded, not after matching.
 // Throws core::Error(InvalidParameter) naming the group and the parameter.
 void validateParameters(const Project& project);
 
@@ -70,7 +61,7 @@ MatchingOutcome computeDisparity(const Project& project, const cv::Mat& left, co
 // Roof disparity interval suggested for an operator's rough polygon: the most populated
 // histogram peak inside it, away from its border and above the ground level, as wide as the
 // peak's spread (delineation::proposeRoofInterval, default parameters). nullopt when the polygon
-// holds fewer than 10 finite disparities or the active polygon is not part of this build.
+// holds fewer than 10 finite disparities.
 std::optional<DisparityInterval> suggestRoofInterval(const cv::Mat& disparity, const core::Polygon& polygon);
 
 // Ground level (px) around a polygon: the main low disparity level of a 120 px band
@@ -93,10 +84,9 @@ cv::Mat heightsFromDisparity(const Project& project, const cv::Mat& disparity);
 // delineation::aboveGroundObjectAt() with the project's "pick" parameters and the ground estimate
 // of suggestGroundLevel(). It reads the disparity map when there is one and the height model is
 // known, else the DEM brought to disparity by the height model (or read as disparity at 1 m per
-// px without one). Outcome NoHeights when there is neither, Unavailable without the active
-// polygon's library.
+// px without one). Outcome NoHeights when there is neither.
 struct ObjectPick {
-  enum class Outcome { Found, NoHeights, NoGround, NotAboveGround, Unavailable };
+  enum class Outcome { Found, NoHeights, NoGround, NotAboveGround };
   Outcome outcome = Outcome::NoHeights;
   core::Polygon outline;  // Found: the initial polygon of a new building
   double groundLevel = std::nan("");   // px of disparity of the map read (suggestGroundLevel of the outline)
@@ -109,7 +99,7 @@ ObjectPick pickAboveGroundObject(const Project& project, const cv::Mat& disparit
 // estimate of suggestGroundLevel() on the DEM brought to disparity by the height model, brought
 // back to metres; with a DEM derived from the disparity, the histogram's ground line in metres.
 // Without a height model the DEM is read as disparity at 1 m per px. nullopt when no height is
-// near the polygon or the active polygon's library is absent.
+// near the polygon.
 std::optional<double> groundHeightNextTo(const Project& project, const cv::Mat& dem, const core::Polygon& polygon);
 
 // Median disparity inside `polygon` turned into metres by the project's height model; NaN when
@@ -214,13 +204,11 @@ inline constexpr const char* kDetectGroup = "detect";      // segmentation::Dete
 // its pixels is that building: it is not added again.
 inline constexpr double kProposalOverlap = 0.3;
 
-bool sceneAnalysisAvailable();
-
 // segmentation::analyseScene() with the project's groups and the height model's gsd: ground /
 // above-ground, DTM, nDSM, building vs vegetation, objects and building proposals. `heights` as
 // projectHeights() gives them, `image` the left image 8-bit grey or BGR (io::readImage8),
 // `disparity` (may be empty) gives the objects their disparity intervals. Throws
-// InvalidParameter without heights or gsd, ProcessingFailed without the segmentation library.
+// InvalidParameter without heights or gsd.
 struct SceneAnalysisOutcome {
   core::RunStatus status = core::RunStatus::Completed;
   cv::Mat dtm;          // CV_32F m
@@ -306,7 +294,7 @@ ExportSummary exportBuildings(const Project& project, const std::string& path,
 // The bundled sample: a deterministic simulated scene written into `directory` (left, right,
 // ground-truth DEM and labels) and a project file "sample.delineo.json" referencing them, with
 // no disparity yet so the first step of the workflow is there to run. Reuses an existing
-// sample. Returns the project path. Throws ProcessingFailed without the simulator.
+// sample. Returns the project path. Throws ProcessingFailed when the simulation is canceled.
 std::string ensureSampleProject(const std::string& directory, core::Progress* progress = nullptr);
 
 }  // namespace delineo::project
