@@ -6,7 +6,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "delineation_bridge.hpp"
 #include "delineo/boxfit/params.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/delineation/above_ground.hpp"
@@ -214,23 +213,6 @@ double roofHeight(const Project& project, const cv::Mat& disparity, const core::
   std::vector<float> values = finiteValuesInside(disparity, polygon);
   if (values.empty()) return std::nan("");
   return project.height.heightAt(percentile(values, 0.5));
-}
-
-DelineationOutcome delineateBuilding(const Project& project, const Building& building,
-                                     const StereoPair& pair, core::Progress* progress,
-                                     const ContourListener& onContour) {
-  return runActivePolygon(project, building, pair, progress, onContour);
-}
-
-EnergyOutcome outlineEnergy(const Project& project, const Building& building, const StereoPair& pair,
-                            const core::Polygon& outline, core::Progress* progress) {
-  return evaluateBuildingOutline(project, building, pair, outline, progress);
-}
-
-RegularizationOutcome regularizeOutline(const Project& project, const Building& building,
-                                        const StereoPair& pair, const core::Polygon& outline,
-                                        core::Progress* progress) {
-  return regularizeBuilding(project, building, pair, outline, progress);
 }
 
 std::string ensureSampleProject(const std::string& directory, core::Progress* progress) {

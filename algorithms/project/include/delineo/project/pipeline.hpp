@@ -106,6 +106,8 @@ std::optional<double> groundHeightNextTo(const Project& project, const cv::Mat& 
 // the model is unknown or no disparity is finite there.
 double roofHeight(const Project& project, const cv::Mat& disparity, const core::Polygon& polygon);
 
+// ---- the active polygon (src/active_polygon_steps.cpp) ----
+
 // The active polygon for one building. `onContour` (may be empty) receives intermediate
 // contours in left-image pixels from the worker thread.
 struct DelineationOutcome {

@@ -1,7 +1,8 @@
-#include "delineation_bridge.hpp"
-
+// The project's steps of the active polygon: a building delineated, an outline scored and an
+// outline regularized, each with the building's roof interval and the project's parameters.
 #include "delineo/core/error.hpp"
 #include "delineo/delineation/delineate.hpp"
+#include "delineo/project/pipeline.hpp"
 
 namespace delineo::project {
 
@@ -27,9 +28,9 @@ delineation::DelineationRequest requestFor(const Project& project, const Buildin
 
 }  // namespace
 
-DelineationOutcome runActivePolygon(const Project& project, const Building& building,
-                                    const StereoPair& pair, core::Progress* progress,
-                                    const ContourListener& onContour) {
+DelineationOutcome delineateBuilding(const Project& project, const Building& building,
+                                     const StereoPair& pair, core::Progress* progress,
+                                     const ContourListener& onContour) {
   const delineation::DelineationRequest request = requestFor(project, building, pair);
   const auto params = parameters<delineation::DelineationParams>(project, "delineation");
   // delineate() reports its contours in left-image pixels already, as the listener wants them.
@@ -53,9 +54,8 @@ DelineationOutcome runActivePolygon(const Project& project, const Building& buil
   return outcome;
 }
 
-EnergyOutcome evaluateBuildingOutline(const Project& project, const Building& building,
-                                      const StereoPair& pair, const core::Polygon& outline,
-                                      core::Progress* progress) {
+EnergyOutcome outlineEnergy(const Project& project, const Building& building, const StereoPair& pair,
+                            const core::Polygon& outline, core::Progress* progress) {
   const delineation::DelineationRequest request = requestFor(project, building, pair);
   const auto params = parameters<delineation::DelineationParams>(project, "delineation");
   const delineation::OutlineEnergy energy =
@@ -67,9 +67,9 @@ EnergyOutcome evaluateBuildingOutline(const Project& project, const Building& bu
   return outcome;
 }
 
-RegularizationOutcome regularizeBuilding(const Project& project, const Building& building,
-                                         const StereoPair& pair, const core::Polygon& outline,
-                                         core::Progress* progress) {
+RegularizationOutcome regularizeOutline(const Project& project, const Building& building,
+                                        const StereoPair& pair, const core::Polygon& outline,
+                                        core::Progress* progress) {
   const delineation::DelineationRequest request = requestFor(project, building, pair);
   const auto params = parameters<delineation::DelineationParams>(project, "delineation");
   const delineation::RegularizationOutcome r = delineation::regularizeBuildingOutline(
