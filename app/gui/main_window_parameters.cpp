@@ -25,23 +25,15 @@
 #include "error_text.hpp"
 #include "main_window.hpp"
 
-#include "delineo/dem/enhance.hpp"
-#ifdef DELINEO_HAVE_DELINEATION
+#include "delineo/boxfit/params.hpp"
 #include "delineo/delineation/above_ground.hpp"
 #include "delineo/delineation/params.hpp"
-#endif
-#ifdef DELINEO_HAVE_BOXFIT
-#include "delineo/boxfit/params.hpp"
-#endif
-#ifdef DELINEO_HAVE_STEREO
-#include "delineo/stereo/match.hpp"
-#endif
-#ifdef DELINEO_HAVE_SEGMENTATION
+#include "delineo/dem/enhance.hpp"
 #include "delineo/segmentation/classify.hpp"
 #include "delineo/segmentation/detect.hpp"
 #include "delineo/segmentation/ground.hpp"
 #include "delineo/segmentation/objects.hpp"
-#endif
+#include "delineo/stereo/match.hpp"
 
 namespace delineo::gui {
 
@@ -89,26 +81,17 @@ QTabWidget* MainWindow::createParameterTabs() {
   auto* tabs = new QTabWidget;
   tabs->setObjectName(QStringLiteral("parameterTabs"));
   tabs->setUsesScrollButtons(true);
-#ifdef DELINEO_HAVE_DELINEATION
   addParameterGroup<delineation::DelineationParams>(tabs, "delineation", tr("Active polygon"), {});
-#endif
-#ifdef DELINEO_HAVE_STEREO
   addParameterGroup<stereo::MatchParams>(tabs, "matching", tr("Matching"), {});
-#endif
-#ifdef DELINEO_HAVE_BOXFIT
   addParameterGroup<boxfit::BoxFitParams>(
       tabs, "boxfit", tr("Box-fitting"),
       tr("Building → Box-fitting: the building's region from the DEM, boxes grown on the left image's edges."));
-#endif
   addParameterGroup<dem::EnhanceParams>(
       tabs, "enhance", tr("Enhanced DEM"),
       tr("View → Enhanced DEM: vertical walls at the outlines and filtered roofs."));
-#ifdef DELINEO_HAVE_DELINEATION
   addParameterGroup<delineation::AboveGroundParams>(
       tabs, "pick", tr("Object pick"),
       tr("Pick an above-ground object: the raised object under a click, above the ground beside it."));
-#endif
-#ifdef DELINEO_HAVE_SEGMENTATION
   addParameterGroup<segmentation::GroundParams>(
       tabs, project::kSegmentGroup, tr("Ground"),
       tr("Processing → Analyse the scene: regions of even height, ground or above ground, and the DTM under them."));
@@ -121,7 +104,6 @@ QTabWidget* MainWindow::createParameterTabs() {
   addParameterGroup<segmentation::DetectParams>(
       tabs, project::kDetectGroup, tr("Detection"),
       tr("Building → Detect buildings: which building objects become pending buildings."));
-#endif
   return tabs;
 }
 
@@ -201,10 +183,7 @@ void MainWindow::refreshHistogram() {
   histogram_->setPlaceholder(b == nullptr ? tr("Select a building to see the disparities around it.") : QString());
   if (b == nullptr) return;
   const cv::Rect2d box = core::boundingBox(b->initial.outer);
-  int margin = 24;
-#ifdef DELINEO_HAVE_DELINEATION
-  margin = project::parameters<delineation::DelineationParams>(document_->project(), "delineation").roiMargin;
-#endif
+  const int margin = project::parameters<delineation::DelineationParams>(document_->project(), "delineation").roiMargin;
   QRectF roi(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin);
   roi &= QRectF(0, 0, document_->leftGrey().cols, document_->leftGrey().rows);
   leftView_->polygons().setRoi(roi);
