@@ -27,9 +27,7 @@
 #include "delineo/stereo/match.hpp"
 #include "bench_image.hpp"
 #include "energy_diag.hpp"
-#ifdef DELINEO_HAVE_EVAL
 #include "delineo/eval/footprint_metrics.hpp"
-#endif
 
 using namespace delineo;
 using namespace delineo::delineation;
@@ -83,22 +81,9 @@ struct Scores {
   double iou = 0, p1 = 0, polis = 0, hausdorff = std::nan(""), corner = std::nan("");
 };
 
-Scores score(const core::Polygon& pred, const core::Polygon& truth, cv::Size size) {
-  Scores s;
-#ifdef DELINEO_HAVE_EVAL
+Scores score(const core::Polygon& pred, const core::Polygon& truth) {
   const auto f = eval::compareFootprints(pred, truth);
-  s.iou = f.iou;
-  s.p1 = f.p1;
-  s.polis = f.polis;
-  s.hausdorff = f.hausdorff;
-  s.corner = f.cornerRms;
-#else
-  const cv::Mat a = core::rasterize(pred, size), b = core::rasterize(truth, size);
-  s.iou = double(cv::countNonZero(a & b)) / std::max(1, cv::countNonZero(a | b));
-  s.p1 = s.polis = std::nan("");
-#endif
-  (void)size;
-  return s;
+  return {f.iou, f.p1, f.polis, f.hausdorff, f.cornerRms};
 }
 
 core::Polygon grownBox(const core::Polygon& p, double g) {
@@ -322,11 +307,11 @@ int main(int argc, char** argv) {
           const auto t0 = Clock::now();
           const auto r = delineate(left, right, req, params);
           const auto t1 = Clock::now();
-          const Scores sc = score(r.polygon, fp.polygon, left.size());
+          const Scores sc = score(r.polygon, fp.polygon);
           std::string regLine;
           {
             // The same run before its last stage (regularization), and that stage alone timed.
-            const Scores raw = score(r.rawPolygon, fp.polygon, left.size());
+            const Scores raw = score(r.rawPolygon, fp.polygon);
             const auto t2 = Clock::now();
             const RegularizationOutcome again = regularizeOutline(r.rawPolygon, params.regularization, left);
             regTimes.push_back(ms(t2, Clock::now()));

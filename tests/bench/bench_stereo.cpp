@@ -58,9 +58,7 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
 #include "bench_image.hpp"
-#ifdef DELINEO_BENCH_HAVE_SIM
 #include "delineo/sim/scene.hpp"
-#endif
 
 namespace {
 using namespace delineo;
@@ -456,7 +454,6 @@ void runCase(const Case& c, const std::vector<std::string>& methods, const std::
   }
 }
 
-#ifdef DELINEO_BENCH_HAVE_SIM
 Case simulated(int size, int seed) {
   const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(size, seed));
   Case c;
@@ -514,7 +511,6 @@ Case simulated(int size, int seed) {
   }
   return c;
 }
-#endif
 
 cv::Mat readFloat(const fs::path& p) {
   return io::readGreyFloat(p.string());
@@ -649,13 +645,9 @@ int main(int argc, char** argv) {
   std::printf(
       "bench_stereo: adaptive = contour-adaptive shapes, square = same matcher with "
       "square windows, sgbm = OpenCV StereoSGBM (3-way)\n");
-#ifdef DELINEO_BENCH_HAVE_SIM
   Case sim = simulated(size, seed);
   if (range > sim.dmax - sim.dmin + 1) sim.dmax = sim.dmin + range - 1;
   runCase(sim, methods, dump, overrides, repeat, printCpu);
-#else
-  std::printf("simulated scenes: skipped (delineo::sim not built)\n");
-#endif
   if (useData) {
     if (!fs::exists(data)) {
       std::printf("\nreal datasets: skipped (%s not found)\n", data.c_str());
