@@ -17,9 +17,7 @@
 #include "delineo/core/nan_mask.hpp"
 #include "delineo/segmentation/detect.hpp"
 #include "delineo/segmentation/scene.hpp"
-#ifdef DELINEO_TEST_HAVE_IO
 #include "delineo/io/vector.hpp"
-#endif
 
 using delineo::core::Error;
 using delineo::core::ErrorCode;
@@ -305,7 +303,6 @@ TEST(Detect, ProposalsCarryWhatDelineateReads) {
   strict = {};
   strict.minHeight = 13;
   EXPECT_TRUE(proposeBuildings(set.objects, strict).empty());
-#ifdef DELINEO_TEST_HAVE_IO
   // Round trip through the file delineate --init reads: the same integers come back.
   const std::string path = ::testing::TempDir() + "proposals_roundtrip.geojson";
   delineo::io::writeFeatures(path, proposals);
@@ -317,7 +314,6 @@ TEST(Detect, ProposalsCarryWhatDelineateReads) {
     EXPECT_EQ(std::get<long long>(back[0].attributes.at(key)), std::get<long long>(a.at(key))) << key;
   }
   EXPECT_EQ(back[0].polygon.outer.size(), proposals[0].polygon.outer.size());
-#endif
 }
 
 TEST(Segmentation, BadInputsAreErrors) {
