@@ -1951,6 +1951,10 @@
         <source>%1 stay pending.</source>
         <translation>%1 restent en attente.</translation>
     </message>
+    <message>
+        <source>Some roof intervals could not be read: set them on the histogram (%1).</source>
+        <translation>Certains intervalles de toit n’ont pas pu être lus : définissez-les sur l’histogramme (%1).</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::ProjectSettingsDialog</name>

@@ -126,9 +126,10 @@ int Document::addBuilding(const core::Polygon& initial) {
   return b.id;
 }
 
-std::vector<int> Document::addProposedBuildings(const std::vector<core::Feature>& proposals) {
+std::vector<int> Document::addProposedBuildings(const std::vector<core::Feature>& proposals,
+                                                std::vector<std::string>* problems) {
   project::Project after = project_;
-  const std::vector<int> ids = project::addProposedBuildings(after, proposals, "delineo");
+  const std::vector<int> ids = project::addProposedBuildings(after, proposals, "delineo", problems);
   if (ids.empty()) return ids;
   BuildingsCommand::States before, added;
   for (int id : ids) {

@@ -67,8 +67,10 @@ class Document : public QObject {
   // have changed it meanwhile); returns whether it was applied.
   bool setOutlinedPending(const project::Building& after);
   // The scene analysis's building proposals that are not buildings yet, added as Pending
-  // buildings (project::addProposedBuildings) in one undoable step. Returns the new ids.
-  std::vector<int> addProposedBuildings(const std::vector<core::Feature>& proposals);
+  // buildings (project::addProposedBuildings) in one undoable step. Returns the new ids; a proposal's
+  // malformed roof interval is left out and said in `problems` when given.
+  std::vector<int> addProposedBuildings(const std::vector<core::Feature>& proposals,
+                                        std::vector<std::string>* problems = nullptr);
   void setStatus(int id, project::BuildingStatus status);
   void setRoofInterval(int id, project::DisparityInterval interval);
   void setParameters(const std::string& group, const nlohmann::json& values);

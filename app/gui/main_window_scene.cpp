@@ -276,13 +276,20 @@ widgets::JobId MainWindow::detectBuildings() {
 void MainWindow::addDetectedBuildings() {
   if (!document_ || !scene_) return;
   const int proposed = static_cast<int>(scene_->proposals.size());
-  const int added = static_cast<int>(document_->addProposedBuildings(scene_->proposals).size());
+  std::vector<std::string> problems;
+  const int added = static_cast<int>(document_->addProposedBuildings(scene_->proposals, &problems).size());
   showDock(QStringLiteral("buildingsDock"));
   QString text = (added == 1 ? tr("%1 building proposed (%2 already present).")
                               : tr("%1 buildings proposed (%2 already present)."))
                      .arg(added)
                      .arg(proposed - added);
   if (added > 0) text += QLatin1Char(' ') + tr("Review them in the buildings list and delineate them.");
+  QStringList unread;
+  for (const std::string& problem : problems) unread << QString::fromStdString(problem);
+  if (!unread.isEmpty()) {
+    text += QLatin1Char(' ') + tr("Some roof intervals could not be read: set them on the histogram (%1).")
+                                   .arg(unread.join(QStringLiteral("; ")));
+  }
   showInformation(tr("Detect buildings"), text);
   emit buildingsDetected(added, proposed - added);
 }

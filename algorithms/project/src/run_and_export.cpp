@@ -139,7 +139,8 @@ bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& di
   io::writeGeoTiff((out / "labels.tif").string(), analysis.classes, geo);
   io::writeFeatures((out / "objects.geojson").string(), analysis.objects, geo, "objects");
   summary.objects = static_cast<int>(analysis.objects.size());
-  summary.proposed = static_cast<int>(addProposedBuildings(project, analysis.proposals, "delineo-cli run").size());
+  summary.proposed =
+      static_cast<int>(addProposedBuildings(project, analysis.proposals, "delineo-cli run", &summary.messages).size());
   return true;
 }
 }  // namespace

@@ -2,13 +2,13 @@
 // objects and building proposals with the project's parameter groups, and proposals turned into
 // pending buildings.
 #include <algorithm>
-#include <cmath>
 #include <optional>
 #include <string>
 
 #include <opencv2/core.hpp>
 
 #include "delineo/core/error.hpp"
+#include "delineo/delineation/feature_request.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/segmentation/scene.hpp"
 
@@ -76,22 +76,23 @@ double coveredShare(const core::Polygon& polygon, const core::Polygon& other) {
   return inside > 0 ? static_cast<double>(cv::countNonZero(ma & mb)) / inside : 0.0;
 }
 
-// The proposal's roof interval (detect's roof_disparity_min/max, integers); none when either is
-// missing or malformed: the operator then sets it, as for a drawn building.
-std::optional<DisparityInterval> roofInterval(const core::Feature& proposal) {
+// The proposal's roof interval (detect's roof_disparity_min/max), read as every feature's is;
+// none when it carries none. A malformed one is left out too, with the reason in `problem`: the
+// operator then sets the interval, as for a drawn building.
+std::optional<DisparityInterval> roofInterval(const core::Feature& proposal, std::string& problem) {
   try {
-    const auto low = core::numberProperty(proposal, "roof_disparity_min", 1e5);
-    const auto high = core::numberProperty(proposal, "roof_disparity_max", 1e5);
-    if (!low || !high || *low > *high) return std::nullopt;
-    return DisparityInterval{static_cast<int>(std::floor(*low)), static_cast<int>(std::ceil(*high))};
-  } catch (const core::Error&) {
+    const auto roof = delineation::readFeatureIntervals(proposal).roof;
+    if (!roof) return std::nullopt;
+    return DisparityInterval{roof->min, roof->max};
+  } catch (const core::Error& e) {
+    problem = "roof interval not read: " + e.detail();
     return std::nullopt;
   }
 }
 }  // namespace
 
 std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
-                                      const std::string& origin) {
+                                      const std::string& origin, std::vector<std::string>* problems) {
   std::vector<int> added;
   for (const core::Feature& proposal : proposals) {
     if (proposal.polygon.outer.size() < 3) continue;
@@ -104,8 +105,14 @@ std::vector<int> addProposedBuildings(Project& project, const std::vector<core::
     Building b;
     b.id = project.nextBuildingId();
     b.initial = proposal.polygon;
-    b.roofInterval = roofInterval(proposal);
-    b.addHistory("detected", origin.empty() ? std::string("building proposal") : origin + ": building proposal");
+    std::string problem;
+    b.roofInterval = roofInterval(proposal, problem);
+    std::string detail = origin.empty() ? std::string("building proposal") : origin + ": building proposal";
+    if (!problem.empty()) {
+      detail += ", " + problem;
+      if (problems != nullptr) problems->push_back("building " + std::to_string(b.id) + ": " + problem);
+    }
+    b.addHistory("detected", detail);
     project.buildings.push_back(b);
     added.push_back(b.id);
   }

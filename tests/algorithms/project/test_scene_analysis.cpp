@@ -2,6 +2,9 @@
 // and proposals turned into pending buildings without doubling known ones.
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
 #include "delineo/core/error.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/sim/scene.hpp"
@@ -42,6 +45,28 @@ TEST(SceneAnalysisStep, ProposalsBecomePendingBuildingsOnce) {
   // Asked again, nothing is added.
   EXPECT_TRUE(project::addProposedBuildings(p, proposals).empty());
   EXPECT_EQ(p.buildings.size(), 2u);
+}
+
+// A proposal's malformed roof interval is no crash and no silent loss: the building comes without
+// one (the operator sets it), and its history and the caller's problems say why.
+TEST(SceneAnalysisStep, AMalformedRoofIntervalIsLeftOutAndSaid) {
+  project::Project p;
+  core::Feature inverted = proposal(10, 10, 30, 40, 30);  // min above max
+  core::Feature text = proposal(100, 100, 30, 30, 33);
+  text.attributes["roof_disparity_max"] = std::string("high");
+  core::Feature plain = proposal(200, 200, 30, 30, 33);
+  plain.attributes.erase("roof_disparity_min");  // none given: nothing to say
+  std::vector<std::string> problems;
+  const std::vector<int> added = project::addProposedBuildings(p, {inverted, text, plain}, "test", &problems);
+  ASSERT_EQ(added.size(), 3u);
+  for (int id : added) EXPECT_FALSE(p.find(id)->roofInterval.has_value()) << id;
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].rfind("building " + std::to_string(added[0]) + ": roof interval not read: ", 0), 0u)
+      << problems[0];
+  EXPECT_NE(problems[0].find("roof_disparity_min is above roof_disparity_max"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("roof_disparity_max"), std::string::npos) << problems[1];
+  EXPECT_NE(p.find(added[0])->history.back().detail.find("roof interval not read"), std::string::npos);
+  EXPECT_EQ(p.find(added[2])->history.back().detail, "test: building proposal");
 }
 
 TEST(SceneAnalysisStep, TheChainRunsWithTheProjectsParametersAndGsd) {

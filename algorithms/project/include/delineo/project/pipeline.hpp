@@ -226,10 +226,12 @@ SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights
                                   const cv::Mat& disparity, core::Progress* progress);
 
 // Adds each proposal that is not already a building (kProposalOverlap) as a Pending building:
-// its polygon as the initial polygon, its roof interval, a "detected" history entry (`origin`
-// first). Returns the new buildings' ids.
+// its polygon as the initial polygon, its roof interval (delineation::readFeatureIntervals), a
+// "detected" history entry (`origin` first). Returns the new buildings' ids. A proposal whose
+// roof interval is malformed is added without one; its history entry says why, and so does a
+// line "building ID: ..." appended to `problems` when given.
 std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
-                                      const std::string& origin = {});
+                                      const std::string& origin = {}, std::vector<std::string>* problems = nullptr);
 
 // ---- run and export (src/run_and_export.cpp) ----
 
