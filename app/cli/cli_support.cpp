@@ -205,6 +205,16 @@ void checkOutputs(const Options& opts, const std::vector<std::pair<std::string, 
   io::checkOutputs(files, inputFiles);
 }
 
+long long featureId(const core::Feature& feature, size_t index, const std::string& file) {
+  const std::string position = "feature " + std::to_string(index + 1);
+  try {
+    const auto id = core::numberProperty(feature, "id", 9e15);
+    return id ? static_cast<long long>(*id) : static_cast<long long>(index + 1);
+  } catch (const core::Error& e) {
+    throw core::Error(e.code(), position + ": " + e.detail(), file);
+  }
+}
+
 namespace {
 std::vector<CommandInfo>& registry() {
   static std::vector<CommandInfo> r;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "delineo/core/geometry.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/core/progress.hpp"
 #include "delineo/io/output_file.hpp"
@@ -149,6 +150,11 @@ void throwIfCanceled(const core::Progress& p);
 // given, against those of the `inputs` options given.
 void checkOutputs(const Options& opts, const std::vector<std::pair<std::string, io::OutputFormat>>& outputs,
                   const std::vector<std::string>& inputs);
+
+// The id of the `index`-th (from 0) feature of `file` (an --init file): its "id" property as a
+// number (core::numberProperty, within +-9e15), else its position in the file from 1. Throws
+// core::Error(InvalidParameter) naming the feature and the file when the id is not a number.
+long long featureId(const core::Feature& feature, size_t index, const std::string& file);
 
 using CommandFn = std::function<int(const std::vector<std::string>& args)>;
 struct CommandInfo {

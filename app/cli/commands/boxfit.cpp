@@ -4,9 +4,7 @@
 // --init nor --roi every building segment of the image is fitted.
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <string>
-#include <variant>
 
 #include "cli_support.hpp"
 #include "delineo/boxfit/box_fitting.hpp"
@@ -16,14 +14,6 @@
 
 namespace {
 using namespace delineo;
-
-std::optional<long long> idAttribute(const core::Feature& f) {
-  const auto it = f.attributes.find("id");
-  if (it == f.attributes.end()) return std::nullopt;
-  if (const auto* i = std::get_if<long long>(&it->second)) return *i;
-  if (const auto* d = std::get_if<double>(&it->second)) return std::llround(*d);
-  return std::nullopt;
-}
 
 double polygonArea(const core::Polygon& p) {
   double area = std::abs(core::signedArea(p.outer));
@@ -131,6 +121,10 @@ int run(const std::vector<std::string>& args) {
   const cv::Mat image = io::readGreyFloat(opts.get("image"), &geo);
   const cv::Mat heights = readHeights(opts, image.size(), quiet);
   const std::vector<core::Feature> inits = initialPolygons(opts, geo);
+  const std::string initFile = opts.has("init") ? opts.get("init") : "";
+  // Every id read before any work: a malformed one is an input error, not a failure found late.
+  std::vector<long long> ids;
+  for (size_t i = 0; i < inits.size(); ++i) ids.push_back(cli::featureId(inits[i], i, initFile));
 
   std::vector<core::Feature> outlines, boxes;
   int failed = 0;
@@ -148,7 +142,7 @@ int run(const std::vector<std::string>& args) {
   }
   const size_t count = inits.size();
   for (size_t i = 0; i < count && !canceled; ++i) {
-    const long long id = idAttribute(inits[i]).value_or(static_cast<long long>(i + 1));
+    const long long id = ids[i];
     progress.setStage("building " + std::to_string(i + 1) + "/" + std::to_string(count));
     core::Progress::Range range(&progress, double(i) / count, double(i + 1) / count);
     boxfit::BoxFitRequest request;
@@ -169,7 +163,7 @@ int run(const std::vector<std::string>& args) {
       error = e.detail();
     }
     if (canceled) break;
-    if (count == 1) throw core::Error(core::ErrorCode::ProcessingFailed, error, opts.has("init") ? opts.get("init") : "");
+    if (count == 1) throw core::Error(core::ErrorCode::ProcessingFailed, error, initFile);
     // One building without an outline does not stop the batch: its init is written, marked.
     ++failed;
     core::Feature f;

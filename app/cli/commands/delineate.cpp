@@ -78,10 +78,8 @@ std::vector<BuildingJob> buildingJobs(const std::vector<core::Feature>& inits, c
   std::vector<BuildingJob> jobs;
   for (size_t i = 0; i < inits.size(); ++i) {
     const core::Feature& init = inits[i];
-    const std::string position = "feature " + std::to_string(i + 1);
     BuildingJob job;
-    const auto id = readProperties([&] { return core::numberProperty(init, "id", 9e15); }, position, file);
-    job.id = id ? static_cast<long long>(*id) : static_cast<long long>(i + 1);
+    job.id = cli::featureId(init, i, file);
     const std::string name = "building id " + std::to_string(job.id);
     const auto intervals = readProperties([&] { return delineation::readFeatureIntervals(init); }, name, file);
     auto& req = job.request;

@@ -56,6 +56,11 @@ expect_rc both_heights 2 "$CLI" boxfit --dem "$S/dem_gt.tif" --disparity "$S/dis
 expect_rc init_and_roi 2 "$CLI" boxfit --dem "$S/dem_gt.tif" --image "$S/left.tif" --init "$WORK/init.geojson" \
   --roi 10,10,50,50 --out "$WORK/x.geojson"
 expect_rc bad_param 3 "$CLI" boxfit --dem "$S/dem_gt.tif" --image "$S/left.tif" --angle-step 0 --out "$WORK/x.geojson"
+# An id that is not a number is refused before any work, naming the feature (as delineate does).
+sed -E '0,/"id": [0-9]+/s//"id": "first"/' "$WORK/init.geojson" >"$WORK/bad_id.geojson"
+expect_rc bad_id 3 "$CLI" boxfit --dem "$S/dem_gt.tif" --image "$S/left.tif" --init "$WORK/bad_id.geojson" \
+  --out "$WORK/x.geojson"
+expect_in "$WORK/bad_id.err" "feature 1: property id" "a malformed id names the feature"
 expect_rc small 0 "$CLI" simulate --out "$WORK/small" --width 200 --height 150 --buildings 1 --trees 0 --seed 3
 expect_rc mismatched 3 "$CLI" boxfit --dem "$WORK/small/dem_gt.tif" --image "$S/left.tif" --out "$WORK/x.geojson"
 expect_in "$WORK/mismatched.err" "small/dem_gt.tif" "the size error names the DEM"
