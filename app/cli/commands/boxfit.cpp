@@ -2,7 +2,6 @@
 // from a DEM, boxes grown from its skeleton onto the left image's Canny edges, merged and
 // straightened. One call runs a batch: every polygon of --init is one building; with neither
 // --init nor --roi every building segment of the image is fitted.
-#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -14,12 +13,6 @@
 
 namespace {
 using namespace delineo;
-
-double polygonArea(const core::Polygon& p) {
-  double area = std::abs(core::signedArea(p.outer));
-  for (const auto& h : p.holes) area -= std::abs(core::signedArea(h));
-  return area;
-}
 
 // Heights (m) on the image's grid: --dem as it is, or --disparity through the height model.
 cv::Mat readHeights(const cli::Options& opts, cv::Size imageSize, bool quiet) {
@@ -66,7 +59,7 @@ core::Feature outlineFeature(const boxfit::BoxFitBuilding& b, long long id) {
   f.attributes["method"] = std::string("box-fitting");
   f.attributes["status"] = std::string("completed");
   f.attributes["boxes"] = static_cast<long long>(b.boxes.size());
-  f.attributes["area"] = polygonArea(b.outline);
+  f.attributes["area"] = core::area(b.outline);
   f.attributes["vertices"] = static_cast<long long>(b.diagnostics.vertices);
   f.attributes["energy"] = b.energy;
   f.attributes["roof_height_m"] = b.diagnostics.roofHeight;
