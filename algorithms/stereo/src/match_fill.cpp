@@ -213,6 +213,68 @@ cv::Mat outlineRing(const cv::Mat& region) {
   return outer & ~inner;
 }
 
+// Calls visit(residual) for each pixel of `ring` (over `box`) with data in both views, residual =
+// left − (gain · right + offset) with the right view read at the plane's disparity by linear
+// interpolation (the candidates are sub-pixel); `stopAtRow()` is asked before each row. False
+// when the outline leaves the right image or stopAtRow() said stop.
+template <typename Visit, typename StopAtRow>
+bool visitRingResiduals(const cv::Mat& left, const cv::Mat& right, const cv::Mat& ring,
+                        const cv::Rect& box, const FillPlane& plane,
+                        const std::pair<double, double>& map, Visit&& visit,
+                        StopAtRow&& stopAtRow) {
+  const auto [mapGain, mapOffset] = map;
+  for (int y = 0; y < box.height; ++y) {
+    if (stopAtRow()) return false;
+    const uchar* m = ring.ptr<uchar>(y);
+    const float* a = left.ptr<float>(box.y + y) + box.x;
+    const float* b = right.ptr<float>(box.y + y);
+    for (int x = 0; x < box.width; ++x) {
+      if (!m[x]) continue;
+      const double value = plane.at(box.x + x, box.y + y);
+      const int whole = static_cast<int>(std::floor(value));
+      const float t = static_cast<float>(value - whole);
+      const int xr = box.x + x - whole;             // x − value lies in [xr − 1, xr]
+      if (xr - 1 < 0 || xr >= right.cols) return false;
+      const float bv = (1 - t) * b[xr] + t * b[xr - 1];
+      if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
+      visit(a[x] - (mapGain * bv + mapOffset));
+    }
+  }
+  return true;
+}
+
+// The ring's error in the region's own light (see RegionFillSettings::shadowOwnLight): mean
+// |residual − median residual|; 1e30 when the outline leaves the right image or has no data.
+double ringErrorInOwnLight(const cv::Mat& left, const cv::Mat& right, const cv::Mat& ring,
+                           const cv::Rect& box, const FillPlane& plane,
+                           const std::pair<double, double>& map) {
+  std::vector<double> residuals;
+  const bool inside = visitRingResiduals(
+      left, right, ring, box, plane, map, [&](double r) { residuals.push_back(r); },
+      [] { return false; });
+  if (!inside || residuals.empty()) return 1e30;
+  const auto middle = residuals.begin() + static_cast<long>(residuals.size() / 2);
+  std::nth_element(residuals.begin(), middle, residuals.end());
+  const double own = *middle;
+  double sum = 0;
+  for (const double r : residuals) sum += std::abs(r - own);
+  return sum / static_cast<double>(residuals.size());
+}
+
+// The median grey of the valid pixels of `image`, from about 10 000 of them.
+double medianGrey(const cv::Mat& image) {
+  std::vector<float> sample;
+  const size_t step = std::max<size_t>(1, image.total() / 10000);
+  const float* p = image.ptr<float>();
+  for (size_t i = 0; i < image.total(); i += step) {
+    if (std::isfinite(p[i])) sample.push_back(p[i]);
+  }
+  if (sample.empty()) return 0;
+  const auto middle = sample.begin() + static_cast<long>(sample.size() / 2);
+  std::nth_element(sample.begin(), middle, sample.end());
+  return *middle;
+}
+
 // Half-width of the flat test's window (5x5).
 constexpr int kFlatReach = 2;
 
@@ -1004,6 +1066,7 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       if (l[x] != 0 && !std::isfinite(d[x])) ++unmatched[static_cast<size_t>(l[x])];
     }
   }
+  const double leftMedian = settings.shadowOwnLight ? medianGrey(left) : 0;
   const GreyMaps& greyMaps = greyMapsOf();
   const auto [gain, offset] = greyMaps.images;
   // A sloped facet's counterpart is chosen by its grey level, so the map must hold at that level:
@@ -1074,34 +1137,23 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         }
       }
     }
-    // Mean |left − mapped right| over the ring at the plane's disparity, the right view read
-    // with linear interpolation (the candidates are sub-pixel) and mapped by `map` (gain,
+    // Mean |left − mapped right| over the ring at the plane's disparity, mapped by `map` (gain,
     // offset). 1e30 as soon as the sum exceeds `stopAboveSum` (a bound on the mean times the
     // ring's size: the mean is sure to exceed the bound; the scans of the whole range mostly meet
-    // such errors).
+    // such errors). In the region's own light when `inOwnLight` (see the constant below).
+    bool inOwnLight = false;
     auto ringErrorUnder = [&](const std::pair<double, double>& map, const FillPlane& plane,
                               double stopAboveSum) {
-      const auto [mapGain, mapOffset] = map;
+      if (inOwnLight) return ringErrorInOwnLight(left, right, ring, box, plane, map);
       double sum = 0, n = 0;
-      for (int y = 0; y < box.height; ++y) {
-        if (sum > stopAboveSum) return 1e30;
-        const uchar* m = ring.ptr<uchar>(y);
-        const float* a = left.ptr<float>(box.y + y) + box.x;
-        const float* b = right.ptr<float>(box.y + y);
-        for (int x = 0; x < box.width; ++x) {
-          if (!m[x]) continue;
-          const double value = plane.at(box.x + x, box.y + y);
-          const int whole = static_cast<int>(std::floor(value));
-          const float t = static_cast<float>(value - whole);
-          const int xr = box.x + x - whole;                 // x − value lies in [xr − 1, xr]
-          if (xr - 1 < 0 || xr >= right.cols) return 1e30;  // the outline leaves the right image
-          const float bv = (1 - t) * b[xr] + t * b[xr - 1];
-          if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
-          sum += std::abs(a[x] - (mapGain * bv + mapOffset));
-          n += 1;
-        }
-      }
-      return n > 0 ? sum / n : 1e30;
+      const bool complete = visitRingResiduals(
+          left, right, ring, box, plane, map,
+          [&](double residual) {
+            sum += std::abs(residual);
+            n += 1;
+          },
+          [&] { return sum > stopAboveSum; });
+      return complete && n > 0 ? sum / n : 1e30;
     };
     auto planeRingError = [&](const FillPlane& plane, double stopAboveSum = 1e300) {
       return ringErrorUnder(imagesMap, plane, stopAboveSum);
@@ -1132,7 +1184,8 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
     // The constant disparity of the outline's matches, when the outline lines up there.
     double constantError = 0;      // the constant's error on the (final) ring
     double candidateError = 1e30;  // the best candidate's, filled or not
-    const auto constant = [&]() -> std::optional<float> {
+    bool failedPhotometric = false;  // the best candidate's ring error was above the limit
+    const auto decideConstant = [&]() -> std::optional<float> {
       if (static_cast<int>(matches.size()) < settings.minMatched) return std::nullopt;
       auto ringError = [&](float value) { return planeRingError(FillPlane{value, 0, 0}); };
       // The cluster candidates ranked by their error on the current ring.
@@ -1199,7 +1252,10 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
         constantError = error;
         return edges;
       };
-      if (bestError > settings.photometric * sigma) return decidedByEdges();
+      if (bestError > settings.photometric * sigma) {
+        failedPhotometric = true;
+        return decidedByEdges();
+      }
       // The scan compares errors within a few tenths of each other across the range, so it reads
       // the right view through the matches' grey map: the images' moments can be off by several
       // grey levels on a dark roof, the same at every disparity, which flattens the scan (seed
@@ -1244,6 +1300,20 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
       if (const auto edges = edgeConstantNear(best)) value = *edges;
       constantError = ringError(value);
       return value;
+    };
+    // A shaded region whose outline lines up nowhere through the images' grey map is decided
+    // again in its own light (see RegionFillSettings::shadowOwnLight); its constantError is
+    // then an error in its own light, which a plane (measured through the map) does not beat.
+    const std::optional<float> constant = [&]() -> std::optional<float> {
+      if (const auto found = decideConstant()) return found;
+      if (!settings.shadowOwnLight || !failedPhotometric ||
+          !(cv::mean(left(box), region)[0] < leftMedian)) {
+        return std::nullopt;
+      }
+      inOwnLight = true;
+      const auto found = decideConstant();
+      inOwnLight = false;
+      return found;
     }();
     FillPlane plane;
     if (settings.planeMinRows > 0) {

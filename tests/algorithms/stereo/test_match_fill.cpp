@@ -216,6 +216,36 @@ TEST(FillFlatRegions, TheScanReadsTheRightViewThroughTheMatchesGreyMap) {
   EXPECT_LT(spilledOntoTheGround(s), perimeter / 2);
 }
 
+// The scene with the right view `offset` grey levels off over the roof and 10 px around it.
+Scene seenInOtherLight(float roofGrey, float offset) {
+  Scene s = scene(roofGrey);
+  const cv::Rect seen(s.roof.x - static_cast<int>(kRoof) - 10, s.roof.y - 10, s.roof.width + 20,
+                      s.roof.height + 20);
+  s.right(seen) += offset;
+  return s;
+}
+
+TEST(FillFlatRegions, AShadedRoofIsDecidedInItsOwnLight) {
+  // A dark plain roof (grey 60, under the left image's median) in a shadow that the right view
+  // sees 20 grey levels brighter than the images' grey map says: through the map no candidate
+  // lines the outline up; with the ring's own brightness offset removed, the roof's does.
+  Scene ownLight = seenInOtherLight(60.0f, 20.0f);
+  fill(ownLight, RegionFillSettings{}, 32);
+  Scene mapOnly = seenInOtherLight(60.0f, 20.0f);
+  RegionFillSettings noOwnLight;
+  noOwnLight.shadowOwnLight = false;
+  fill(mapOnly, noOwnLight, 32);
+  const cv::Rect inner = innerRoof(ownLight);
+  EXPECT_EQ(roofPixelsIn(mapOnly, inner), 0);
+  EXPECT_EQ(roofPixelsIn(ownLight, inner), inner.area());
+  EXPECT_LE(spilledOntoTheGround(ownLight), 2);  // (measured: 1)
+  // A bright roof (grey 200) seen 40 levels darker is not retried: brighter than most of the
+  // scene, it is no shadow (without the median test its 1 200 inner pixels were filled).
+  Scene sunlit = seenInOtherLight(200.0f, -40.0f);
+  fill(sunlit, RegionFillSettings{}, 32);
+  EXPECT_EQ(roofPixelsIn(sunlit, innerRoof(sunlit)), 0);
+}
+
 TEST(FillFlatRegions, ThinFlatPartsJoinedToARoofDoNotDecideItsFill) {
   // Three plain 6-row bands of the roof's grey at the ground's disparity (a facade's bands
   // between its window rows) touch the roof's left side: their flat middles join the roof's flat
