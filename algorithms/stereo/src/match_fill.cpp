@@ -1317,6 +1317,12 @@ std::optional<float> RegionDecision::outlineConstant() {
   inOwnLight = true;
   const auto found = decideConstant();
   inOwnLight = false;
+  if (!found) return std::nullopt;
+  const auto agreeing = std::count_if(matchesBeside.begin(), matchesBeside.end(),
+                                      [&](float d) { return std::abs(d - *found) <= 1.5f; });
+  if (agreeing < settings.ownLightAgreement * static_cast<double>(matchesBeside.size())) {
+    return std::nullopt;
+  }
   return found;
 }
 

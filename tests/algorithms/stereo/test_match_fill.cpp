@@ -216,12 +216,15 @@ TEST(FillFlatRegions, TheScanReadsTheRightViewThroughTheMatchesGreyMap) {
   EXPECT_LT(spilledOntoTheGround(s), perimeter / 2);
 }
 
-// The scene with the right view `offset` grey levels off over the roof and 10 px around it.
-Scene seenInOtherLight(float roofGrey, float offset) {
+// The scene with the right view `offset` grey levels off over the roof and 10 px around it, and
+// the roof's last column matched at the roof's disparity (the matches beside the region on its
+// rows agree with it) unless `carriedGround`.
+Scene seenInOtherLight(float roofGrey, float offset, bool carriedGround = false) {
   Scene s = scene(roofGrey);
   const cv::Rect seen(s.roof.x - static_cast<int>(kRoof) - 10, s.roof.y - 10, s.roof.width + 20,
                       s.roof.height + 20);
   s.right(seen) += offset;
+  if (!carriedGround) s.disparity(cv::Rect(s.roof.br().x - 1, s.roof.y + 10, 1, 10)).setTo(kRoof);
   return s;
 }
 
@@ -239,6 +242,11 @@ TEST(FillFlatRegions, AShadedRoofIsDecidedInItsOwnLight) {
   EXPECT_EQ(roofPixelsIn(mapOnly, inner), 0);
   EXPECT_EQ(roofPixelsIn(ownLight, inner), inner.area());
   EXPECT_LE(spilledOntoTheGround(ownLight), 2);  // (measured: 1)
+  // Where the matches beside it on its rows carry another disparity (the ground's, on the roof's
+  // last column), the value found in its own light is not trusted.
+  Scene disagreeing = seenInOtherLight(60.0f, 20.0f, true);
+  fill(disagreeing, RegionFillSettings{}, 32);
+  EXPECT_EQ(roofPixelsIn(disagreeing, innerRoof(disagreeing)), 0);
   // A bright roof (grey 200) seen 40 levels darker is not retried: brighter than most of the
   // scene, it is no shadow (without the median test its 1 200 inner pixels were filled).
   Scene sunlit = seenInOtherLight(200.0f, -40.0f);
