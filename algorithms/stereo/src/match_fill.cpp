@@ -253,9 +253,7 @@ double ringErrorInOwnLight(const cv::Mat& left, const cv::Mat& right, const cv::
       left, right, ring, box, plane, map, [&](double r) { residuals.push_back(r); },
       [] { return false; });
   if (!inside || residuals.empty()) return 1e30;
-  const auto middle = residuals.begin() + static_cast<long>(residuals.size() / 2);
-  std::nth_element(residuals.begin(), middle, residuals.end());
-  const double own = *middle;
+  const double own = middleValue(residuals);
   double sum = 0;
   for (const double r : residuals) sum += std::abs(r - own);
   return sum / static_cast<double>(residuals.size());
@@ -263,16 +261,13 @@ double ringErrorInOwnLight(const cv::Mat& left, const cv::Mat& right, const cv::
 
 // The median grey of the valid pixels of `image`, from about 10 000 of them.
 double medianGrey(const cv::Mat& image) {
-  std::vector<float> sample;
+  std::vector<double> sample;
   const size_t step = std::max<size_t>(1, image.total() / 10000);
   const float* p = image.ptr<float>();
   for (size_t i = 0; i < image.total(); i += step) {
     if (std::isfinite(p[i])) sample.push_back(p[i]);
   }
-  if (sample.empty()) return 0;
-  const auto middle = sample.begin() + static_cast<long>(sample.size() / 2);
-  std::nth_element(sample.begin(), middle, sample.end());
-  return *middle;
+  return sample.empty() ? 0 : middleValue(sample);
 }
 
 // Half-width of the flat test's window (5x5).
