@@ -206,13 +206,17 @@ void checkOutputs(const Options& opts, const std::vector<std::pair<std::string, 
 }
 
 long long featureId(const core::Feature& feature, size_t index, const std::string& file) {
-  const std::string position = "feature " + std::to_string(index + 1);
-  try {
-    const auto id = core::numberProperty(feature, "id", 9e15);
-    return id ? static_cast<long long>(*id) : static_cast<long long>(index + 1);
-  } catch (const core::Error& e) {
-    throw core::Error(e.code(), position + ": " + e.detail(), file);
-  }
+  const auto id = readFeatureProperties([&] { return core::numberProperty(feature, "id", 9e15); },
+                                        "feature " + std::to_string(index + 1), file);
+  return id ? static_cast<long long>(*id) : static_cast<long long>(index + 1);
+}
+
+core::Feature roiFeature(const Options& opts) {
+  const auto v = opts.getList("roi");
+  if (v.size() != 4 || v[2] <= 0 || v[3] <= 0) throw UsageError("--roi expects X,Y,W,H with positive W and H");
+  core::Feature f;
+  f.polygon.outer = {{v[0], v[1]}, {v[0] + v[2], v[1]}, {v[0] + v[2], v[1] + v[3]}, {v[0], v[1] + v[3]}};
+  return f;
 }
 
 namespace {

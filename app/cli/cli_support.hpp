@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "delineo/core/error.hpp"
 #include "delineo/core/geometry.hpp"
 #include "delineo/core/params.hpp"
 #include "delineo/core/progress.hpp"
@@ -155,6 +156,21 @@ void checkOutputs(const Options& opts, const std::vector<std::pair<std::string, 
 // number (core::numberProperty, within +-9e15), else its position in the file from 1. Throws
 // core::Error(InvalidParameter) naming the feature and the file when the id is not a number.
 long long featureId(const core::Feature& feature, size_t index, const std::string& file);
+
+// Reads `read()`, a feature's properties; a malformed one (core::Error) becomes the same error
+// with `feature` ("feature 3", "building id 12") before its detail and `file` as its file.
+template <class Read>
+auto readFeatureProperties(Read&& read, const std::string& feature, const std::string& file) {
+  try {
+    return read();
+  } catch (const core::Error& e) {
+    throw core::Error(e.code(), feature + ": " + e.detail(), file);
+  }
+}
+
+// The rectangle of --roi X,Y,W,H (left-image pixels) as a feature. Throws UsageError when it is
+// not four numbers with positive W and H.
+core::Feature roiFeature(const Options& opts);
 
 using CommandFn = std::function<int(const std::vector<std::string>& args)>;
 struct CommandInfo {

@@ -45,11 +45,7 @@ std::vector<core::Feature> initialPolygons(const cli::Options& opts, const io::G
   if (opts.has("init") && opts.has("roi")) throw cli::UsageError("give at most one of --init and --roi");
   if (opts.has("init")) return io::readFeatures(opts.get("init"), geo);
   if (!opts.has("roi")) return {};
-  const auto v = opts.getList("roi");
-  if (v.size() != 4 || v[2] <= 0 || v[3] <= 0) throw cli::UsageError("--roi expects X,Y,W,H with positive W and H");
-  core::Feature f;
-  f.polygon.outer = {{v[0], v[1]}, {v[0] + v[2], v[1]}, {v[0] + v[2], v[1] + v[3]}, {v[0], v[1] + v[3]}};
-  return {f};
+  return {cli::roiFeature(opts)};
 }
 
 core::Feature outlineFeature(const boxfit::BoxFitBuilding& b, long long id) {

@@ -32,16 +32,6 @@ DisparityInterval intervalFlag(const cli::Options& opts, const std::string& key)
   return {static_cast<int>(a), static_cast<int>(b)};
 }
 
-// Reads `read(feature)`; a malformed property becomes an error naming the building and the file.
-template <class Read>
-auto readProperties(Read&& read, const std::string& building, const std::string& file) {
-  try {
-    return read();
-  } catch (const core::Error& e) {
-    throw core::Error(e.code(), building + ": " + e.detail(), file);
-  }
-}
-
 // The estimated search range widened to hold the building's intervals: the operator's (or the
 // feature's) intervals are known, the estimate is a statistic of the whole pair.
 DisparityInterval hull(DisparityInterval range, const DisparityInterval& roof,
@@ -81,7 +71,8 @@ std::vector<BuildingJob> buildingJobs(const std::vector<core::Feature>& inits, c
     BuildingJob job;
     job.id = cli::featureId(init, i, file);
     const std::string name = "building id " + std::to_string(job.id);
-    const auto intervals = readProperties([&] { return delineation::readFeatureIntervals(init); }, name, file);
+    const auto intervals =
+        cli::readFeatureProperties([&] { return delineation::readFeatureIntervals(init); }, name, file);
     auto& req = job.request;
     req.init.outer = init.polygon.outer;
     if (intervals.roof) {
@@ -113,13 +104,7 @@ std::vector<BuildingJob> buildingJobs(const std::vector<core::Feature>& inits, c
 
 std::vector<core::Feature> initialPolygons(const cli::Options& opts, const io::GeoReference& geo) {
   if (opts.has("init")) return io::readFeatures(opts.get("init"), geo);
-  const auto v = opts.getList("roi");
-  if (v.size() != 4 || v[2] <= 0 || v[3] <= 0) {
-    throw cli::UsageError("--roi expects X,Y,W,H with positive W and H");
-  }
-  core::Feature f;
-  f.polygon.outer = {{v[0], v[1]}, {v[0] + v[2], v[1]}, {v[0] + v[2], v[1] + v[3]}, {v[0], v[1] + v[3]}};
-  return {f};
+  return {cli::roiFeature(opts)};
 }
 
 // The delineated building as an output feature with its energies and what the stage did.
