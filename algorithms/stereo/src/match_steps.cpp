@@ -396,231 +396,300 @@ int stepBoundary(const std::vector<float>& costA, const std::vector<float>& cost
   return beta;
 }
 
+// Steps along the columns are scored on each pixel's error summed over x ± 2 of its row (the
+// pixel alone was too noisy to place a boundary across the rows; those pixels lie on the same
+// side of an outline that runs with the rows).
+constexpr int kColumnCostHalf = 2;
+
+// The step cut of one map (refineDepthSteps, docs/stereo.md step 9) in its stages: the side of
+// each pixel of a row's step segments and gaps (chooseRowSides), then of the columns' segments
+// the rows did not decide (chooseColumnSides), then each pixel given a side matched again on
+// its window cut at the steps (matchAgain).
+struct StepCut {
+  void chooseRowSides(int rowStart, int rowEnd);
+  void markRowStepsNear(int y, const std::vector<int>& valid);
+  bool decideRowSegment(int y, const StepSegment& seg, std::vector<float>& costA,
+                        std::vector<float>& costB);
+  void chooseGapSides(int y, const std::vector<int>& valid);
+  void chooseColumnSides(int colStart, int colEnd);
+  bool rowsDecided(int x, int p, int q) const;
+  bool rowCost(int x, int y, float d, int dy, float& cost) const;
+  bool decideColumnSegment(int x, const float* val, const StepSegment& seg,
+                           std::vector<float>& costA, std::vector<float>& costB);
+  void matchAgain(int rowStart, int rowEnd);
+
+  const cv::Mat& ref;
+  const cv::Mat& other;
+  const cv::Mat& refValid;
+  const cv::Mat& otherValid;
+  const cv::Mat& validated;  // the map after the left/right check
+  const StepRefineSettings& s;
+  LevelOutput& raw;          // the map before it, matched again in place
+  const cv::Mat& matchOnly;  // (optional) the pixels that may be matched again
+  const int W = ref.cols, H = ref.rows;
+  const int h = s.window / 2;  // half window: the fattening reaches this far past a step
+  // Line shifts of the sides' source pixels: only matchAgain writes raw.lineShift, after the
+  // sides have read them (no copy needed).
+  const cv::Mat& shifts = raw.lineShift;
+  // Side chosen for each pixel of a step segment: its surface's disparity and line shift (each
+  // band of rows initialises its own rows).
+  cv::Mat sideD = cv::Mat(ref.size(), CV_32F);
+  cv::Mat sideDy = cv::Mat(ref.size(), CV_8S);
+  cv::Mat inStrip = cv::Mat(ref.size(), CV_8U);  // occluded strips of the rows' segments
+  // Pixels with a step of their row (consecutive validated pixels ≥ minStep apart) within half a
+  // window on both sides: the column pass leaves the steps those pixels lie on to the rows.
+  cv::Mat rowStepNear = cv::Mat(ref.size(), CV_8U);
+  cv::Mat otherInvalidSum{};  // integral image of the other image's nodata pixels (matchAgain)
+  std::atomic<long> changed{0};
+};
+
+// The rows' step segments and gaps, row by row: the row's sides cleared, its steps near each
+// pixel marked (for the column pass), each segment's side chosen, then its gaps'.
+void StepCut::chooseRowSides(int rowStart, int rowEnd) {
+  std::vector<int> valid;
+  std::vector<float> costA, costB;
+  for (int y = rowStart; y < rowEnd; ++y) {
+    std::fill_n(sideD.ptr<float>(y), W, kNaN);
+    std::fill_n(sideDy.ptr<schar>(y), W, schar{0});
+    std::fill_n(inStrip.ptr<uchar>(y), W, uchar{0});
+    const float* val = validated.ptr<float>(y);
+    valid.clear();
+    for (int x = 0; x < W; ++x) {
+      if (std::isfinite(val[x])) valid.push_back(x);
+    }
+    markRowStepsNear(y, valid);
+    int done = -1;  // last column re-decided in this row
+    for (size_t i = 0; i + 1 < valid.size(); ++i) {
+      const int p = valid[i], q = valid[i + 1];
+      // (Most pairs are no step: tested here, the call is made for the others only.)
+      if (std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
+      StepSegment seg;
+      if (!stepSegment(val, W, p, q, h, done, static_cast<float>(s.minStep), seg)) continue;
+      if (decideRowSegment(y, seg, costA, costB)) done = seg.s1;
+    }
+    if (s.gapFill > 0) chooseGapSides(y, valid);
+  }
+}
+
+// rowStepNear on row y (its validated pixels `valid`): the pixels with a step of the row within
+// half a window on both sides (none without columnSteps).
+void StepCut::markRowStepsNear(int y, const std::vector<int>& valid) {
+  const float* val = validated.ptr<float>(y);
+  uchar* near = rowStepNear.ptr<uchar>(y);
+  std::fill_n(near, W, uchar{0});
+  for (size_t i = 0; s.columnSteps && i + 1 < valid.size(); ++i) {
+    const int p = valid[i], q = valid[i + 1];
+    if (q - p > 2 * h || std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
+    // x − h ≤ p and q ≤ x + h.
+    for (int x = std::max(0, q - h); x <= std::min(W - 1, p + h); ++x) near[x] = 1;
+  }
+}
+
+// The sides of a row's step segment: the boundary β between them, the occluded strip after it
+// left unmatched. False (nothing written) when a side's error cannot be scored.
+bool StepCut::decideRowSegment(int y, const StepSegment& seg, std::vector<float>& costA,
+                               std::vector<float>& costB) {
+  const int s0 = seg.s0, s1 = seg.s1;
+  const float da = seg.da, db = seg.db;
+  const float* shift = shifts.ptr<float>(y);
+  const int dyA = roundHalfAway(shift[seg.ua]);
+  const int dyB = roundHalfAway(shift[seg.ub]);
+  // Boundary β: columns ≤ β on the −x surface, > β on the +x one.
+  const int n = s1 - s0 + 1;
+  costA.resize(static_cast<size_t>(n));
+  costB.resize(static_cast<size_t>(n));
+  if (!columnErrors(ref, other, refValid, otherValid, s0, n, y, s.costRadius, da, dyA,
+                    costA.data()) ||
+      !columnErrors(ref, other, refValid, otherValid, s0, n, y, s.costRadius, db, dyB,
+                    costB.data())) {
+    return false;
+  }
+  // Occluded strip: when the +x surface is nearer, the `strip` columns before it are not
+  // seen in the other view; the boundary then has the strip between the two sides.
+  const int strip = s.occlusionStrip && db > da ? roundHalfAway(db - da) : 0;
+  if (n - strip < 2) return false;
+  const int beta = stepBoundary(costA, costB, s0, strip);
+  float* rawRow = raw.disparity.ptr<float>(y);
+  for (int x = s0; x <= s1; ++x) {
+    if (x > beta && x <= beta + strip) {
+      rawRow[x] = kNaN;             // occluded in the other view
+      inStrip.at<uchar>(y, x) = 1;  // decided: the column pass leaves it
+      continue;
+    }
+    const bool sideA = x <= beta;
+    sideD.at<float>(y, x) = sideA ? da : db;
+    sideDy.at<schar>(y, x) = static_cast<schar>(sideA ? dyA : dyB);
+  }
+  return true;
+}
+
+// Gaps of one surface on row y: unmatched pixels between two validated pixels of the same
+// surface (no step), at most gapFill px apart, matched again around that surface.
+void StepCut::chooseGapSides(int y, const std::vector<int>& valid) {
+  const float* val = validated.ptr<float>(y);
+  const float* shift = shifts.ptr<float>(y);
+  float* sideRow = sideD.ptr<float>(y);
+  schar* sideDyRow = sideDy.ptr<schar>(y);
+  for (size_t i = 0; i + 1 < valid.size(); ++i) {
+    const int p = valid[i], q = valid[i + 1];
+    if (q - p < 2 || q - p > s.gapFill + 1) continue;
+    if (std::abs(val[p] - val[q]) > s.gapTolerance) continue;
+    const float surface = 0.5F * (val[p] + val[q]);
+    const schar dySurface = static_cast<schar>(roundHalfAway(shift[p]));
+    for (int x = p + 1; x < q; ++x) {
+      if (std::isfinite(sideRow[x])) continue;  // part of a step segment
+      sideRow[x] = surface;
+      sideDyRow[x] = dySurface;
+    }
+  }
+}
+
+// Steps along the columns colStart .. colEnd − 1 (outlines that run with the rows: no row
+// crosses them), after the rows' segments, which keep their sides. The same boundary search, on
+// errors summed along the rows (kColumnCostHalf); no occluded strip (the views are displaced
+// along the rows only).
+void StepCut::chooseColumnSides(int colStart, int colEnd) {
+  // The band's columns, each contiguous (one pass over the rows).
+  const int bandWidth = colEnd - colStart;
+  std::vector<float> columns(static_cast<size_t>(bandWidth) * H), costA, costB;
+  for (int y = 0; y < H; ++y) {
+    const float* row = validated.ptr<float>(y);
+    for (int c = 0; c < bandWidth; ++c) {
+      columns[static_cast<size_t>(c) * H + y] = row[colStart + c];
+    }
+  }
+  std::vector<int> valid;
+  for (int x = colStart; x < colEnd; ++x) {
+    const float* val = &columns[static_cast<size_t>(x - colStart) * H];
+    valid.clear();
+    for (int y = 0; y < H; ++y) {
+      if (std::isfinite(val[y])) valid.push_back(y);
+    }
+    int done = -1;
+    for (size_t i = 0; i + 1 < valid.size(); ++i) {
+      const int p = valid[i], q = valid[i + 1];
+      if (std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
+      StepSegment seg;
+      if (!stepSegment(val, H, p, q, h, done, static_cast<float>(s.minStep), seg)) continue;
+      if (rowsDecided(x, p, q)) continue;
+      if (decideColumnSegment(x, val, seg, costA, costB)) done = seg.s1;
+    }
+  }
+}
+
+// Only outlines that run with the rows: where a row steps within half a window of the column's
+// step p .. q, the outline crosses the rows and the rows decided it (a diagonal outline decided
+// by both passes moved by 2-8 px).
+bool StepCut::rowsDecided(int x, int p, int q) const {
+  bool crossesRows = false;
+  for (int y = p; y <= q && !crossesRows; ++y) crossesRows = rowStepNear.at<uchar>(y, x) != 0;
+  return crossesRows;
+}
+
+// The error of pixel (x, y) under disparity d for the column pass: summed over x ± 2 of its row.
+bool StepCut::rowCost(int x, int y, float d, int dy, float& cost) const {
+  float rowErr[2 * kColumnCostHalf + 1];
+  if (!columnErrors(ref, other, refValid, otherValid, x - kColumnCostHalf, 2 * kColumnCostHalf + 1,
+                    y, 0, d, dy, rowErr)) {
+    return false;
+  }
+  cost = 0;
+  for (float e : rowErr) cost += e;
+  return true;
+}
+
+// The sides of a column's step segment (column x, validated values `val`): its validated pixels
+// the rows did not decide take the side of the boundary they lie on; unmatched pixels take none.
+// False (nothing written) when an error cannot be scored.
+bool StepCut::decideColumnSegment(int x, const float* val, const StepSegment& seg,
+                                  std::vector<float>& costA, std::vector<float>& costB) {
+  const int s0 = seg.s0, s1 = seg.s1;
+  const float da = seg.da, db = seg.db;
+  const int dyA = roundHalfAway(shifts.at<float>(seg.ua, x));
+  const int dyB = roundHalfAway(shifts.at<float>(seg.ub, x));
+  const int n = s1 - s0 + 1;
+  costA.resize(static_cast<size_t>(n));
+  costB.resize(static_cast<size_t>(n));
+  bool scored = x - kColumnCostHalf >= 0 && x + kColumnCostHalf < W;
+  for (int k = 0; k < n && scored; ++k) {
+    scored = rowCost(x, s0 + k, da, dyA, costA[static_cast<size_t>(k)]) &&
+             rowCost(x, s0 + k, db, dyB, costB[static_cast<size_t>(k)]);
+  }
+  if (!scored) return false;
+  const int beta = stepBoundary(costA, costB, s0, 0);  // last row of the upper side
+  for (int y = s0; y <= s1; ++y) {
+    float& side = sideD.at<float>(y, x);
+    if (!std::isnan(side) || inStrip.at<uchar>(y, x)) continue;  // a row's segment decided it
+    if (!std::isfinite(val[y])) continue;
+    const bool sideA = y <= beta;
+    side = sideA ? da : db;
+    sideDy.at<schar>(y, x) = static_cast<schar>(sideA ? dyA : dyB);
+  }
+  return true;
+}
+
+// Each pixel given a side is matched again on the window cut by the steps: the pixels of its
+// own side (same side value), and the validated pixels off the segments on that surface.
+void StepCut::matchAgain(int rowStart, int rowEnd) {
+  CutWindow window;
+  for (int y = rowStart; y < rowEnd; ++y) {
+    float* outD = raw.disparity.ptr<float>(y);
+    float* outS = raw.lineShift.ptr<float>(y);
+    float* outScore = raw.score.ptr<float>(y);
+    const float* sides = sideD.ptr<float>(y);
+    const float* val = validated.ptr<float>(y);
+    const schar* sideShift = sideDy.ptr<schar>(y);
+    const uchar* wanted = matchOnly.empty() ? nullptr : matchOnly.ptr<uchar>(y);
+    for (int x = 0; x < W; ++x) {
+      const float side = sides[x];
+      if (!std::isfinite(side) || (wanted != nullptr && !wanted[x])) continue;
+      // A validated value already on this side stays: re-matching it costs the most (most
+      // segment pixels) and changed little.
+      const float kept = val[x];
+      if (std::isfinite(kept) && std::abs(kept - side) <= 1.0F) continue;
+      const int dy = sideShift[x];
+      buildCutWindow(ref, refValid, sideD, validated, side, x, y, h, s.minShape, window);
+      const Hypothesis hyp = bestNear(window, other, otherValid, otherInvalidSum, side, dy);
+      const float before = outD[x];
+      if (hyp.score >= static_cast<float>(s.minScore)) {
+        outD[x] = hyp.disparity;
+        outS[x] = static_cast<float>(dy);
+        outScore[x] = hyp.score;
+      } else {
+        outD[x] = kNaN;
+      }
+      if (!(before == outD[x])) ++changed;
+    }
+  }
+}
+
 }  // namespace
 
 long refineDepthSteps(const cv::Mat& ref, const cv::Mat& other, const cv::Mat& refValid,
                       const cv::Mat& otherValid, const cv::Mat& validated,
                       const StepRefineSettings& s, LevelOutput& raw, const cv::Mat& matchOnly) {
+  StepCut cut{ref, other, refValid, otherValid, validated, s, raw, matchOnly};
   const int W = ref.cols, H = ref.rows;
-  const int h = s.window / 2;
-  std::atomic<long> changed{0};
-  // Line shifts of the sides' source pixels: only the second pass below writes raw.lineShift,
-  // after the first has read them (no copy needed).
-  const cv::Mat& shifts = raw.lineShift;
-  // Side chosen for each pixel of a step segment: its surface's disparity and line shift (each
-  // band of the first pass initialises its own rows).
-  cv::Mat sideD(ref.size(), CV_32F);
-  cv::Mat sideDy(ref.size(), CV_8S);
-  cv::Mat inStrip(ref.size(), CV_8U);  // occluded strips of the rows' segments
-  // Pixels with a step of their row (consecutive validated pixels ≥ minStep apart) within half a
-  // window on both sides: the column pass leaves the steps those pixels lie on to the rows.
-  cv::Mat rowStepNear(ref.size(), CV_8U);
-  auto chooseSides = [&](int rowStart, int rowEnd) {
-    std::vector<int> valid;
-    std::vector<float> costA, costB;
-    for (int y = rowStart; y < rowEnd; ++y) {
-      std::fill_n(sideD.ptr<float>(y), W, kNaN);
-      std::fill_n(sideDy.ptr<schar>(y), W, schar{0});
-      std::fill_n(inStrip.ptr<uchar>(y), W, uchar{0});
-      const float* val = validated.ptr<float>(y);
-      const float* shift = shifts.ptr<float>(y);
-      valid.clear();
-      for (int x = 0; x < W; ++x) {
-        if (std::isfinite(val[x])) valid.push_back(x);
-      }
-      uchar* near = rowStepNear.ptr<uchar>(y);
-      std::fill_n(near, W, uchar{0});
-      for (size_t i = 0; s.columnSteps && i + 1 < valid.size(); ++i) {
-        const int p = valid[i], q = valid[i + 1];
-        if (q - p > 2 * h || std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
-        // x − h ≤ p and q ≤ x + h.
-        for (int x = std::max(0, q - h); x <= std::min(W - 1, p + h); ++x) near[x] = 1;
-      }
-      int done = -1;  // last column re-decided in this row
-      for (size_t i = 0; i + 1 < valid.size(); ++i) {
-        const int p = valid[i], q = valid[i + 1];
-        // (Most pairs are no step: tested here, the call is made for the others only.)
-        if (std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
-        StepSegment seg;
-        if (!stepSegment(val, W, p, q, h, done, static_cast<float>(s.minStep), seg)) continue;
-        const int s0 = seg.s0, s1 = seg.s1;
-        const float da = seg.da, db = seg.db;
-        const int dyA = roundHalfAway(shift[seg.ua]);
-        const int dyB = roundHalfAway(shift[seg.ub]);
-        // Boundary β: columns ≤ β on the −x surface, > β on the +x one.
-        const int n = s1 - s0 + 1;
-        costA.resize(static_cast<size_t>(n));
-        costB.resize(static_cast<size_t>(n));
-        if (!columnErrors(ref, other, refValid, otherValid, s0, n, y, s.costRadius, da, dyA,
-                          costA.data()) ||
-            !columnErrors(ref, other, refValid, otherValid, s0, n, y, s.costRadius, db, dyB,
-                          costB.data())) {
-          continue;
-        }
-        // Occluded strip: when the +x surface is nearer, the `strip` columns before it are not
-        // seen in the other view; the boundary then has the strip between the two sides.
-        const int strip = s.occlusionStrip && db > da ? roundHalfAway(db - da) : 0;
-        if (n - strip < 2) continue;
-        const int beta = stepBoundary(costA, costB, s0, strip);
-        float* rawRow = raw.disparity.ptr<float>(y);
-        for (int x = s0; x <= s1; ++x) {
-          if (x > beta && x <= beta + strip) {
-            rawRow[x] = kNaN;             // occluded in the other view
-            inStrip.at<uchar>(y, x) = 1;  // decided: the column pass leaves it
-            continue;
-          }
-          const bool sideA = x <= beta;
-          sideD.at<float>(y, x) = sideA ? da : db;
-          sideDy.at<schar>(y, x) = static_cast<schar>(sideA ? dyA : dyB);
-        }
-        done = s1;
-      }
-      if (s.gapFill > 0) {
-        // Gaps of one surface: unmatched pixels between two validated pixels of the same
-        // surface (no step), at most gapFill px apart, matched again around that surface.
-        float* sideRow = sideD.ptr<float>(y);
-        schar* sideDyRow = sideDy.ptr<schar>(y);
-        for (size_t i = 0; i + 1 < valid.size(); ++i) {
-          const int p = valid[i], q = valid[i + 1];
-          if (q - p < 2 || q - p > s.gapFill + 1) continue;
-          if (std::abs(val[p] - val[q]) > s.gapTolerance) continue;
-          const float surface = 0.5F * (val[p] + val[q]);
-          const schar dySurface = static_cast<schar>(roundHalfAway(shift[p]));
-          for (int x = p + 1; x < q; ++x) {
-            if (std::isfinite(sideRow[x])) continue;  // part of a step segment
-            sideRow[x] = surface;
-            sideDyRow[x] = dySurface;
-          }
-        }
-      }
-    }
-  };
   // Bands of 8 rows as tasks, with the integral image of the other image's nodata pixels (for
-  // the second pass) one more task among them.
-  cv::Mat otherInvalidSum;
+  // matchAgain) one more task among them.
   constexpr int kBandRows = 8;
   std::vector<std::function<void()>> tasks;
-  tasks.emplace_back([&] { cv::integral(1 - otherValid, otherInvalidSum, CV_32S); });
+  tasks.emplace_back([&] { cv::integral(1 - otherValid, cut.otherInvalidSum, CV_32S); });
   for (int y0 = 0; y0 < H; y0 += kBandRows) {
-    tasks.emplace_back([&, y0] { chooseSides(y0, std::min(H, y0 + kBandRows)); });
+    tasks.emplace_back([&, y0] { cut.chooseRowSides(y0, std::min(H, y0 + kBandRows)); });
   }
   runTasks(tasks, s.threads);
-  // Steps along the columns (outlines that run with the rows: no row crosses them), after the
-  // rows' segments, which keep their sides. The same boundary search, on each pixel's error
-  // summed over x ± 2 of its row (the pixel alone was too noisy to place a boundary across the
-  // rows; those pixels lie on the same side of an outline that runs with the rows); no occluded
-  // strip (the views are displaced along the rows only).
-  constexpr int kColumnCostHalf = 2;
-  auto chooseColumnSides = [&](int colStart, int colEnd) {
-    // The band's columns, each contiguous (one pass over the rows).
-    const int bandWidth = colEnd - colStart;
-    std::vector<float> columns(static_cast<size_t>(bandWidth) * H), costA, costB;
-    for (int y = 0; y < H; ++y) {
-      const float* row = validated.ptr<float>(y);
-      for (int c = 0; c < bandWidth; ++c) {
-        columns[static_cast<size_t>(c) * H + y] = row[colStart + c];
-      }
-    }
-    std::vector<int> valid;
-    for (int x = colStart; x < colEnd; ++x) {
-      const float* val = &columns[static_cast<size_t>(x - colStart) * H];
-      valid.clear();
-      for (int y = 0; y < H; ++y) {
-        if (std::isfinite(val[y])) valid.push_back(y);
-      }
-      int done = -1;
-      for (size_t i = 0; i + 1 < valid.size(); ++i) {
-        const int p = valid[i], q = valid[i + 1];
-        if (std::abs(val[p] - val[q]) < static_cast<float>(s.minStep)) continue;
-        StepSegment seg;
-        if (!stepSegment(val, H, p, q, h, done, static_cast<float>(s.minStep), seg)) continue;
-        const int s0 = seg.s0, s1 = seg.s1;
-        const float da = seg.da, db = seg.db;
-        // Only outlines that run with the rows: where a row steps within half a window of the
-        // column's step, the outline crosses the rows and the rows decided it (a diagonal
-        // outline decided by both passes moved by 2-8 px).
-        bool crossesRows = false;
-        for (int y = p; y <= q && !crossesRows; ++y) crossesRows = rowStepNear.at<uchar>(y, x) != 0;
-        if (crossesRows) continue;
-        const int dyA = roundHalfAway(shifts.at<float>(seg.ua, x));
-        const int dyB = roundHalfAway(shifts.at<float>(seg.ub, x));
-        const int n = s1 - s0 + 1;
-        costA.resize(static_cast<size_t>(n));
-        costB.resize(static_cast<size_t>(n));
-        bool scored = x - kColumnCostHalf >= 0 && x + kColumnCostHalf < W;
-        float rowErr[2 * kColumnCostHalf + 1];
-        auto rowCost = [&](int y, float d, int dy, float& cost) {
-          if (!columnErrors(ref, other, refValid, otherValid, x - kColumnCostHalf,
-                            2 * kColumnCostHalf + 1, y, 0, d, dy, rowErr)) {
-            return false;
-          }
-          cost = 0;
-          for (float e : rowErr) cost += e;
-          return true;
-        };
-        for (int k = 0; k < n && scored; ++k) {
-          scored = rowCost(s0 + k, da, dyA, costA[static_cast<size_t>(k)]) &&
-                   rowCost(s0 + k, db, dyB, costB[static_cast<size_t>(k)]);
-        }
-        if (!scored) continue;
-        const int beta = stepBoundary(costA, costB, s0, 0);  // last row of the upper side
-        for (int y = s0; y <= s1; ++y) {
-          float& side = sideD.at<float>(y, x);
-          if (!std::isnan(side) || inStrip.at<uchar>(y, x)) continue;  // a row's segment decided it
-          if (!std::isfinite(val[y])) continue;
-          const bool sideA = y <= beta;
-          side = sideA ? da : db;
-          sideDy.at<schar>(y, x) = static_cast<schar>(sideA ? dyA : dyB);
-        }
-        done = s1;
-      }
-    }
-  };
   if (s.columnSteps) {
     std::vector<std::function<void()>> columnTasks;
     for (int x0 = 0; x0 < W; x0 += 16) {
-      columnTasks.emplace_back([&, x0] { chooseColumnSides(x0, std::min(W, x0 + 16)); });
+      columnTasks.emplace_back([&, x0] { cut.chooseColumnSides(x0, std::min(W, x0 + 16)); });
     }
     runTasks(columnTasks, s.threads);
   }
-  // Each pixel given a side is matched again on the window cut by the steps: the pixels of its
-  // own side (same side value), and the validated pixels off the segments on that surface.
   forRowBands(
-      H, s.threads,
-      [&](int rowStart, int rowEnd) {
-        CutWindow window;
-        for (int y = rowStart; y < rowEnd; ++y) {
-          float* outD = raw.disparity.ptr<float>(y);
-          float* outS = raw.lineShift.ptr<float>(y);
-          float* outScore = raw.score.ptr<float>(y);
-          const float* sides = sideD.ptr<float>(y);
-          const float* val = validated.ptr<float>(y);
-          const schar* sideShift = sideDy.ptr<schar>(y);
-          const uchar* wanted = matchOnly.empty() ? nullptr : matchOnly.ptr<uchar>(y);
-          for (int x = 0; x < W; ++x) {
-            const float side = sides[x];
-            if (!std::isfinite(side) || (wanted != nullptr && !wanted[x])) continue;
-            // A validated value already on this side stays: re-matching it costs the most (most
-            // segment pixels) and changed little.
-            const float kept = val[x];
-            if (std::isfinite(kept) && std::abs(kept - side) <= 1.0F) continue;
-            const int dy = sideShift[x];
-            buildCutWindow(ref, refValid, sideD, validated, side, x, y, h, s.minShape, window);
-            const Hypothesis hyp = bestNear(window, other, otherValid, otherInvalidSum, side, dy);
-            const float before = outD[x];
-            if (hyp.score >= static_cast<float>(s.minScore)) {
-              outD[x] = hyp.disparity;
-              outS[x] = static_cast<float>(dy);
-              outScore[x] = hyp.score;
-            } else {
-              outD[x] = kNaN;
-            }
-            if (!(before == outD[x])) ++changed;
-          }
-        }
-      },
+      H, s.threads, [&](int rowStart, int rowEnd) { cut.matchAgain(rowStart, rowEnd); },
       /*bandRows=*/8);
-  return changed.load();
+  return cut.changed.load();
 }
 
 }  // namespace delineo::stereo::detail
