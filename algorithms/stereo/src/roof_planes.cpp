@@ -230,24 +230,50 @@ void fitPlanes(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
   }
 }
 
-}  // namespace
+// fitRoofPlanes in its stages (docs/stereo.md step 18): the surfaces labelled, fitted, and the
+// planar ones kept (fitSurfaces); the ring around each measured (measureRings) and the raised
+// ones kept (keepRaised); their inliers set to their plane (setInliers); then the small pieces
+// on or around them within absorbWithin of it (absorbPieces).
+struct RoofPlanes {
+  bool fitSurfaces();
+  void measureRings();
+  void measureRing(size_t i);
+  cv::Mat surfaceWithHoles(size_t i, const cv::Rect& area) const;
+  cv::Mat acrossRim(const Surface& f, const cv::Mat& filled, const cv::Rect& area) const;
+  void countRing(Surface& f, const cv::Mat& across, const cv::Rect& area) const;
+  int keepRaised();
+  long setInliers();
+  long absorbPieces();
+  int absorbAround(size_t i, cv::Mat& taken);
 
-RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& settings) {
-  CV_Assert(disparity.type() == CV_32F);
-  const RoofPlaneSettings& s = settings;
-  RoofPlaneCounts counts;
-  std::vector<Surface> surfaces;
-  // The roofs' other pixels (below) come from small pieces only: a piece as large as a surface is
-  // a structure (a box on a roof, a parapet), not the matches' noise.
+  cv::Mat& disparity;
+  const RoofPlaneSettings& s;
+  // The roofs' other pixels (absorbPieces) come from small pieces only: a piece as large as a
+  // surface is a structure (a box on a roof, a parapet), not the matches' noise.
   const int maxPiece = s.minPixels;
-  const cv::Mat labels =
-      labelSurfaces(disparity, s.link, s.minPixels, maxPiece, s.threads, surfaces);
-  if (surfaces.empty()) return counts;
-  cv::Mat keep(disparity.size(), CV_8U);
+  const cv::Rect image = cv::Rect(0, 0, disparity.cols, disparity.rows);
+  const cv::Mat square = cv::Mat::ones(2 * s.ringRadius + 1, 2 * s.ringRadius + 1, CV_8U);
+  std::vector<Surface> surfaces{};
+  cv::Mat labels{};                    // the surfaces (labelSurfaces)
+  cv::Mat keep{};                      // each surface's pixels within its plane's inlier band
+  std::vector<std::uint8_t> planar{};  // by surface: it takes its plane
+  // By planar surface: its box with the margin the ring needs, and over it where its small pieces
+  // are looked for.
+  std::vector<cv::Rect> areaOf{};
+  std::vector<cv::Mat> grownOf{};
+};
+
+// The surfaces labelled and fitted with their trimmed planes; `planar` marks those whose inliers'
+// RMS is within maxResidual and that are minInlierShare of their pixels. False when there is no
+// surface.
+bool RoofPlanes::fitSurfaces() {
+  labels = labelSurfaces(disparity, s.link, s.minPixels, maxPiece, s.threads, surfaces);
+  if (surfaces.empty()) return false;
+  keep = cv::Mat(disparity.size(), CV_8U);
   keep.setTo(1);
   constexpr int kRounds = 3;  // the band settles after two; the third confirms it
   fitPlanes(disparity, labels, keep, surfaces, s, kRounds);
-  std::vector<std::uint8_t> planar(surfaces.size(), 0);
+  planar.assign(surfaces.size(), 0);
   for (size_t i = 0; i < surfaces.size(); ++i) {
     const Surface& f = surfaces[i];
     planar[i] = f.fitted && f.rms <= s.maxResidual &&
@@ -255,74 +281,102 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
                     ? 1
                     : 0;
   }
-  // The ring around each planar surface: the matched pixels within ringRadius outside its outer
-  // outline (its holes filled: the ground around a sunken courtyard would be raised above it).
-  const int r = s.ringRadius;
-  const cv::Mat square = cv::Mat::ones(2 * r + 1, 2 * r + 1, CV_8U);
-  const cv::Rect image(0, 0, disparity.cols, disparity.rows);
-  std::vector<cv::Mat> grownOf(surfaces.size());
-  std::vector<cv::Rect> areaOf(surfaces.size());
-  // One task per planar surface (each writes only its own ring, mask and area).
+  return true;
+}
+
+// The ring around each planar surface, one task per surface (each writes only its own ring, mask
+// and area).
+void RoofPlanes::measureRings() {
+  grownOf.resize(surfaces.size());
+  areaOf.resize(surfaces.size());
   std::vector<std::function<void()>> ringTasks;
   for (size_t i = 0; i < surfaces.size(); ++i) {
     if (planar[i] == 0) continue;
-    ringTasks.emplace_back([&, i] {
-      Surface& f = surfaces[i];
-      // The box with a margin of r + 1 + gapReach: the complement's part reached from the margin
-      // is outside.
-      const int m = r + 1 + s.gapReach;
-      const cv::Rect& b = f.box;
-      const cv::Rect area(b.x - m, b.y - m, b.width + 2 * m, b.height + 2 * m);
-      cv::Mat filled(area.size(), CV_8U, cv::Scalar(0));
-      const cv::Rect inImage = area & image;
-      filled(inImage - area.tl()).setTo(255, labels(inImage) == static_cast<int>(i));
-      // From a corner of the margin, which is never the surface; 8-connected, as the complement of
-      // a 4-connected surface is.
-      cv::floodFill(filled, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(),
-                    8);
-      filled = filled != 128;  // the surface and its holes
-      cv::Mat grown;
-      cv::dilate(filled, grown, square);
-      areaOf[i] = area;
-      // Across the unmatched pixels along its outline (a roof's occluded or unmatched border) and
-      // those at its level (its own rim, cut from the surface by jumps), up to gapReach px: the
-      // ring is what lies beyond them.
-      cv::Mat passable(area.size(), CV_8U, cv::Scalar(0));
-      for (int y = inImage.y; y < inImage.br().y; ++y) {
-        const float* d = disparity.ptr<float>(y);
-        std::uint8_t* out = passable.ptr<std::uint8_t>(y - area.y);
-        for (int x = inImage.x; x < inImage.br().x; ++x) {
-          const bool level = std::isfinite(d[x]) && std::abs(d[x] - f.at(x, y)) < s.lowerBy;
-          out[x - area.x] = !std::isfinite(d[x]) || level ? 255 : 0;
-        }
-      }
-      cv::Mat across = filled.clone(), step;
-      const cv::Mat cross = cv::getStructuringElement(cv::MORPH_RECT, {3, 3});
-      for (int k = 0; k < s.gapReach; ++k) {
-        cv::dilate(across, step, cross);
-        step &= passable;
-        if (cv::countNonZero(step & ~across) == 0) break;
-        across |= step;
-      }
-      // The roofs' other pixels (below) are looked for there too: within ringRadius of the outer
-      // outline and across its rim.
-      grownOf[i] = grown | across;
-      cv::Mat ring;
-      cv::dilate(across, ring, square);
-      for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
-        const float* d = disparity.ptr<float>(y);
-        const std::uint8_t* in = across.ptr<std::uint8_t>(y - area.y);
-        const std::uint8_t* near = ring.ptr<std::uint8_t>(y - area.y);
-        for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
-          const int u = x - area.x;
-          if (in[u] != 0 || near[u] == 0 || !std::isfinite(d[x])) continue;
-          ++f.ring;
-          if (d[x] <= f.at(x, y) - s.lowerBy) ++f.lower;
-        }
-      }
-    });
+    ringTasks.emplace_back([this, i] { measureRing(i); });
   }
   runTasks(ringTasks, s.threads);
+}
+
+// The ring around planar surface i: the matched pixels within ringRadius outside its outer
+// outline (its holes filled: the ground around a sunken courtyard would be raised above it),
+// past its rim; and where its small pieces are looked for (grownOf).
+void RoofPlanes::measureRing(size_t i) {
+  Surface& f = surfaces[i];
+  // The box with a margin of r + 1 + gapReach: the complement's part reached from the margin
+  // is outside.
+  const int m = s.ringRadius + 1 + s.gapReach;
+  const cv::Rect& b = f.box;
+  const cv::Rect area(b.x - m, b.y - m, b.width + 2 * m, b.height + 2 * m);
+  const cv::Mat filled = surfaceWithHoles(i, area);
+  cv::Mat grown;
+  cv::dilate(filled, grown, square);
+  areaOf[i] = area;
+  const cv::Mat across = acrossRim(f, filled, area);
+  // The roofs' other pixels (absorbPieces) are looked for there too: within ringRadius of the
+  // outer outline and across its rim.
+  grownOf[i] = grown | across;
+  countRing(f, across, area);
+}
+
+// Surface i and its holes, over `area` (CV_8U 0/255).
+cv::Mat RoofPlanes::surfaceWithHoles(size_t i, const cv::Rect& area) const {
+  cv::Mat filled(area.size(), CV_8U, cv::Scalar(0));
+  const cv::Rect inImage = area & image;
+  filled(inImage - area.tl()).setTo(255, labels(inImage) == static_cast<int>(i));
+  // From a corner of the margin, which is never the surface; 8-connected, as the complement of
+  // a 4-connected surface is.
+  cv::floodFill(filled, cv::Point(0, 0), cv::Scalar(128), nullptr, cv::Scalar(), cv::Scalar(), 8);
+  filled = filled != 128;  // the surface and its holes
+  return filled;
+}
+
+// Across the unmatched pixels along the surface's outline (a roof's occluded or unmatched border)
+// and those at its level (its own rim, cut from the surface by jumps), up to gapReach px from
+// `filled` (over `area`): the ring is what lies beyond them.
+cv::Mat RoofPlanes::acrossRim(const Surface& f, const cv::Mat& filled, const cv::Rect& area) const {
+  const cv::Rect inImage = area & image;
+  cv::Mat passable(area.size(), CV_8U, cv::Scalar(0));
+  for (int y = inImage.y; y < inImage.br().y; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    std::uint8_t* out = passable.ptr<std::uint8_t>(y - area.y);
+    for (int x = inImage.x; x < inImage.br().x; ++x) {
+      const bool level = std::isfinite(d[x]) && std::abs(d[x] - f.at(x, y)) < s.lowerBy;
+      out[x - area.x] = !std::isfinite(d[x]) || level ? 255 : 0;
+    }
+  }
+  cv::Mat across = filled.clone(), step;
+  const cv::Mat cross = cv::getStructuringElement(cv::MORPH_RECT, {3, 3});
+  for (int k = 0; k < s.gapReach; ++k) {
+    cv::dilate(across, step, cross);
+    step &= passable;
+    if (cv::countNonZero(step & ~across) == 0) break;
+    across |= step;
+  }
+  return across;
+}
+
+// f.ring and f.lower: the matched pixels within ringRadius of `across` (over `area`) outside it,
+// and those lowerBy or more below the plane.
+void RoofPlanes::countRing(Surface& f, const cv::Mat& across, const cv::Rect& area) const {
+  const cv::Rect inImage = area & image;
+  cv::Mat ring;
+  cv::dilate(across, ring, square);
+  for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    const std::uint8_t* in = across.ptr<std::uint8_t>(y - area.y);
+    const std::uint8_t* near = ring.ptr<std::uint8_t>(y - area.y);
+    for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
+      const int u = x - area.x;
+      if (in[u] != 0 || near[u] == 0 || !std::isfinite(d[x])) continue;
+      ++f.ring;
+      if (d[x] <= f.at(x, y) - s.lowerBy) ++f.lower;
+    }
+  }
+}
+
+// The planar surfaces that are raised: `planar` keeps those only. Returns their count.
+int RoofPlanes::keepRaised() {
+  int planes = 0;
   for (size_t i = 0; i < surfaces.size(); ++i) {
     const Surface& f = surfaces[i];
     // A ring of a few pixels tells nothing (the ground, whose outer outline is the image's
@@ -331,8 +385,13 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
     const bool raised = static_cast<double>(f.ring) >= std::sqrt(static_cast<double>(f.count)) &&
                         static_cast<double>(f.lower) >= s.minLowerShare * f.ring;
     planar[i] = planar[i] != 0 && raised ? 1 : 0;
-    if (planar[i] != 0) ++counts.planes;
+    if (planar[i] != 0) ++planes;
   }
+  return planes;
+}
+
+// The kept surfaces' inliers set to their plane, by bands of rows. Returns the pixels set.
+long RoofPlanes::setInliers() {
   std::vector<int> setIn(static_cast<size_t>(disparity.rows), 0);
   forRowBands(disparity.rows, s.threads, [&](int rowStart, int rowEnd) {
     for (int y = rowStart; y < rowEnd; ++y) {
@@ -348,66 +407,88 @@ RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& setti
       setIn[static_cast<size_t>(y)] = set;
     }
   });
-  for (const int n : setIn) counts.pixels += n;
-  // Then the other matched pixels on the roof or around it (within ringRadius of its outer
-  // outline, and across its rim) that lie within absorbWithin of its plane, when they are small
-  // pieces: a roof's pixels beyond the inlier band (or cut from the surface by a jump of more
-  // than `link`) are its matches' outliers, at the roof's level all the same. In surface order;
-  // a pixel takes the first roof that claims it.
-  // A surface reads and writes only the rows of its area: surfaces on disjoint rows are absorbed
-  // side by side, in surface order where their rows overlap (the same result).
-  if (s.absorbWithin > 0) {
-    cv::Mat taken(disparity.size(), CV_8U, cv::Scalar(0));
-    std::vector<size_t> order;
-    std::vector<std::pair<int, int>> rows;
-    for (size_t i = 0; i < surfaces.size(); ++i) {
-      if (planar[i] == 0) continue;
-      const cv::Rect inImage = areaOf[i] & image;
-      order.push_back(i);
-      rows.emplace_back(inImage.y, inImage.y + inImage.height);
-    }
-    std::vector<int> absorbedBy(order.size(), 0);
-    const auto absorb = [&](size_t task) {
-      const size_t i = order[task];
-      const Surface& f = surfaces[i];
-      const cv::Rect area = areaOf[i];
-      const cv::Rect inImage = area & image;
-      // The surface's own pixels beyond its inlier band, by 8-connected blob: a blob of maxPiece
-      // pixels or more is a structure on the roof (a box, a parapet), not its noise.
-      cv::Mat outside(area.size(), CV_8U, cv::Scalar(0));
-      outside(inImage - area.tl())
-          .setTo(255, (labels(inImage) == static_cast<int>(i)) & (keep(inImage) == 0));
-      cv::Mat blobs, blobStats, blobCentroids;
-      cv::connectedComponentsWithStats(outside, blobs, blobStats, blobCentroids, 8, CV_32S);
-      int absorbed = 0;
-      for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
-        float* d = disparity.ptr<float>(y);
-        const int* l = labels.ptr<int>(y);
-        const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-        const int* blob = blobs.ptr<int>(y - area.y);
-        const std::uint8_t* near = grownOf[i].ptr<std::uint8_t>(y - area.y);
-        std::uint8_t* t = taken.ptr<std::uint8_t>(y);
-        for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
-          if (near[x - area.x] == 0 || !std::isfinite(d[x]) || t[x] != 0) continue;
-          if (l[x] >= 0 && k[x] != 0 && planar[static_cast<size_t>(l[x])] != 0) continue;
-          const bool piece = l[x] == kPiece;
-          const bool ownNoise = l[x] == static_cast<int>(i) &&
-                                blobStats.at<int>(blob[x - area.x], cv::CC_STAT_AREA) < maxPiece;
-          if (!piece && !ownNoise) continue;
-          const double p = f.at(x, y);
-          if (std::abs(d[x] - p) <= s.absorbWithin) {
-            d[x] = static_cast<float>(p);
-            t[x] = 1;
-            ++absorbed;
-          }
-        }
-      }
-      absorbedBy[task] = absorbed;
-    };
-    const int helpers = order.size() > 1 ? std::max(0, s.threads - 1) : 0;
-    RowOrderedTasks(rows, absorb, helpers).runWithHelpers();
-    for (const int n : absorbedBy) counts.absorbed += n;
+  long pixels = 0;
+  for (const int n : setIn) pixels += n;
+  return pixels;
+}
+
+// Then the other matched pixels on the roof or around it (within ringRadius of its outer
+// outline, and across its rim) that lie within absorbWithin of its plane, when they are small
+// pieces: a roof's pixels beyond the inlier band (or cut from the surface by a jump of more
+// than `link`) are its matches' outliers, at the roof's level all the same. In surface order;
+// a pixel takes the first roof that claims it.
+// A surface reads and writes only the rows of its area: surfaces on disjoint rows are absorbed
+// side by side, in surface order where their rows overlap (the same result). Returns the pixels
+// set.
+long RoofPlanes::absorbPieces() {
+  cv::Mat taken(disparity.size(), CV_8U, cv::Scalar(0));
+  std::vector<size_t> order;
+  std::vector<std::pair<int, int>> rows;
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    if (planar[i] == 0) continue;
+    const cv::Rect inImage = areaOf[i] & image;
+    order.push_back(i);
+    rows.emplace_back(inImage.y, inImage.y + inImage.height);
   }
+  std::vector<int> absorbedBy(order.size(), 0);
+  const auto absorb = [&](size_t task) { absorbedBy[task] = absorbAround(order[task], taken); };
+  const int helpers = order.size() > 1 ? std::max(0, s.threads - 1) : 0;
+  RowOrderedTasks(rows, absorb, helpers).runWithHelpers();
+  long absorbed = 0;
+  for (const int n : absorbedBy) absorbed += n;
+  return absorbed;
+}
+
+// The small pieces around kept surface i set to its plane, those not `taken` by an earlier
+// roof (marked as taken). Returns their count.
+int RoofPlanes::absorbAround(size_t i, cv::Mat& taken) {
+  const Surface& f = surfaces[i];
+  const cv::Rect area = areaOf[i];
+  const cv::Rect inImage = area & image;
+  // The surface's own pixels beyond its inlier band, by 8-connected blob: a blob of maxPiece
+  // pixels or more is a structure on the roof (a box, a parapet), not its noise.
+  cv::Mat outside(area.size(), CV_8U, cv::Scalar(0));
+  outside(inImage - area.tl())
+      .setTo(255, (labels(inImage) == static_cast<int>(i)) & (keep(inImage) == 0));
+  cv::Mat blobs, blobStats, blobCentroids;
+  cv::connectedComponentsWithStats(outside, blobs, blobStats, blobCentroids, 8, CV_32S);
+  int absorbed = 0;
+  for (int y = inImage.y; y < inImage.y + inImage.height; ++y) {
+    float* d = disparity.ptr<float>(y);
+    const int* l = labels.ptr<int>(y);
+    const std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+    const int* blob = blobs.ptr<int>(y - area.y);
+    const std::uint8_t* near = grownOf[i].ptr<std::uint8_t>(y - area.y);
+    std::uint8_t* t = taken.ptr<std::uint8_t>(y);
+    for (int x = inImage.x; x < inImage.x + inImage.width; ++x) {
+      if (near[x - area.x] == 0 || !std::isfinite(d[x]) || t[x] != 0) continue;
+      if (l[x] >= 0 && k[x] != 0 && planar[static_cast<size_t>(l[x])] != 0) continue;
+      const bool piece = l[x] == kPiece;
+      const bool ownNoise = l[x] == static_cast<int>(i) &&
+                            blobStats.at<int>(blob[x - area.x], cv::CC_STAT_AREA) < maxPiece;
+      if (!piece && !ownNoise) continue;
+      const double p = f.at(x, y);
+      if (std::abs(d[x] - p) <= s.absorbWithin) {
+        d[x] = static_cast<float>(p);
+        t[x] = 1;
+        ++absorbed;
+      }
+    }
+  }
+  return absorbed;
+}
+
+}  // namespace
+
+RoofPlaneCounts fitRoofPlanes(cv::Mat& disparity, const RoofPlaneSettings& settings) {
+  CV_Assert(disparity.type() == CV_32F);
+  RoofPlaneCounts counts;
+  RoofPlanes roofs{disparity, settings};
+  if (!roofs.fitSurfaces()) return counts;
+  roofs.measureRings();
+  counts.planes = roofs.keepRaised();
+  counts.pixels = roofs.setInliers();
+  if (settings.absorbWithin > 0) counts.absorbed = roofs.absorbPieces();
   return counts;
 }
 
