@@ -162,95 +162,191 @@ int threadCount(const MatchParams& p) {
   return std::max(1U, std::thread::hardware_concurrency());
 }
 
-MatchResult matchAdaptiveSteps(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                               core::Progress* progress) {
-  MatchResult result;
+// The pyramid's levels: as asked or from the range, the coarsest kept at least kMinLevelSide.
+int levelCount(const cv::Mat& image, const MatchParams& p) {
   int levels = p.levels > 0 ? p.levels : autoLevels(p.dmin, p.dmax);
-  while (levels > 1 && std::min(left.cols, left.rows) / (1 << (levels - 1)) < kMinLevelSide) {
+  while (levels > 1 && std::min(image.cols, image.rows) / (1 << (levels - 1)) < kMinLevelSide) {
     --levels;
   }
-  result.levelsUsed = levels;
+  return levels;
+}
 
-  const int threads = threadCount(p);
-  // Its helpers serve the match's parallel steps (see WorkerPool).
-  detail::WorkerPool workerPool(threads - 1);
-  const detail::WorkerPool::Scope poolScope(workerPool);
+// The adaptive matcher's state from the pyramids to the final map; runStages() lists its stages.
+struct AdaptiveMatch {
+  AdaptiveMatch(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                core::Progress* progress, int threads);
+  bool runStages();
+  void buildPyramids();
+  void buildPyramidSide(bool isLeft, const GreyMapping& g);
+  void findEdgesAndFlatPixels();
+  bool matchLevels();
+  bool reachedButCanceled(double fraction);
+  void takeFinestLevelMap();
+  void fillFlatRegions();
+  void prepareImages();
+  void releaseLevels();
+  void rejectWeakMatchesBesideSteps();
+  void rejectWeakPlainMatchesBesideSteps();
+  void rejectWeakMatchesBesideUnmatchedPlain();
+  void recoverSlantedFacets();
+  void removeSpeckles(core::StageId stage);
+  void snapDepthSteps();
+  void rejectOrderingViolations();
+  void smoothSurfaces();
+  void fitRoofPlanes();
+
+  const cv::Mat& left;
+  const cv::Mat& right;
+  const MatchParams& p;
+  core::Progress* const progress;
+  const int threads, levels;
+  const bool plainPass;  // the weak-match passes over plain pixels run (they read `plain`)
+  const detail::RegionFillSettings fillSettings;
+  MatchResult result;
+  std::vector<detail::PyramidLevel> pyramid;
+  detail::LocalMoments leftMoments;  // for the steps after the levels
+  cv::Mat rightFlat;                 // the right image's flat pixels, for the fill
+  detail::LevelMaps maps;
+  detail::StepContrast contrast;  // for the snapping
+  cv::Mat plain;                  // the left image's plain pixels, for the weak-match passes
+};
+
+AdaptiveMatch::AdaptiveMatch(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                             core::Progress* progress, int threads)
+    : left(left),
+      right(right),
+      p(p),
+      progress(progress),
+      threads(threads),
+      levels(levelCount(left, p)),
+      plainPass(p.adaptive && (p.plainStepMinScore > 0 || p.unmatchedPlainMinScore > 0)) {
+  result.levelsUsed = levels;
+}
+
+// The stages in order. False when canceled between them (status Canceled, no maps); a cancel
+// within a step throws (workers.hpp).
+bool AdaptiveMatch::runStages() {
+  buildPyramids();
+  findEdgesAndFlatPixels();
+  if (!matchLevels()) return false;
+  // The steps after the levels report their share and are polled too: a cancel is honoured
+  // between them.
+  if (reachedButCanceled(0.85)) return false;
+  takeFinestLevelMap();
+  fillFlatRegions();
+  if (p.adaptive && p.stepMinScore > 0) rejectWeakMatchesBesideSteps();
+  if (plainPass && p.plainStepMinScore > 0) rejectWeakPlainMatchesBesideSteps();
+  if (plainPass && p.unmatchedPlainMinScore > 0) rejectWeakMatchesBesideUnmatchedPlain();
+  if (p.adaptive && p.facetMaxSlope > 0) recoverSlantedFacets();
+  if (reachedButCanceled(0.9)) return false;
+  if (p.speckleSize > 0) {
+    removeSpeckles(core::StageId::RemovingSpeckles);
+    if (reachedButCanceled(0.92)) return false;
+  }
+  if (p.snapSteps && p.adaptive) {
+    snapDepthSteps();
+    if (reachedButCanceled(0.98)) return false;
+  }
+  if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {
+    removeSpeckles(core::StageId::RemovingSnappingSpeckles);
+  }
+  if (p.orderingCheck) rejectOrderingViolations();
+  if (p.smoothWindow > 0) smoothSurfaces();
+  if (p.planeResidual > 0) {
+    if (reachedButCanceled(0.99)) return false;
+    fitRoofPlanes();
+  }
+  return true;
+}
+
+// Both images grey-mapped alike, then halved level by level. Left and right are independent up
+// to the matching: each side's preparation and pyramid is one task.
+void AdaptiveMatch::buildPyramids() {
   core::setStage(progress, core::StageId::PreparingPyramids);
   const GreyMapping g = greyMapping(left, right, threads);
-  std::vector<detail::PyramidLevel> pyramid(static_cast<size_t>(levels));
-  // Left and right are independent up to the matching: each side's preparation and pyramid is
-  // one task, then the Canny edges of every level and side are one task each.
-  auto buildSide = [&](bool isLeft) {
-    detail::PyramidLevel& base = pyramid[0];
-    prepare(isLeft ? left : right, g, isLeft ? base.left : base.right,
-            isLeft ? base.leftValid : base.rightValid);
-    for (int k = 1; k < levels; ++k) {
-      detail::throwIfCanceled();
-      detail::PyramidLevel& fine = pyramid[static_cast<size_t>(k - 1)];
-      detail::PyramidLevel& coarse = pyramid[static_cast<size_t>(k)];
-      cv::pyrDown(isLeft ? fine.left : fine.right, isLeft ? coarse.left : coarse.right);
-      // A coarse pixel holds data only when its whole footprint did.
-      (isLeft ? coarse.leftValid : coarse.rightValid) =
-          coarseValid(isLeft ? fine.leftValid : fine.rightValid);
-    }
-  };
-  runTasks({[&] { buildSide(true); }, [&] { buildSide(false); }}, threads);
+  pyramid.resize(static_cast<size_t>(levels));
+  runTasks({[&] { buildPyramidSide(true, g); }, [&] { buildPyramidSide(false, g); }}, threads);
+  for (int k = 0; k < levels; ++k) {
+    detail::PyramidLevel& lv = pyramid[static_cast<size_t>(k)];
+    lv.dmin = floorDiv(p.dmin, 1 << k);
+    lv.dmax = ceilDiv(p.dmax, 1 << k);
+  }
+}
+
+void AdaptiveMatch::buildPyramidSide(bool isLeft, const GreyMapping& g) {
+  detail::PyramidLevel& base = pyramid[0];
+  prepare(isLeft ? left : right, g, isLeft ? base.left : base.right,
+          isLeft ? base.leftValid : base.rightValid);
+  for (int k = 1; k < levels; ++k) {
+    detail::throwIfCanceled();
+    detail::PyramidLevel& fine = pyramid[static_cast<size_t>(k - 1)];
+    detail::PyramidLevel& coarse = pyramid[static_cast<size_t>(k)];
+    cv::pyrDown(isLeft ? fine.left : fine.right, isLeft ? coarse.left : coarse.right);
+    // A coarse pixel holds data only when its whole footprint did.
+    (isLeft ? coarse.leftValid : coarse.rightValid) =
+        coarseValid(isLeft ? fine.leftValid : fine.rightValid);
+  }
+}
+
+// The Canny edges of every level and side, one task each, and among them the flat tests' inputs.
+void AdaptiveMatch::findEdgesAndFlatPixels() {
   // The left image's 5x5 moments and noise, for the steps after the levels (the fill's flat
   // regions, the plain pixels, the snapping's contrast): one more task here, where the edges
   // leave a worker idle at times, instead of three computations of them after the levels.
   const bool afterSteps = p.adaptive && (p.fillRegions || p.snapSteps || p.plainStepMinScore > 0 ||
                                          p.unmatchedPlainMinScore > 0);
-  detail::LocalMoments leftMoments;
   // The right image's flat pixels, for the fill's right flat regions, which its regions wait for:
   // made here, where they lengthen the stage by less than they did the fill's wait (1000² /
   // 128 d, ~6 ms); the mask only is kept (the moments took 32 MB more at 2000² up to the fill).
   const bool fillsRegions = p.adaptive && p.fillRegions;
-  const detail::RegionFillSettings fillSettings;
-  cv::Mat rightFlat;
   std::vector<std::function<void()>> edgeTasks;
   for (int k = 0; k < levels; ++k) {
     detail::PyramidLevel& lv = pyramid[static_cast<size_t>(k)];
-    edgeTasks.emplace_back([&lv, &p] { lv.leftEdges = edgeMap(lv.left, p); });
-    edgeTasks.emplace_back([&lv, &p] { lv.rightEdges = edgeMap(lv.right, p); });
-    lv.dmin = floorDiv(p.dmin, 1 << k);
-    lv.dmax = ceilDiv(p.dmax, 1 << k);
+    edgeTasks.emplace_back([&lv, this] { lv.leftEdges = edgeMap(lv.left, p); });
+    edgeTasks.emplace_back([&lv, this] { lv.rightEdges = edgeMap(lv.right, p); });
     // The tasks are taken in order, the longest first: the moments (full size, about 60 % of a
-    // finest edge map's time) right after the finest level's edges. Last, they ran alone on one
-    // worker for ~10 ms at 1000² while the other waited.
+    // finest edge map's time) right after the finest level's edges, not last, where they ran
+    // alone on one worker (~10 ms at 1000²).
     if (k == 0 && afterSteps) {
-      edgeTasks.emplace_back([&] { leftMoments = detail::localMoments(left); });
+      edgeTasks.emplace_back([this] { leftMoments = detail::localMoments(left); });
     }
     if (k == 0 && fillsRegions) {
       edgeTasks.emplace_back(
-          [&] { rightFlat = detail::plainPixels(right, fillSettings.flatSigmas); });
+          [this] { rightFlat = detail::plainPixels(right, fillSettings.flatSigmas); });
     }
   }
   runTasks(edgeTasks, threads);
+}
 
+// The levels, coarse to fine. False when canceled (status Canceled, no maps).
+bool AdaptiveMatch::matchLevels() {
   // The steps after the levels' matching (the finest level's refinement, fill, speckles,
   // snapping) take ~20 % of the time at 1 Mpx: the bar does not sit at 100 % meanwhile.
   const bool postSteps =
       (p.adaptive && (p.stepCut || p.fillRegions || p.snapSteps)) || p.speckleSize > 0;
   const double levelsShare = postSteps ? 0.8 : 1.0;
-  detail::LevelMaps maps;
-  if (!detail::matchLevelsCoarseToFine(pyramid, p, threads, levelsShare, progress, maps)) {
-    result.status = core::RunStatus::Canceled;
-    return result;
-  }
-  // The steps after the levels report their share and are polled too: a cancel is honoured
-  // between them.
-  const auto reachedButCanceled = [&](double fraction) {
-    core::report(progress, fraction);
-    if (!core::isCanceled(progress)) return false;
-    // As when canceled during the levels: no maps.
-    result.disparity.release();
-    result.score.release();
-    result.status = core::RunStatus::Canceled;
+  if (detail::matchLevelsCoarseToFine(pyramid, p, threads, levelsShare, progress, maps)) {
     return true;
-  };
-  if (reachedButCanceled(0.85)) return result;
+  }
+  result.status = core::RunStatus::Canceled;
+  return false;
+}
+
+// Reports `fraction`; when canceled, the status says so and the maps are released (as when
+// canceled during the levels).
+bool AdaptiveMatch::reachedButCanceled(double fraction) {
+  core::report(progress, fraction);
+  if (!core::isCanceled(progress)) return false;
+  result.disparity.release();
+  result.score.release();
+  result.status = core::RunStatus::Canceled;
+  return true;
+}
+
+// The finest level's validated left map, and its scores where the disparity is a number (NaN
+// elsewhere), in one pass by bands.
+void AdaptiveMatch::takeFinestLevelMap() {
   result.disparity = maps.validatedLeft;
-  // The left scores where the disparity is a number (NaN elsewhere), in one pass by bands.
   result.score.create(maps.leftOut.score.size(), CV_32F);
   forRowBands(result.score.rows, threads, [&](int rowStart, int rowEnd) {
     for (int y = rowStart; y < rowEnd; ++y) {
@@ -260,136 +356,149 @@ MatchResult matchAdaptiveSteps(const cv::Mat& left, const cv::Mat& right, const 
       for (int x = 0; x < result.score.cols; ++x) out[x] = d[x] == d[x] ? sc[x] : kNaN;
     }
   });
-  // The fill runs on one worker; the snapping's contrast map and the plain pixels of the weak
-  // matches' wider pass (images only) are prepared on the other meanwhile, after the fill's own
-  // preparations there.
+}
+
+// The fill runs on one worker; the snapping's contrast map and the plain pixels of the weak
+// matches' wider pass (images only) are prepared on the other meanwhile, after the fill's own
+// preparations there.
+void AdaptiveMatch::fillFlatRegions() {
   core::setStage(progress, core::StageId::FillingFlatRegions);
-  detail::StepContrast contrast;
-  cv::Mat plain;
-  const bool plainPass = p.adaptive && (p.plainStepMinScore > 0 || p.unmatchedPlainMinScore > 0);
-  const auto prepareImages = [&] {
-    if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right, leftMoments.noise);
-    if (plainPass) plain = detail::plainPixels(left, 3.0, &leftMoments);
-  };
-  // The levels' maps and images are no longer needed (but the finest left edges, for the
-  // facets): released by the fill's second worker once the regions are decided, where their
-  // pages' return to the system (~5 ms at 1 Mpx) fills the gaps of the regions' extension instead
-  // of running alone at the end.
-  const auto releaseLevels = [&] {
-    const cv::Mat finestLeftEdges = pyramid[0].leftEdges;
-    pyramid.assign(1, detail::PyramidLevel{});
-    pyramid[0].leftEdges = finestLeftEdges;
-    maps.leftOut = {};
-    maps.rightOut = {};
-    maps.validatedRight.release();
-    maps.finestBuffers = {};
-    rightFlat.release();  // the right flat regions are made by then
-  };
   if (p.fillRegions && p.adaptive) {
-    detail::fillFlatRegions(left, right, fillSettings, p.dmin, p.dmax,
-                            static_cast<float>(p.minScore), result.disparity, result.score, threads,
-                            prepareImages, &leftMoments, releaseLevels, &rightFlat);
+    detail::fillFlatRegions(
+        left, right, fillSettings, p.dmin, p.dmax, static_cast<float>(p.minScore), result.disparity,
+        result.score, threads, [this] { prepareImages(); }, &leftMoments,
+        [this] { releaseLevels(); }, &rightFlat);
   } else {
     prepareImages();
     releaseLevels();
   }
-  // After the fill, whose candidates are the matches around a region (before it, a roof's weak
-  // edge matches went and the fill took a box on it for the whole roof: sim seed 15 600², roof
-  // RMS 0.290 -> 0.432 px), and before the speckles and the snapping, which close the gaps left.
-  if (p.adaptive && p.stepMinScore > 0) {
-    detail::WeakMatchSettings weak;
-    weak.minScore = p.stepMinScore;
-    weak.threads = threads;
-    detail::rejectWeakMatchesBesideSteps(weak, static_cast<float>(p.minScore), result.disparity,
-                                         result.score);
-  }
-  // Then a wider pass over plain pixels (5x5 standard deviation below 3 noise sigmas): a plain
-  // roof's pixels up to 7 px from a step whose windows reached the ground across a contour Canny
-  // missed (seed 28 600²: an 8 px patch 62 px off, 4-7 px inside the roof, scoring 0.53-0.59;
-  // roof RMS 0.919 -> 0.210 px). Textured pixels are left alone: on the Dublin tile the same pass
-  // over every pixel removed 3.8 points of density whose bad-2 was below the rest's.
-  if (plainPass && p.plainStepMinScore > 0) {
-    detail::WeakMatchSettings wide;
-    wide.minScore = p.plainStepMinScore;
-    wide.radius = 7;
-    wide.threads = threads;
-    detail::rejectWeakMatchesBesideSteps(wide, static_cast<float>(p.minScore), result.disparity,
-                                         result.score, plain);
-  }
-  // Then the weak matches on plain pixels beside a plain region the fill could not decide (a roof
-  // and the ground of one grey): the windows of the surface beside it that reached into it (sim
-  // seed 15 1000²: roof RMS 0.260 -> 0.134 px; see docs/stereo.md, step 11).
-  if (plainPass && p.unmatchedPlainMinScore > 0) {
-    detail::UnmatchedPlainSettings beside;
-    beside.minScore = p.unmatchedPlainMinScore;
-    beside.threads = threads;
-    detail::rejectWeakMatchesBesideUnmatchedPlain(beside, static_cast<float>(p.minScore), plain,
-                                                  result.disparity, result.score);
-  }
-  // Then the steep facets left unmatched, matched region by region on slanted planes; before the
-  // speckles, the snapping and the ordering check, which treat their matches like any other.
-  if (p.adaptive && p.facetMaxSlope > 0) {
-    detail::SlantedFacetSettings facets;
-    facets.maxSlope = p.facetMaxSlope;
-    facets.threads = threads;
-    detail::recoverSlantedFacets(left, right, pyramid[0].leftEdges, facets, p.dmin, p.dmax,
-                                 result.disparity, result.score);
-  }
-  if (reachedButCanceled(0.9)) return result;
-  // Speckles are removed after the fill (before it, the fill lost its seeds: 600² edge 66.1 %
-  // against 74.7 % removed last) and before the snapping, whose steps a wrong island inside the
-  // gap between a roof and the ground split (sim 400² edge 88.1 → 90.7 %, seed 3 600² 76.1 →
-  // 79.5 %); and again last, for the islands the snapping's cuts leave.
-  if (p.speckleSize > 0) {
-    core::setStage(progress, core::StageId::RemovingSpeckles);
-    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
-    if (reachedButCanceled(0.92)) return result;
-  }
-  if (p.snapSteps && p.adaptive) {
-    // Last, after the fill: a filled roof's edges are snapped like matched ones.
-    core::setStage(progress, core::StageId::SnappingDepthSteps);
-    detail::StepSnapSettings snap;
-    snap.threads = threads;
-    detail::snapStepsToContours(left, right, contrast, snap, static_cast<float>(p.minScore),
-                                result.disparity, result.score);
-    detail::RowStepSnapSettings rows;
-    rows.threads = threads;
-    detail::snapStepsAcrossRows(left, right, contrast.sigma, rows, static_cast<float>(p.minScore),
-                                result.disparity, result.score);
-    if (reachedButCanceled(0.98)) return result;
-  }
-  if (p.speckleSize > 0 && p.snapSteps && p.adaptive) {
-    core::setStage(progress, core::StageId::RemovingSnappingSpeckles);
-    detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
-  }
-  // On the final map, after every step that sets matches (the fill's matches can be hidden too)
-  // and before the smoothing, which would average a hidden match into the surface hiding it.
-  // (600² roof RMS over all matches 2.121 -> 0.226 px; see docs/stereo.md, step 16.)
-  if (p.orderingCheck) {
-    detail::OrderingSettings ordering;
-    ordering.threads = threads;
-    detail::rejectOrderingViolations(result.disparity, result.score, ordering);
-  }
-  // Last: on the final map, where the fill, the snapping and the speckle removal have set the
-  // steps that the smoothing must not cross. (Flat-roof RMS of the matches within 1 px, 5x5 and
-  // 1 px: sim seed 6 600² 0.255 -> 0.220, 600² 0.233 -> 0.205; see docs/stereo.md.)
-  if (p.smoothWindow > 0) {
-    detail::smoothSurfaces(result.disparity, p.smoothWindow, p.smoothTolerance, threads);
-  }
-  // After the smoothing: a roof's matches are noisy at the scale of the correlation window, which
-  // a 5x5 mean cannot average out; a plane over the whole roof does (see docs/stereo.md, step
-  // 18).
-  if (p.planeResidual > 0) {
-    if (reachedButCanceled(0.99)) return result;
-    core::setStage(progress, core::StageId::FittingRoofPlanes);
-    detail::RoofPlaneSettings planes;
-    planes.maxResidual = p.planeResidual;
-    planes.minPixels = p.planeMinArea;
-    planes.threads = threads;
-    detail::fitRoofPlanes(result.disparity, planes);
-  }
-  core::report(progress, 1.0);
-  return result;
+}
+
+void AdaptiveMatch::prepareImages() {
+  if (p.snapSteps && p.adaptive) contrast = detail::stepContrast(left, right, leftMoments.noise);
+  if (plainPass) plain = detail::plainPixels(left, 3.0, &leftMoments);
+}
+
+// The levels' maps and images are no longer needed (but the finest left edges, for the facets):
+// released by the fill's second worker once the regions are decided, where their pages' return
+// to the system (~5 ms at 1 Mpx) fills the gaps of the regions' extension instead of running
+// alone at the end.
+void AdaptiveMatch::releaseLevels() {
+  const cv::Mat finestLeftEdges = pyramid[0].leftEdges;
+  pyramid.assign(1, detail::PyramidLevel{});
+  pyramid[0].leftEdges = finestLeftEdges;
+  maps.leftOut = {};
+  maps.rightOut = {};
+  maps.validatedRight.release();
+  maps.finestBuffers = {};
+  rightFlat.release();  // the right flat regions are made by then
+}
+
+// After the fill, whose candidates are the matches around a region (before it, a roof's weak
+// edge matches went and the fill took a box on it for the whole roof: sim seed 15 600², roof
+// RMS 0.290 -> 0.432 px), and before the speckles and the snapping, which close the gaps left.
+void AdaptiveMatch::rejectWeakMatchesBesideSteps() {
+  detail::WeakMatchSettings weak;
+  weak.minScore = p.stepMinScore;
+  weak.threads = threads;
+  detail::rejectWeakMatchesBesideSteps(weak, static_cast<float>(p.minScore), result.disparity,
+                                       result.score);
+}
+
+// Then a wider pass over plain pixels (5x5 standard deviation below 3 noise sigmas): a plain
+// roof's pixels up to 7 px from a step whose windows reached the ground across a contour Canny
+// missed (seed 28 600²: an 8 px patch 62 px off, 4-7 px inside the roof, scoring 0.53-0.59;
+// roof RMS 0.919 -> 0.210 px). Textured pixels are left alone: on the Dublin tile the same pass
+// over every pixel removed 3.8 points of density whose bad-2 was below the rest's.
+void AdaptiveMatch::rejectWeakPlainMatchesBesideSteps() {
+  detail::WeakMatchSettings wide;
+  wide.minScore = p.plainStepMinScore;
+  wide.radius = 7;
+  wide.threads = threads;
+  detail::rejectWeakMatchesBesideSteps(wide, static_cast<float>(p.minScore), result.disparity,
+                                       result.score, plain);
+}
+
+// Then the weak matches on plain pixels beside a plain region the fill could not decide (a roof
+// and the ground of one grey): the windows of the surface beside it that reached into it (sim
+// seed 15 1000²: roof RMS 0.260 -> 0.134 px; see docs/stereo.md, step 11).
+void AdaptiveMatch::rejectWeakMatchesBesideUnmatchedPlain() {
+  detail::UnmatchedPlainSettings beside;
+  beside.minScore = p.unmatchedPlainMinScore;
+  beside.threads = threads;
+  detail::rejectWeakMatchesBesideUnmatchedPlain(beside, static_cast<float>(p.minScore), plain,
+                                                result.disparity, result.score);
+}
+
+// Then the steep facets left unmatched, matched region by region on slanted planes; before the
+// speckles, the snapping and the ordering check, which treat their matches like any other.
+void AdaptiveMatch::recoverSlantedFacets() {
+  detail::SlantedFacetSettings facets;
+  facets.maxSlope = p.facetMaxSlope;
+  facets.threads = threads;
+  detail::recoverSlantedFacets(left, right, pyramid[0].leftEdges, facets, p.dmin, p.dmax,
+                               result.disparity, result.score);
+}
+
+// Speckles are removed after the fill (before it, the fill lost its seeds: 600² edge 66.1 %
+// against 74.7 % removed last) and before the snapping, whose steps a wrong island inside the
+// gap between a roof and the ground split (sim 400² edge 88.1 → 90.7 %, seed 3 600² 76.1 →
+// 79.5 %); and again last, for the islands the snapping's cuts leave.
+void AdaptiveMatch::removeSpeckles(core::StageId stage) {
+  core::setStage(progress, stage);
+  detail::removeSpeckles(result.disparity, result.score, p.speckleSize, p.speckleRange, threads);
+}
+
+// Along the rows, then across them. After the fill: a filled roof's edges are snapped like
+// matched ones.
+void AdaptiveMatch::snapDepthSteps() {
+  core::setStage(progress, core::StageId::SnappingDepthSteps);
+  detail::StepSnapSettings snap;
+  snap.threads = threads;
+  detail::snapStepsToContours(left, right, contrast, snap, static_cast<float>(p.minScore),
+                              result.disparity, result.score);
+  detail::RowStepSnapSettings rows;
+  rows.threads = threads;
+  detail::snapStepsAcrossRows(left, right, contrast.sigma, rows, static_cast<float>(p.minScore),
+                              result.disparity, result.score);
+}
+
+// On the final map, after every step that sets matches (the fill's matches can be hidden too)
+// and before the smoothing, which would average a hidden match into the surface hiding it.
+// (600² roof RMS over all matches 2.121 -> 0.226 px; see docs/stereo.md, step 16.)
+void AdaptiveMatch::rejectOrderingViolations() {
+  detail::OrderingSettings ordering;
+  ordering.threads = threads;
+  detail::rejectOrderingViolations(result.disparity, result.score, ordering);
+}
+
+// On the final map, where the fill, the snapping and the speckle removal have set the steps
+// that the smoothing must not cross. (Flat-roof RMS of the matches within 1 px, 5x5 and 1 px:
+// sim seed 6 600² 0.255 -> 0.220, 600² 0.233 -> 0.205; see docs/stereo.md.)
+void AdaptiveMatch::smoothSurfaces() {
+  detail::smoothSurfaces(result.disparity, p.smoothWindow, p.smoothTolerance, threads);
+}
+
+// After the smoothing: a roof's matches are noisy at the scale of the correlation window, which
+// a 5x5 mean cannot average out; a plane over the whole roof does (see docs/stereo.md, step 18).
+void AdaptiveMatch::fitRoofPlanes() {
+  core::setStage(progress, core::StageId::FittingRoofPlanes);
+  detail::RoofPlaneSettings planes;
+  planes.maxResidual = p.planeResidual;
+  planes.minPixels = p.planeMinArea;
+  planes.threads = threads;
+  detail::fitRoofPlanes(result.disparity, planes);
+}
+
+MatchResult matchAdaptiveSteps(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
+                               core::Progress* progress) {
+  const int threads = threadCount(p);
+  // Its helpers serve the match's parallel steps (see WorkerPool).
+  detail::WorkerPool workerPool(threads - 1);
+  const detail::WorkerPool::Scope poolScope(workerPool);
+  AdaptiveMatch match(left, right, p, progress, threads);
+  if (match.runStages()) core::report(progress, 1.0);
+  return std::move(match.result);
 }
 
 // The steps poll the cancel within (workers.hpp): a cancel ends the match from any of them.
