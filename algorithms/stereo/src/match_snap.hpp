@@ -30,7 +30,7 @@ struct StepSnapSettings {
   double errorCap = 6.0;            // noise sigmas: most a single pixel's error counts
   int nearSlopePixels = 16;         // px: near-side pixels its slope is fitted on (0 = off)
   double maxNearSlope = 0.5;        // px of disparity per px: steepest near-side slope taken
-  // Continuity of the checked cut across rows (see chooseCuts in match_snap.cpp).
+  // Continuity of the checked cut across rows (see chooseCuts in match_snap_cut_lines.hpp).
   int lineRows = 6;            // rows each side of a row's line through the cuts (0 = off)
   double lineCap = 5.0;        // noise sigmas: most a row off the line adds to its cost
   double linkDisparity = 1.5;  // px: same step in the next row when both sides are this close
