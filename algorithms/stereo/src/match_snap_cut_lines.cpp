@@ -159,8 +159,8 @@ class CutChain {
       if (q == nullptr) continue;
       const int e = e0 + offsets[k + settings_.lineRows];
       const int j = e - q->eFirst;
-      sum += j >= 0 && j < static_cast<int>(q->cost.size()) ? q->cost[static_cast<size_t>(j)]
-                                                            : cap_;
+      sum +=
+          j >= 0 && j < static_cast<int>(q->cost.size()) ? q->cost[static_cast<size_t>(j)] : cap_;
     }
     return sum;
   }

@@ -199,8 +199,7 @@ class AcrossRowsPass {
 int snapPass(const cv::Mat& left, const cv::Mat& right, double sigma, double gain, double offset,
              const RowStepSnapSettings& settings, float fillScore, cv::Mat& disparity,
              cv::Mat& score) {
-  AcrossRowsPass pass(left, right, sigma, gain, offset, settings, fillScore, disparity,
-                            score);
+  AcrossRowsPass pass(left, right, sigma, gain, offset, settings, fillScore, disparity, score);
   std::vector<int> changedPerColumn(static_cast<size_t>(left.cols), 0);
   forRowBands(left.cols, settings.threads, [&](int colStart, int colEnd) {
     for (int x = colStart; x < colEnd; ++x) {
