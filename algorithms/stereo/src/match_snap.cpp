@@ -357,7 +357,7 @@ int AlongRowsSnapping::snapSteps(const SnapRow& row, std::vector<NearSideCut>& c
 // is missing: it biased the cut towards the ground), minus contourWeight × the contrast between
 // e and e + 1. s0 goes back over the near side's pixels by up to cutReach (fattened roofs),
 // over holes of at most nearHoleGap unmatched pixels too (a roof's pixel matched alone before
-// its outline was kept by the cut and then removed as a speckle, the hole left open). Errors
+// its outline would otherwise stay an island, removed as a speckle, and leave a hole). Errors
 // are capped so that one outlier pixel does not decide. Pixels up to e take the near
 // disparity, the near pixels after it become unmatched; the far side is left alone.
 NearSideCut AlongRowsSnapping::cutCosts(const SnapRow& row, int a, int b) const {
@@ -380,8 +380,8 @@ NearSideCut AlongRowsSnapping::cutCosts(const SnapRow& row, int a, int b) const 
   double nearSum[kMaxCutSpan + 1], farSum[kMaxCutSpan + 1];
   nearSum[0] = farSum[0] = 0;
   // The near surface may slope along the row (a pitched roof's facet, sloping towards its
-  // outline): its disparity follows the line fitted to its last pixels, through d[a]. (The hard
-  // end below reads the level near disparity: along the slope, seed 3 600² lost 0.2 edge%.)
+  // outline): its disparity follows the line fitted to its last pixels, through d[a]. (hardEnd
+  // reads the level near disparity: along the slope, seed 3 600² lost 0.2 edge%.)
   cut.a = a;
   cut.slope = static_cast<float>(nearSlope(a, d, 0.5 * (cut.dNear + cut.dFar)));
   for (int k = 0; k < n; ++k) {

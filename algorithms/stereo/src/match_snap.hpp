@@ -34,9 +34,8 @@ struct StepSnapSettings {
   int lineRows = 6;            // rows each side of a row's line through the cuts (0 = off)
   double lineCap = 5.0;        // noise sigmas: most a row off the line adds to its cost
   double linkDisparity = 1.5;  // px: same step in the next row when both sides are this close
-  double maxSlope = 6.0;       // px per row: steepest line tried (at 3, a roof's outline at
-                               //   3.7 px per row was left to each row alone, and rows 2-5 px
-                               //   fattened stayed; 6 against 3: 38 scenes' mean edge +0.1)
+  double maxSlope = 6.0;       // px per row: steepest line tried (roof outlines reach 3.7 px
+                               //   per row; 6 against 3: 38 scenes' mean edge +0.1)
   int slopeSteps = 24;         // slopes tried on each side of vertical (0.25 px per row apart)
   int threads = 1;             // workers over bands of rows (same result on any number)
 };
@@ -47,8 +46,8 @@ struct StepSnapSettings {
 // `right` given and checkSigmas > 0, the near side's last pixel e is chosen in [a − cutReach,
 // b − 1] (back over the near side's own pixels only, and over holes of at most nearHoleGap
 // unmatched pixels between them: a roof's pixel matched alone just before its outline, a few pixels
-// after the roof's run, was kept by the cut and then removed as a speckle, the hole between them
-// left open) at the least total photometric error (mean |left − mapped right| of the pixel and its
+// after the roof's run, would otherwise stay an island that the speckle filter removes, leaving
+// a hole) at the least total photometric error (mean |left − mapped right| of the pixel and its
 // two vertical neighbours, in noise sigmas, capped at errorCap): near pixels at the near disparity
 // up to e, far ones at the far disparity from e + 2 (the near disparity follows the near side's
 // slope along the row: the least-squares line through the row's matched pixels of its last
