@@ -276,27 +276,17 @@ int real(const std::string& dataRoot, const std::string& labels, const std::stri
   std::ifstream in(labels);
   const nlohmann::json data = nlohmann::json::parse(in);
   constexpr double kMetresPerPixel = 0.25;  // as the GUI scenario's height model on Toulouse
-  std::map<std::string, cv::Mat> maps, lefts, rights;
+  bench::RealPairs pairs(data, dataRoot, cache);
   std::map<std::string, std::vector<double>> boxIou, activeIou, boxMs, boxVerts, activeVerts;
   std::printf("%-18s %-9s | %-7s %5s %5s %6s | %-7s %5s | %s\n", "roof", "set", "boxfit", "verts", "boxes", "ms", "active",
               "verts", "note");
   for (const auto& roof : data.at("roofs")) {
     const std::string name = roof.at("name"), pairName = roof.at("pair");
     if (const char* only = std::getenv("BENCH_ONLY"); only && name != only) continue;
-    const auto& pair = data.at("pairs").at(pairName);
-    const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
-    const std::string right = (fs::path(dataRoot) / pair.at("right").get<std::string>()).string();
-    if (!fs::exists(left) || !fs::exists(right)) {
-      std::printf("skipped %s: %s missing\n", name.c_str(), left.c_str());
-      continue;
-    }
-    const int dmin = pair.at("disparity_range").at(0), dmax = pair.at("disparity_range").at(1);
-    if (!maps.count(pairName)) {
-      maps[pairName] = bench::disparityFor(pairName, left, right, dmin, dmax, cache);
-      lefts[pairName] = io::readGreyFloat(left);
-      rights[pairName] = io::readGreyFloat(right);
-    }
-    const cv::Mat& disparity = maps[pairName];
+    const bench::RealPair* pair = pairs.get(pairName);
+    if (!pair) continue;
+    const int dmin = pair->dmin, dmax = pair->dmax;
+    const cv::Mat& disparity = pair->disparity;
     const cv::Mat heights = boxfit::heightsFromDisparity(disparity, 0.0, kMetresPerPixel);
     const core::Polygon truth = bench::ringOf(roof.at("outline"));
     const core::Polygon rect = grownBox(truth, grow, disparity.size());
@@ -304,7 +294,7 @@ int real(const std::string& dataRoot, const std::string& labels, const std::stri
     boxfit::BoxFitRequest request;
     request.init = rect;
     const double t0 = cpuMs();
-    const auto result = boxfit::fitBoxes(heights, lefts[pairName], request, params);
+    const auto result = boxfit::fitBoxes(heights, pair->left, request, params);
     const double ms = cpuMs() - t0;
     const boxfit::BoxFitBuilding* b = result.buildings.empty() ? nullptr : &result.buildings.front();
     const double bi = b ? iou(b->outline, truth) : 0.0;
@@ -323,7 +313,7 @@ int real(const std::string& dataRoot, const std::string& labels, const std::stri
         dr.searchRange = delineation::DisparityInterval{dmin, dmax};
         dr.disparity = disparity;  // as the GUI and `run` give it (the map's costs and ground)
         try {
-          const auto r = delineation::delineate(lefts[pairName], rights[pairName], dr, {});
+          const auto r = delineation::delineate(pair->left, pair->right, dr, {});
           active = r.polygon;
           ai = iou(r.polygon, truth);
           av = r.vertexCount;
@@ -337,7 +327,7 @@ int real(const std::string& dataRoot, const std::string& labels, const std::stri
     std::printf("%-18s %-9s | %7.3f %5d %5zu %6.0f | %7.3f %5d | %s\n", name.c_str(), set.c_str(), bi,
                 b ? b->diagnostics.vertices : 0, b ? b->boxes.size() : 0, ms, ai, av, b ? "" : result.message.c_str());
     if (!dumpDir.empty()) {
-      dump((fs::path(dumpDir) / (name + ".png")).string(), lefts[pairName], b, cv::Rect(core::boundingBox(rect.outer)), truth,
+      dump((fs::path(dumpDir) / (name + ".png")).string(), pair->left, b, cv::Rect(core::boundingBox(rect.outer)), truth,
            rect, params, withActive ? &active : nullptr);
     }
   }
@@ -358,7 +348,7 @@ int main(int argc, char** argv) {
   int scenes = 3, firstSeed = 1, grow = 30;
   bool tiny = false, realMode = false, withMatcher = true, withActive = true;
   std::string dumpDir, dataRoot = "/work/shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  std::string cache = bench::defaultDisparityCache().string();
   sim::SceneParams sceneParams;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--tiny")) {

@@ -639,7 +639,7 @@ int main(int argc, char** argv) {
   SimOptions sim;
   bool tiny = false;
   std::string dataRoot = "/work/shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string(), pngDir;
+  std::string cache = bench::defaultDisparityCache().string(), pngDir;
   dem::EnhanceParams params;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];

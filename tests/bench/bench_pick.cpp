@@ -31,7 +31,6 @@
 
 namespace fs = std::filesystem;
 using namespace delineo;
-using bench::disparityFor;
 using bench::ringOf;
 
 namespace {
@@ -91,7 +90,7 @@ int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   std::string dataRoot = "/work/shared/data";
   std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  std::string cache = bench::defaultDisparityCache().string();
   double metresPerPixel = 0.25;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
@@ -117,21 +116,15 @@ int main(int argc, char** argv) {
   const double margin = params.heightMargin / metresPerPixel;
   std::ifstream in(labels);
   const nlohmann::json data = nlohmann::json::parse(in);
-  std::map<std::string, cv::Mat> maps;
+  bench::RealPairs pairs(data, dataRoot, cache);
   std::printf("%-18s %9s %6s | %-6s %6s %6s | %-6s %6s %6s %4s %4s %7s %6s\n", "roof", "click", "ground",
               "before", "ground", "err", "after", "ground", "err", "ref", "vtx", "px", "ms");
   int runs = 0, beforeGood = 0, afterGood = 0;
   double beforeSum = 0.0, afterSum = 0.0;
   for (const auto& roof : data.at("roofs")) {
-    const std::string pairName = roof.at("pair");
-    const auto& pair = data.at("pairs").at(pairName);
-    const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
-    if (!fs::exists(left)) continue;
-    if (!maps.count(pairName)) {
-      maps[pairName] = disparityFor(pairName, left, (fs::path(dataRoot) / pair.at("right").get<std::string>()).string(),
-                                    pair.at("disparity_range").at(0), pair.at("disparity_range").at(1), cache);
-    }
-    const cv::Mat& map = maps[pairName];
+    const bench::RealPair* pair = pairs.get(roof.at("pair"));
+    if (!pair) continue;
+    const cv::Mat& map = pair->disparity;
     const core::Polygon hand = ringOf(roof.at("outline"));
     const cv::Mat handMask = core::rasterize(hand, map.size());
     const double groundRef = median(valuesIn(map, core::rasterize(ringOf(roof.at("ground")), map.size())));

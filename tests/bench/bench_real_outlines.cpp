@@ -264,7 +264,7 @@ int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   std::string dataRoot = "/work/shared/data";
   std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  std::string cache = bench::defaultDisparityCache().string();
   std::string dumpDir, montagePath;
   std::vector<std::pair<std::string, cv::Mat>> panels;
   int grow = 30;
@@ -316,7 +316,7 @@ int main(int argc, char** argv) {
   const nlohmann::json data = nlohmann::json::parse(in);
   std::printf("%-18s %-9s | %-13s | %-13s | %-13s | %-11s %s\n", "roof", "interval", "naive IoU/v",
               "raw IoU/v", "regular. IoU/v", "reg ms", "regularization");
-  std::map<std::string, cv::Mat> maps, lefts, rights;
+  bench::RealPairs pairs(data, dataRoot, cache);
   // Per set: the tuning roofs and the held-out ones (marked "heldOut", labelled afterwards).
   struct Set {
     std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV;
@@ -329,20 +329,10 @@ int main(int argc, char** argv) {
   for (const auto& roof : data.at("roofs")) {
     const std::string name = roof.at("name"), pairName = roof.at("pair");
     if (const char* only = std::getenv("BENCH_ONLY"); only && name != only) continue;
-    const auto& pair = data.at("pairs").at(pairName);
-    const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
-    const std::string right = (fs::path(dataRoot) / pair.at("right").get<std::string>()).string();
-    if (!fs::exists(left) || !fs::exists(right)) {
-      std::printf("skipped %s: %s missing\n", name.c_str(), left.c_str());
-      continue;
-    }
-    const int dmin = pair.at("disparity_range").at(0), dmax = pair.at("disparity_range").at(1);
-    if (!maps.count(pairName)) {
-      maps[pairName] = bench::disparityFor(pairName, left, right, dmin, dmax, cache);
-      lefts[pairName] = io::readGreyFloat(left);
-      rights[pairName] = io::readGreyFloat(right);
-    }
-    const cv::Mat& map = maps[pairName];
+    const bench::RealPair* pair = pairs.get(pairName);
+    if (!pair) continue;
+    const int dmin = pair->dmin, dmax = pair->dmax;
+    const cv::Mat& map = pair->disparity;
     const core::Polygon truth = bench::ringOf(roof.at("outline"));
     const cv::Rect2d box = core::boundingBox(truth.outer);
     const double x0 = std::max(0.0, box.x - grow), y0 = std::max(0.0, box.y - grow);
@@ -373,7 +363,7 @@ int main(int argc, char** argv) {
       request.ground = delineation::DisparityInterval{g - t, std::min(g + t, proposal.low - 1)};
     }
     try {
-      const auto r = delineation::delineate(lefts[pairName], rights[pairName], request, params);
+      const auto r = delineation::delineate(pair->left, pair->right, request, params);
       // The stage's outline part (without the energy gate), CPU time of this thread, best of 3
       // (the machine may be shared; BENCH_REG_REPS=N repeats it N times, for a profiler).
       double ms = 1e300;
@@ -391,7 +381,7 @@ int main(int argc, char** argv) {
           }
           return out;
         };
-        const auto stage = delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
+        const auto stage = delineation::regularizeOutline(r.rawPolygon, params.regularization, pair->left);
         const nlohmann::json line{{"roof", name}, {"raw", rings(r.rawPolygon)}, {"regularized", rings(stage.polygon)},
                                   {"status", delineation::toString(stage.status)}, {"reason", stage.reason}};
         if (FILE* f = std::fopen(path, "a")) {
@@ -407,7 +397,7 @@ int main(int argc, char** argv) {
         const bool kept = r.regularization.status == delineation::RegularizationStatus::Regularized;
         const double t0 = cpuMs();
         for (int k = 0; k < 3; ++k, tried.tolerance /= 2) {
-          (void)delineation::regularizeOutline(r.rawPolygon, tried, lefts[pairName]);
+          (void)delineation::regularizeOutline(r.rawPolygon, tried, pair->left);
           if (kept && tried.tolerance <= r.regularization.tolerance) break;
         }
         ms = std::min(ms, cpuMs() - t0);
@@ -428,7 +418,7 @@ int main(int argc, char** argv) {
         // t.
         delineation::DelineationParams other = params;
         other.regularization.tolerance = t;
-        const auto g = delineation::regularizeBuildingOutline(lefts[pairName], rights[pairName],
+        const auto g = delineation::regularizeBuildingOutline(pair->left, pair->right,
                                                               request, other, r.rawPolygon);
         std::printf("    tolerance %4.1f px: IoU %.3f, %3d vertices, %s%s%s\n", t,
                     iou(g.polygon, truth, size), g.outputVertices,
@@ -438,12 +428,12 @@ int main(int argc, char** argv) {
         tolVertices[t].push_back(g.outputVertices);
       }
       if (diag) {
-        diagnoseRoof(name, lefts[pairName], rights[pairName], map, request, params, r, truth,
+        diagnoseRoof(name, pair->left, pair->right, map, request, params, r, truth,
                      bench::ringOf(roof.at("ground")), dumpDir);
       }
       if (std::getenv("BENCH_VERBOSE")) {
         const auto g =
-            delineation::regularizeOutline(r.rawPolygon, params.regularization, lefts[pairName]);
+            delineation::regularizeOutline(r.rawPolygon, params.regularization, pair->left);
         for (const auto& [label, poly] :
              {std::pair{"raw", r.rawPolygon}, std::pair{"regularized", g.polygon}}) {
           std::printf("    %s:", label);
@@ -463,7 +453,7 @@ int main(int argc, char** argv) {
       regMs.push_back(ms);
       ++runs;
       if (!dumpDir.empty() || !montagePath.empty()) {
-        const cv::Mat panel = drawOutlines(lefts[pairName],
+        const cv::Mat panel = drawOutlines(pair->left,
                                            cv::Rect(static_cast<int>(x0), static_cast<int>(y0),
                                                     static_cast<int>(x1 - x0), static_cast<int>(y1 - y0)),
                                            {{rect, {255, 80, 0}},

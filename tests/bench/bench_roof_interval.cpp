@@ -33,7 +33,6 @@
 
 namespace fs = std::filesystem;
 using namespace delineo;
-using bench::disparityFor;
 using bench::ringOf;
 
 namespace {
@@ -142,7 +141,7 @@ int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   std::string dataRoot = "/work/shared/data";
   std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  std::string cache = bench::defaultDisparityCache().string();
   std::vector<int> grows = {8, 15, 30};
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
@@ -172,30 +171,22 @@ int main(int argc, char** argv) {
   std::printf("%-18s %4s %5s %6s | %-9s %3s %6s %5s | %-9s %3s %6s %5s %5s\n", "roof", "grow", "peak", "ground",
               "before", "in", "ground", "err", "after", "in", "ground", "err", "peak*");
   Tally sets[2];  // tuning set, held-out set
-  std::map<std::string, cv::Mat> maps;
+  bench::RealPairs pairs(data, dataRoot, cache);
   bool heldOutShown = false;
   for (const auto& roof : data.at("roofs")) {
     const std::string pairName = roof.at("pair");
     const bool heldOut = roof.value("heldOut", false);
     if (heldOut && !heldOutShown) std::printf("-- held out (see tests/bench/data/README.md) --\n");
     heldOutShown = heldOutShown || heldOut;
-    const auto& pair = data.at("pairs").at(pairName);
-    const std::string left = (fs::path(dataRoot) / pair.at("left").get<std::string>()).string();
-    if (!fs::exists(left)) {
-      std::printf("skipped %s: %s missing\n", roof.at("name").get<std::string>().c_str(), left.c_str());
-      continue;
-    }
-    if (!maps.count(pairName)) {
-      maps[pairName] = disparityFor(pairName, left, (fs::path(dataRoot) / pair.at("right").get<std::string>()).string(),
-                                    pair.at("disparity_range").at(0), pair.at("disparity_range").at(1), cache);
-    }
-    const cv::Mat& map = maps[pairName];
+    const bench::RealPair* pair = pairs.get(pairName);
+    if (!pair) continue;
+    const cv::Mat& map = pair->disparity;
     const core::Polygon outline = ringOf(roof.at("outline"));
     const core::Polygon groundPolygon = ringOf(roof.at("ground"));
     double groundRef;
-    if (pair.contains("ground_truth_disparity")) {
-      const cv::Mat gt = readGroundTruth((fs::path(dataRoot) / pair.at("ground_truth_disparity").get<std::string>()).string(),
-                                         pair.value("ground_truth_scale", 1.0));
+    if (const auto& files = data.at("pairs").at(pairName); files.contains("ground_truth_disparity")) {
+      const cv::Mat gt = readGroundTruth((fs::path(dataRoot) / files.at("ground_truth_disparity").get<std::string>()).string(),
+                                         files.value("ground_truth_scale", 1.0));
       groundRef = quantile(valuesIn(gt, core::rasterize(groundPolygon, gt.size())), 0.5);
     } else {
       groundRef = quantile(valuesIn(map, core::rasterize(groundPolygon, map.size())), 0.5);

@@ -141,7 +141,7 @@ void delineateProposals(const std::string& name, const nlohmann::json& pair, con
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   std::string data = "../shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json", out = "/tmp";
-  std::string cache = (fs::temp_directory_path() / "delineo_bench_disparity").string();
+  std::string cache = bench::defaultDisparityCache().string();
   bool delineate = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) data = argv[++i];

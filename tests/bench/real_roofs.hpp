@@ -1,9 +1,14 @@
 #pragma once
 // Loading of the hand-labelled real roofs (tests/bench/data/real_roofs.json) shared by the
-// benchmarks that read them: rings from JSON, and the matcher's disparity map of a pair, computed
-// once and cached as a GeoTIFF.
+// benchmarks that read them: rings from JSON, and each pair's images and matcher's disparity map,
+// loaded once, the map cached as a GeoTIFF.
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <map>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -21,12 +26,31 @@ inline core::Polygon ringOf(const nlohmann::json& points) {
   return p;
 }
 
+inline std::filesystem::path defaultDisparityCache() {
+  return std::filesystem::temp_directory_path() / "delineo_bench_disparity";
+}
+
+// A digest of the running executable: the cached maps are those of this very build of the
+// matcher, so a map made before a matcher change is never read after it.
+inline std::string executableDigest() {
+  static const std::string digest = [] {
+    std::ifstream in("/proc/self/exe", std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016zx", std::hash<std::string>{}(bytes));
+    return std::string(hex);
+  }();
+  return digest;
+}
+
+// The matcher's map of a pair with the default parameters, read from the cache when this build
+// made it, else computed and cached (replacing the pair's maps of other builds).
 inline cv::Mat disparityFor(const std::string& name, const std::string& left,
                             const std::string& right, int dmin, int dmax,
                             const std::filesystem::path& cache) {
   namespace fs = std::filesystem;
-  const fs::path cached =
-      cache / (name + "_" + std::to_string(dmin) + "_" + std::to_string(dmax) + ".tif");
+  const std::string stem = name + "_" + std::to_string(dmin) + "_" + std::to_string(dmax) + "_";
+  const fs::path cached = cache / (stem + executableDigest() + ".tif");
   if (fs::exists(cached)) {
     io::ReadOptions options;
     options.type = io::PixelType::Float32;
@@ -39,8 +63,56 @@ inline cv::Mat disparityFor(const std::string& name, const std::string& left,
   const cv::Mat disparity =
       stereo::matchStereo(io::readGreyFloat(left), io::readGreyFloat(right), params).disparity;
   fs::create_directories(cache);
+  for (const auto& entry : fs::directory_iterator(cache)) {
+    if (entry.path().filename().string().rfind(stem, 0) == 0) fs::remove(entry.path());
+  }
   io::writeFloatGeoTiff(cached.string(), disparity);
   return disparity;
 }
+
+// One pair of real_roofs.json: its files, search range, grey images and matcher's map.
+struct RealPair {
+  std::string name, leftPath, rightPath;
+  int dmin = 0, dmax = 0;
+  cv::Mat left, right, disparity;
+};
+
+// The pairs of real_roofs.json, each loaded on first use.
+class RealPairs {
+ public:
+  RealPairs(const nlohmann::json& labels, std::filesystem::path dataRoot,
+            std::filesystem::path cache)
+      : labels_(labels), dataRoot_(std::move(dataRoot)), cache_(std::move(cache)) {}
+
+  // nullptr, after a "skipped" line naming the missing image, when the pair's images are absent.
+  const RealPair* get(const std::string& pairName) {
+    if (const auto it = loaded_.find(pairName); it != loaded_.end()) {
+      return it->second ? &*it->second : nullptr;
+    }
+    const nlohmann::json& pair = labels_.at("pairs").at(pairName);
+    RealPair p;
+    p.name = pairName;
+    p.leftPath = (dataRoot_ / pair.at("left").get<std::string>()).string();
+    p.rightPath = (dataRoot_ / pair.at("right").get<std::string>()).string();
+    p.dmin = pair.at("disparity_range").at(0);
+    p.dmax = pair.at("disparity_range").at(1);
+    for (const std::string& path : {p.leftPath, p.rightPath}) {
+      if (!std::filesystem::exists(path)) {
+        std::printf("skipped %s: %s missing\n", pairName.c_str(), path.c_str());
+        loaded_[pairName] = std::nullopt;
+        return nullptr;
+      }
+    }
+    p.disparity = disparityFor(pairName, p.leftPath, p.rightPath, p.dmin, p.dmax, cache_);
+    p.left = io::readGreyFloat(p.leftPath);
+    p.right = io::readGreyFloat(p.rightPath);
+    return &*(loaded_[pairName] = std::move(p));
+  }
+
+ private:
+  const nlohmann::json& labels_;
+  std::filesystem::path dataRoot_, cache_;
+  std::map<std::string, std::optional<RealPair>> loaded_;
+};
 
 }  // namespace delineo::bench
