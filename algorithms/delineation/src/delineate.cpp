@@ -399,17 +399,13 @@ cv::Rect regionOfInterest(const cv::Mat& left, const cv::Mat& right,
   return grown & cv::Rect(0, 0, left.cols, left.rows);
 }
 
-PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const cv::Mat& left,
-                             const cv::Mat& right, const DelineationRequest& request,
-                             const DelineationParams& params) {
-  PreparedEnergy out;
-  out.roi = costs.roi();
+namespace {
+
+// The initial polygon in ROI coordinates, polygonised (out.init), and where a vertex may go
+// (within `max-excursion` of it, when that is less than the ROI margin). Returns its mask.
+cv::Mat initialInRoi(const core::Polygon& init, const DelineationParams& params, PreparedEnergy& out) {
   const cv::Rect roi = out.roi;
   const cv::Size size = roi.size();
-  EnergyImages& im = out.images;
-
-  // Initial polygon in ROI coordinates.
-  const core::Polygon init = initialPolygon(request, left.size());
   core::Ring local;
   for (const auto& v : init.outer) local.emplace_back(v.x - roi.x, v.y - roi.y);
   out.init.outer = polygonise(local, params.initialSpacing, size);
@@ -417,13 +413,18 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   if (params.maxExcursion < params.roiMargin) {
     cv::Mat distance;
     cv::distanceTransform(initMask == 0, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-    im.allowed = distance <= params.maxExcursion;
+    out.images.allowed = distance <= params.maxExcursion;
   }
+  return initMask;
+}
 
-  const cv::Mat bestCost = costs.bestCost();
-  im.noMatchCost = static_cast<float>(quantile(bestCost, 1.0 - params.occlusionPercent / 100.0));
-  if (!std::isfinite(im.noMatchCost)) im.noMatchCost = 1.0f;
-
+// c_roof and c_ground: the lowest Crit over the roof interval and over the ground's (given, or
+// estimated around the init), both as searched (balanceIntervals); then the matcher's map where
+// it has a value (map-cost) and the box filter (cost-aggregation).
+void areaCosts(const stereo::CorrelationCostService& costs, const DelineationRequest& request,
+               const core::Polygon& init, const cv::Mat& initMask, const DelineationParams& params,
+               PreparedEnergy& out) {
+  EnergyImages& im = out.images;
   // Ground interval: given, or estimated around the init.
   if (request.ground) {
     out.ground = *request.ground;
@@ -436,16 +437,23 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   im.roofCost = costs.minCost(out.roofSearched.min, out.roofSearched.max);
   im.groundCost = costs.minCost(out.groundSearched.min, out.groundSearched.max);
   if (params.mapCost > 0 && !request.disparity.empty()) {
-    im.aboveRoof = applyMapCosts(request.disparity(roi), request.roof, params, im.roofCost, im.groundCost);
+    im.aboveRoof = applyMapCosts(request.disparity(out.roi), request.roof, params, im.roofCost, im.groundCost);
   }
   if (params.costAggregation > 1) {
     const cv::Size k(params.costAggregation, params.costAggregation);
     cv::blur(im.roofCost, im.roofCost, k, {-1, -1}, cv::BORDER_REPLICATE);
     cv::blur(im.groundCost, im.groundCost, k, {-1, -1}, cv::BORDER_REPLICATE);
   }
+}
 
-  out.excluded = cv::Mat::zeros(size, CV_8U);
-  if (!request.excludeMask.empty()) out.excluded = request.excludeMask(roi) != 0;
+// The pixels kept out of the roof (out.excluded): the request's exclusion mask and, with
+// `intermediate-margin`, the pixels seen at a height between the roof's and the ground's; their
+// costs made those of a non-roof pixel.
+void excludeNonRoof(const stereo::CorrelationCostService& costs, const DelineationRequest& request,
+                    const DelineationParams& params, PreparedEnergy& out) {
+  EnergyImages& im = out.images;
+  out.excluded = cv::Mat::zeros(out.roi.size(), CV_8U);
+  if (!request.excludeMask.empty()) out.excluded = request.excludeMask(out.roi) != 0;
   if (params.intermediateMargin > 0) {
     // Something at another height than both the roof and the ground (a tree crown lower than
     // the roof, a wall, a neighbour's lower annex) matches a disparity between the intervals. A
@@ -475,8 +483,13 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
     im.roofCost.setTo(1.0f, out.excluded);
     im.groundCost.setTo(im.noMatchCost, out.excluded & (im.groundCost > im.noMatchCost));
   }
-  // Roof disparity per pixel: argmin of Crit within the roof interval, median-filtered.
-  const int d0 = std::max(request.roof.min, costs.dmin()), d1 = std::min(request.roof.max, costs.dmax());
+}
+
+// Roof disparity per pixel of `roi`: argmin of Crit within the roof interval, median-filtered.
+cv::Mat roofDisparityPerPixel(const stereo::CorrelationCostService& costs, const DisparityInterval& roof,
+                              cv::Rect roi) {
+  const cv::Size size = roi.size();
+  const int d0 = std::max(roof.min, costs.dmin()), d1 = std::min(roof.max, costs.dmax());
   cv::Mat roofDisparity(size, CV_32F, cv::Scalar(0.5f * (d0 + d1)));
   for (int y = 0; y < size.height; ++y) {
     float* rd = roofDisparity.ptr<float>(y);
@@ -492,38 +505,44 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
     }
   }
   cv::medianBlur(roofDisparity, roofDisparity, 5);
-  // d_xy: the roof disparity at the nearest roof-like pixel of the initial region (inside the
-  // init, roof interval matching better than the ground's). The paper takes the nearest pixel
-  // of the initial contour; an operator's rough contour often lies on the ground, so its own
-  // disparity would be the ground's.
+  return roofDisparity;
+}
+
+// d_xy: the roof disparity at the nearest roof-like pixel of the initial region (inside the
+// init, roof interval matching better than the ground's). The paper takes the nearest pixel
+// of the initial contour; an operator's rough contour often lies on the ground, so its own
+// disparity would be the ground's. Also sets out.roofDisparity, the median over those pixels
+// (the roof interval's middle when there are none).
+cv::Mat nearestRoofDisparity(const cv::Mat& roofDisparity, const cv::Mat& initMask, const DisparityInterval& roof,
+                             PreparedEnergy& out) {
+  const EnergyImages& im = out.images;
+  const cv::Size size = roofDisparity.size();
   cv::Mat roofLike = initMask & (im.roofCost < im.groundCost);
   cv::Mat dxy(size, CV_32F);
   if (cv::countNonZero(roofLike) == 0) {
-    dxy.setTo(0.5 * (request.roof.min + request.roof.max));
-    out.roofDisparity = 0.5 * (request.roof.min + request.roof.max);
-  } else {
-    cv::Mat seeds = ~roofLike, dist, labels;
-    cv::distanceTransform(seeds, dist, labels, cv::DIST_L2, 3, cv::DIST_LABEL_PIXEL);
-    std::vector<float> labelDisparity(static_cast<size_t>(size.area()) + 1, 0.f);
-    for (int y = 0; y < size.height; ++y) {
-      for (int x = 0; x < size.width; ++x) {
-        if (roofLike.at<uchar>(y, x)) labelDisparity[labels.at<int>(y, x)] = roofDisparity.at<float>(y, x);
-      }
-    }
-    for (int y = 0; y < size.height; ++y) {
-      for (int x = 0; x < size.width; ++x) dxy.at<float>(y, x) = labelDisparity[labels.at<int>(y, x)];
-    }
-    out.roofDisparity = quantile(roofDisparity, 0.5, roofLike);
+    dxy.setTo(0.5 * (roof.min + roof.max));
+    out.roofDisparity = 0.5 * (roof.min + roof.max);
+    return dxy;
   }
+  cv::Mat seeds = ~roofLike, dist, labels;
+  cv::distanceTransform(seeds, dist, labels, cv::DIST_L2, 3, cv::DIST_LABEL_PIXEL);
+  std::vector<float> labelDisparity(static_cast<size_t>(size.area()) + 1, 0.f);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      if (roofLike.at<uchar>(y, x)) labelDisparity[labels.at<int>(y, x)] = roofDisparity.at<float>(y, x);
+    }
+  }
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) dxy.at<float>(y, x) = labelDisparity[labels.at<int>(y, x)];
+  }
+  out.roofDisparity = quantile(roofDisparity, 0.5, roofLike);
+  return dxy;
+}
 
-  // Occlusion band: walls seen in the left image and ground hidden in the right one lie next to
-  // the roof on the -x side when the roof is nearer (larger d, since x_right = x_left - d).
-  im.occlusionSide = out.roofDisparity >= out.groundDisparity ? -1 : +1;
-  cv::Mat width = cv::abs(dxy - out.groundDisparity);
-  width.convertTo(im.occlusionWidth, CV_32S);  // rounds to nearest
-
-  // Gradients: left on the ROI (computed with a border so that the ROI edge is exact), right
-  // resampled at (x - d_xy, y).
+// Gradients: left on the ROI (computed with a border so that the ROI edge is exact), right
+// resampled at (x - d_xy, y).
+void edgeImages(const cv::Mat& left, const cv::Mat& right, cv::Rect roi, const cv::Mat& dxy, EnergyImages& im) {
+  const cv::Size size = roi.size();
   const cv::Rect full(0, 0, left.cols, left.rows);
   const cv::Rect leftBox = cv::Rect(roi.x - 3, roi.y - 3, roi.width + 6, roi.height + 6) & full;
   cv::Mat lgx, lgy;
@@ -545,6 +564,73 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   cv::remap(rgx, im.rightGradX, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   cv::remap(rgy, im.rightGradY, mapX, mapY, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
   normaliseBy99(im.rightGradX, im.rightGradY);
+}
+
+// The region stage (`region-init`): an outline of the roof-like region inside the init replaces
+// the operator's (out.init) when its energy is lower.
+void regionStage(const cv::Mat& initMask, const DelineationParams& params, PreparedEnergy& out) {
+  const EnergyImages& im = out.images;
+  const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast,
+                              params.minAngle, params.minGap};
+  PolygonEnergy energy(im, weights);
+  energy.setPolygon(out.init);
+  const double operatorEnergy = energy.total();
+  // The energy decides: the region outline (finest tolerance) replaces the operator's only
+  // when it is lower; then the coarser outlines may replace it when lower still. (Letting a
+  // coarse outline compete with the operator's directly replaced good operator contours by
+  // simpler, lower-F but worse outlines on textureless roofs.)
+  std::vector<IntPolygon> candidates = regionStageCandidates(im, initMask, params);
+  if (candidates.empty()) return;
+  energy.setPolygon(candidates.front());
+  double lowest = energy.total();
+  if (!(lowest < operatorEnergy)) return;
+  size_t best = 0;
+  for (size_t i = 1; i < candidates.size(); ++i) {
+    energy.setPolygon(candidates[i]);
+    if (energy.total() < lowest) {
+      lowest = energy.total();
+      best = i;
+    }
+  }
+  out.init = std::move(candidates[best]);
+  out.regionInit = true;
+}
+
+// `cost-cap`: a pixel that matches neither interval (a tree or a neighbour's wall left as
+// ground, a wall taken as roof) costs no more than the occlusion band. After the region stage,
+// which compares outlines on the plain costs.
+void capCosts(const DelineationParams& params, EnergyImages& im) {
+  im.uncappedDifference = im.groundCost - im.roofCost;
+  // The floor keeps the cap meaningful on clean pairs, where NoMatchCost is near 0 and a
+  // multiple of it would flatten every cost (no area evidence left against the edge terms).
+  const float cap = static_cast<float>(std::max(params.costCap * im.noMatchCost, params.costCapFloor));
+  im.roofCost = cv::min(im.roofCost, cap);
+  im.groundCost = cv::min(im.groundCost, cap);
+}
+
+}  // namespace
+
+PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const cv::Mat& left,
+                             const cv::Mat& right, const DelineationRequest& request,
+                             const DelineationParams& params) {
+  PreparedEnergy out;
+  out.roi = costs.roi();
+  EnergyImages& im = out.images;
+  const core::Polygon init = initialPolygon(request, left.size());
+  const cv::Mat initMask = initialInRoi(init, params, out);
+  const cv::Mat bestCost = costs.bestCost();
+  im.noMatchCost = static_cast<float>(quantile(bestCost, 1.0 - params.occlusionPercent / 100.0));
+  if (!std::isfinite(im.noMatchCost)) im.noMatchCost = 1.0f;
+  areaCosts(costs, request, init, initMask, params, out);
+  excludeNonRoof(costs, request, params, out);
+  const cv::Mat dxy =
+      nearestRoofDisparity(roofDisparityPerPixel(costs, request.roof, out.roi), initMask, request.roof, out);
+  // Occlusion band: walls seen in the left image and ground hidden in the right one lie next to
+  // the roof on the -x side when the roof is nearer (larger d, since x_right = x_left - d).
+  im.occlusionSide = out.roofDisparity >= out.groundDisparity ? -1 : +1;
+  cv::Mat width = cv::abs(dxy - out.groundDisparity);
+  width.convertTo(im.occlusionWidth, CV_32S);  // rounds to nearest
+  edgeImages(left, right, out.roi, dxy, im);
   if (params.bandBestCost) {
     // The band says "this pixel cannot be matched": that must not make a pixel cheaper than its
     // best explanation as roof or ground. With the constant NoMatchCost alone, the band is a
@@ -553,45 +639,8 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
     // true outline pays more"). Pre-integrable like the other terms (one more prefix sum).
     im.bandCost = cv::max(cv::min(im.roofCost, im.groundCost), im.noMatchCost);
   }
-  if (params.regionInit) {
-    const EnergyWeights weights{params.edgeWeight, params.rigidity, params.edgeContrast,
-                                params.minAngle, params.minGap};
-    PolygonEnergy energy(im, weights);
-    energy.setPolygon(out.init);
-    const double operatorEnergy = energy.total();
-    // The energy decides: the region outline (finest tolerance) replaces the operator's only
-    // when it is lower; then the coarser outlines may replace it when lower still. (Letting a
-    // coarse outline compete with the operator's directly replaced good operator contours by
-    // simpler, lower-F but worse outlines on textureless roofs.)
-    std::vector<IntPolygon> candidates = regionStageCandidates(im, initMask, params);
-    if (!candidates.empty()) {
-      energy.setPolygon(candidates.front());
-      double lowest = energy.total();
-      if (lowest < operatorEnergy) {
-        size_t best = 0;
-        for (size_t i = 1; i < candidates.size(); ++i) {
-          energy.setPolygon(candidates[i]);
-          if (energy.total() < lowest) {
-            lowest = energy.total();
-            best = i;
-          }
-        }
-        out.init = std::move(candidates[best]);
-        out.regionInit = true;
-      }
-    }
-  }
-  if (params.costCap > 0) {
-    // A pixel that matches neither interval (a tree or a neighbour's wall left as ground, a wall
-    // taken as roof) costs no more than the occlusion band. After the region stage, which
-    // compares outlines on the plain costs.
-    im.uncappedDifference = im.groundCost - im.roofCost;
-    // The floor keeps the cap meaningful on clean pairs, where NoMatchCost is near 0 and a
-    // multiple of it would flatten every cost (no area evidence left against the edge terms).
-    const float cap = static_cast<float>(std::max(params.costCap * im.noMatchCost, params.costCapFloor));
-    im.roofCost = cv::min(im.roofCost, cap);
-    im.groundCost = cv::min(im.groundCost, cap);
-  }
+  if (params.regionInit) regionStage(initMask, params, out);
+  if (params.costCap > 0) capCosts(params, im);
   return out;
 }
 
