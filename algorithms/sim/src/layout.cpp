@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -181,6 +182,255 @@ bool makeShape(Shape shape, double hl, double hw, double metre, Rng& rng, ShapeG
 
 cv::Rect2d boundsOf(const core::Ring& ring) { return core::boundingBox(ring); }
 
+// The random draws of a layout, in the order that makes a seed give its scene: the terrain and
+// the sun, then each building's attempts, then each tree's.
+struct LayoutDraw {
+  explicit LayoutDraw(const SceneParams& params)
+      : p(params), rng(static_cast<std::uint64_t>(params.seed)), placer(params) {}
+
+  void terrainAndSun();
+  void buildings();
+  bool drawFootprint(Shape shape, double scale, Building& bld);
+  void drawRoof(Building& bld);
+  void drawSuperstructures(Building& bld);
+  bool fitsInScene(const Building& bld) const;
+  void drawAppearance(Building& bld);
+  void trees();
+  bool placeTree();
+  cv::Point2d treeCentre(const Tree& tree);
+  bool clearOfOthers(const Tree& tree) const;
+
+  const SceneParams& p;
+  Rng rng;
+  const double metre = 1.0 / p.gsd;             // px per metre
+  const double grad = p.slope / 100.0 * p.gsd;  // m per px
+  Placer placer;
+  Layout layout;
+};
+
+// Terrain: a plane of the given slope in a random direction, plus gentle relief.
+void LayoutDraw::terrainAndSun() {
+  Terrain& t = layout.terrain;
+  const double dir = rng.uniform(0.0, 2.0 * kPi);
+  t.gradX = grad * std::cos(dir);
+  t.gradY = grad * std::sin(dir);
+  t.centreX = 0.5 * p.width;
+  t.centreY = 0.5 * p.height;
+  t.undulation = p.undulation;
+  t.undulationPeriod = 60.0 * metre;
+  t.seed = rng.next();
+  t.undulationAtCentre = fbm(t.seed, t.centreX, t.centreY, t.undulationPeriod, 2);
+  layout.groundSeed = rng.next();
+  layout.sunElevation = rng.uniform(35.0, 55.0) * kPi / 180.0;
+  layout.sunSide = rng.chance(0.5) ? -1 : 1;
+}
+
+// Buildings: shapes cycle through a shuffled list so every six buildings show each shape.
+void LayoutDraw::buildings() {
+  std::array<Shape, 6> shapes{Shape::Rect, Shape::L, Shape::T, Shape::U, Shape::Courtyard,
+                              Shape::Angled};
+  const int attemptsPerBuilding = 80;
+  for (int b = 0; b < p.buildings; ++b) {
+    if (b % 6 == 0) {
+      for (int i = 5; i > 0; --i) std::swap(shapes[i], shapes[rng.uniformInt(0, i)]);
+    }
+    const Shape shape = shapes[b % 6];
+    bool placed = false;
+    for (int attempt = 0; attempt < attemptsPerBuilding && !placed; ++attempt) {
+      Building bld;
+      // Shrink the size draw as attempts fail, so crowded scenes still fill up.
+      const double scale = 1.0 - 0.5 * attempt / attemptsPerBuilding;
+      if (!drawFootprint(shape, scale, bld)) continue;
+      drawRoof(bld);
+      drawSuperstructures(bld);
+      if (!fitsInScene(bld)) continue;
+      drawAppearance(bld);
+      bld.id = static_cast<int>(layout.buildings.size()) + 1;
+      placer.occupy(bld.footprint.outer, rng.uniform(3.0, 7.0) * metre);
+      layout.buildings.push_back(std::move(bld));
+      placed = true;
+    }
+  }
+}
+
+// The building's size (drawn at `scale`), shape, orientation, position and footprint; false when
+// the size cannot hold the shape.
+bool LayoutDraw::drawFootprint(Shape shape, double scale, Building& bld) {
+  double lengthM = rng.uniform(14.0, 36.0) * scale;
+  double widthM = rng.uniform(9.0, 22.0) * scale;
+  if (shape == Shape::Courtyard || shape == Shape::U) {
+    lengthM = rng.uniform(24.0, 40.0) * std::max(scale, 0.8);
+    widthM = rng.uniform(20.0, 30.0) * std::max(scale, 0.8);
+  }
+  if (widthM > lengthM) std::swap(widthM, lengthM);
+  const double hl = 0.5 * lengthM * metre, hw = 0.5 * widthM * metre;
+
+  bld.shape = shape;
+  ShapeGeometry geom;
+  if (!makeShape(shape, hl, hw, metre, rng, &geom)) return false;
+
+  const double orient = rng.uniform();
+  double angle;
+  if (orient < 0.35) {
+    angle = rng.chance(0.5) ? 0.0 : 0.5 * kPi;
+  } else if (orient < 0.55) {
+    angle = rng.chance(0.5) ? 0.25 * kPi : 0.75 * kPi;
+  } else {
+    angle = rng.uniform(0.0, kPi);
+  }
+  const bool mirror = rng.chance(0.5);
+  const cv::Point2d centre(rng.uniform(0.0, p.width), rng.uniform(0.0, p.height));
+  bld.centre = centre;
+  bld.angle = angle;
+  bld.cosAngle = std::cos(angle);
+  bld.sinAngle = std::sin(angle);
+  bld.halfLength = hl;
+  bld.halfWidth = hw;
+  bld.footprint.outer = transform(geom.outer, centre, angle, mirror);
+  for (const auto& h : geom.holes) bld.footprint.holes.push_back(transform(h, centre, angle, mirror));
+  return true;
+}
+
+// Roof: pitched roofs on plain rectangles only (their ridge follows the long axis).
+void LayoutDraw::drawRoof(Building& bld) {
+  const double roofDraw = rng.uniform();
+  if (bld.shape == Shape::Rect && roofDraw < 0.35) {
+    bld.roof = RoofType::Gable;
+  } else if (bld.shape == Shape::Rect && roofDraw < 0.6) {
+    bld.roof = RoofType::Hip;
+  }
+  const double heightM = bld.roof == RoofType::Flat ? rng.uniform(6.0, 30.0) : rng.uniform(6.0, 15.0);
+  bld.baseZ = layout.terrain.z(bld.centre.x, bld.centre.y);
+  bld.eaveZ = bld.baseZ + heightM;
+  bld.ridgeZ = bld.eaveZ;
+  if (bld.roof != RoofType::Flat) {
+    const double pitch = rng.uniform(20.0, 38.0) * kPi / 180.0;
+    bld.pitchSlope = std::tan(pitch) / metre;  // m per px
+    bld.ridgeZ = bld.eaveZ + bld.pitchSlope * bld.halfWidth;
+  }
+}
+
+// Superstructures: machine rooms on flat roofs, chimneys on pitched ones.
+void LayoutDraw::drawSuperstructures(Building& bld) {
+  const double hl = bld.halfLength, hw = bld.halfWidth;
+  const int boxCount = bld.roof == RoofType::Flat ? rng.uniformInt(0, 3) : rng.uniformInt(0, 2);
+  bld.topZ = bld.ridgeZ;
+  for (int k = 0; k < boxCount; ++k) {
+    const bool chimney = bld.roof != RoofType::Flat;
+    const double sizeU = (chimney ? rng.uniform(0.7, 1.3) : rng.uniform(1.5, 4.0)) * metre;
+    const double sizeV = (chimney ? rng.uniform(0.7, 1.3) : rng.uniform(1.5, 3.5)) * metre;
+    const double rise = chimney ? rng.uniform(0.9, 1.8) : rng.uniform(1.0, 2.5);
+    const double u = rng.uniform(-hl, hl), v = rng.uniform(-hw, hw);
+    // Keep the box and a 1.5 m border inside the footprint (checked on a 5x5 grid).
+    const double border = 1.5 * metre;
+    bool inside = true;
+    for (int gy = 0; gy < 5 && inside; ++gy) {
+      for (int gx = 0; gx < 5 && inside; ++gx) {
+        const double lu = u + (gx / 4.0 - 0.5) * (sizeU + 2 * border);
+        const double lv = v + (gy / 4.0 - 0.5) * (sizeV + 2 * border);
+        const core::Ring probe = transform({{lu, lv}}, bld.centre, bld.angle, false);
+        inside = insidePolygon(bld.footprint, probe[0].x, probe[0].y);
+      }
+    }
+    if (!inside) continue;
+    Box box;
+    box.ring = transform({{u - sizeU / 2, v - sizeV / 2}, {u + sizeU / 2, v - sizeV / 2},
+                          {u + sizeU / 2, v + sizeV / 2}, {u - sizeU / 2, v + sizeV / 2}},
+                         bld.centre, bld.angle, false);
+    double base = bld.eaveZ;
+    for (const auto& c : box.ring) base = std::max(base, bld.roofZ(c.x, c.y));
+    box.topZ = base + rise;
+    bld.topZ = std::max(bld.topZ, box.topZ);
+    bld.boxes.push_back(std::move(box));
+  }
+}
+
+// Whether the building stays inside both views and clear of the buildings placed so far.
+bool LayoutDraw::fitsInScene(const Building& bld) const {
+  const cv::Rect2d bb = boundsOf(bld.footprint.outer);
+  // Terrain under the footprint may sit below the base: the walls reach down to it.
+  const double zLo = bld.baseZ - std::abs(grad) * std::hypot(bb.width, bb.height) - 2 * p.undulation;
+  if (!placer.fits(bb.x, bb.x + bb.width, bb.y, bb.y + bb.height, zLo, bld.topZ)) return false;
+  return placer.freeOfBuildings(bld.footprint.outer);
+}
+
+// Appearance: a quarter of the roofs are weakly textured (hard for matchers).
+void LayoutDraw::drawAppearance(Building& bld) {
+  bld.roofAlbedo = rng.uniform(0.3, 0.8);
+  bld.roofContrast = rng.chance(0.25) ? rng.uniform(0.03, 0.1) : rng.uniform(0.6, 1.2);
+  bld.wallAlbedo = rng.uniform(0.35, 0.75);
+  bld.boxAlbedo = std::clamp(bld.roofAlbedo + rng.uniform(-0.25, 0.25), 0.15, 0.9);
+  bld.textureSeed = rng.next();
+}
+
+// Trees: round-ish crowns; about a third of them touch a building.
+void LayoutDraw::trees() {
+  for (int k = 0; k < p.trees; ++k) {
+    for (int attempt = 0; attempt < 40; ++attempt) {
+      if (placeTree()) break;
+    }
+  }
+}
+
+// One attempt at a tree: its crown, position and heights; false when it does not fit.
+bool LayoutDraw::placeTree() {
+  Tree tree;
+  tree.radius = rng.uniform(2.0, 5.0) * metre;
+  tree.lobeAmp = rng.uniform(0.05, 0.18);
+  for (double& ph : tree.lobePhase) ph = rng.uniform(0.0, 2.0 * kPi);
+  const double heightM = rng.uniform(5.0, 20.0);
+  const double rimShare = rng.uniform(0.35, 0.6);
+  tree.albedo = rng.uniform(0.2, 0.38);
+  tree.textureSeed = rng.next();
+  const double rmax = tree.maxRadius();
+  tree.centre = treeCentre(tree);
+  if (!clearOfOthers(tree)) return false;
+  tree.baseZ = layout.terrain.z(tree.centre.x, tree.centre.y);
+  tree.topZ = tree.baseZ + heightM;
+  tree.rimZ = tree.baseZ + rimShare * heightM;
+  const double zLo = tree.baseZ - std::abs(grad) * rmax - 2 * p.undulation;
+  if (!placer.fits(tree.centre.x - rmax, tree.centre.x + rmax, tree.centre.y - rmax,
+                   tree.centre.y + rmax, zLo, tree.topZ)) {
+    return false;
+  }
+  layout.trees.push_back(tree);
+  return true;
+}
+
+// The crown's centre: beside a random edge of a random building (35 % of the draws), else
+// anywhere.
+cv::Point2d LayoutDraw::treeCentre(const Tree& tree) {
+  if (!layout.buildings.empty() && rng.chance(0.35)) {
+    const Building& bld = layout.buildings[static_cast<size_t>(
+        rng.uniformInt(0, static_cast<int>(layout.buildings.size()) - 1))];
+    const core::Ring& ring = bld.footprint.outer;
+    const size_t e = static_cast<size_t>(rng.uniformInt(0, static_cast<int>(ring.size()) - 1));
+    const cv::Point2d a = ring[e], b = ring[(e + 1) % ring.size()];
+    const cv::Point2d onEdge = a + rng.uniform(0.2, 0.8) * (b - a);
+    cv::Point2d normal(b.y - a.y, -(b.x - a.x));
+    normal *= 1.0 / std::max(1e-9, std::hypot(normal.x, normal.y));
+    const cv::Point2d probe = onEdge + normal * 0.5;
+    if (insidePolygon(bld.footprint, probe.x, probe.y)) normal = -normal;
+    return onEdge + normal * (tree.radius + 0.3);
+  }
+  return {rng.uniform(0.0, p.width), rng.uniform(0.0, p.height)};
+}
+
+// Whether the crown stays off every building and apart from the trees placed so far.
+bool LayoutDraw::clearOfOthers(const Tree& tree) const {
+  for (const auto& bld : layout.buildings) {
+    if (insidePolygon(bld.footprint, tree.centre.x, tree.centre.y) ||
+        distanceToRings(bld.footprint, tree.centre) < tree.radius) {
+      return false;
+    }
+  }
+  for (const auto& other : layout.trees) {
+    const double d = std::hypot(other.centre.x - tree.centre.x, other.centre.y - tree.centre.y);
+    if (d < 0.7 * (other.radius + tree.radius)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 const char* toString(RoofType r) {
@@ -290,197 +540,11 @@ bool insidePolygon(const core::Polygon& polygon, double x, double y) {
 }
 
 Layout makeLayout(const SceneParams& p) {
-  Layout layout;
-  Rng rng(static_cast<std::uint64_t>(p.seed));
-  const double metre = 1.0 / p.gsd;  // px per metre
-
-  // Terrain: a plane of the given slope in a random direction, plus gentle relief.
-  Terrain& t = layout.terrain;
-  const double dir = rng.uniform(0.0, 2.0 * kPi);
-  const double grad = p.slope / 100.0 * p.gsd;  // m per px
-  t.gradX = grad * std::cos(dir);
-  t.gradY = grad * std::sin(dir);
-  t.centreX = 0.5 * p.width;
-  t.centreY = 0.5 * p.height;
-  t.undulation = p.undulation;
-  t.undulationPeriod = 60.0 * metre;
-  t.seed = rng.next();
-  t.undulationAtCentre = fbm(t.seed, t.centreX, t.centreY, t.undulationPeriod, 2);
-  layout.groundSeed = rng.next();
-  layout.sunElevation = rng.uniform(35.0, 55.0) * kPi / 180.0;
-  layout.sunSide = rng.chance(0.5) ? -1 : 1;
-
-  Placer placer(p);
-
-  // Buildings: shapes cycle through a shuffled list so every six buildings show each shape.
-  std::array<Shape, 6> shapes{Shape::Rect, Shape::L, Shape::T, Shape::U, Shape::Courtyard,
-                              Shape::Angled};
-  const int attemptsPerBuilding = 80;
-  for (int b = 0; b < p.buildings; ++b) {
-    if (b % 6 == 0) {
-      for (int i = 5; i > 0; --i) std::swap(shapes[i], shapes[rng.uniformInt(0, i)]);
-    }
-    const Shape shape = shapes[b % 6];
-    bool placed = false;
-    for (int attempt = 0; attempt < attemptsPerBuilding && !placed; ++attempt) {
-      // Shrink the size draw as attempts fail, so crowded scenes still fill up.
-      const double scale = 1.0 - 0.5 * attempt / attemptsPerBuilding;
-      double lengthM = rng.uniform(14.0, 36.0) * scale;
-      double widthM = rng.uniform(9.0, 22.0) * scale;
-      if (shape == Shape::Courtyard || shape == Shape::U) {
-        lengthM = rng.uniform(24.0, 40.0) * std::max(scale, 0.8);
-        widthM = rng.uniform(20.0, 30.0) * std::max(scale, 0.8);
-      }
-      if (widthM > lengthM) std::swap(widthM, lengthM);
-      const double hl = 0.5 * lengthM * metre, hw = 0.5 * widthM * metre;
-
-      Building bld;
-      bld.shape = shape;
-      ShapeGeometry geom;
-      if (!makeShape(shape, hl, hw, metre, rng, &geom)) continue;
-
-      const double orient = rng.uniform();
-      double angle;
-      if (orient < 0.35) {
-        angle = rng.chance(0.5) ? 0.0 : 0.5 * kPi;
-      } else if (orient < 0.55) {
-        angle = rng.chance(0.5) ? 0.25 * kPi : 0.75 * kPi;
-      } else {
-        angle = rng.uniform(0.0, kPi);
-      }
-      const bool mirror = rng.chance(0.5);
-      const cv::Point2d centre(rng.uniform(0.0, p.width), rng.uniform(0.0, p.height));
-      bld.centre = centre;
-      bld.angle = angle;
-      bld.cosAngle = std::cos(angle);
-      bld.sinAngle = std::sin(angle);
-      bld.halfLength = hl;
-      bld.halfWidth = hw;
-      bld.footprint.outer = transform(geom.outer, centre, angle, mirror);
-      for (const auto& h : geom.holes) bld.footprint.holes.push_back(transform(h, centre, angle, mirror));
-
-      // Roof: pitched roofs on plain rectangles only (their ridge follows the long axis).
-      const double roofDraw = rng.uniform();
-      if (shape == Shape::Rect && roofDraw < 0.35) {
-        bld.roof = RoofType::Gable;
-      } else if (shape == Shape::Rect && roofDraw < 0.6) {
-        bld.roof = RoofType::Hip;
-      }
-      const double heightM = bld.roof == RoofType::Flat ? rng.uniform(6.0, 30.0) : rng.uniform(6.0, 15.0);
-      bld.baseZ = t.z(centre.x, centre.y);
-      bld.eaveZ = bld.baseZ + heightM;
-      bld.ridgeZ = bld.eaveZ;
-      if (bld.roof != RoofType::Flat) {
-        const double pitch = rng.uniform(20.0, 38.0) * kPi / 180.0;
-        bld.pitchSlope = std::tan(pitch) / metre;  // m per px
-        bld.ridgeZ = bld.eaveZ + bld.pitchSlope * hw;
-      }
-
-      // Superstructures: machine rooms on flat roofs, chimneys on pitched ones.
-      const int boxCount = bld.roof == RoofType::Flat ? rng.uniformInt(0, 3) : rng.uniformInt(0, 2);
-      bld.topZ = bld.ridgeZ;
-      for (int k = 0; k < boxCount; ++k) {
-        const bool chimney = bld.roof != RoofType::Flat;
-        const double sizeU = (chimney ? rng.uniform(0.7, 1.3) : rng.uniform(1.5, 4.0)) * metre;
-        const double sizeV = (chimney ? rng.uniform(0.7, 1.3) : rng.uniform(1.5, 3.5)) * metre;
-        const double rise = chimney ? rng.uniform(0.9, 1.8) : rng.uniform(1.0, 2.5);
-        const double u = rng.uniform(-hl, hl), v = rng.uniform(-hw, hw);
-        // Keep the box and a 1.5 m border inside the footprint (checked on a 5x5 grid).
-        const double border = 1.5 * metre;
-        bool inside = true;
-        for (int gy = 0; gy < 5 && inside; ++gy) {
-          for (int gx = 0; gx < 5 && inside; ++gx) {
-            const double lu = u + (gx / 4.0 - 0.5) * (sizeU + 2 * border);
-            const double lv = v + (gy / 4.0 - 0.5) * (sizeV + 2 * border);
-            const core::Ring probe = transform({{lu, lv}}, centre, angle, false);
-            inside = insidePolygon(bld.footprint, probe[0].x, probe[0].y);
-          }
-        }
-        if (!inside) continue;
-        Box box;
-        box.ring = transform({{u - sizeU / 2, v - sizeV / 2}, {u + sizeU / 2, v - sizeV / 2},
-                              {u + sizeU / 2, v + sizeV / 2}, {u - sizeU / 2, v + sizeV / 2}},
-                             centre, angle, false);
-        double base = bld.eaveZ;
-        for (const auto& c : box.ring) base = std::max(base, bld.roofZ(c.x, c.y));
-        box.topZ = base + rise;
-        bld.topZ = std::max(bld.topZ, box.topZ);
-        bld.boxes.push_back(std::move(box));
-      }
-
-      const cv::Rect2d bb = boundsOf(bld.footprint.outer);
-      // Terrain under the footprint may sit below the base: the walls reach down to it.
-      const double zLo = bld.baseZ - std::abs(grad) * std::hypot(bb.width, bb.height) - 2 * p.undulation;
-      if (!placer.fits(bb.x, bb.x + bb.width, bb.y, bb.y + bb.height, zLo, bld.topZ)) continue;
-      if (!placer.freeOfBuildings(bld.footprint.outer)) continue;
-
-      // Appearance: a quarter of the roofs are weakly textured (hard for matchers).
-      bld.roofAlbedo = rng.uniform(0.3, 0.8);
-      bld.roofContrast = rng.chance(0.25) ? rng.uniform(0.03, 0.1) : rng.uniform(0.6, 1.2);
-      bld.wallAlbedo = rng.uniform(0.35, 0.75);
-      bld.boxAlbedo = std::clamp(bld.roofAlbedo + rng.uniform(-0.25, 0.25), 0.15, 0.9);
-      bld.textureSeed = rng.next();
-      bld.id = static_cast<int>(layout.buildings.size()) + 1;
-      placer.occupy(bld.footprint.outer, rng.uniform(3.0, 7.0) * metre);
-      layout.buildings.push_back(std::move(bld));
-      placed = true;
-    }
-  }
-
-  // Trees: round-ish crowns; about a third of them touch a building.
-  for (int k = 0; k < p.trees; ++k) {
-    for (int attempt = 0; attempt < 40; ++attempt) {
-      Tree tree;
-      tree.radius = rng.uniform(2.0, 5.0) * metre;
-      tree.lobeAmp = rng.uniform(0.05, 0.18);
-      for (double& ph : tree.lobePhase) ph = rng.uniform(0.0, 2.0 * kPi);
-      const double heightM = rng.uniform(5.0, 20.0);
-      const double rimShare = rng.uniform(0.35, 0.6);
-      tree.albedo = rng.uniform(0.2, 0.38);
-      tree.textureSeed = rng.next();
-      const double rmax = tree.maxRadius();
-      if (!layout.buildings.empty() && rng.chance(0.35)) {
-        const Building& bld = layout.buildings[static_cast<size_t>(
-            rng.uniformInt(0, static_cast<int>(layout.buildings.size()) - 1))];
-        const core::Ring& ring = bld.footprint.outer;
-        const size_t e = static_cast<size_t>(rng.uniformInt(0, static_cast<int>(ring.size()) - 1));
-        const cv::Point2d a = ring[e], b = ring[(e + 1) % ring.size()];
-        const cv::Point2d onEdge = a + rng.uniform(0.2, 0.8) * (b - a);
-        cv::Point2d normal(b.y - a.y, -(b.x - a.x));
-        normal *= 1.0 / std::max(1e-9, std::hypot(normal.x, normal.y));
-        const cv::Point2d probe = onEdge + normal * 0.5;
-        if (insidePolygon(bld.footprint, probe.x, probe.y)) normal = -normal;
-        tree.centre = onEdge + normal * (tree.radius + 0.3);
-      } else {
-        tree.centre = {rng.uniform(0.0, p.width), rng.uniform(0.0, p.height)};
-      }
-      bool clear = true;
-      for (const auto& bld : layout.buildings) {
-        if (insidePolygon(bld.footprint, tree.centre.x, tree.centre.y) ||
-            distanceToRings(bld.footprint, tree.centre) < tree.radius) {
-          clear = false;
-          break;
-        }
-      }
-      for (const auto& other : layout.trees) {
-        if (!clear) break;
-        const double d = std::hypot(other.centre.x - tree.centre.x, other.centre.y - tree.centre.y);
-        if (d < 0.7 * (other.radius + tree.radius)) clear = false;
-      }
-      if (!clear) continue;
-      tree.baseZ = t.z(tree.centre.x, tree.centre.y);
-      tree.topZ = tree.baseZ + heightM;
-      tree.rimZ = tree.baseZ + rimShare * heightM;
-      const double zLo = tree.baseZ - std::abs(grad) * rmax - 2 * p.undulation;
-      if (!placer.fits(tree.centre.x - rmax, tree.centre.x + rmax, tree.centre.y - rmax,
-                       tree.centre.y + rmax, zLo, tree.topZ)) {
-        continue;
-      }
-      layout.trees.push_back(tree);
-      break;
-    }
-  }
-  return layout;
+  LayoutDraw draw(p);
+  draw.terrainAndSun();
+  draw.buildings();
+  draw.trees();
+  return std::move(draw.layout);
 }
 
 }  // namespace delineo::sim::detail
