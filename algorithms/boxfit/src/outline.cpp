@@ -90,18 +90,11 @@ double lineDistance(const Line& l, const cv::Point2d& p) {
 
 cv::Point2d project(const Line& l, const cv::Point2d& p) { return l.point + l.direction * (p - l.point).dot(l.direction); }
 
-// The border of one region (contour points in image pixels, pixel centres at the union's scale)
-// as straight lines: corners by Douglas-Peucker, sides cut into pieces of at most `pieceLength`
-// px, one line per piece, collinear neighbours merged, consecutive lines intersected (a jog
-// between parallel lines gets two vertices). `shift` moves every line by that many px away from
-// the region (the contour runs through the border pixels' centres, half a pixel inside); the
-// region is inside the ring, or outside it for a `hole`.
-core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& params, double shift,
-                      double pointSpacing, bool hole) {
+// Corners of the closed contour: Douglas-Peucker from the point farthest from the first, then
+// breakpoints that a straight chord would replace within the tolerance are removed (the start is
+// arbitrary). Indices into pts, in order.
+std::vector<size_t> ringCorners(const std::vector<cv::Point2d>& pts, double tolerance) {
   const size_t n = pts.size();
-  if (n < 8) return pts;
-  // Corners: Douglas-Peucker from the point farthest from the first, then breakpoints that a
-  // straight chord would replace within the tolerance are removed (the start is arbitrary).
   size_t far = 0;
   double farthest = -1;
   for (size_t i = 0; i < n; ++i) {
@@ -109,9 +102,9 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
     if (d > farthest) farthest = d, far = i;
   }
   std::vector<size_t> corners{0};
-  breakpoints(pts, 0, far, params.cornerTolerance, corners);
+  breakpoints(pts, 0, far, tolerance, corners);
   corners.push_back(far);
-  breakpoints(pts, far, n, params.cornerTolerance, corners);
+  breakpoints(pts, far, n, tolerance, corners);
   for (bool removed = true; removed && corners.size() > 3;) {
     removed = false;
     for (size_t c = 0; c < corners.size() && corners.size() > 3; ++c) {
@@ -119,15 +112,21 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
       const size_t end = b > a ? b : b + n;
       double worst = 0;
       for (size_t i = a + 1; i < end; ++i) worst = std::max(worst, distanceToChord(pts[i % n], pts[a], pts[b]));
-      if (worst <= params.cornerTolerance) {
+      if (worst <= tolerance) {
         corners.erase(corners.begin() + static_cast<std::ptrdiff_t>(c));
         removed = true;
         break;
       }
     }
   }
-  // Pieces of at most refine-length px along each side, one line each; the closing rounds the
-  // corners, so a few points next to each corner are left out of the fit when the side is long.
+  return corners;
+}
+
+// Pieces of at most refine-length px along each side, one line each; the closing rounds the
+// corners, so a few points next to each corner are left out of the fit when the side is long.
+std::vector<Line> sideLines(const std::vector<cv::Point2d>& pts, const std::vector<size_t>& corners,
+                            const BoxFitParams& params, double pointSpacing) {
+  const size_t n = pts.size();
   std::vector<Line> lines;
   const size_t perPiece = std::max<size_t>(3, static_cast<size_t>(params.refineLength / pointSpacing));
   const size_t trim = static_cast<size_t>(std::ceil((params.closingRadius + 0.5) / pointSpacing));
@@ -143,11 +142,15 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
       lines.push_back(fitLine(pts, first, last));
     }
   }
-  // The closing rounds concave corners and the slopes of small jogs; such a rounding, cut off as
-  // a side of its own, would be a short slanted line. A line fitted to no more than the
-  // rounding's extent is dropped: its neighbours then meet at the corner itself, or, parallel,
-  // make a jog square to them.
-  const double rounding = 2.0 * params.closingRadius + 2.0;
+  return lines;
+}
+
+// The closing rounds concave corners and the slopes of small jogs; such a rounding, cut off as
+// a side of its own, would be a short slanted line. A line fitted to no more than the
+// rounding's extent is dropped: its neighbours then meet at the corner itself, or, parallel,
+// make a jog square to them.
+void dropRoundings(std::vector<Line>& lines, int closingRadius, double pointSpacing) {
+  const double rounding = 2.0 * closingRadius + 2.0;
   for (bool dropped = true; dropped && lines.size() > 3;) {
     dropped = false;
     for (size_t i = 0; i < lines.size() && lines.size() > 3; ++i) {
@@ -157,7 +160,11 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
       break;
     }
   }
-  // Neighbouring lines within 10° whose points lie within the tolerance of one line are merged.
+}
+
+// Neighbouring lines within 10° whose points lie within the tolerance of one line are merged.
+void mergeCollinear(std::vector<Line>& lines, const std::vector<cv::Point2d>& pts, double tolerance) {
+  const size_t n = pts.size();
   const double cosMerge = std::cos(10.0 * 3.14159265358979323846 / 180.0);
   for (bool merged = true; merged && lines.size() > 3;) {
     merged = false;
@@ -169,21 +176,30 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
       const Line both = fitLine(pts, first, last);
       double worst = 0;
       for (size_t p = first; p <= last; ++p) worst = std::max(worst, lineDistance(both, pts[p % n]));
-      if (worst > params.cornerTolerance) continue;
+      if (worst > tolerance) continue;
       lines[i] = both;
       lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(j));
       if (j < i) --i;  // the first line was merged into the last: indices moved
       merged = true;
     }
   }
-  // Shift away from the region. For a ring running clockwise on screen (positive shoelace sum
-  // with y down) (-dy, dx) points into the ring.
+}
+
+// Shift away from the region. For a ring running clockwise on screen (positive shoelace sum
+// with y down) (-dy, dx) points into the ring.
+void shiftAway(std::vector<Line>& lines, const std::vector<cv::Point2d>& pts, double shift, bool hole) {
+  const size_t n = pts.size();
   double area2 = 0;
   for (size_t i = 0; i < n; ++i) area2 += pts[i].x * pts[(i + 1) % n].y - pts[(i + 1) % n].x * pts[i].y;
   const double intoRing = area2 > 0 ? 1.0 : -1.0;
   const double away = hole ? shift : -shift;
   for (auto& l : lines) l.point += intoRing * away * cv::Point2d(-l.direction.y, l.direction.x);
+}
 
+// Consecutive lines intersected: one corner where they cross at 20° or more and near the contour
+// point between their runs, else both projected onto that point (a jog: two vertices).
+core::Ring intersected(const std::vector<Line>& lines, const std::vector<cv::Point2d>& pts, double refineLength) {
+  const size_t n = pts.size();
   core::Ring ring;
   const double sinCorner = std::sin(20.0 * 3.14159265358979323846 / 180.0);
   for (size_t i = 0; i < lines.size(); ++i) {
@@ -195,7 +211,7 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
       const cv::Point2d d = b.point - a.point;
       const double t = (d.x * b.direction.y - d.y * b.direction.x) / cross;
       const cv::Point2d corner = a.point + a.direction * t;
-      if (cv::norm(corner - junction) <= params.refineLength) {
+      if (cv::norm(corner - junction) <= refineLength) {
         ring.push_back(corner);
         continue;
       }
@@ -203,7 +219,11 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
     ring.push_back(project(a, junction));
     ring.push_back(project(b, junction));
   }
-  // Vertices closer than half a pixel are merged; vertices on a straight line dropped.
+  return ring;
+}
+
+// Vertices closer than half a pixel are merged; vertices on a straight line dropped.
+core::Ring cleaned(const core::Ring& ring) {
   core::Ring clean;
   for (const auto& v : ring) {
     if (clean.empty() || cv::norm(v - clean.back()) >= 0.5) clean.push_back(v);
@@ -222,6 +242,23 @@ core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& p
     }
   }
   return clean;
+}
+
+// The border of one region (contour points in image pixels, pixel centres at the union's scale)
+// as straight lines: corners by Douglas-Peucker, sides cut into pieces of at most `pieceLength`
+// px, one line per piece, collinear neighbours merged, consecutive lines intersected (a jog
+// between parallel lines gets two vertices). `shift` moves every line by that many px away from
+// the region (the contour runs through the border pixels' centres, half a pixel inside); the
+// region is inside the ring, or outside it for a `hole`.
+core::Ring refineRing(const std::vector<cv::Point2d>& pts, const BoxFitParams& params, double shift,
+                      double pointSpacing, bool hole) {
+  if (pts.size() < 8) return pts;
+  const std::vector<size_t> corners = ringCorners(pts, params.cornerTolerance);
+  std::vector<Line> lines = sideLines(pts, corners, params, pointSpacing);
+  dropRoundings(lines, params.closingRadius, pointSpacing);
+  mergeCollinear(lines, pts, params.cornerTolerance);
+  shiftAway(lines, pts, shift, hole);
+  return cleaned(intersected(lines, pts, params.refineLength));
 }
 
 // The contour (pixel centres at the union's scale) in image pixels.
