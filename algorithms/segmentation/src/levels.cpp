@@ -152,29 +152,23 @@ void mergeSmallLevels(std::vector<int>& partOf, const std::vector<RegionStats>& 
   }
 }
 
-}  // namespace
-
-cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat& ndsm, double gsd,
-                    const LevelSplit& rules, int& count) {
-  cv::Mat parts = cv::Mat::zeros(piece.size(), CV_32S);
-  count = cv::countNonZero(piece) > 0 ? 1 : 0;
-  cv::Mat local;
-  const int n = count > 0 && rules.minStep > 0 && !regions.empty() ? localRegions(piece, regions, local) : 0;
-  if (n <= 1) {
-    parts.setTo(1, piece);
-    return parts;
-  }
-  // Per region: size, steep pixels, mean height, contacts off the piece; per pair: the border.
-  const cv::Mat steep = steepPixels(ndsm, std::tan(rules.wallSlope * CV_PI / 180.0) * gsd);
-  const int band = std::max(1, static_cast<int>(std::lround(rules.stepBand / gsd)));
-  std::vector<RegionStats> stats(static_cast<size_t>(n));
+// Per region: size, steep pixels, mean height, contacts off the piece; per pair: the border.
+struct PieceRegions {
+  std::vector<RegionStats> stats;
   std::map<std::uint64_t, Border> borders;
-  for (int y = 0; y < piece.rows; ++y) {
-    for (int x = 0; x < piece.cols; ++x) {
+};
+
+// The `n` local regions measured: `steep` marks wall pixels, a border's step is read `band` px
+// inside each side.
+PieceRegions measureRegions(const cv::Mat& local, const cv::Mat& ndsm, const cv::Mat& steep, int band, int n) {
+  PieceRegions measured;
+  measured.stats.resize(static_cast<size_t>(n));
+  for (int y = 0; y < local.rows; ++y) {
+    for (int x = 0; x < local.cols; ++x) {
       const cv::Point p(x, y);
       const int id = local.at<int>(p);
       if (id < 0) continue;
-      RegionStats& s = stats[static_cast<size_t>(id)];
+      RegionStats& s = measured.stats[static_cast<size_t>(id)];
       ++s.pixels;
       s.steep += steep.at<uchar>(p) != 0;
       if (const float h = ndsm.at<float>(p); std::isfinite(h)) s.heightSum += h, ++s.heights;
@@ -183,7 +177,7 @@ cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat&
         const int other = inside(local, q) ? local.at<int>(q) : -1;
         if (other < 0) ++s.outside;
         if (other < 0 || other == id || k >= 2) continue;
-        Border& b = borders[pairKey(id, other)];
+        Border& b = measured.borders[pairKey(id, other)];
         ++b.length;
         const float ha = heightInside(local, ndsm, p, -kSteps[k], band);
         const float hb = heightInside(local, ndsm, q, kSteps[k], band);
@@ -191,30 +185,39 @@ cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat&
       }
     }
   }
-  // Levels: non-wall regions joined across borders of a step under δ_0. A border without heights
-  // on both sides (unmatched on both) compares the two regions' mean heights instead.
-  std::vector<bool> wall(static_cast<size_t>(n));
-  for (size_t i = 0; i < wall.size(); ++i) wall[i] = 2 * stats[i].steep > stats[i].pixels;
+  return measured;
+}
+
+// Levels: non-wall regions joined across borders of a step under δ_0 (`minStep`). A border
+// without heights on both sides (unmatched on both) compares the two regions' mean heights
+// instead. Returns the union-find parents.
+std::vector<int> joinLevels(const PieceRegions& measured, const std::vector<bool>& wall, double minStep) {
   const auto meanHeight = [&](int r) {
-    const RegionStats& s = stats[static_cast<size_t>(r)];
+    const RegionStats& s = measured.stats[static_cast<size_t>(r)];
     return s.heights > 0 ? s.heightSum / s.heights : std::nan("");
   };
-  std::vector<int> parent(static_cast<size_t>(n));
+  std::vector<int> parent(measured.stats.size());
   std::iota(parent.begin(), parent.end(), 0);
-  for (const auto& [key, border] : borders) {
+  for (const auto& [key, border] : measured.borders) {
     const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
     if (wall[static_cast<size_t>(a)] || wall[static_cast<size_t>(b)]) continue;
     const double step = border.steps.empty() ? meanHeight(a) - meanHeight(b) : median(border.steps);
-    if (!(std::abs(step) >= rules.minStep)) {  // NaN (no height at all): one level
+    if (!(std::abs(step) >= minStep)) {  // NaN (no height at all): one level
       parent[static_cast<size_t>(rootOf(parent, a))] = rootOf(parent, b);
     }
   }
-  // Walls join the level they touch whose mean height is nearest the wall's top (95th percentile
-  // of its heights): a wall's ramp hangs from the eave of its roof, and the 1 px steep rim of a
-  // roof beside a higher one stays with its own roof.
+  return parent;
+}
+
+// Walls join the level they touch whose mean height is nearest the wall's top (95th percentile
+// of its heights): a wall's ramp hangs from the eave of its roof, and the 1 px steep rim of a
+// roof beside a higher one stays with its own roof.
+void attachWalls(const cv::Mat& local, const cv::Mat& ndsm, const PieceRegions& measured, const std::vector<bool>& wall,
+                 std::vector<int>& parent) {
+  const int n = static_cast<int>(wall.size());
   std::vector<std::vector<float>> wallHeights(static_cast<size_t>(n));
-  for (int y = 0; y < piece.rows; ++y) {
-    for (int x = 0; x < piece.cols; ++x) {
+  for (int y = 0; y < local.rows; ++y) {
+    for (int x = 0; x < local.cols; ++x) {
       const int id = local.at<int>(y, x);
       const float h = ndsm.at<float>(y, x);
       if (id >= 0 && wall[static_cast<size_t>(id)] && std::isfinite(h)) wallHeights[static_cast<size_t>(id)].push_back(h);
@@ -224,12 +227,12 @@ cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat&
   std::vector<int> levelCount(static_cast<size_t>(n), 0);
   for (int r = 0; r < n; ++r) {
     if (wall[static_cast<size_t>(r)]) continue;
-    levelSum[static_cast<size_t>(rootOf(parent, r))] += stats[static_cast<size_t>(r)].heightSum;
-    levelCount[static_cast<size_t>(rootOf(parent, r))] += stats[static_cast<size_t>(r)].heights;
+    levelSum[static_cast<size_t>(rootOf(parent, r))] += measured.stats[static_cast<size_t>(r)].heightSum;
+    levelCount[static_cast<size_t>(rootOf(parent, r))] += measured.stats[static_cast<size_t>(r)].heights;
   }
   std::vector<int> nearest(static_cast<size_t>(n), -1);
   std::vector<double> nearestGap(static_cast<size_t>(n), 0.0);
-  for (const auto& [key, border] : borders) {
+  for (const auto& [key, border] : measured.borders) {
     for (const auto& [w, r] : {std::pair{static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu)},
                                std::pair{static_cast<int>(key & 0xffffffffu), static_cast<int>(key >> 32)}}) {
       const size_t wi = static_cast<size_t>(w);
@@ -246,29 +249,35 @@ cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat&
   for (size_t w = 0; w < wall.size(); ++w) {
     if (nearest[w] >= 0) parent[w] = nearest[w];
   }
-  std::vector<int> partOf(static_cast<size_t>(n));
-  for (int r = 0; r < n; ++r) partOf[static_cast<size_t>(r)] = rootOf(parent, r);
-  // Ramps: levels whose heights span more than 2 δ_0 from their 10th to their 90th percentile
-  // (a wall seen obliquely but less steep than the wall slope) are no roof of their own.
-  std::vector<std::vector<float>> levelHeights(static_cast<size_t>(n));
-  for (int y = 0; y < piece.rows; ++y) {
-    for (int x = 0; x < piece.cols; ++x) {
+}
+
+// Ramps: levels whose heights span more than 2 δ_0 from their 10th to their 90th percentile
+// (a wall seen obliquely but less steep than the wall slope) are no roof of their own.
+std::vector<bool> rampLevels(const cv::Mat& local, const cv::Mat& ndsm, const std::vector<int>& partOf,
+                             double minStep) {
+  const size_t n = partOf.size();
+  std::vector<std::vector<float>> levelHeights(n);
+  for (int y = 0; y < local.rows; ++y) {
+    for (int x = 0; x < local.cols; ++x) {
       const int id = local.at<int>(y, x);
       const float h = ndsm.at<float>(y, x);
       if (id >= 0 && std::isfinite(h)) levelHeights[static_cast<size_t>(partOf[static_cast<size_t>(id)])].push_back(h);
     }
   }
-  std::vector<bool> ramp(static_cast<size_t>(n), false);
+  std::vector<bool> ramp(n, false);
   for (size_t l = 0; l < ramp.size(); ++l) {
     std::vector<float>& h = levelHeights[l];
-    if (!h.empty()) ramp[l] = quantile(h, 0.9) - quantile(h, 0.1) > 2.0 * rules.minStep;
+    if (!h.empty()) ramp[l] = quantile(h, 0.9) - quantile(h, 0.1) > 2.0 * minStep;
   }
-  mergeSmallLevels(partOf, stats, borders, rules.minPartArea / (gsd * gsd), ramp);
-  // Parts numbered 1..count in scan order.
-  std::vector<int> number(static_cast<size_t>(n), 0);
+  return ramp;
+}
+
+// Parts numbered 1..count in scan order into `parts`.
+void numberParts(const cv::Mat& local, const std::vector<int>& partOf, cv::Mat& parts, int& count) {
+  std::vector<int> number(partOf.size(), 0);
   count = 0;
-  for (int y = 0; y < piece.rows; ++y) {
-    for (int x = 0; x < piece.cols; ++x) {
+  for (int y = 0; y < local.rows; ++y) {
+    for (int x = 0; x < local.cols; ++x) {
       const int id = local.at<int>(y, x);
       if (id < 0) continue;
       int& k = number[static_cast<size_t>(partOf[static_cast<size_t>(id)])];
@@ -276,6 +285,32 @@ cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat&
       parts.at<int>(y, x) = k;
     }
   }
+}
+
+}  // namespace
+
+cv::Mat splitLevels(const cv::Mat& piece, const cv::Mat& regions, const cv::Mat& ndsm, double gsd,
+                    const LevelSplit& rules, int& count) {
+  cv::Mat parts = cv::Mat::zeros(piece.size(), CV_32S);
+  count = cv::countNonZero(piece) > 0 ? 1 : 0;
+  cv::Mat local;
+  const int n = count > 0 && rules.minStep > 0 && !regions.empty() ? localRegions(piece, regions, local) : 0;
+  if (n <= 1) {
+    parts.setTo(1, piece);
+    return parts;
+  }
+  const cv::Mat steep = steepPixels(ndsm, std::tan(rules.wallSlope * CV_PI / 180.0) * gsd);
+  const int band = std::max(1, static_cast<int>(std::lround(rules.stepBand / gsd)));
+  const PieceRegions measured = measureRegions(local, ndsm, steep, band, n);
+  std::vector<bool> wall(static_cast<size_t>(n));
+  for (size_t i = 0; i < wall.size(); ++i) wall[i] = 2 * measured.stats[i].steep > measured.stats[i].pixels;
+  std::vector<int> parent = joinLevels(measured, wall, rules.minStep);
+  attachWalls(local, ndsm, measured, wall, parent);
+  std::vector<int> partOf(static_cast<size_t>(n));
+  for (int r = 0; r < n; ++r) partOf[static_cast<size_t>(r)] = rootOf(parent, r);
+  const std::vector<bool> ramp = rampLevels(local, ndsm, partOf, rules.minStep);
+  mergeSmallLevels(partOf, measured.stats, measured.borders, rules.minPartArea / (gsd * gsd), ramp);
+  numberParts(local, partOf, parts, count);
   return parts;
 }
 
