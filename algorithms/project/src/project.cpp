@@ -304,7 +304,10 @@ json toJson(const Project& project, const std::string& baseDir) {
   return out;
 }
 
-Project fromJson(const json& in, const std::string& baseDir) {
+namespace {
+
+// The root is a Delineo project of a version this program reads.
+void checkFormat(const json& in) {
   if (!in.is_object()) badField("(root)", "a project must be a JSON object");
   // (find, not value(): value() throws json's type_error when "format" is not a string.)
   if (const auto format = in.find("format");
@@ -318,9 +321,10 @@ Project fromJson(const json& in, const std::string& baseDir) {
                             " is newer than this program supports (" +
                             std::to_string(kFormatVersion) + ")");
   }
-  Project p;
-  p.name = get<std::string>(in, "name", "", "");
-  const json images = in.value("images", json::object());
+}
+
+// The image paths of `images`, resolved against the project's folder.
+void readImages(const json& images, const std::string& baseDir, Project& p) {
   if (!images.is_object()) badField("images", "must be an object");
   p.left = resolveAgainst(get<std::string>(images, "left", "", "images."), baseDir);
   p.right = resolveAgainst(get<std::string>(images, "right", "", "images."), baseDir);
@@ -329,29 +333,26 @@ Project fromJson(const json& in, const std::string& baseDir) {
   p.labels = resolveAgainst(get<std::string>(images, "labels", "", "images."), baseDir);
   p.exclude = resolveAgainst(get<std::string>(images, "exclude", "", "images."), baseDir);
   if (p.left.empty() || p.right.empty()) badField("images", "left and right images are required");
-  // Relative output folders stay relative (to wherever the project file is saved next).
-  p.outputDir = get<std::string>(in, "outputDir", "output", "");
-  if (p.outputDir.empty()) badField("outputDir", "must not be empty (the default is \"output\")");
-  if (auto it = in.find("disparityRange"); it != in.end() && !it->is_null()) {
-    p.disparityRange = intervalFromJson(*it, "disparityRange");
+}
+
+// The "heightModel" object, each value within its bounds.
+void readHeightModel(const json& model, HeightModel& height) {
+  height.groundDisparity = get<double>(model, "groundDisparity", 0.0, "heightModel.");
+  height.metresPerPixel = get<double>(model, "metresPerPixel", 0.0, "heightModel.");
+  height.gsd = get<double>(model, "gsd", 1.0, "heightModel.");
+  if (!(height.gsd > 0 && height.gsd <= kMaxMetresPerPixel)) {
+    badField("heightModel.gsd", "must be positive, at most " + std::to_string(kMaxMetresPerPixel) + " m");
   }
-  if (auto it = in.find("heightModel"); it != in.end() && it->is_object()) {
-    p.height.groundDisparity = get<double>(*it, "groundDisparity", 0.0, "heightModel.");
-    p.height.metresPerPixel = get<double>(*it, "metresPerPixel", 0.0, "heightModel.");
-    p.height.gsd = get<double>(*it, "gsd", 1.0, "heightModel.");
-    if (!(p.height.gsd > 0 && p.height.gsd <= kMaxMetresPerPixel)) {
-      badField("heightModel.gsd", "must be positive, at most " + std::to_string(kMaxMetresPerPixel) + " m");
-    }
-    if (!(std::abs(p.height.metresPerPixel) <= kMaxMetresPerPixel)) {
-      badField("heightModel.metresPerPixel", "must be within +-" + std::to_string(kMaxMetresPerPixel));
-    }
-    if (!(std::abs(p.height.groundDisparity) <= kMaxDisparity)) {
-      badField("heightModel.groundDisparity", "must be within +-" + std::to_string(kMaxDisparity) + " px");
-    }
+  if (!(std::abs(height.metresPerPixel) <= kMaxMetresPerPixel)) {
+    badField("heightModel.metresPerPixel", "must be within +-" + std::to_string(kMaxMetresPerPixel));
   }
-  // Files written before outlines had a method name none: the active polygon, the only one then.
-  p.method = get<std::string>(in, "method", kActivePolygon, "");
-  if (!isOutlineMethod(p.method)) badField("method", methodProblem(p.method));
+  if (!(std::abs(height.groundDisparity) <= kMaxDisparity)) {
+    badField("heightModel.groundDisparity", "must be within +-" + std::to_string(kMaxDisparity) + " px");
+  }
+}
+
+// The parameter groups, each an object; an older file's search range moved to disparityRange.
+void readParameters(const json& in, Project& p) {
   p.parameters = in.value("parameters", json::object());
   if (!p.parameters.is_object()) badField("parameters", "must be an object of groups");
   for (auto it = p.parameters.begin(); it != p.parameters.end(); ++it) {
@@ -372,46 +373,70 @@ Project fromJson(const json& in, const std::string& baseDir) {
     matching->erase("dmin");
     matching->erase("dmax");
   }
+}
+
+// One building (`where`: "buildings[i]."), its id new to the buildings read before it (`p`).
+Building buildingFromJson(const json& jb, const std::string& where, const Project& p) {
+  if (!jb.is_object()) badField(where, "must be an object");
+  Building b;
+  b.id = get<int>(jb, "id", 0, where);
+  if (b.id <= 0) badField(where + "id", "must be a positive integer");
+  if (p.find(b.id) != nullptr) badField(where + "id", "duplicate id " + std::to_string(b.id));
+  b.status = statusFromString(get<std::string>(jb, "status", "pending", where));
+  b.initial = polygonFromJson(jb.value("initial", json::array()), where + "initial");
+  b.outline = polygonFromJson(jb.value("outline", json::array()), where + "outline");
+  if (b.initial.outer.empty()) badField(where + "initial", "a building needs an initial polygon");
+  if (auto it = jb.find("roofInterval"); it != jb.end() && !it->is_null()) {
+    b.roofInterval = intervalFromJson(*it, where + "roofInterval");
+  }
+  b.roofHeight = get<double>(jb, "roofHeight", std::nan(""), where);
+  b.energy = get<double>(jb, "energy", std::nan(""), where);
+  if (auto it = jb.find("energyTerms"); it != jb.end() && !it->is_null()) {
+    if (!it->is_object()) badField(where + "energyTerms", "must be an object of numbers");
+    EnergyTerms terms{};
+    for (size_t t = 0; t < kEnergyTermNames.size(); ++t) {
+      terms[t] = get<double>(*it, kEnergyTermNames[t], std::nan(""), where + "energyTerms.");
+    }
+    b.energyTerms = terms;
+  }
+  b.method = get<std::string>(jb, "method", "", where);
+  if (!b.method.empty() && !isOutlineMethod(b.method)) badField(where + "method", methodProblem(b.method));
+  const json history = jb.value("history", json::array());
+  if (!history.is_array()) badField(where + "history", "must be an array");
+  for (const auto& h : history) {
+    if (!h.is_object()) badField(where + "history", "entries must be objects");
+    b.history.push_back({get<std::string>(h, "action", "", where + "history."),
+                         get<std::string>(h, "time", "", where + "history."),
+                         get<std::string>(h, "detail", "", where + "history.")});
+  }
+  b.unknownKeys = unknownKeys(jb, {"id", "status", "method", "initial", "outline", "roofInterval", "roofHeight",
+                                   "energy", "energyTerms", "history"});
+  return b;
+}
+
+}  // namespace
+
+Project fromJson(const json& in, const std::string& baseDir) {
+  checkFormat(in);
+  Project p;
+  p.name = get<std::string>(in, "name", "", "");
+  const json images = in.value("images", json::object());
+  readImages(images, baseDir, p);
+  // Relative output folders stay relative (to wherever the project file is saved next).
+  p.outputDir = get<std::string>(in, "outputDir", "output", "");
+  if (p.outputDir.empty()) badField("outputDir", "must not be empty (the default is \"output\")");
+  if (auto it = in.find("disparityRange"); it != in.end() && !it->is_null()) {
+    p.disparityRange = intervalFromJson(*it, "disparityRange");
+  }
+  if (auto it = in.find("heightModel"); it != in.end() && it->is_object()) readHeightModel(*it, p.height);
+  // Files written before outlines had a method name none: the active polygon, the only one then.
+  p.method = get<std::string>(in, "method", kActivePolygon, "");
+  if (!isOutlineMethod(p.method)) badField("method", methodProblem(p.method));
+  readParameters(in, p);
   const json buildings = in.value("buildings", json::array());
   if (!buildings.is_array()) badField("buildings", "must be an array");
   for (size_t i = 0; i < buildings.size(); ++i) {
-    const json& jb = buildings[i];
-    const std::string where = "buildings[" + std::to_string(i) + "].";
-    if (!jb.is_object()) badField(where, "must be an object");
-    Building b;
-    b.id = get<int>(jb, "id", 0, where);
-    if (b.id <= 0) badField(where + "id", "must be a positive integer");
-    if (p.find(b.id) != nullptr) badField(where + "id", "duplicate id " + std::to_string(b.id));
-    b.status = statusFromString(get<std::string>(jb, "status", "pending", where));
-    b.initial = polygonFromJson(jb.value("initial", json::array()), where + "initial");
-    b.outline = polygonFromJson(jb.value("outline", json::array()), where + "outline");
-    if (b.initial.outer.empty()) badField(where + "initial", "a building needs an initial polygon");
-    if (auto it = jb.find("roofInterval"); it != jb.end() && !it->is_null()) {
-      b.roofInterval = intervalFromJson(*it, where + "roofInterval");
-    }
-    b.roofHeight = get<double>(jb, "roofHeight", std::nan(""), where);
-    b.energy = get<double>(jb, "energy", std::nan(""), where);
-    if (auto it = jb.find("energyTerms"); it != jb.end() && !it->is_null()) {
-      if (!it->is_object()) badField(where + "energyTerms", "must be an object of numbers");
-      EnergyTerms terms{};
-      for (size_t t = 0; t < kEnergyTermNames.size(); ++t) {
-        terms[t] = get<double>(*it, kEnergyTermNames[t], std::nan(""), where + "energyTerms.");
-      }
-      b.energyTerms = terms;
-    }
-    b.method = get<std::string>(jb, "method", "", where);
-    if (!b.method.empty() && !isOutlineMethod(b.method)) badField(where + "method", methodProblem(b.method));
-    const json history = jb.value("history", json::array());
-    if (!history.is_array()) badField(where + "history", "must be an array");
-    for (const auto& h : history) {
-      if (!h.is_object()) badField(where + "history", "entries must be objects");
-      b.history.push_back({get<std::string>(h, "action", "", where + "history."),
-                           get<std::string>(h, "time", "", where + "history."),
-                           get<std::string>(h, "detail", "", where + "history.")});
-    }
-    b.unknownKeys = unknownKeys(jb, {"id", "status", "method", "initial", "outline", "roofInterval", "roofHeight",
-                                     "energy", "energyTerms", "history"});
-    p.buildings.push_back(std::move(b));
+    p.buildings.push_back(buildingFromJson(buildings[i], "buildings[" + std::to_string(i) + "].", p));
   }
   p.unknownKeys = unknownKeys(in, {"format", "version", "name", "method", "images", "outputDir", "disparityRange",
                                    "heightModel", "parameters", "buildings"});
