@@ -129,7 +129,9 @@ void describeResult(const delineation::DelineationResult& r, core::Feature& resu
   result.attributes["no_match_cost"] = r.noMatchCost;
 }
 
-int run(const std::vector<std::string>& args) {
+// The command's flags: the pair, the initial polygons (or rectangle), the intervals, the optional
+// mask and map, the output, and every parameter of the active polygon.
+cli::Options delineateOptions() {
   cli::Options opts("delineate",
                     "Delineates buildings on an epipolar pair with the statistical active polygon: "
                     "one output polygon per initial polygon (or per --roi rectangle).");
@@ -155,16 +157,100 @@ int run(const std::vector<std::string>& args) {
       .required("out", "FILE", "output polygons (GeoJSON/GeoPackage) with energies and status")
       .flag("quiet", "no progress and no range estimate on stderr")
       .params(delineation::DelineationParams{});
+  return opts;
+}
+
+// The intervals given by --roof-disparity, --ground-disparity and --disparity-range.
+Flags intervalFlags(const cli::Options& opts) {
+  Flags flags;
+  if (opts.has("roof-disparity")) flags.roof = intervalFlag(opts, "roof-disparity");
+  if (opts.has("ground-disparity")) flags.ground = intervalFlag(opts, "ground-disparity");
+  if (opts.has("disparity-range")) flags.search = intervalFlag(opts, "disparity-range");
+  return flags;
+}
+
+// The --disparity map (empty without it), of the left image's size.
+cv::Mat readDisparityMap(const cli::Options& opts, cv::Size leftSize) {
+  cv::Mat disparity;
+  if (opts.has("disparity")) {
+    io::ReadOptions options;
+    options.type = io::PixelType::Float32;
+    options.toGrey = true;
+    disparity = io::readRaster(opts.get("disparity"), options).data;
+    if (disparity.size() != leftSize) {
+      throw core::Error(core::ErrorCode::MismatchedInputs,
+                        "the disparity map does not have the size of the left image", opts.get("disparity"));
+    }
+  }
+  return disparity;
+}
+
+// The pair's search range from feature matches (the first 5 % of `progress`); none, with a
+// warning, when the pair gives no estimate.
+std::optional<DisparityInterval> estimatedRange(const cv::Mat& left, const cv::Mat& right, bool quiet,
+                                                core::Progress* progress) {
+  core::Progress::Range rangeProgress(progress, 0.0, 0.05);
+  try {
+    const auto e = cli::estimateRangeForCommand(left, right, "give --disparity-range", quiet,
+                                                &rangeProgress);
+    return DisparityInterval{e.dmin, e.dmax};
+  } catch (const core::Error& e) {
+    // Each building then searches around its own intervals, as without an estimate.
+    std::fprintf(stderr, "warning: %s; searching around each building's intervals only\n",
+                 e.what());
+    return std::nullopt;
+  }
+}
+
+// What every building of the batch is delineated with besides its own request.
+struct Batch {
+  const cv::Mat& left;
+  const cv::Mat& right;
+  const cv::Mat& exclude;
+  const cv::Mat& disparity;
+  std::optional<DisparityInterval> search;     // --disparity-range
+  std::optional<DisparityInterval> estimated;  // the pair's estimate, without it
+  const delineation::DelineationParams& params;
+};
+
+// One building as an output feature: its outline with what the stage did, or, in a batch of
+// more than one (`single` false), its error (counted in `failed`).
+core::Feature delineateBuilding(const BuildingJob& job, const Batch& batch, bool single,
+                                const core::Progress& progress, core::Progress::Range& range, int& failed) {
+  core::Feature result;
+  result.polygon = job.request.init;
+  result.attributes["id"] = job.id;
+  try {
+    if (!job.missing.empty()) throw core::Error(core::ErrorCode::InvalidParameter, job.missing);
+    delineation::DelineationRequest req = job.request;
+    req.searchRange = batch.search;
+    if (batch.estimated) req.searchRange = hull(*batch.estimated, req.roof, req.ground);
+    req.excludeMask = batch.exclude;
+    req.disparity = batch.disparity;
+    const auto r = delineation::delineate(batch.left, batch.right, req, batch.params, {}, &range);
+    // A canceled batch writes nothing: the previous output, if any, stays as it was.
+    if (r.status == core::RunStatus::Canceled || progress.canceled()) throw cli::Canceled();
+    describeResult(r, result);
+  } catch (const core::Error& e) {
+    // One bad building does not stop the batch; a single-building run reports the error.
+    if (single) throw;
+    ++failed;
+    result.attributes["status"] = std::string("failed");
+    result.attributes["error"] = e.detail();
+    std::fprintf(stderr, "building id %lld: %s\n", job.id, e.what());
+  }
+  return result;
+}
+
+int run(const std::vector<std::string>& args) {
+  cli::Options opts = delineateOptions();
   if (!opts.parse(args)) return cli::kExitOk;
   if (opts.has("init") == opts.has("roi")) {
     throw cli::UsageError("give exactly one of --init and --roi");
   }
   delineation::DelineationParams params;
   opts.apply(params);
-  Flags flags;
-  if (opts.has("roof-disparity")) flags.roof = intervalFlag(opts, "roof-disparity");
-  if (opts.has("ground-disparity")) flags.ground = intervalFlag(opts, "ground-disparity");
-  if (opts.has("disparity-range")) flags.search = intervalFlag(opts, "disparity-range");
+  const Flags flags = intervalFlags(opts);
   cli::checkOutputs(opts, {{"out", io::OutputFormat::Vector}}, {"left", "right", "init", "exclude", "disparity"});
 
   auto& progress = cli::commandProgress();
@@ -182,62 +268,20 @@ int run(const std::vector<std::string>& args) {
       buildingJobs(initialPolygons(opts, geo), flags, params, opts.has("init") ? opts.get("init") : "");
   cv::Mat exclude;
   if (opts.has("exclude")) exclude = io::readMask(opts.get("exclude"), left.size());
-  cv::Mat disparity;
-  if (opts.has("disparity")) {
-    io::ReadOptions options;
-    options.type = io::PixelType::Float32;
-    options.toGrey = true;
-    disparity = io::readRaster(opts.get("disparity"), options).data;
-    if (disparity.size() != left.size()) {
-      throw core::Error(core::ErrorCode::MismatchedInputs,
-                        "the disparity map does not have the size of the left image", opts.get("disparity"));
-    }
-  }
+  const cv::Mat disparity = readDisparityMap(opts, left.size());
 
   core::Progress::Range buildingsProgress(&progress, flags.search ? 0.0 : 0.05, 1.0);
   std::optional<DisparityInterval> estimated;
-  if (!flags.search) {
-    core::Progress::Range rangeProgress(&progress, 0.0, 0.05);
-    try {
-      const auto e = cli::estimateRangeForCommand(left, right, "give --disparity-range", quiet,
-                                                  &rangeProgress);
-      estimated = DisparityInterval{e.dmin, e.dmax};
-    } catch (const core::Error& e) {
-      // Each building then searches around its own intervals, as without an estimate.
-      std::fprintf(stderr, "warning: %s; searching around each building's intervals only\n",
-                   e.what());
-    }
-  }
+  if (!flags.search) estimated = estimatedRange(left, right, quiet, &progress);
+  const Batch batch{left, right, exclude, disparity, flags.search, estimated, params};
 
   std::vector<core::Feature> out;
   int failed = 0;
   const size_t count = jobs.size();
   for (size_t i = 0; i < count; ++i) {
-    core::Feature result;
-    result.polygon = jobs[i].request.init;
-    result.attributes["id"] = jobs[i].id;
     progress.setStage("building " + std::to_string(i + 1) + "/" + std::to_string(count));
     core::Progress::Range range(&buildingsProgress, double(i) / count, double(i + 1) / count);
-    try {
-      if (!jobs[i].missing.empty()) throw core::Error(core::ErrorCode::InvalidParameter, jobs[i].missing);
-      delineation::DelineationRequest req = jobs[i].request;
-      req.searchRange = flags.search;
-      if (estimated) req.searchRange = hull(*estimated, req.roof, req.ground);
-      req.excludeMask = exclude;
-      req.disparity = disparity;
-      const auto r = delineation::delineate(left, right, req, params, {}, &range);
-      // A canceled batch writes nothing: the previous output, if any, stays as it was.
-      if (r.status == core::RunStatus::Canceled || progress.canceled()) throw cli::Canceled();
-      describeResult(r, result);
-    } catch (const core::Error& e) {
-      // One bad building does not stop the batch; a single-building run reports the error.
-      if (count == 1) throw;
-      ++failed;
-      result.attributes["status"] = std::string("failed");
-      result.attributes["error"] = e.detail();
-      std::fprintf(stderr, "building id %lld: %s\n", jobs[i].id, e.what());
-    }
-    out.push_back(std::move(result));
+    out.push_back(delineateBuilding(jobs[i], batch, count == 1, progress, range, failed));
   }
   io::writeFeatures(opts.get("out"), out, geo, "buildings");
   progress.report(1.0);
