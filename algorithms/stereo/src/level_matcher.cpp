@@ -591,29 +591,14 @@ class LevelMatcher {
         outX_(inner.x),
         outY_(inner.y),
         rowStride_(s.window <= 16 ? 16 : 32) {
+    takeBuffers(scratch);
     // Independent preparations, run on the level's threads (serial, they took ~12 % of the
     // matcher's time).
     std::vector<std::function<void()>> tasks;
-    // The buffers the other view left (empty for the first view), overwritten below.
-    blocked_ = std::move(scratch.blocked);
-    blockedBits_ = std::move(scratch.blockedBits);
-    nearEdge_ = std::move(scratch.nearEdge);
-    otherInvalidBits_ = std::move(scratch.otherInvalidBits);
-    otherPrefixB_ = std::move(scratch.prefixB);
-    otherPrefixBB_ = std::move(scratch.prefixBB);
-    otherSq_ = std::move(scratch.otherSq);
-    freeColumns_ = std::move(scratch.freeColumns);
     // The other view's preparations, mirrored, when it left them (see LevelPreparations).
     const bool mirrored = shared != nullptr && !shared->empty();
     if (mirrored) {
-      // Taken over (the other view is done with them) and mirrored in place.
-      refStats_ = shared->other;
-      otherStats_ = shared->ref;
-      refQ_ = shared->otherQ;
-      otherQ_ = shared->refQ;
-      const double scale = shared->scale;
-      *shared = LevelPreparations{};
-      shared->scale = scale;
+      takePreparations(*shared);
       for (cv::Mat* m : {&refStats_.mean, &refStats_.sd, &refStats_.usable, &otherStats_.mean,
                          &otherStats_.sd, &otherStats_.usable}) {
         tasks.emplace_back([m, inner] { mirrorInner(*m, inner); });
@@ -623,79 +608,17 @@ class LevelMatcher {
       tasks.emplace_back([&] { otherStats_ = windowStats(in.other, in.otherValid, s.window); });
     }
     tasks.emplace_back([&] {
-      double scale = 0;
       if (mirrored) {
         // (Here, before the prefix sums read otherQ_.)
-        scale = shared->scale;
         mirrorInner(refQ_, inner);
         mirrorInner(otherQ_, inner);
+        scale_ = shared->scale;
       } else {
-        // Quantised copies for the integer shape kernels: one scale for both images, the largest
-        // that keeps |q| ≤ kShapeQuantMax (the images are mapped to ~±128: a step of < 0.1 grey).
-        double refMin = 0, refMax = 0, otherMin = 0, otherMax = 0;
-        cv::minMaxLoc(in.ref, &refMin, &refMax);
-        cv::minMaxLoc(in.other, &otherMin, &otherMax);
-        const double maxAbs = std::max(
-            {std::abs(refMin), std::abs(refMax), std::abs(otherMin), std::abs(otherMax), 1e-6});
-        scale = std::floor(kShapeQuantMax / maxAbs * 1e6) / 1e6;  // round(scale·v) ≤ max
-        in.ref.convertTo(refQ_, CV_16S, scale);
-        in.other.convertTo(otherQ_, CV_16S, scale);
+        scale_ = quantiseImages();
       }
-      scale_ = scale;
-      if (useSpans_) {
-        // Row prefix sums of B and B² for the main-line span kernel.
-        otherPrefixB_.create(H_, W_ + 1 + kPrefixPad, CV_32S);
-        otherPrefixBB_.create(H_, W_ + 1 + kPrefixPad, CV_32S);
-        for (int y = 0; y < H_; ++y) {
-          rowPrefixSums(otherQ_.ptr<int16_t>(y), W_, otherPrefixB_.ptr<int32_t>(y),
-                        otherPrefixBB_.ptr<int32_t>(y));
-        }
-      }
-      flatQ_ = kFlatVariance * scale * scale;
-      // Float rows of the wider windows take B² from this image.
-      if (s.window > 15) cv::multiply(in.other, in.other, otherSq_);
-      // Nodata of the other image as row words (see blockedBits_): a shape window touches
-      // nodata when one of its rows shares a bit with these (one AND per row).
-      rowWindowBits(in.otherValid, /*markedWhenZero=*/true, otherInvalidBits_);
+      prepareOtherImage();
     });
-    tasks.emplace_back([&] {
-      // Pixels a shape never enters: contours and nodata. blockedBits_(y, x): bit u set when
-      // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
-      blocked_.create(in.ref.size(), CV_8U);
-      for (int y = 0; y < H_; ++y) {
-        const uchar* edge = in.refEdges.ptr<uchar>(y);
-        const uchar* valid = in.refValid.ptr<uchar>(y);
-        uchar* b = blocked_.ptr<uchar>(y);
-        for (int x = 0; x < W_; ++x) b[x] = (edge[x] != 0) | (valid[x] == 0) ? 255 : 0;
-      }
-      rowWindowBits(blocked_, /*markedWhenZero=*/false, blockedBits_);
-      if (s.window <= 15) {
-        // Column-major copy of the free (not blocked) row words: the 16 rows of a window are
-        // contiguous, one load for the fill. 16 spare rows keep every window's read inside.
-        const auto full = static_cast<uint32_t>((1U << s.window) - 1U);
-        columnStride_ = static_cast<size_t>(H_) + 16;
-        freeColumns_.assign(static_cast<size_t>(W_) * columnStride_, 0);
-        for (int y = 0; y < H_; ++y) {
-          const int* bits = blockedBits_.ptr<int>(y);
-          for (int x = 0; x < W_; ++x) {
-            freeColumns_[static_cast<size_t>(x) * columnStride_ + static_cast<size_t>(y)] =
-                static_cast<uint16_t>(~static_cast<uint32_t>(bits[x]) & full);
-          }
-        }
-        for (int v = 0; v < s.window; ++v) {
-          windowRows_[v >> 2] |= uint64_t{0xFFFF} << (16 * (v & 3));
-        }
-      }
-      if (s.adaptive) {
-        // Shapes also serve pixels whose window holds nodata or leaves the image (the input is
-        // padded with nodata): S stops there as it stops at contours.
-        cv::dilate(blocked_, nearEdge_,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(s.window, s.window)));
-      } else {
-        nearEdge_.create(in.ref.size(), CV_8U);
-        nearEdge_.setTo(0);
-      }
-    });
+    tasks.emplace_back([&] { prepareBlockedPixels(); });
     tasks.emplace_back([&] { out.disparity = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
     tasks.emplace_back([&] { out.lineShift = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
     tasks.emplace_back([&] { out.score = cv::Mat(inner.size(), CV_32F, cv::Scalar(kNaN)); });
@@ -707,21 +630,7 @@ class LevelMatcher {
       shared->refQ = refQ_;
       shared->otherQ = otherQ_;
     }
-    otherQStride_ = static_cast<ptrdiff_t>(otherQ_.step1());
-    refQStride_ = static_cast<ptrdiff_t>(refQ_.step1());
-    refStride_ = in.ref.step1();
-    otherStride_ = in.other.step1();
-    invalidStride_ = static_cast<ptrdiff_t>(otherInvalidBits_.step1());
-    if (useSpans_) {
-      prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
-      prefixBData_ = otherPrefixB_.ptr<int32_t>(0);
-      prefixBBData_ = otherPrefixBB_.ptr<int32_t>(0);
-    }
-    otherOk_ = otherStats_.usable.ptr<uchar>(0);
-    okStride_ = static_cast<ptrdiff_t>(otherStats_.usable.step1());
-    otherQData_ = otherQ_.ptr<int16_t>(0);
-    for (int v = 0; v < 16; ++v) prefixRowOffsets_[v] = static_cast<int32_t>(v * prefixStride_);
-    for (int u = 0; u < std::min(16, s.window); ++u) squareLanes_[u] = 1.0F;
+    preparePerPixelAccess();
   }
 
   // Rows of the other image's buffers by plain arithmetic (cv::Mat::ptr reads the data pointer
@@ -803,6 +712,130 @@ class LevelMatcher {
   }
 
  private:
+  // ---- preparations ----------------------------------------------------------------------
+
+  // The buffers the other view left (empty for the first view), overwritten by the
+  // preparations.
+  void takeBuffers(LevelScratch& scratch) {
+    blocked_ = std::move(scratch.blocked);
+    blockedBits_ = std::move(scratch.blockedBits);
+    nearEdge_ = std::move(scratch.nearEdge);
+    otherInvalidBits_ = std::move(scratch.otherInvalidBits);
+    otherPrefixB_ = std::move(scratch.prefixB);
+    otherPrefixBB_ = std::move(scratch.prefixBB);
+    otherSq_ = std::move(scratch.otherSq);
+    freeColumns_ = std::move(scratch.freeColumns);
+  }
+
+  // The other view's moments and quantised copies, taken over (it is done with them; they are
+  // mirrored in place afterwards): its ref is this view's other image and vice versa. `shared`
+  // keeps only the scale.
+  void takePreparations(LevelPreparations& shared) {
+    refStats_ = shared.other;
+    otherStats_ = shared.ref;
+    refQ_ = shared.otherQ;
+    otherQ_ = shared.refQ;
+    const double scale = shared.scale;
+    shared = LevelPreparations{};
+    shared.scale = scale;
+  }
+
+  // Quantised copies for the integer shape kernels: one scale for both images, the largest
+  // that keeps |q| ≤ kShapeQuantMax (the images are mapped to ~±128: a step of < 0.1 grey).
+  // Returns the scale.
+  double quantiseImages() {
+    double refMin = 0, refMax = 0, otherMin = 0, otherMax = 0;
+    cv::minMaxLoc(in_.ref, &refMin, &refMax);
+    cv::minMaxLoc(in_.other, &otherMin, &otherMax);
+    const double maxAbs = std::max(
+        {std::abs(refMin), std::abs(refMax), std::abs(otherMin), std::abs(otherMax), 1e-6});
+    const double scale = std::floor(kShapeQuantMax / maxAbs * 1e6) / 1e6;  // round(scale·v) ≤ max
+    in_.ref.convertTo(refQ_, CV_16S, scale);
+    in_.other.convertTo(otherQ_, CV_16S, scale);
+    return scale;
+  }
+
+  // What the shape kernels read of the other image besides its quantised copy (scale_ set).
+  void prepareOtherImage() {
+    if (useSpans_) {
+      // Row prefix sums of B and B² for the main-line span kernel.
+      otherPrefixB_.create(H_, W_ + 1 + kPrefixPad, CV_32S);
+      otherPrefixBB_.create(H_, W_ + 1 + kPrefixPad, CV_32S);
+      for (int y = 0; y < H_; ++y) {
+        rowPrefixSums(otherQ_.ptr<int16_t>(y), W_, otherPrefixB_.ptr<int32_t>(y),
+                      otherPrefixBB_.ptr<int32_t>(y));
+      }
+    }
+    flatQ_ = kFlatVariance * scale_ * scale_;
+    // Float rows of the wider windows take B² from this image.
+    if (s_.window > 15) cv::multiply(in_.other, in_.other, otherSq_);
+    // Nodata of the other image as row words (see blockedBits_): a shape window touches
+    // nodata when one of its rows shares a bit with these (one AND per row).
+    rowWindowBits(in_.otherValid, /*markedWhenZero=*/true, otherInvalidBits_);
+  }
+
+  // Pixels a shape never enters: contours and nodata. blockedBits_(y, x): bit u set when
+  // (x - r + u, y) is blocked, the row of a window as one word for the bit-parallel fill.
+  // nearEdge_: where a window holds a blocked pixel (the shapes' pixels).
+  void prepareBlockedPixels() {
+    blocked_.create(in_.ref.size(), CV_8U);
+    for (int y = 0; y < H_; ++y) {
+      const uchar* edge = in_.refEdges.ptr<uchar>(y);
+      const uchar* valid = in_.refValid.ptr<uchar>(y);
+      uchar* b = blocked_.ptr<uchar>(y);
+      for (int x = 0; x < W_; ++x) b[x] = (edge[x] != 0) | (valid[x] == 0) ? 255 : 0;
+    }
+    rowWindowBits(blocked_, /*markedWhenZero=*/false, blockedBits_);
+    if (s_.window <= 15) prepareFreeColumns();
+    if (s_.adaptive) {
+      // Shapes also serve pixels whose window holds nodata or leaves the image (the input is
+      // padded with nodata): S stops there as it stops at contours.
+      cv::dilate(blocked_, nearEdge_,
+                 cv::getStructuringElement(cv::MORPH_RECT, cv::Size(s_.window, s_.window)));
+    } else {
+      nearEdge_.create(in_.ref.size(), CV_8U);
+      nearEdge_.setTo(0);
+    }
+  }
+
+  // Windows ≤ 15 columns: a column-major copy of the free (not blocked) row words, so that the
+  // 16 rows of a window are contiguous, one load for the fill. 16 spare rows keep every
+  // window's read inside.
+  void prepareFreeColumns() {
+    const auto full = static_cast<uint32_t>((1U << s_.window) - 1U);
+    columnStride_ = static_cast<size_t>(H_) + 16;
+    freeColumns_.assign(static_cast<size_t>(W_) * columnStride_, 0);
+    for (int y = 0; y < H_; ++y) {
+      const int* bits = blockedBits_.ptr<int>(y);
+      for (int x = 0; x < W_; ++x) {
+        freeColumns_[static_cast<size_t>(x) * columnStride_ + static_cast<size_t>(y)] =
+            static_cast<uint16_t>(~static_cast<uint32_t>(bits[x]) & full);
+      }
+    }
+    for (int v = 0; v < s_.window; ++v) {
+      windowRows_[v >> 2] |= uint64_t{0xFFFF} << (16 * (v & 3));
+    }
+  }
+
+  // The strides and row-0 pointers the per-pixel paths read (see their members), and the
+  // square window's lanes.
+  void preparePerPixelAccess() {
+    otherQStride_ = static_cast<ptrdiff_t>(otherQ_.step1());
+    refQStride_ = static_cast<ptrdiff_t>(refQ_.step1());
+    refStride_ = in_.ref.step1();
+    otherStride_ = in_.other.step1();
+    invalidStride_ = static_cast<ptrdiff_t>(otherInvalidBits_.step1());
+    if (useSpans_) {
+      prefixStride_ = static_cast<ptrdiff_t>(otherPrefixB_.step1());
+      prefixBData_ = otherPrefixB_.ptr<int32_t>(0);
+      prefixBBData_ = otherPrefixBB_.ptr<int32_t>(0);
+    }
+    otherOk_ = otherStats_.usable.ptr<uchar>(0);
+    okStride_ = static_cast<ptrdiff_t>(otherStats_.usable.step1());
+    otherQData_ = otherQ_.ptr<int16_t>(0);
+    for (int v = 0; v < 16; ++v) prefixRowOffsets_[v] = static_cast<int32_t>(v * prefixStride_);
+    for (int u = 0; u < std::min(16, s_.window); ++u) squareLanes_[u] = 1.0F;
+  }
   void matchTile(const cv::Rect& tile, Scratch& sc) {
     const size_t area = static_cast<size_t>(tile.area());
     sc.square.assign(area, 0);
