@@ -1160,86 +1160,118 @@ class LevelMatcher {
   // template; returns false when the shape is the full square (the square path serves it),
   // smaller than minShape, or flat.
   bool buildShape(int x, int y, ShapeTemplate& t, bool squareServes) const {
-    const int w = s_.window;
-    const uint32_t full = w == 32 ? ~0U : (1U << w) - 1U;
     // Bit-parallel flood fill on w-bit rows: a row's reach grows from the rows above and below
     // and is then filled along the row through free pixels (shift-and-mask doubling, the
-    // "occluded fill" of bitboards), until no row changes. Filled in place in the template.
-    uint32_t* reach = t.rowBits;
+    // "occluded fill" of bitboards), until no row changes. The rows of S go to t.rowBits.
+    alignas(32) uint16_t rows16[16];  // windows ≤ 15 columns: the fill's 16 row words
+    const bool cut = s_.window <= 15 ? fillNarrowWindow(x, y, rows16) : fillWideWindow(x, y, t);
     // When S is the whole window minus its contour pixels (no free pixel left unreached: no
     // part of the window is cut off) and the square window is usable, the square serves the
     // pixel: the few contour pixels change its NCC little, and the square path is much cheaper.
-    alignas(32) uint16_t rows16[16];
-    bool rowsFound = false;  // t.rowFirst, t.rowLast
-    if (w <= 15) {
-      const uint16_t* freeRows = &freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)];
-#ifdef DELINEO_STEREO_X86
-      const bool cut = fillAvx2_ ? fillWindow15Avx2(freeRows, windowRows_, r_, rows16)
-                                 : fillWindow15(freeRows, windowRows_, r_, rows16);
-#else
-      const bool cut = fillWindow15(freeRows, windowRows_, r_, rows16);
-#endif
-      if (squareServes && !cut) return false;
-      // All 16 rows (those past the window are 0): a fixed count the compiler widens in vectors.
-      for (int v = 0; v < 16; ++v) reach[v] = rows16[v];
-#ifdef DELINEO_STEREO_X86
-      // The rows holding part of S from one mask of the empty rows (the scans below cost ~20
-      // instructions a shape).
-      const __m128i zero = _mm_setzero_si128();
-      const auto* words = reinterpret_cast<const __m128i*>(rows16);
-      const auto empty = static_cast<uint32_t>(
-          _mm_movemask_epi8(_mm_packs_epi16(_mm_cmpeq_epi16(_mm_load_si128(words), zero),
-                                            _mm_cmpeq_epi16(_mm_load_si128(words + 1), zero))));
-      const uint32_t used = ~empty & 0xFFFFU;  // the centre row is never empty
-      t.rowFirst = __builtin_ctz(used);
-      t.rowLast = 31 - __builtin_clz(used);
-      rowsFound = true;
-#endif
+    if (squareServes && !cut) return false;
+    if (s_.window <= 15) {
+      takeNarrowShapeRows(rows16, t);
     } else {
-      uint32_t free[32];
-      for (int v = 0; v < w; ++v) {
-        free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
-        reach[v] = 0;
-      }
-      fillRows(free, reach);
-      uint32_t unreached = 0;
-      for (int v = 0; v < w; ++v) unreached |= free[v] & ~reach[v];
-      if (squareServes && unreached == 0) return false;
+      findShapeRows(t);
     }
-    const int P = rowStride_;
-    if (!rowsFound) {
-      t.rowFirst = 0;
-      while (reach[t.rowFirst] == 0) ++t.rowFirst;  // the centre row is never empty
-      t.rowLast = w - 1;
-      while (reach[t.rowLast] == 0) --t.rowLast;
+    if (rowStride_ == 16) return quantisedShapeTemplate(x, y, rows16, t);
+    return floatShapeTemplate(x, y, t);
+  }
+
+  // Windows ≤ 15 columns: the fill (fillWindow15) into `rows16`; true when S cuts part of the
+  // window off.
+  bool fillNarrowWindow(int x, int y, uint16_t* rows16) const {
+    const uint16_t* freeRows = &freeColumns_[static_cast<size_t>(x) * columnStride_ + (y - r_)];
+#ifdef DELINEO_STEREO_X86
+    return fillAvx2_ ? fillWindow15Avx2(freeRows, windowRows_, r_, rows16)
+                     : fillWindow15(freeRows, windowRows_, r_, rows16);
+#else
+    return fillWindow15(freeRows, windowRows_, r_, rows16);
+#endif
+  }
+
+  // Wider windows: the fill (fillRows) into t.rowBits; true when S cuts part of the window off.
+  bool fillWideWindow(int x, int y, ShapeTemplate& t) const {
+    const int w = s_.window;
+    const uint32_t full = w == 32 ? ~0U : (1U << w) - 1U;
+    uint32_t* reach = t.rowBits;
+    uint32_t free[32];
+    for (int v = 0; v < w; ++v) {
+      free[v] = ~static_cast<uint32_t>(blockedBits_.at<int>(y + v - r_, x)) & full;
+      reach[v] = 0;
     }
+    fillRows(free, reach);
+    uint32_t unreached = 0;
+    for (int v = 0; v < w; ++v) unreached |= free[v] & ~reach[v];
+    return unreached != 0;
+  }
+
+  // Windows ≤ 15 columns: the fill's row words as t.rowBits, and the window rows holding part
+  // of S.
+  void takeNarrowShapeRows(const uint16_t* rows16, ShapeTemplate& t) const {
+    // All 16 rows (those past the window are 0): a fixed count the compiler widens in vectors.
+    for (int v = 0; v < 16; ++v) t.rowBits[v] = rows16[v];
+#ifdef DELINEO_STEREO_X86
+    // The rows holding part of S from one mask of the empty rows (the scans of findShapeRows
+    // cost ~20 instructions a shape).
+    const __m128i zero = _mm_setzero_si128();
+    const auto* words = reinterpret_cast<const __m128i*>(rows16);
+    const auto empty = static_cast<uint32_t>(
+        _mm_movemask_epi8(_mm_packs_epi16(_mm_cmpeq_epi16(_mm_load_si128(words), zero),
+                                          _mm_cmpeq_epi16(_mm_load_si128(words + 1), zero))));
+    const uint32_t used = ~empty & 0xFFFFU;  // the centre row is never empty
+    t.rowFirst = __builtin_ctz(used);
+    t.rowLast = 31 - __builtin_clz(used);
+#else
+    findShapeRows(t);
+#endif
+  }
+
+  // The window rows holding part of S (t.rowBits).
+  void findShapeRows(ShapeTemplate& t) const {
+    t.rowFirst = 0;
+    while (t.rowBits[t.rowFirst] == 0) ++t.rowFirst;  // the centre row is never empty
+    t.rowLast = s_.window - 1;
+    while (t.rowBits[t.rowLast] == 0) --t.rowLast;
+  }
+
+  // Windows ≤ 16 columns: the template's quantised rows and NCC terms (and S's spans for the
+  // span kernel, from the fill's `rows16`); false when S is smaller than minShape, the whole
+  // window, or flat.
+  bool quantisedShapeTemplate(int x, int y, [[maybe_unused]] const uint16_t* rows16,
+                              ShapeTemplate& t) const {
     const int rows = t.rowLast - t.rowFirst + 1;
-    if (P == 16) {
-      // The rows first: they give |S| too (cheaper than counting bits without popcnt).
-      int32_t count = 0, sumA = 0, sumAA = 0;
-      shapeRowsInt(&reach[t.rowFirst], rows, refQ_.ptr<int16_t>(y + t.rowFirst - r_) + x - r_,
-                   refQStride_, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], count, sumA,
-                   sumAA);
-      t.count = count;
-      if (t.count < s_.minShape || t.count >= n_) return false;
+    // The rows first: they give |S| too (cheaper than counting bits without popcnt).
+    int32_t count = 0, sumA = 0, sumAA = 0;
+    shapeRowsInt(&t.rowBits[t.rowFirst], rows, refQ_.ptr<int16_t>(y + t.rowFirst - r_) + x - r_,
+                 refQStride_, &t.maskQ[16 * t.rowFirst], &t.aQ[16 * t.rowFirst], count, sumA,
+                 sumAA);
+    t.count = count;
+    if (t.count < s_.minShape || t.count >= n_) return false;
 #ifdef DELINEO_STEREO_X86
-      t.hasSpans = useSpans_ && shapeSpansAvx2(rows16, t.spans);
+    t.hasSpans = useSpans_ && shapeSpansAvx2(rows16, t.spans);
 #endif
-      const double n = t.count;
-      // n² var_S(A), exact (< 2^53).
-      const double varN = n * sumAA - static_cast<double>(sumA) * sumA;
-      if (varN < flatQ_ * n * n) return false;
-      t.terms.n = count;
-      t.terms.sumA = sumA;
-      t.terms.invNormA = static_cast<float>(1.0 / std::sqrt(varN));
-      t.terms.flatN = static_cast<float>(flatQ_ * n * n);
+    const double n = t.count;
+    // n² var_S(A), exact (< 2^53).
+    const double varN = n * sumAA - static_cast<double>(sumA) * sumA;
+    if (varN < flatQ_ * n * n) return false;
+    t.terms.n = count;
+    t.terms.sumA = sumA;
+    t.terms.invNormA = static_cast<float>(1.0 / std::sqrt(varN));
+    t.terms.flatN = static_cast<float>(flatQ_ * n * n);
 #ifdef DELINEO_STEREO_X86
-      if (t.hasSpans) shapeSpanTermsAvx2(t.spans, t.rowFirst, rows, prefixRowOffsets_, t.spanTerms);
+    if (t.hasSpans) shapeSpanTermsAvx2(t.spans, t.rowFirst, rows, prefixRowOffsets_, t.spanTerms);
 #endif
-      return true;
-    }
+    return true;
+  }
+
+  // Wider windows: the template's float rows, T = (A - mean_S) / sd_S on S, and the indicator
+  // M of S; false when S is smaller than minShape, the whole window, or flat.
+  bool floatShapeTemplate(int x, int y, ShapeTemplate& t) const {
+    const int w = s_.window, P = rowStride_;
+    const int rows = t.rowLast - t.rowFirst + 1;
     t.count = 0;
-    for (int v = 0; v < w; ++v) t.count += popcount64(reach[v]);
+    for (int v = 0; v < w; ++v) t.count += popcount64(t.rowBits[v]);
     if (t.count < s_.minShape || t.count >= n_) return false;
     t.mask.resize(static_cast<size_t>(w * P));
     t.templ.resize(static_cast<size_t>(w * P));
@@ -1252,7 +1284,7 @@ class LevelMatcher {
     for (int v = 0; v < rows; ++v) {
       const float* av = a + static_cast<size_t>(v) * stride;
       float* m = mask + static_cast<size_t>(v * P);
-      for (uint32_t bits = reach[t.rowFirst + v]; bits != 0; bits &= bits - 1) {
+      for (uint32_t bits = t.rowBits[t.rowFirst + v]; bits != 0; bits &= bits - 1) {
         const int u = __builtin_ctz(bits);
         m[u] = 1.0F;
         sum += av[u];
