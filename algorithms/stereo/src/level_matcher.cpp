@@ -519,6 +519,20 @@ struct LinePeak {
   }
 };
 
+// The main-line peak as the border test settles it: at d, with its score and those at d ± 1.
+struct MainLinePeak {
+  int d;
+  float below, best, above;
+};
+
+// The peak on the 2D correlation surface as the ascent over line shifts moves it: at (d, dy),
+// with its 3x3 neighbourhood s[i][j] at (d + i − 1, dy + j − 1) (NaN where not evaluated;
+// s[1][1] is the peak's score).
+struct SurfacePeak {
+  int d, dy;
+  float s[3][3];
+};
+
 // Dense rows of an adaptive shape S.
 //  - Windows ≤ 15 columns: quantised grey levels, rows of 16 int16: mask (−1 on S) and A on S
 //    (0 elsewhere); NCC(d, dy) = (n Σ A·B − Σ A Σ B) / sqrt((n Σ A² − (Σ A)²)(n Σ B² − (Σ B)²))
@@ -1497,135 +1511,166 @@ class LevelMatcher {
     return s_.uniqueMinInterval > 0 && hi - lo + 1 >= s_.uniqueMinInterval;
   }
 
-  // From the main-line peak: local ascent over the line shifts (3x3 neighbourhoods of the 2D
-  // surface, d within the pixel's interval, |dy| <= lineShift), rejection tests, sub-pixel
-  // offset, output.
+  // From the main-line peak: rejection tests (uniqueness, border peaks), local ascent over the
+  // line shifts (3x3 neighbourhoods of the 2D surface, d within the pixel's interval,
+  // |dy| <= lineShift), score floor, sub-pixel offset, output.
   // `pair(d, minus, plus)` may give the scores at (d, ∓1) in one go (returns false when not),
   // `line(d, dy, scores)` those at (d .. d + 2, dy) (the same values as `score`, or false).
   // [lo, hi]: the pixel's interval (in_.lo, in_.hi at (x, y)).
   template <class Score, class Pair, class Line>
   void finish(int x, int y, int lo, int hi, const LinePeak& peak, Score&& score, Pair&& pair,
               Line&& line) {
-    if (!(peak.best > kNegInf)) return;
-    if (peak.trackSecond && peak.second > kNegInf &&
-        (1.0F - peak.best) * (1.0F + static_cast<float>(s_.uniqueMargin)) >= 1.0F - peak.second) {
-      return;  // another disparity explains the window about as well
-    }
-    int cd = peak.bestD, cdy = 0;
-    float best = peak.best;
-    float below = peak.below, above = peak.above;
-    // A maximum on the border of a guided interval may be a slope: the coarser level's
-    // disparities are biased by a px or two next to depth steps, and the interval can stop just
-    // short of the true peak. The score one step outside decides: lower, the border is a peak
-    // and is kept; higher, the peak moves there (at most kMaxIntervalExtension steps); still
-    // rising after that, the pixel is rejected. (Rejecting every border peak, as before, lost
-    // roof pixels along outlines: measured sim 600² edge 55.1 -> 57.3 %, density 85.3 -> 85.7 %;
-    // more steps added errors for little gain.)
-    for (int step = 0; step < kMaxIntervalExtension && cd == lo && lo > in_.dmin; ++step) {
-      const float next = score(cd - 1, 0);
-      if (!(next > best)) {
-        below = next;
-        break;
-      }
-      above = best;
-      best = next;
-      below = kNaN;
-      lo = --cd;
-    }
-    for (int step = 0; step < kMaxIntervalExtension && cd == hi && hi < in_.dmax; ++step) {
-      const float next = score(cd + 1, 0);
-      if (!(next > best)) {
-        above = next;
-        break;
-      }
-      below = best;
-      best = next;
-      above = kNaN;
-      hi = ++cd;
-    }
-    if (cd == lo && lo > in_.dmin && std::isnan(below)) below = score(cd - 1, 0);
-    if (cd == hi && hi < in_.dmax && std::isnan(above)) above = score(cd + 1, 0);
-    // Still rising at the border after the extension: no peak found.
-    const bool slope = (cd == lo && lo > in_.dmin && !(below < best)) ||
-                       (cd == hi && hi < in_.dmax && !(above < best));
-    if (slope) return;
+    if (!(peak.best > kNegInf) || repeatedElsewhere(peak)) return;
+    MainLinePeak mainPeak{peak.bestD, peak.below, peak.best, peak.above};
+    if (!settleBorderPeak(mainPeak, lo, hi, score)) return;
     // The parabola and the ascent may use the scores just outside the interval.
-    lo = std::max(in_.dmin, std::min(lo, cd - 1));
-    hi = std::min(in_.dmax, std::max(hi, cd + 1));
-    float s[3][3];
-    auto at = [&](int d, int dy) -> float {
-      if (d < lo || d > hi || dy < -L_ || dy > L_) return kNaN;
-      return score(d, dy);
-    };
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) s[i][j] = kNaN;
+    lo = std::max(in_.dmin, std::min(lo, mainPeak.d - 1));
+    hi = std::min(in_.dmax, std::max(hi, mainPeak.d + 1));
+    SurfacePeak surfacePeak{
+        mainPeak.d,
+        0,
+        {{kNaN, mainPeak.below, kNaN}, {kNaN, mainPeak.best, kNaN}, {kNaN, mainPeak.above, kNaN}}};
+    if (L_ > 0) ascendLineShifts(surfacePeak, lo, hi, score, pair, line);
+    if (!(surfacePeak.s[1][1] >= static_cast<float>(s_.minScore))) return;
+    // The ascent may have ended on the border of the (extended) interval: a slope again.
+    if ((surfacePeak.d == lo && lo > in_.dmin) || (surfacePeak.d == hi && hi < in_.dmax)) return;
+    writeMatch(x, y, surfacePeak);
+  }
+
+  // The uniqueness test of wide intervals (LevelSettings::uniqueMinInterval): true when another
+  // disparity explains the window about as well.
+  bool repeatedElsewhere(const LinePeak& peak) const {
+    return peak.trackSecond && peak.second > kNegInf &&
+           (1.0F - peak.best) * (1.0F + static_cast<float>(s_.uniqueMargin)) >= 1.0F - peak.second;
+  }
+
+  // A maximum on the border of a guided interval may be a slope: the coarser level's
+  // disparities are biased by a px or two next to depth steps, and the interval can stop just
+  // short of the true peak. The score one step outside decides: lower, the border is a peak
+  // and is kept; higher, the peak moves there (at most kMaxIntervalExtension steps, [lo, hi]
+  // with it); still rising after that, the pixel is rejected (returns false). (Rejecting every
+  // border peak lost roof pixels along outlines: this test, measured on the sim 600² scene,
+  // edge 55.1 -> 57.3 %, density 85.3 -> 85.7 %; more steps added errors for little gain.)
+  template <class Score>
+  bool settleBorderPeak(MainLinePeak& p, int& lo, int& hi, Score& score) const {
+    for (int step = 0; step < kMaxIntervalExtension && p.d == lo && lo > in_.dmin; ++step) {
+      const float next = score(p.d - 1, 0);
+      if (!(next > p.best)) {
+        p.below = next;
+        break;
+      }
+      p.above = p.best;
+      p.best = next;
+      p.below = kNaN;
+      lo = --p.d;
     }
-    s[0][1] = below;
-    s[1][1] = best;
-    s[2][1] = above;
-    if (L_ > 0) {
-      for (int step = 0;; ++step) {
-        if (step == 0) {
-          // The main line is known; the neighbouring lines at the peak's d decide whether the
-          // ascent leaves it (and give the sub-pixel line shift when it does not).
-          if (L_ < 1 || cd < lo || cd > hi || !pair(cd, s[1][0], s[1][2])) {
-            s[1][0] = at(cd, -1);
-            s[1][2] = at(cd, 1);
-          }
-        } else {
-          // The 8 neighbours by line: the three windows of a line in one pass when they all
-          // lie in the interval and the line in range (`at` gives the same values then).
-          for (int j = 0; j < 3; ++j) {
-            const int dy = cdy + j - 1;
-            float three[3];
-            const bool batched =
-                cd - 1 >= lo && cd + 1 <= hi && dy >= -L_ && dy <= L_ && line(cd - 1, dy, three);
-            for (int i = 0; i < 3; ++i) {
-              if (i != 1 || j != 1) s[i][j] = batched ? three[i] : at(cd + i - 1, dy);
-            }
-          }
+    for (int step = 0; step < kMaxIntervalExtension && p.d == hi && hi < in_.dmax; ++step) {
+      const float next = score(p.d + 1, 0);
+      if (!(next > p.best)) {
+        p.above = next;
+        break;
+      }
+      p.below = p.best;
+      p.best = next;
+      p.above = kNaN;
+      hi = ++p.d;
+    }
+    if (p.d == lo && lo > in_.dmin && std::isnan(p.below)) p.below = score(p.d - 1, 0);
+    if (p.d == hi && hi < in_.dmax && std::isnan(p.above)) p.above = score(p.d + 1, 0);
+    // Still rising at the border after the extension: no peak found.
+    const bool slope = (p.d == lo && lo > in_.dmin && !(p.below < p.best)) ||
+                       (p.d == hi && hi < in_.dmax && !(p.above < p.best));
+    return !slope;
+  }
+
+  // The local ascent over the line shifts from the main-line peak `p` (dy = 0, its scores along
+  // d known): moves to the best of the centre's neighbours while one beats it, at most
+  // kMaxAscentSteps steps.
+  template <class Score, class Pair, class Line>
+  void ascendLineShifts(SurfacePeak& p, int lo, int hi, Score& score, Pair& pair,
+                        Line& line) const {
+    for (int step = 0;; ++step) {
+      if (step == 0) {
+        // The main line is known; the neighbouring lines at the peak's d decide whether the
+        // ascent leaves it (and give the sub-pixel line shift when it does not).
+        if (L_ < 1 || p.d < lo || p.d > hi || !pair(p.d, p.s[1][0], p.s[1][2])) {
+          p.s[1][0] = scoreInRange(score, lo, hi, p.d, -1);
+          p.s[1][2] = scoreInRange(score, lo, hi, p.d, 1);
         }
-        int bi = 1, bj = 1;
-        // Leaving the current line needs a clear gain: on weakly textured surfaces the
-        // neighbouring lines correlate almost as well and noise would pick among them.
-        auto consider = [&](int i, int j) {
-          const float gain = j != 1 ? kLineShiftGain : 0.0F;
-          if (s[i][j] > s[bi][bj] + gain) {
-            bi = i;
-            bj = j;
-          }
-        };
-        if (step == 0) {
-          // Same order and outcome as the loop below: the corners are still NaN (never win),
-          // and the centre never beats a neighbour that beat it.
-          consider(0, 1);
-          consider(1, 0);
-          consider(1, 2);
-          consider(2, 1);
-        } else {
-          for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) consider(i, j);
-          }
-        }
-        if ((bi == 1 && bj == 1) || step == kMaxAscentSteps) break;
-        cd += bi - 1;
-        cdy += bj - 1;
-        best = s[bi][bj];
-        s[1][1] = best;
+      } else {
+        scoreNeighbours(p, lo, hi, score, line);
+      }
+      int bi = 1, bj = 1;
+      ascentStep(p.s, step == 0, bi, bj);
+      if ((bi == 1 && bj == 1) || step == kMaxAscentSteps) break;
+      p.d += bi - 1;
+      p.dy += bj - 1;
+      p.s[1][1] = p.s[bi][bj];
+    }
+  }
+
+  // The 8 neighbours of the centre of `p`, by line: the three windows of a line in one pass
+  // when they all lie in the interval and the line in range (scoreInRange gives the same
+  // values then).
+  template <class Score, class Line>
+  void scoreNeighbours(SurfacePeak& p, int lo, int hi, Score& score, Line& line) const {
+    for (int j = 0; j < 3; ++j) {
+      const int dy = p.dy + j - 1;
+      float three[3];
+      const bool batched =
+          p.d - 1 >= lo && p.d + 1 <= hi && dy >= -L_ && dy <= L_ && line(p.d - 1, dy, three);
+      for (int i = 0; i < 3; ++i) {
+        if (i == 1 && j == 1) continue;
+        p.s[i][j] = batched ? three[i] : scoreInRange(score, lo, hi, p.d + i - 1, dy);
       }
     }
-    if (!(best >= static_cast<float>(s_.minScore))) return;
-    // The ascent may have ended on the border of the (extended) interval: a slope again.
-    if ((cd == lo && lo > in_.dmin) || (cd == hi && hi < in_.dmax)) return;
+  }
+
+  // score(d, dy) within the ascent's reach (d in [lo, hi], |dy| <= lineShift), NaN outside.
+  template <class Score>
+  float scoreInRange(Score& score, int lo, int hi, int d, int dy) const {
+    if (d < lo || d > hi || dy < -L_ || dy > L_) return kNaN;
+    return score(d, dy);
+  }
+
+  // The neighbour (bi, bj) of the centre s[1][1] the ascent moves to; (1, 1) to stay. On the
+  // `first` step only the main line's and the two lines' scores at the centre's d are known.
+  static void ascentStep(const float (&s)[3][3], bool first, int& bi, int& bj) {
+    // Leaving the current line needs a clear gain: on weakly textured surfaces the
+    // neighbouring lines correlate almost as well and noise would pick among them.
+    auto consider = [&](int i, int j) {
+      const float gain = j != 1 ? kLineShiftGain : 0.0F;
+      if (s[i][j] > s[bi][bj] + gain) {
+        bi = i;
+        bj = j;
+      }
+    };
+    if (first) {
+      // Same order and outcome as the loop below: the corners are still NaN (never win),
+      // and the centre never beats a neighbour that beat it.
+      consider(0, 1);
+      consider(1, 0);
+      consider(1, 2);
+      consider(2, 1);
+    } else {
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) consider(i, j);
+      }
+    }
+  }
+
+  // The match at (x, y): the peak's disparity and line shift with the sub-pixel offset of its
+  // neighbourhood, and its score.
+  void writeMatch(int x, int y, const SurfacePeak& p) {
     float du = 0, dv = 0;
     if (s_.subpixel) {
-      const cv::Point2f off = subpixelOffset(s);
+      const cv::Point2f off = subpixelOffset(p.s);
       du = off.x;
       dv = off.y;
     }
-    out_.disparity.at<float>(y - outY_, x - outX_) = static_cast<float>(cd) + du;
-    out_.lineShift.at<float>(y - outY_, x - outX_) = static_cast<float>(cdy) + dv;
-    out_.score.at<float>(y - outY_, x - outX_) = std::min(best, 1.0F);
+    out_.disparity.at<float>(y - outY_, x - outX_) = static_cast<float>(p.d) + du;
+    out_.lineShift.at<float>(y - outY_, x - outX_) = static_cast<float>(p.dy) + dv;
+    out_.score.at<float>(y - outY_, x - outX_) = std::min(p.s[1][1], 1.0F);
   }
 
   const LevelInput& in_;
