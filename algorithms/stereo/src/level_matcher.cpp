@@ -947,16 +947,32 @@ class LevelMatcher {
     return true;
   }
 
+  // The square path's pixels of `tile` (sc.square): main-line peaks by the box-filter sweep or
+  // by direct correlation, then the peaks finished.
   void matchSquarePixels(const cv::Rect& tile, Scratch& sc) {
     const size_t area = static_cast<size_t>(tile.area());
     sc.peaks.assign(area, LinePeak{});
     sc.swept.assign(area, 0);
-    // Which square pixels the box-filter sweep serves: the sweep costs ~5 operations per tile
-    // pixel and disparity of the union of the served intervals, a direct correlation (below)
-    // per disparity of the pixel's own interval. Pixels are added by increasing interval width
-    // while that keeps the total cheaper.
-    // (width, tile index) in increasing order of both: a counting sort by width of the pixels
-    // taken in index order (std::sort of the pairs gave the same order, ~5 % of this function).
+    const int widest = collectSquarePixels(tile, sc);
+    if (sc.byWidth.empty()) return;
+    sortByWidth(widest, sc);
+    const size_t swept = sweptPixelCount(tile, sc.byWidth);
+    sweepPixels(tile, swept, sc);
+    correlateDirectly(tile, swept, sc);
+    for (const auto& [width, i] : sc.byWidth) {
+      const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
+      finish(
+          x, y, in_.lo.at<int>(y, x), in_.hi.at<int>(y, x), sc.peaks[static_cast<size_t>(i)],
+          [&](int d, int dy) { return squareScore(x, y, d, dy); },
+          [&](int d, float& minus, float& plus) { return squareScorePair(x, y, d, minus, plus); },
+          [](int, int, float*) { return false; });
+    }
+  }
+
+  // The square path's pixels of `tile` as (interval width, tile index) in sc.byWidth, in index
+  // order, their peaks told whether to track the uniqueness test; returns the widest width.
+  int collectSquarePixels(const cv::Rect& tile, Scratch& sc) const {
+    const size_t area = static_cast<size_t>(tile.area());
     std::vector<std::pair<int, int>>& byWidth = sc.byWidth;
     byWidth.clear();
     int widest = 0;
@@ -969,7 +985,14 @@ class LevelMatcher {
       byWidth.emplace_back(hi - lo + 1, static_cast<int>(i));
       widest = std::max(widest, hi - lo + 1);
     }
-    if (byWidth.empty()) return;
+    return widest;
+  }
+
+  // sc.byWidth in increasing order of (width, tile index): a counting sort by width of the
+  // pixels taken in index order (std::sort of the pairs gave the same order, ~5 % of
+  // matchSquarePixels).
+  static void sortByWidth(int widest, Scratch& sc) {
+    std::vector<std::pair<int, int>>& byWidth = sc.byWidth;
     std::vector<int>& starts = sc.widthStarts;
     starts.assign(static_cast<size_t>(widest) + 2, 0);
     for (const auto& entry : byWidth) ++starts[static_cast<size_t>(entry.first) + 1];
@@ -980,6 +1003,14 @@ class LevelMatcher {
       sorted[static_cast<size_t>(starts[static_cast<size_t>(entry.first)]++)] = entry;
     }
     byWidth.swap(sorted);
+  }
+
+  // How many of the square pixels (`byWidth`, by increasing width) the box-filter sweep
+  // serves: the sweep costs ~5 operations per tile pixel and disparity of the union of the
+  // served intervals, a direct correlation (correlateDirectly) per disparity of the pixel's
+  // own interval. The narrowest pixels are swept, as many as make the total cheapest.
+  size_t sweptPixelCount(const cv::Rect& tile,
+                         const std::vector<std::pair<int, int>>& byWidth) const {
     const double sweepUnit = 5.0 * (tile.width + 2 * r_) * (tile.height + 2 * r_);
     // A direct correlation: n_ / 2 per disparity, as the four windows of a pass share the loads
     // of the template rows (squareScores4; with n_ the sweep served more pixels than paid off:
@@ -1002,18 +1033,28 @@ class LevelMatcher {
         bestCount = k + 1;
       }
     }
-    uLo = std::numeric_limits<int>::max();
-    uHi = std::numeric_limits<int>::min();
-    for (size_t k = 0; k < bestCount; ++k) {
-      const int i = byWidth[k].second;
+    return bestCount;
+  }
+
+  // The first `count` square pixels of sc.byWidth, marked in sc.swept, and the sweep of the
+  // union of their intervals.
+  void sweepPixels(const cv::Rect& tile, size_t count, Scratch& sc) {
+    int uLo = std::numeric_limits<int>::max(), uHi = std::numeric_limits<int>::min();
+    for (size_t k = 0; k < count; ++k) {
+      const int i = sc.byWidth[k].second;
       const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
       sc.swept[static_cast<size_t>(i)] = 1;
       uLo = std::min(uLo, in_.lo.at<int>(y, x));
       uHi = std::max(uHi, in_.hi.at<int>(y, x));
     }
-    if (bestCount > 0) sweepTile(tile, uLo, uHi, sc);
-    for (size_t k = bestCount; k < byWidth.size(); ++k) {
-      const int i = byWidth[k].second;
+    if (count > 0) sweepTile(tile, uLo, uHi, sc);
+  }
+
+  // Main-line peaks of the square pixels of sc.byWidth from `first` on, correlated directly
+  // (four disparities a pass where the windows allow).
+  void correlateDirectly(const cv::Rect& tile, size_t first, Scratch& sc) const {
+    for (size_t k = first; k < sc.byWidth.size(); ++k) {
+      const int i = sc.byWidth[k].second;
       const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
       LinePeak& peak = sc.peaks[static_cast<size_t>(i)];
       const int hi = in_.hi.at<int>(y, x);
@@ -1027,20 +1068,14 @@ class LevelMatcher {
       }
       for (; d <= hi; ++d) peak.update(d, squareScore(x, y, d, 0));
     }
-    for (const auto& [width, i] : byWidth) {
-      const int x = tile.x + i % tile.width, y = tile.y + i / tile.width;
-      finish(
-          x, y, in_.lo.at<int>(y, x), in_.hi.at<int>(y, x), sc.peaks[static_cast<size_t>(i)],
-          [&](int d, int dy) { return squareScore(x, y, d, dy); },
-          [&](int d, float& minus, float& plus) { return squareScorePair(x, y, d, minus, plus); },
-          [](int, int, float*) { return false; });
-    }
   }
 
   // Main-line scores of the swept pixels of `tile` for every d in [dLo, dHi]: per d, the
   // product A(x', y') B(x' - d, y') over the tile grown by the window radius is box-filtered
-  // with running column sums and a running row sum.
-  void sweepTile(const cv::Rect& tile, int dLo, int dHi, Scratch& sc) {
+  // with running column sums and a running row sum. Inlined in matchSquarePixels: out of line,
+  // the square path took ~3 % more instructions (400² scene).
+  __attribute__((always_inline)) void sweepTile(const cv::Rect& tile, int dLo, int dHi,
+                                                Scratch& sc) {
     const int gx0 = tile.x - r_, gw = tile.width + 2 * r_;  // grown tile columns
     const int gy0 = tile.y - r_, gh = tile.height + 2 * r_;
     sc.product.assign(static_cast<size_t>(gw) * gh, 0.0F);
