@@ -286,20 +286,12 @@ double pixelScore(const cv::Mat& left, const cv::Mat& right, const cv::Mat& labe
   return (sab - sa * sb / n) / std::sqrt(va * vb);
 }
 
-}  // namespace
-
-int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Mat& edges,
-                         const SlantedFacetSettings& settings, int dmin, int dmax,
-                         cv::Mat& disparity, cv::Mat& score) {
-  CV_Assert(left.type() == CV_32F && right.type() == CV_32F && left.size() == right.size());
-  CV_Assert(disparity.type() == CV_32F && disparity.size() == left.size());
-  CV_Assert(score.type() == CV_32F && score.size() == left.size());
-  CV_Assert(edges.type() == CV_8U && edges.size() == left.size());
-  if (settings.maxSlope <= 0) return 0;
-  // The unmatched pixels with data off the contours, in one pass by bands of rows (a match is a
-  // number: NaN is the only value unequal to itself).
+// The unmatched pixels with data off the contours, in one pass by bands of rows (a match is a
+// number: NaN is the only value unequal to itself).
+cv::Mat unmatchedOffContours(const cv::Mat& left, const cv::Mat& edges, const cv::Mat& disparity,
+                             int threads) {
   cv::Mat unmatched(disparity.size(), CV_8U);
-  forRowBands(disparity.rows, settings.threads, [&](int rowStart, int rowEnd) {
+  forRowBands(disparity.rows, threads, [&](int rowStart, int rowEnd) {
     for (int y = rowStart; y < rowEnd; ++y) {
       const float* d = disparity.ptr<float>(y);
       const float* a = left.ptr<float>(y);
@@ -310,6 +302,184 @@ int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Ma
       }
     }
   });
+  return unmatched;
+}
+
+// What the regions' tasks share: the views, the settings, the unmatched regions
+// (componentsWithStats) and the matches as they were before any region took a plane.
+struct FacetRegions {
+  const cv::Mat& left;
+  const cv::Mat& right;
+  const SlantedFacetSettings& settings;
+  int dmin, dmax;
+  const cv::Mat& labels;
+  const cv::Mat& stats;
+  const cv::Mat& centroids;
+  const cv::Mat& matchedBefore;
+  cv::Mat& disparity;
+  cv::Mat& score;
+};
+
+// One unmatched region matched on a plane (docs/stereo.md step 12), in its steps: its pixels
+// (at construction); the matches around it (readRing); the best plane (bestPlane, on samples of
+// its pixels); the tests the plane must pass (linesUp, continuesSurface, mostPixelsPass); the
+// plane written (write).
+struct SlantedRegion : FacetRegions {
+  SlantedRegion(const FacetRegions& shared, int label);
+
+  int match();
+  bool readRing();
+  std::vector<cv::Point> scattered(double target) const;
+  bool linesUp(const Fit& fit) const;
+  bool continuesSurface(const Plane& plane) const;
+  std::vector<float> pixelScores(const Plane& plane) const;
+  bool mostPixelsPass(const std::vector<float>& scores) const;
+  int write(const Plane& plane, const std::vector<float>& scores) const;
+
+  const int r;                       // the region's label
+  const cv::Rect box;                // its bounding box
+  std::vector<cv::Point> points;     // its pixels, in raster order
+  std::vector<cv::Point3d> ringAll;  // the matches within 2 px of it: x, y, d
+  std::vector<cv::Point3d> ring;     // those that guide the search
+  double lo = 1e30, hi = -1e30;      // the range searched for its plane's value at its centre
+};
+
+SlantedRegion::SlantedRegion(const FacetRegions& shared, int label)
+    : FacetRegions(shared),
+      r(label),
+      box(stats.at<int>(r, cv::CC_STAT_LEFT), stats.at<int>(r, cv::CC_STAT_TOP),
+          stats.at<int>(r, cv::CC_STAT_WIDTH), stats.at<int>(r, cv::CC_STAT_HEIGHT)) {
+  // The region's pixels in raster order, from its box (in the task: one pass over the whole
+  // map for every region before took ~1 ms on one worker at 1000²).
+  points.reserve(static_cast<size_t>(stats.at<int>(r, cv::CC_STAT_AREA)));
+  for (int y = box.y; y < box.br().y; ++y) {
+    const int* l = labels.ptr<int>(y);
+    for (int x = box.x; x < box.br().x; ++x) {
+      if (l[x] == r) points.push_back({x, y});
+    }
+  }
+}
+
+// The region matched on its best plane when that passes the tests; the pixels matched.
+int SlantedRegion::match() {
+  if (!readRing()) return 0;
+  const double cx = centroids.at<double>(r, 0), cy = centroids.at<double>(r, 1);
+  const Samples all = samplesOf(left, points, cx, cy);
+  // About 64 pixels (12 a band, for tall regions) score the coarse planes, about 256 choose
+  // among the best of them.
+  const double bands = static_cast<double>(box.height / kBandRows + 1);
+  const Samples sparse = samplesOf(left, scattered(std::max(64.0, 12 * bands)), cx, cy);
+  const Samples medium = samplesOf(left, scattered(256), cx, cy);
+  if (sparse.points.size() < 8) return 0;
+  const Fit fit = bestPlane(right, sparse, medium, all, ring, settings.minRingShare, cx, cy, lo, hi,
+                            settings.maxSlope, settings.minRegionScore - kHopeless);
+  const Plane& plane = fit.best.plane;
+  if (!linesUp(fit) || !continuesSurface(plane)) return 0;
+  const std::vector<float> scores = pixelScores(plane);
+  if (!mostPixelsPass(scores)) return 0;
+  return write(plane, scores);
+}
+
+// The matches within 2 px of the region (ringAll, and at most about 96 of them in `ring`, which
+// guide the search); their disparities bound its plane's value at its centre (lo, hi): a facet
+// lies between its ridge and the ground beside its eave. False when there are none.
+bool SlantedRegion::readRing() {
+  const cv::Rect around =
+      (box + cv::Size(4, 4) - cv::Point(2, 2)) & cv::Rect(0, 0, left.cols, left.rows);
+  const cv::Mat inRegion = labels(around) == r;
+  cv::Mat near;
+  cv::dilate(inRegion, near, cv::Mat::ones(5, 5, CV_8U));
+  near &= ~inRegion;
+  for (int y = 0; y < around.height; ++y) {
+    for (int x = 0; x < around.width; ++x) {
+      if (!near.at<uchar>(y, x)) continue;
+      const float d = matchedBefore.at<float>(around.y + y, around.x + x);
+      if (!std::isfinite(d)) continue;
+      ringAll.emplace_back(around.x + x, around.y + y, d);
+      lo = std::min(lo, static_cast<double>(d));
+      hi = std::max(hi, static_cast<double>(d));
+    }
+  }
+  if (ringAll.empty()) return false;
+  const size_t ringStride = (ringAll.size() + 95) / 96;
+  for (size_t k = 0; k < ringAll.size(); k += ringStride) ring.push_back(ringAll[k]);
+  lo = std::max(lo - 1, static_cast<double>(dmin));
+  hi = std::min(hi + 1, static_cast<double>(dmax));
+  return true;
+}
+
+// About `target` of the region's pixels, scattered by a hash of their position (a regular
+// grid aliases with periodic texture: seed 33 600²'s facet, period 4 px, sampled every
+// 6 px, scored 0.48 at its best plane against 0.90 at the truth).
+std::vector<cv::Point> SlantedRegion::scattered(double target) const {
+  const auto every = static_cast<uint32_t>(std::max(1.0, std::floor(points.size() / target)));
+  std::vector<cv::Point> kept;
+  for (const cv::Point& p : points) {
+    const uint32_t h =
+        (static_cast<uint32_t>(p.x) * 73856093U) ^ (static_cast<uint32_t>(p.y) * 19349663U);
+    if ((h >> 7) % every == 0) kept.push_back(p);
+  }
+  return kept;
+}
+
+// Lines up well, and clearly better than anywhere 2 px away (periodic texture, plain or
+// occluded regions line up about as well at several places).
+bool SlantedRegion::linesUp(const Fit& fit) const {
+  return fit.best.score >= settings.minRegionScore &&
+         fit.elsewhere <= fit.best.score - settings.uniqueness;
+}
+
+// Continues the surface beside it somewhere: a facet meets its roof's other facets at the ridge
+// and hips (its eave is a step down to the ground).
+bool SlantedRegion::continuesSurface(const Plane& plane) const {
+  int agree = 0;
+  for (const cv::Point3d& q : ringAll) agree += std::abs(q.z - plane.at(q.x, q.y)) <= 1 ? 1 : 0;
+  return agree >= settings.minRingShare * static_cast<double>(ringAll.size());
+}
+
+// Each pixel's score at the plane on its own 7 x 7 window (pixelScore).
+std::vector<float> SlantedRegion::pixelScores(const Plane& plane) const {
+  std::vector<float> scores(points.size(), -2.0F);
+  for (size_t i = 0; i < points.size(); ++i) {
+    scores[i] =
+        static_cast<float>(pixelScore(left, right, labels, r, plane, points[i].x, points[i].y));
+  }
+  return scores;
+}
+
+// Most of its pixels line up there on their own too.
+bool SlantedRegion::mostPixelsPass(const std::vector<float>& scores) const {
+  int passing = 0;
+  for (const float s : scores) passing += s >= settings.minPixelScore ? 1 : 0;
+  return passing >= settings.minPixelShare * static_cast<double>(points.size());
+}
+
+// The pixels that line up at the plane on their own take it, with their score; the pixels
+// written.
+int SlantedRegion::write(const Plane& plane, const std::vector<float>& scores) const {
+  int matched = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double d = plane.at(points[i].x, points[i].y);
+    // A plane may run out of the searched range at a region's far end: left unmatched there.
+    if (scores[i] < settings.minPixelScore || d < dmin || d > dmax) continue;
+    disparity.at<float>(points[i]) = static_cast<float>(d);
+    score.at<float>(points[i]) = scores[i];
+    ++matched;
+  }
+  return matched;
+}
+
+}  // namespace
+
+int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Mat& edges,
+                         const SlantedFacetSettings& settings, int dmin, int dmax,
+                         cv::Mat& disparity, cv::Mat& score) {
+  CV_Assert(left.type() == CV_32F && right.type() == CV_32F && left.size() == right.size());
+  CV_Assert(disparity.type() == CV_32F && disparity.size() == left.size());
+  CV_Assert(score.type() == CV_32F && score.size() == left.size());
+  CV_Assert(edges.type() == CV_8U && edges.size() == left.size());
+  if (settings.maxSlope <= 0) return 0;
+  const cv::Mat unmatched = unmatchedOffContours(left, edges, disparity, settings.threads);
   // Each region's result is written by its own task into its own pixels: no two tasks touch the
   // same pixel, and the matches read around a region are ones no task writes (copied meanwhile).
   cv::Mat labels, stats, centroids, matchedBefore;
@@ -319,106 +489,23 @@ int recoverSlantedFacets(const cv::Mat& left, const cv::Mat& right, const cv::Ma
             },
             [&] { matchedBefore = disparity.clone(); }},
            settings.threads);
+  const FacetRegions shared{.left = left,
+                            .right = right,
+                            .settings = settings,
+                            .dmin = dmin,
+                            .dmax = dmax,
+                            .labels = labels,
+                            .stats = stats,
+                            .centroids = centroids,
+                            .matchedBefore = matchedBefore,
+                            .disparity = disparity,
+                            .score = score};
   std::vector<int> matchedPerRegion(static_cast<size_t>(count), 0);
   std::vector<std::function<void()>> tasks;
   for (int r = 1; r < count; ++r) {
     if (stats.at<int>(r, cv::CC_STAT_AREA) < settings.minArea) continue;
-    tasks.emplace_back([&, r] {
-      const cv::Rect box(stats.at<int>(r, cv::CC_STAT_LEFT), stats.at<int>(r, cv::CC_STAT_TOP),
-                         stats.at<int>(r, cv::CC_STAT_WIDTH), stats.at<int>(r, cv::CC_STAT_HEIGHT));
-      // The region's pixels in raster order, from its box (in the task: one pass over the whole
-      // map for every region before took ~1 ms on one worker at 1000²).
-      std::vector<cv::Point> points;
-      points.reserve(static_cast<size_t>(stats.at<int>(r, cv::CC_STAT_AREA)));
-      for (int y = box.y; y < box.br().y; ++y) {
-        const int* l = labels.ptr<int>(y);
-        for (int x = box.x; x < box.br().x; ++x) {
-          if (l[x] == r) points.push_back({x, y});
-        }
-      }
-      // The disparities of the matches within 2 px of the region bound its plane's value at
-      // its centre: a facet lies between its ridge and the ground beside its eave.
-      const cv::Rect around =
-          (box + cv::Size(4, 4) - cv::Point(2, 2)) & cv::Rect(0, 0, left.cols, left.rows);
-      const cv::Mat inRegion = labels(around) == r;
-      cv::Mat near;
-      cv::dilate(inRegion, near, cv::Mat::ones(5, 5, CV_8U));
-      near &= ~inRegion;
-      std::vector<cv::Point3d> ringAll;  // the matches within 2 px of the region: x, y, d
-      double lo = 1e30, hi = -1e30;
-      for (int y = 0; y < around.height; ++y) {
-        for (int x = 0; x < around.width; ++x) {
-          if (!near.at<uchar>(y, x)) continue;
-          const float d = matchedBefore.at<float>(around.y + y, around.x + x);
-          if (!std::isfinite(d)) continue;
-          ringAll.emplace_back(around.x + x, around.y + y, d);
-          lo = std::min(lo, static_cast<double>(d));
-          hi = std::max(hi, static_cast<double>(d));
-        }
-      }
-      if (ringAll.empty()) return;
-      // At most about 96 of them guide the search.
-      const size_t ringStride = (ringAll.size() + 95) / 96;
-      std::vector<cv::Point3d> ring;
-      for (size_t k = 0; k < ringAll.size(); k += ringStride) ring.push_back(ringAll[k]);
-      lo = std::max(lo - 1, static_cast<double>(dmin));
-      hi = std::min(hi + 1, static_cast<double>(dmax));
-      // About `target` of the region's pixels, scattered by a hash of their position (a regular
-      // grid aliases with periodic texture: seed 33 600²'s facet, period 4 px, sampled every
-      // 6 px, scored 0.48 at its best plane against 0.90 at the truth).
-      const auto scattered = [&](double target) {
-        const auto every = static_cast<uint32_t>(std::max(1.0, std::floor(points.size() / target)));
-        std::vector<cv::Point> kept;
-        for (const cv::Point& p : points) {
-          const uint32_t h =
-              (static_cast<uint32_t>(p.x) * 73856093U) ^ (static_cast<uint32_t>(p.y) * 19349663U);
-          if ((h >> 7) % every == 0) kept.push_back(p);
-        }
-        return kept;
-      };
-      const double cx = centroids.at<double>(r, 0), cy = centroids.at<double>(r, 1);
-      const Samples all = samplesOf(left, points, cx, cy);
-      // About 64 pixels (12 a band, for tall regions) score the coarse planes, about 256 choose
-      // among the best of them.
-      const double bands = static_cast<double>(box.height / kBandRows + 1);
-      const Samples sparse = samplesOf(left, scattered(std::max(64.0, 12 * bands)), cx, cy);
-      const Samples medium = samplesOf(left, scattered(256), cx, cy);
-      if (sparse.points.size() < 8) return;
-      const Fit fit = bestPlane(right, sparse, medium, all, ring, settings.minRingShare, cx, cy, lo,
-                                hi, settings.maxSlope, settings.minRegionScore - kHopeless);
-      const Plane& plane = fit.best.plane;
-      // Lines up well, and clearly better than anywhere 2 px away (periodic texture, plain
-      // or occluded regions line up about as well at several places).
-      bool accepted = fit.best.score >= settings.minRegionScore &&
-                      fit.elsewhere <= fit.best.score - settings.uniqueness;
-      // Continues the surface beside it somewhere: a facet meets its roof's other facets at the
-      // ridge and hips (its eave is a step down to the ground).
-      int agree = 0;
-      for (const cv::Point3d& q : ringAll) agree += std::abs(q.z - plane.at(q.x, q.y)) <= 1 ? 1 : 0;
-      accepted = accepted && agree >= settings.minRingShare * static_cast<double>(ringAll.size());
-      std::vector<float> pixelScores(points.size(), -2.0F);
-      int passing = 0;
-      if (accepted) {
-        for (size_t i = 0; i < points.size(); ++i) {
-          pixelScores[i] = static_cast<float>(
-              pixelScore(left, right, labels, r, plane, points[i].x, points[i].y));
-          passing += pixelScores[i] >= settings.minPixelScore ? 1 : 0;
-        }
-        // Most of its pixels line up there on their own too.
-        accepted = passing >= settings.minPixelShare * static_cast<double>(points.size());
-      }
-      if (!accepted) return;
-      int matched = 0;
-      for (size_t i = 0; i < points.size(); ++i) {
-        const double d = plane.at(points[i].x, points[i].y);
-        // A plane may run out of the searched range at a region's far end: left unmatched there.
-        if (pixelScores[i] < settings.minPixelScore || d < dmin || d > dmax) continue;
-        disparity.at<float>(points[i]) = static_cast<float>(d);
-        score.at<float>(points[i]) = pixelScores[i];
-        ++matched;
-      }
-      matchedPerRegion[static_cast<size_t>(r)] = matched;
-    });
+    tasks.emplace_back(
+        [&, r] { matchedPerRegion[static_cast<size_t>(r)] = SlantedRegion(shared, r).match(); });
   }
   runTasks(tasks, settings.threads);
   int total = 0;
