@@ -32,20 +32,22 @@ struct Surface {
   [[nodiscard]] double at(int x, int y) const { return a * (x - cx) + b * (y - cy) + c; }
 };
 
-// The 4-connected surfaces of `disparity` (neighbours within `link`), as labels 0.. of the
-// surfaces of minPixels or more (kPiece on the matched pixels of those under maxPiece, −1
-// elsewhere), with their pixel counts and centroids.
-cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int maxPiece,
-                      int threads, std::vector<Surface>& surfaces) {
+// A row's matched pixels x0..x1 whose left neighbours are within `link` of them: a piece of a
+// surface.
+struct Run {
+  int y, x0, x1;
+};
+
+// The runs of every row, in row order: row y's are runs[rowStart[y] .. rowStart[y + 1]).
+struct RowRuns {
+  std::vector<Run> runs;
+  std::vector<size_t> rowStart;
+};
+
+// The runs, found by bands of rows on `threads` workers and put together in row order (one pass
+// on one worker, they were most of this labelling's ~2.5 ms at 1000²).
+RowRuns rowRuns(const cv::Mat& disparity, float link, int threads) {
   const int W = disparity.cols, H = disparity.rows;
-  // Runs of a row's matched pixels whose left neighbours are within `link`, joined across rows
-  // where a pixel of one and the pixel below it in the other are within `link` (the union-find
-  // then works on runs, not pixels). The runs are found by bands of rows on `threads` workers and
-  // put together in row order (one pass on one worker, they were most of this labelling's
-  // ~2.5 ms at 1000²).
-  struct Run {
-    int y, x0, x1;
-  };
   constexpr int kBandRows = 32;
   std::vector<std::vector<Run>> bandRuns(static_cast<size_t>((H + kBandRows - 1) / kBandRows));
   std::vector<size_t> runsInRow(static_cast<size_t>(H), 0);
@@ -66,16 +68,26 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int m
         }
       },
       kBandRows);
-  std::vector<Run> runs;
-  for (const std::vector<Run>& band : bandRuns) runs.insert(runs.end(), band.begin(), band.end());
-  std::vector<size_t> rowStart(static_cast<size_t>(H) + 1, 0);
-  for (int y = 0; y < H; ++y) {
-    rowStart[static_cast<size_t>(y) + 1] =
-        rowStart[static_cast<size_t>(y)] + runsInRow[static_cast<size_t>(y)];
+  RowRuns rows;
+  for (const std::vector<Run>& band : bandRuns) {
+    rows.runs.insert(rows.runs.end(), band.begin(), band.end());
   }
+  rows.rowStart.assign(static_cast<size_t>(H) + 1, 0);
+  for (int y = 0; y < H; ++y) {
+    rows.rowStart[static_cast<size_t>(y) + 1] =
+        rows.rowStart[static_cast<size_t>(y)] + runsInRow[static_cast<size_t>(y)];
+  }
+  return rows;
+}
+
+// The union-find parents of the runs, joined across rows where a pixel of one and the pixel
+// below it in the other are within `link`.
+std::vector<int> joinRunsAcrossRows(const cv::Mat& disparity, const RowRuns& rows, float link) {
+  const std::vector<Run>& runs = rows.runs;
+  const std::vector<size_t>& rowStart = rows.rowStart;
   std::vector<int> parent(runs.size());
   for (size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-  for (int y = 1; y < H; ++y) {
+  for (int y = 1; y < disparity.rows; ++y) {
     const float* up = disparity.ptr<float>(y - 1);
     const float* d = disparity.ptr<float>(y);
     size_t a = rowStart[static_cast<size_t>(y - 1)], b = rowStart[static_cast<size_t>(y)];
@@ -97,6 +109,14 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int m
       }
     }
   }
+  return parent;
+}
+
+// The labels of the joined runs (see labelSurfaces), numbered in the order of their first run,
+// with the surfaces' pixel counts, centroids, first disparities and boxes.
+cv::Mat numberSurfaces(const cv::Mat& disparity, const std::vector<Run>& runs,
+                       std::vector<int>& parent, int minPixels, int maxPiece,
+                       std::vector<Surface>& surfaces) {
   std::vector<int> size(runs.size(), 0);
   for (size_t i = 0; i < runs.size(); ++i) {
     size[static_cast<size_t>(findRoot(parent, static_cast<int>(i)))] += runs[i].x1 - runs[i].x0 + 1;
@@ -131,6 +151,17 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int m
     s.cy /= static_cast<double>(s.count);
   }
   return labels;
+}
+
+// The 4-connected surfaces of `disparity` (neighbours within `link`), as labels 0.. of the
+// surfaces of minPixels or more (kPiece on the matched pixels of those under maxPiece, −1
+// elsewhere), with their pixel counts and centroids. The union-find works on runs of a row's
+// pixels, not on pixels.
+cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int maxPiece,
+                      int threads, std::vector<Surface>& surfaces) {
+  const RowRuns rows = rowRuns(disparity, link, threads);
+  std::vector<int> parent = joinRunsAcrossRows(disparity, rows, link);
+  return numberSurfaces(disparity, rows.runs, parent, minPixels, maxPiece, surfaces);
 }
 
 // The trimmed fit, `rounds` rounds: the least-squares plane of each surface's pixels marked in
