@@ -164,6 +164,125 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int m
   return numberSurfaces(disparity, rows.runs, parent, minPixels, maxPiece, surfaces);
 }
 
+// Moments of u = x − cx, v = y − cy and z = d − z0 over a surface's kept pixels (z0: the
+// surface's first pixel, so that Σz² stays small and the residual sum below keeps its precision).
+struct Moments {
+  double n = 0, u = 0, v = 0, uu = 0, uv = 0, vv = 0, z = 0, uz = 0, vz = 0, zz = 0;
+
+  void add(double pu, double pv, double pz) {
+    n += 1;
+    u += pu;
+    v += pv;
+    uu += pu * pu;
+    uv += pu * pv;
+    vv += pv * pv;
+    z += pz;
+    uz += pu * pz;
+    vz += pv * pz;
+    zz += pz * pz;
+  }
+  Moments& operator+=(const Moments& b) {
+    n += b.n;
+    u += b.u;
+    v += b.v;
+    uu += b.uu;
+    uv += b.uv;
+    vv += b.vv;
+    z += b.z;
+    uz += b.uz;
+    vz += b.vz;
+    zz += b.zz;
+    return *this;
+  }
+};
+
+// The least-squares plane of the moments and the RMS of its residuals, into f (f.fitted false
+// when they hold a line of pixels or nothing).
+void solvePlane(const Moments& t, Surface& f) {
+  const cv::Matx33d m(t.uu, t.uv, t.u, t.uv, t.vv, t.v, t.u, t.v, t.n);
+  cv::Vec3d plane;
+  if (t.n < 3 || !cv::solve(m, cv::Vec3d(t.uz, t.vz, t.z), plane, cv::DECOMP_LU)) {
+    f.fitted = false;  // a line of pixels, or nothing left in the band
+    return;
+  }
+  f.a = plane[0];
+  f.b = plane[1];
+  f.c = plane[2] + f.z0;
+  // The least-squares residual is orthogonal to the regressors: Σr² = Σz² − θ·(Σuz, Σvz, Σz).
+  const double sq = t.zz - (plane[0] * t.uz + plane[1] * t.vz + plane[2] * t.z);
+  f.rms = std::sqrt(std::max(0.0, sq) / t.n);
+}
+
+// The passes of fitPlanes over the image, by bands of kBandRows rows, each band with its own
+// moments and inlier counts by surface, added up in band order.
+struct TrimmedFit {
+  static constexpr int kBandRows = 32;
+
+  void pass(bool trim, bool sum);
+  void passOverRows(int rowStart, int rowEnd, bool trim, bool sum);
+  void countInliers();
+  void solvePlanes();
+
+  const cv::Mat& disparity;
+  const cv::Mat& labels;
+  cv::Mat& keep;
+  std::vector<Surface>& surfaces;
+  const RoofPlaneSettings& s;
+  const size_t bands = static_cast<size_t>((disparity.rows + kBandRows - 1) / kBandRows);
+  std::vector<std::vector<Moments>> bandSums = std::vector<std::vector<Moments>>(bands);
+  std::vector<std::vector<long>> bandInliers = std::vector<std::vector<long>>(bands);
+};
+
+// One pass: with `trim`, `keep` set from the surfaces' planes; with `sum`, the moments of the
+// pixels kept.
+void TrimmedFit::pass(bool trim, bool sum) {
+  forRowBands(
+      disparity.rows, s.threads,
+      [&](int rowStart, int rowEnd) { passOverRows(rowStart, rowEnd, trim, sum); }, kBandRows);
+}
+
+void TrimmedFit::passOverRows(int rowStart, int rowEnd, bool trim, bool sum) {
+  const auto band = static_cast<size_t>(rowStart / kBandRows);
+  std::vector<Moments>& sums = bandSums[band];
+  std::vector<long>& inliers = bandInliers[band];
+  if (sum) sums.assign(surfaces.size(), Moments{});
+  if (trim) inliers.assign(surfaces.size(), 0);
+  for (int y = rowStart; y < rowEnd; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    const int* l = labels.ptr<int>(y);
+    std::uint8_t* k = keep.ptr<std::uint8_t>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (l[x] < 0) continue;
+      const Surface& f = surfaces[static_cast<size_t>(l[x])];
+      if (trim) {
+        const double within = std::max(s.trimFactor * f.rms, s.trimFloor);
+        const bool in = f.fitted && std::abs(d[x] - f.at(x, y)) <= within;
+        k[x] = in ? 1 : 0;
+        inliers[static_cast<size_t>(l[x])] += in ? 1 : 0;
+      }
+      if (!sum || k[x] == 0) continue;
+      sums[static_cast<size_t>(l[x])].add(x - f.cx, y - f.cy, d[x] - f.z0);
+    }
+  }
+}
+
+// Each surface's inliers, from the bands' counts.
+void TrimmedFit::countInliers() {
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    surfaces[i].inliers = 0;
+    for (const std::vector<long>& band : bandInliers) surfaces[i].inliers += band[i];
+  }
+}
+
+// Each surface's plane, from the bands' moments.
+void TrimmedFit::solvePlanes() {
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    Moments t;
+    for (const std::vector<Moments>& band : bandSums) t += band[i];
+    solvePlane(t, surfaces[i]);
+  }
+}
+
 // The trimmed fit, `rounds` rounds: the least-squares plane of each surface's pixels marked in
 // `keep`, the RMS of their residuals to it, then `keep` set anew to the pixels within the band.
 // One pass over the image per round plus one: a pass sets `keep` from the previous round's planes
@@ -172,92 +291,15 @@ cv::Mat labelSurfaces(const cv::Mat& disparity, float link, int minPixels, int m
 // threads.
 void fitPlanes(const cv::Mat& disparity, const cv::Mat& labels, cv::Mat& keep,
                std::vector<Surface>& surfaces, const RoofPlaneSettings& s, int rounds) {
-  // Moments of u = x − cx, v = y − cy and z = d − z0 (z0: the surface's first pixel, so that
-  // Σz² stays small and the residual sum below keeps its precision).
-  struct Sums {
-    double n = 0, u = 0, v = 0, uu = 0, uv = 0, vv = 0, z = 0, uz = 0, vz = 0, zz = 0;
-  };
-  constexpr int kBandRows = 32;
-  const int bands = (disparity.rows + kBandRows - 1) / kBandRows;
-  std::vector<std::vector<Sums>> bandSums(static_cast<size_t>(bands));
-  std::vector<std::vector<long>> bandInliers(static_cast<size_t>(bands));
+  TrimmedFit fit{
+      .disparity = disparity, .labels = labels, .keep = keep, .surfaces = surfaces, .s = s};
   for (int pass = 0; pass <= rounds; ++pass) {
     const bool trim = pass > 0;      // keep from the previous round's planes
     const bool sum = pass < rounds;  // this round's moments
-    forRowBands(
-        disparity.rows, s.threads,
-        [&](int rowStart, int rowEnd) {
-          const auto band = static_cast<size_t>(rowStart / kBandRows);
-          std::vector<Sums>& sums = bandSums[band];
-          std::vector<long>& inliers = bandInliers[band];
-          if (sum) sums.assign(surfaces.size(), Sums{});
-          if (trim) inliers.assign(surfaces.size(), 0);
-          for (int y = rowStart; y < rowEnd; ++y) {
-            const float* d = disparity.ptr<float>(y);
-            const int* l = labels.ptr<int>(y);
-            std::uint8_t* k = keep.ptr<std::uint8_t>(y);
-            for (int x = 0; x < disparity.cols; ++x) {
-              if (l[x] < 0) continue;
-              const Surface& f = surfaces[static_cast<size_t>(l[x])];
-              if (trim) {
-                const double within = std::max(s.trimFactor * f.rms, s.trimFloor);
-                const bool in = f.fitted && std::abs(d[x] - f.at(x, y)) <= within;
-                k[x] = in ? 1 : 0;
-                inliers[static_cast<size_t>(l[x])] += in ? 1 : 0;
-              }
-              if (!sum || k[x] == 0) continue;
-              Sums& t = sums[static_cast<size_t>(l[x])];
-              const double u = x - f.cx, v = y - f.cy, z = d[x] - f.z0;
-              t.n += 1;
-              t.u += u;
-              t.v += v;
-              t.uu += u * u;
-              t.uv += u * v;
-              t.vv += v * v;
-              t.z += z;
-              t.uz += u * z;
-              t.vz += v * z;
-              t.zz += z * z;
-            }
-          }
-        },
-        kBandRows);
-    if (trim) {
-      for (size_t i = 0; i < surfaces.size(); ++i) {
-        surfaces[i].inliers = 0;
-        for (const std::vector<long>& band : bandInliers) surfaces[i].inliers += band[i];
-      }
-    }
+    fit.pass(trim, sum);
+    if (trim) fit.countInliers();
     if (!sum) break;
-    for (size_t i = 0; i < surfaces.size(); ++i) {
-      Sums t;
-      for (const std::vector<Sums>& band : bandSums) {
-        const Sums& b = band[i];
-        t.n += b.n;
-        t.u += b.u;
-        t.v += b.v;
-        t.uu += b.uu;
-        t.uv += b.uv;
-        t.vv += b.vv;
-        t.z += b.z;
-        t.uz += b.uz;
-        t.vz += b.vz;
-        t.zz += b.zz;
-      }
-      Surface& f = surfaces[i];
-      const cv::Matx33d m(t.uu, t.uv, t.u, t.uv, t.vv, t.v, t.u, t.v, t.n);
-      cv::Vec3d plane;
-      if (t.n < 3 || !cv::solve(m, cv::Vec3d(t.uz, t.vz, t.z), plane, cv::DECOMP_LU)) {
-        f.fitted = false;  // a line of pixels, or nothing left in the band
-        continue;
-      }
-      f.a = plane[0];
-      f.b = plane[1];
-      f.c = plane[2] + f.z0;
-      // The least-squares residual is orthogonal to the regressors: Σr² = Σz² − θ·(Σuz, Σvz, Σz).
-      const double sq = t.zz - (plane[0] * t.uz + plane[1] * t.vz + plane[2] * t.z);
-      f.rms = std::sqrt(std::max(0.0, sq) / t.n);
-    }
+    fit.solvePlanes();
   }
 }
 
