@@ -236,12 +236,9 @@ void addBrightnessTerm(QuantisedCostVolume& volume, const cv::Mat& sumA, const c
   });
 }
 
-}  // namespace
-
-std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
-    const cv::Mat& left, const cv::Mat& right, cv::Rect roi, int dmin, int dmax,
-    const CostParams& params, core::Progress* progress) {
-  params.validate();
+// The inputs compute() takes: two float32 images of one size, a disparity range and an ROI
+// within the image; throws core::Error otherwise.
+void checkInputs(const cv::Mat& left, const cv::Mat& right, cv::Rect roi, int dmin, int dmax) {
   if (left.empty() || right.empty() || left.type() != CV_32FC1 || right.type() != CV_32FC1) {
     throw Error(ErrorCode::UnsupportedInput,
                 "cost service: left and right must be non-empty single-channel float32 images");
@@ -260,34 +257,90 @@ std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
   if (roi.area() <= 0 || (roi & cv::Rect(0, 0, left.cols, left.rows)) != roi) {
     throw Error(ErrorCode::InvalidParameter, "cost service: ROI is empty or outside the image");
   }
-  const int window = params.window;
+}
+
+// What the NCC of every window reads: the grey levels around the ROI (NaN as 0) and the box
+// sums of the left windows (A, at ROI positions) and of the right windows (B, at ROI positions
+// shifted by dmax − d for disparity d), with their counts of valid pixels.
+struct WindowSums {
+  int window = 0;
+  double n = 0;       // pixels in a window
+  cv::Rect leftRect;  // the ROI grown by the window's radius
+  cv::Mat leftVals, rightVals;
+  cv::Mat sumA, sumAA, countA, sumB, sumBB, countB;
+};
+
+WindowSums windowSums(const cv::Mat& left, const cv::Mat& right, cv::Rect roi, int dmin, int dmax,
+                      int window) {
+  WindowSums s;
+  s.window = window;
   const int r = window / 2;
-  const double n = static_cast<double>(window) * window;
-  const int planes = dmax - dmin + 1;
-
-  auto volume = std::make_unique<QuantisedCostVolume>(roi, dmin, dmax, params.unmatchedCost);
-
+  s.n = static_cast<double>(window) * window;
   // Left windows: ROI grown by the window radius; pixels outside the image count as NaN, so
   // windows leaving the image get the unmatched cost.
-  const cv::Rect leftRect(roi.x - r, roi.y - r, roi.width + 2 * r, roi.height + 2 * r);
-  cv::Mat leftVals, leftValid;
-  splitValid(cropWithNaN(left, leftRect), leftVals, leftValid);
+  s.leftRect = cv::Rect(roi.x - r, roi.y - r, roi.width + 2 * r, roi.height + 2 * r);
+  cv::Mat leftValid;
+  splitValid(cropWithNaN(left, s.leftRect), s.leftVals, leftValid);
   // Right windows for every d: columns x - d for x in the grown ROI and d in [dmin, dmax].
   const cv::Rect rightRect(roi.x - r - dmax, roi.y - r, roi.width + 2 * r + (dmax - dmin),
                            roi.height + 2 * r);
-  cv::Mat rightVals, rightValid;
-  splitValid(cropWithNaN(right, rightRect), rightVals, rightValid);
+  cv::Mat rightValid;
+  splitValid(cropWithNaN(right, rightRect), s.rightVals, rightValid);
 
-  const cv::Mat sumA = boxSums(leftVals, window);
-  const cv::Mat sumAA = boxSums(leftVals.mul(leftVals), window);
-  const cv::Mat countA = boxSums(leftValid, window);
-  const cv::Mat sumB = boxSums(rightVals, window);
-  const cv::Mat sumBB = boxSums(rightVals.mul(rightVals), window);
-  const cv::Mat countB = boxSums(rightValid, window);
+  s.sumA = boxSums(s.leftVals, window);
+  s.sumAA = boxSums(s.leftVals.mul(s.leftVals), window);
+  s.countA = boxSums(leftValid, window);
+  s.sumB = boxSums(s.rightVals, window);
+  s.sumBB = boxSums(s.rightVals.mul(s.rightVals), window);
+  s.countB = boxSums(rightValid, window);
+  return s;
+}
 
+// The quantised cost (1 − NCC)/2 of every ROI pixel at the disparity whose right windows start
+// `offset` columns into the right sums (dmax − d), into `out`; `product`: scratch.
+void nccCostPlane(const WindowSums& s, int offset, uint16_t unmatched, cv::Mat& product,
+                  cv::Mat& out) {
+  const double n = s.n;
+  const cv::Rect& leftRect = s.leftRect;
+  cv::multiply(s.leftVals, s.rightVals(cv::Rect(offset, 0, leftRect.width, leftRect.height)),
+               product);
+  const cv::Mat sumAB = boxSums(product, s.window);
+  for (int y = 0; y < out.rows; ++y) {
+    const double* sa = s.sumA.ptr<double>(y);
+    const double* saa = s.sumAA.ptr<double>(y);
+    const double* ca = s.countA.ptr<double>(y);
+    const double* sb = s.sumB.ptr<double>(y) + offset;
+    const double* sbb = s.sumBB.ptr<double>(y) + offset;
+    const double* cb = s.countB.ptr<double>(y) + offset;
+    const double* sab = sumAB.ptr<double>(y);
+    uint16_t* o = out.ptr<uint16_t>(y);
+    for (int x = 0; x < out.cols; ++x) {
+      if (ca[x] < n - 0.5 || cb[x] < n - 0.5) {
+        o[x] = unmatched;
+        continue;
+      }
+      const double varA = saa[x] - sa[x] * sa[x] / n;
+      const double varB = sbb[x] - sb[x] * sb[x] / n;
+      const double scaleA = 1e-10 * (1.0 + saa[x]);
+      const double scaleB = 1e-10 * (1.0 + sbb[x]);
+      // A flat window carries no information: NCC 0, cost 0.5.
+      double ncc = 0.0;
+      if (varA > scaleA && varB > scaleB) {
+        ncc = (sab[x] - sa[x] * sb[x] / n) / std::sqrt(varA * varB);
+      }
+      o[x] = quantise((1.0 - std::clamp(ncc, -1.0, 1.0)) * 0.5);
+    }
+  }
+}
+
+// Every NCC cost plane of `volume`, in parallel, reporting progress up to 0.95; false when
+// canceled.
+bool nccCostPlanes(QuantisedCostVolume& volume, const WindowSums& sums, core::Progress* progress) {
+  const int dmin = volume.dmin(), dmax = volume.dmax();
+  const int planes = dmax - dmin + 1;
   std::atomic<int> done{0};
   std::atomic<bool> canceled{false};
-  const uint16_t unmatched = volume->unmatchedQuantised();
+  const uint16_t unmatched = volume.unmatchedQuantised();
   cv::parallel_for_(cv::Range(0, planes), [&](const cv::Range& range) {
     cv::Mat product;
     for (int k = range.start; k < range.end; ++k) {
@@ -296,48 +349,33 @@ std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
         return;
       }
       const int d = dmin + k;
-      const int offset = dmax - d;  // column of x - d in rightRect for x = leftRect.x
-      cv::multiply(leftVals, rightVals(cv::Rect(offset, 0, leftRect.width, leftRect.height)),
-                   product);
-      const cv::Mat sumAB = boxSums(product, window);
-      cv::Mat& out = volume->plane(k);
-      for (int y = 0; y < roi.height; ++y) {
-        const double* sa = sumA.ptr<double>(y);
-        const double* saa = sumAA.ptr<double>(y);
-        const double* ca = countA.ptr<double>(y);
-        const double* sb = sumB.ptr<double>(y) + offset;
-        const double* sbb = sumBB.ptr<double>(y) + offset;
-        const double* cb = countB.ptr<double>(y) + offset;
-        const double* sab = sumAB.ptr<double>(y);
-        uint16_t* o = out.ptr<uint16_t>(y);
-        for (int x = 0; x < roi.width; ++x) {
-          if (ca[x] < n - 0.5 || cb[x] < n - 0.5) {
-            o[x] = unmatched;
-            continue;
-          }
-          const double varA = saa[x] - sa[x] * sa[x] / n;
-          const double varB = sbb[x] - sb[x] * sb[x] / n;
-          const double scaleA = 1e-10 * (1.0 + saa[x]);
-          const double scaleB = 1e-10 * (1.0 + sbb[x]);
-          // A flat window carries no information: NCC 0, cost 0.5.
-          double ncc = 0.0;
-          if (varA > scaleA && varB > scaleB) {
-            ncc = (sab[x] - sa[x] * sb[x] / n) / std::sqrt(varA * varB);
-          }
-          o[x] = quantise((1.0 - std::clamp(ncc, -1.0, 1.0)) * 0.5);
-        }
-      }
+      const int offset = dmax - d;  // column of x - d in the right sums for x = leftRect.x
+      nccCostPlane(sums, offset, unmatched, product, volume.plane(k));
       const int finished = ++done;
       if (progress != nullptr && (finished % 8 == 0 || finished == planes)) {
         progress->report(0.95 * finished / planes);
       }
     }
   });
-  if (canceled.load() || core::isCanceled(progress)) return nullptr;
+  return !(canceled.load() || core::isCanceled(progress));
+}
+
+}  // namespace
+
+std::unique_ptr<CorrelationCostService> CorrelationCostService::compute(
+    const cv::Mat& left, const cv::Mat& right, cv::Rect roi, int dmin, int dmax,
+    const CostParams& params, core::Progress* progress) {
+  params.validate();
+  checkInputs(left, right, roi, dmin, dmax);
+  auto volume = std::make_unique<QuantisedCostVolume>(roi, dmin, dmax, params.unmatchedCost);
+  const WindowSums sums = windowSums(left, right, roi, dmin, dmax, params.window);
+  if (!nccCostPlanes(*volume, sums, progress)) return nullptr;
   if (params.brightnessScale > 0) {
+    const int r = params.window / 2;
     const auto [gain, shift] = radiometricMap(left, right, dmin, dmax);
-    addBrightnessTerm(*volume, sumA, sumAA, sumB, leftVals(cv::Rect(r, r, roi.width, roi.height)),
-                      window, params.brightnessScale, gain, shift);
+    addBrightnessTerm(*volume, sums.sumA, sums.sumAA, sums.sumB,
+                      sums.leftVals(cv::Rect(r, r, roi.width, roi.height)), params.window,
+                      params.brightnessScale, gain, shift);
   }
   volume->finish();
   core::report(progress, 1.0);
