@@ -1696,6 +1696,147 @@ int RegionDecision::write(const FillPlane& plane, const cv::Mat& grown) const {
   return filled;
 }
 
+// The left view's flat regions (flatMask, 4-connected) and which of them the fill decides on.
+struct LeftFlatRegions {
+  double sigma = 0;   // the left view's noise sigma
+  cv::Mat flatCores;  // the regions without their thin parts (empty without coreOpening)
+  cv::Mat labels, stats, centroids;
+  // By label: a region the fill decides on itself (the extension does not enter them).
+  std::vector<uchar> ownFill;
+};
+
+LeftFlatRegions leftFlatRegions(const cv::Mat& left, const cv::Mat& disparity,
+                                const RegionFillSettings& settings,
+                                const LocalMoments* leftMoments) {
+  LeftFlatRegions regions;
+  const cv::Mat flat = flatMask(left, settings, &regions.sigma, leftMoments);
+  // The regions without their thin parts (see RegionFillSettings::coreOpening).
+  if (settings.coreOpening > 1) {
+    cv::morphologyEx(
+        flat, regions.flatCores, cv::MORPH_OPEN,
+        cv::getStructuringElement(cv::MORPH_RECT, {settings.coreOpening, settings.coreOpening}));
+  }
+  // (On this worker alone: the other prepares the grey maps and the right view's flat regions.)
+  const int count =
+      componentsWithStats(flat, regions.labels, regions.stats, regions.centroids, 4, 1);
+  std::vector<int> unmatched(static_cast<size_t>(count), 0);
+  for (int y = 0; y < regions.labels.rows; ++y) {
+    const int* l = regions.labels.ptr<int>(y);
+    const float* d = disparity.ptr<float>(y);
+    for (int x = 0; x < regions.labels.cols; ++x) {
+      if (l[x] != 0 && !std::isfinite(d[x])) ++unmatched[static_cast<size_t>(l[x])];
+    }
+  }
+  const double maxArea = settings.maxShare * static_cast<double>(left.total());
+  regions.ownFill.assign(static_cast<size_t>(count), 0);
+  for (int r = 1; r < count; ++r) {
+    regions.ownFill[static_cast<size_t>(r)] =
+        unmatched[static_cast<size_t>(r)] >= settings.minUnmatched &&
+        regions.stats.at<int>(r, cv::CC_STAT_AREA) <= maxArea;
+  }
+  return regions;
+}
+
+// The regions decided by the fill, in label order, each in its bounding box grown by 4 px, with
+// the tiles each reads (cells for RowOrderedTasks).
+struct DecidedRegions {
+  std::vector<int> labels;
+  std::vector<cv::Rect> boxes;
+  std::vector<std::vector<int>> cells;
+  int cellCount = 0;
+};
+
+// A region reads and writes the disparities (and scores) of its box only, but for the matches
+// its plane would hide left of it on its rows, up to the range's width (matchesHiddenBy):
+// regions whose such rectangles share no tile of kRegionTile px are decided side by side (with a
+// helper), the others in label order: the same result. (By rows alone before: at 1000² / 128 d
+// the regions ran at ~175 % of one core.)
+DecidedRegions decidedRegions(const LeftFlatRegions& flat, cv::Size size, int dmin, int dmax) {
+  constexpr int kRegionTile = 32;
+  const int regionTilesX = (size.width + kRegionTile - 1) / kRegionTile;
+  const int regionTilesY = (size.height + kRegionTile - 1) / kRegionTile;
+  const cv::Rect image(0, 0, size.width, size.height);
+  DecidedRegions regions;
+  regions.cellCount = regionTilesX * regionTilesY;
+  for (int r = 1; r < static_cast<int>(flat.ownFill.size()); ++r) {
+    if (!flat.ownFill[static_cast<size_t>(r)]) continue;
+    const cv::Rect box = cv::Rect(flat.stats.at<int>(r, cv::CC_STAT_LEFT) - 4,
+                                  flat.stats.at<int>(r, cv::CC_STAT_TOP) - 4,
+                                  flat.stats.at<int>(r, cv::CC_STAT_WIDTH) + 8,
+                                  flat.stats.at<int>(r, cv::CC_STAT_HEIGHT) + 8) &
+                         image;
+    regions.labels.push_back(r);
+    regions.boxes.push_back(box);
+    const cv::Rect reads =
+        cv::Rect(box.x - (dmax - dmin), box.y, box.width + (dmax - dmin), box.height) & image;
+    addTileCells(reads, kRegionTile, regionTilesX, 0, regions.cells.emplace_back());
+  }
+  return regions;
+}
+
+// Each region decided and filled (RegionDecision), one task of RowOrderedTasks each, which
+// `offerRegions(tasks)` hands to `helpers` other threads. Returns the regions filled, in the
+// regions' order (empty without extendReach); `filled` counts their pixels.
+template <class OfferRegions>
+std::vector<FilledRegion> decideRegions(const RegionFillShared& shared,
+                                        const DecidedRegions& regions, int helpers,
+                                        const OfferRegions& offerRegions, int& filled) {
+  std::vector<int> filledIn(regions.labels.size(), 0);
+  std::vector<std::optional<FilledRegion>> filledRegion(regions.labels.size());
+  const auto decideRegion = [&](size_t task) {
+    RegionDecision decision(shared, regions.labels[task], regions.boxes[task]);
+    const std::optional<float> constant = decision.outlineConstant();
+    const std::optional<FillPlane> plane = decision.fillPlane(constant);
+    if (!plane) return;
+    const cv::Mat grown = decision.grownRegion(*plane);
+    filledIn[task] = decision.write(*plane, grown);
+    if (shared.settings.extendReach > 0) {
+      filledRegion[task] = FilledRegion{regions.boxes[task], grown, *plane};
+    }
+  };
+  RowOrderedTasks regionTasks(regions.cells, regions.cellCount, decideRegion, helpers);
+  offerRegions(regionTasks);
+  regionTasks.run();
+  std::vector<FilledRegion> filledRegions;
+  for (size_t k = 0; k < regions.labels.size(); ++k) {
+    filled += filledIn[k];
+    if (filledRegion[k]) filledRegions.push_back(std::move(*filledRegion[k]));
+  }
+  return filledRegions;
+}
+
+// Once every region is filled (the extension's pixels do not become another region's
+// candidates), each filled region extended over the unmatched pixels beside it
+// (extendOverUnmatched): in the regions' order where they may meet, which extensionFootprints()
+// tells. Returns the pixels filled.
+int extendFilledRegions(const RegionFillShared& shared, const std::vector<uchar>& ownFill,
+                        const std::vector<FilledRegion>& filledRegions, int helpers) {
+  std::vector<cv::Rect> filledBoxes;
+  std::vector<FillPlane> filledPlanes;
+  for (const FilledRegion& f : filledRegions) {
+    filledBoxes.push_back(f.box);
+    filledPlanes.push_back(f.plane);
+  }
+  const ExtensionFootprints footprints = extensionFootprints(
+      filledBoxes, filledPlanes, shared.settings, shared.dmin, shared.dmax, shared.disparity);
+  std::vector<int> extendedIn(filledRegions.size(), 0);
+  const int extensionHelpers = filledRegions.size() > 1 ? helpers : 0;
+  RowOrderedTasks extensions(
+      footprints.cells, footprints.cellCount,
+      [&](size_t k) {
+        const FilledRegion& f = filledRegions[k];
+        extendedIn[k] = extendOverUnmatched(shared.left, shared.right, f.box, f.grown, f.plane,
+                                            shared.gain, shared.offset, shared.sigma, shared.dmin,
+                                            shared.dmax, shared.settings, shared.fillScore,
+                                            shared.labels, ownFill, shared.disparity, shared.score);
+      },
+      extensionHelpers);
+  extensions.runWithHelpers();
+  int filled = 0;
+  for (const int n : extendedIn) filled += n;
+  return filled;
+}
+
 // The fill itself; `greyMapsOf()` gives greyMaps() of the disparities as they come in (read
 // before the fill writes any), `rightFlatRegionsOf()` the right view's flat regions.
 // `offerRegions(tasks)` hands the regions' tasks to `helpers` other threads, which each call
@@ -1705,72 +1846,19 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
                 int dmin, int dmax, float fillScore, cv::Mat& disparity, cv::Mat& score,
                 const GreyMapsOf& greyMapsOf, const RightFlat& rightFlatRegionsOf, int helpers,
                 const OfferRegions& offerRegions, const LocalMoments* leftMoments) {
-  double sigma = 0;
-  const cv::Mat flat = flatMask(left, settings, &sigma, leftMoments);
-  // The regions without their thin parts (see RegionFillSettings::coreOpening).
-  cv::Mat flatCores;
-  if (settings.coreOpening > 1) {
-    cv::morphologyEx(
-        flat, flatCores, cv::MORPH_OPEN,
-        cv::getStructuringElement(cv::MORPH_RECT, {settings.coreOpening, settings.coreOpening}));
-  }
-  cv::Mat labels, stats, centroids;
-  // (On this worker alone: the other prepares the grey maps and the right view's flat regions.)
-  const int count = componentsWithStats(flat, labels, stats, centroids, 4, 1);
-  std::vector<int> unmatched(static_cast<size_t>(count), 0);
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* l = labels.ptr<int>(y);
-    const float* d = disparity.ptr<float>(y);
-    for (int x = 0; x < labels.cols; ++x) {
-      if (l[x] != 0 && !std::isfinite(d[x])) ++unmatched[static_cast<size_t>(l[x])];
-    }
-  }
+  const LeftFlatRegions flat = leftFlatRegions(left, disparity, settings, leftMoments);
   const double leftMedian = settings.shadowOwnLight ? medianGrey(left) : 0;
   const GreyMaps& greyMaps = greyMapsOf();
   const auto [gain, offset] = greyMaps.images;
   // A sloped facet's counterpart is chosen by its grey level, so the map must hold at that level:
   // the one of the matched pairs does (seed 5's dark hip facet: the images' moments put its
   // counterpart 5.9 levels off, the matches 0.8). So does the scan that confirms an unclear
-  // candidate (see scanConfirms below). The other tests keep the images' map, which their
+  // candidate (see scanConfirms). The other tests keep the images' map, which their
   // tolerances were measured with (all of them on the matches' map: 600² edge 92.0 -> 89.9, and
   // hip facets filled with a constant on seeds 6 and 38 600²).
   const auto [matchedGain, matchedOffset] = greyMaps.matches;
   const std::pair<double, double> imagesMap{gain, offset}, matchesMap{matchedGain, matchedOffset};
-  const double maxArea = settings.maxShare * static_cast<double>(left.total());
-  const cv::Rect image(0, 0, left.cols, left.rows);
-  // The flat regions the fill decides on itself (the extension does not enter them).
-  std::vector<uchar> ownFill(static_cast<size_t>(count), 0);
-  for (int r = 1; r < count; ++r) {
-    ownFill[static_cast<size_t>(r)] = unmatched[static_cast<size_t>(r)] >= settings.minUnmatched &&
-                                      stats.at<int>(r, cv::CC_STAT_AREA) <= maxArea;
-  }
-  // The regions decided here, in label order, each in its bounding box grown by 4 px. A region
-  // reads and writes the disparities (and scores) of its box only, but for the matches its plane
-  // would hide left of it on its rows, up to the range's width (matchesHiddenBy): regions whose
-  // such rectangles share no tile of kRegionTile px are decided side by side (with a helper), the
-  // others in label order: the same result. (By rows alone before: at 1000² / 128 d the regions
-  // ran at ~175 % of one core.)
-  constexpr int kRegionTile = 32;
-  const int regionTilesX = (left.cols + kRegionTile - 1) / kRegionTile;
-  const int regionTilesY = (left.rows + kRegionTile - 1) / kRegionTile;
-  std::vector<int> decided;
-  std::vector<cv::Rect> boxes;
-  std::vector<std::vector<int>> regionCells;
-  for (int r = 1; r < count; ++r) {
-    if (!ownFill[static_cast<size_t>(r)]) continue;
-    const cv::Rect box =
-        cv::Rect(stats.at<int>(r, cv::CC_STAT_LEFT) - 4, stats.at<int>(r, cv::CC_STAT_TOP) - 4,
-                 stats.at<int>(r, cv::CC_STAT_WIDTH) + 8,
-                 stats.at<int>(r, cv::CC_STAT_HEIGHT) + 8) &
-        image;
-    decided.push_back(r);
-    boxes.push_back(box);
-    const cv::Rect reads =
-        cv::Rect(box.x - (dmax - dmin), box.y, box.width + (dmax - dmin), box.height) & image;
-    addTileCells(reads, kRegionTile, regionTilesX, 0, regionCells.emplace_back());
-  }
-  std::vector<int> filledIn(decided.size(), 0);
-  std::vector<std::optional<FilledRegion>> filledRegion(decided.size());
+  const DecidedRegions regions = decidedRegions(flat, left.size(), dmin, dmax);
   const std::function<const RightFlatRegions&()> rightFlatOf = rightFlatRegionsOf;
   const RegionFillShared shared{.left = left,
                                 .right = right,
@@ -1781,11 +1869,11 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
                                 .disparity = disparity,
                                 .score = score,
                                 .rightFlatRegionsOf = rightFlatOf,
-                                .sigma = sigma,
-                                .labels = labels,
-                                .stats = stats,
-                                .centroids = centroids,
-                                .flatCores = flatCores,
+                                .sigma = flat.sigma,
+                                .labels = flat.labels,
+                                .stats = flat.stats,
+                                .centroids = flat.centroids,
+                                .flatCores = flat.flatCores,
                                 .leftMedian = leftMedian,
                                 .gain = gain,
                                 .offset = offset,
@@ -1793,48 +1881,10 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
                                 .matchedOffset = matchedOffset,
                                 .imagesMap = imagesMap,
                                 .matchesMap = matchesMap};
-  const auto decideRegion = [&](size_t task) {
-    RegionDecision decision(shared, decided[task], boxes[task]);
-    const std::optional<float> constant = decision.outlineConstant();
-    const std::optional<FillPlane> plane = decision.fillPlane(constant);
-    if (!plane) return;
-    const cv::Mat grown = decision.grownRegion(*plane);
-    filledIn[task] = decision.write(*plane, grown);
-    if (settings.extendReach > 0) filledRegion[task] = FilledRegion{boxes[task], grown, *plane};
-  };
-  RowOrderedTasks regionTasks(regionCells, regionTilesX * regionTilesY, decideRegion, helpers);
-  offerRegions(regionTasks);
-  regionTasks.run();
   int filled = 0;
-  std::vector<FilledRegion> filledRegions;
-  for (size_t k = 0; k < decided.size(); ++k) {
-    filled += filledIn[k];
-    if (filledRegion[k]) filledRegions.push_back(std::move(*filledRegion[k]));
-  }
-  // Once every region is filled (the extension's pixels do not become another region's
-  // candidates). In the regions' order where they may meet, which extensionFootprints() tells.
-  std::vector<cv::Rect> filledBoxes;
-  std::vector<FillPlane> filledPlanes;
-  for (const FilledRegion& f : filledRegions) {
-    filledBoxes.push_back(f.box);
-    filledPlanes.push_back(f.plane);
-  }
-  const ExtensionFootprints footprints =
-      extensionFootprints(filledBoxes, filledPlanes, settings, dmin, dmax, disparity);
-  std::vector<int> extendedIn(filledRegions.size(), 0);
-  const int extensionHelpers = filledRegions.size() > 1 ? helpers : 0;
-  RowOrderedTasks extensions(
-      footprints.cells, footprints.cellCount,
-      [&](size_t k) {
-        const FilledRegion& f = filledRegions[k];
-        extendedIn[k] =
-            extendOverUnmatched(left, right, f.box, f.grown, f.plane, gain, offset, sigma, dmin,
-                                dmax, settings, fillScore, labels, ownFill, disparity, score);
-      },
-      extensionHelpers);
-  extensions.runWithHelpers();
-  for (const int n : extendedIn) filled += n;
-  return filled;
+  const std::vector<FilledRegion> filledRegions =
+      decideRegions(shared, regions, helpers, offerRegions, filled);
+  return filled + extendFilledRegions(shared, flat.ownFill, filledRegions, helpers);
 }
 
 }  // namespace
