@@ -2108,6 +2108,109 @@ class Handover {
   mutable std::atomic<int> state_{kWaiting};
 };
 
+// The right view's flat pixels: given (plainPixels made beforehand), or made here.
+cv::Mat rightFlatMask(const cv::Mat& right, const RegionFillSettings& settings,
+                      const cv::Mat* rightFlatPixels) {
+  return rightFlatPixels != nullptr ? *rightFlatPixels : flatMask(right, settings);
+}
+
+// The fill on two workers (see fillFlatRegions): the second makes the grey maps, the right
+// view's flat regions and then runs `alongside` (prepareAndHelp), while this one makes the left
+// flat regions and fills them (fill), waiting for each of the other's results only when it first
+// needs it (the grey maps come first: the fill needs them before its first region, the right
+// flat regions only at a region's edges or facets).
+struct FillOnTwoWorkers {
+  int run(int threads);
+  void fill();
+  void prepareAndHelp();
+  void keepFailure();
+
+  const cv::Mat& left;
+  const cv::Mat& right;
+  const RegionFillSettings& settings;
+  int dmin, dmax;
+  float fillScore;
+  cv::Mat& disparity;
+  cv::Mat& score;
+  const std::function<void()>& alongside;
+  const LocalMoments* leftMoments;
+  const std::function<void()>& afterRegions;
+  const cv::Mat* rightFlatPixels;
+  GreyMaps maps{};
+  RightFlatRegions rightFlat{};
+  Handover mapsReady{}, rightReady{}, regionsOffered{};
+  RowOrderedTasks* regionTasks = nullptr;
+  bool helped = false;  // the second task has been through regionTasks->help()
+  int filled = 0;
+  // The exception that stopped a task first (the other's HandoverBroken only follows from it).
+  std::exception_ptr failure{};
+  std::mutex failureMutex{};
+};
+
+int FillOnTwoWorkers::run(int threads) {
+  runTasks({[this] { fill(); }, [this] { prepareAndHelp(); }}, threads, TaskDependence::MayWait);
+  if (failure) std::rethrow_exception(failure);
+  return filled;
+}
+
+void FillOnTwoWorkers::keepFailure() {
+  const std::lock_guard lock(failureMutex);
+  if (!failure) failure = std::current_exception();
+}
+
+void FillOnTwoWorkers::fill() {
+  try {
+    filled = fillRegions(
+        left, right, settings, dmin, dmax, fillScore, disparity, score,
+        [this]() -> const GreyMaps& {
+          mapsReady.take();
+          return maps;
+        },
+        [this]() -> const RightFlatRegions& {
+          rightReady.take();
+          return rightFlat;
+        },
+        1,
+        [this](RowOrderedTasks& tasks) {
+          regionTasks = &tasks;
+          regionsOffered.give();
+        },
+        leftMoments);
+  } catch (const HandoverBroken&) {
+  } catch (...) {
+    keepFailure();
+  }
+  regionsOffered.breakOff();
+}
+
+void FillOnTwoWorkers::prepareAndHelp() {
+  try {
+    // Reads the disparities before the fill writes any: the fill waits for it first.
+    maps = greyMaps(left, right, disparity, dmin, dmax);
+    mapsReady.give();
+    rightFlat = rightFlatRegions(rightFlatMask(right, settings, rightFlatPixels), right);
+    rightReady.give();
+    if (alongside) alongside();
+    // Then it helps with the regions (the rest of the fill's time is theirs).
+    regionsOffered.take();
+    helped = true;
+    regionTasks->help();
+    if (afterRegions) afterRegions();
+  } catch (const HandoverBroken&) {
+  } catch (...) {
+    keepFailure();
+    mapsReady.breakOff();
+    rightReady.breakOff();
+    // The regions' owner waits for this helper to leave them: it takes none (they are skipped
+    // once one failed, or canceled).
+    try {
+      regionsOffered.take();
+      if (!helped) regionTasks->help();
+    } catch (const HandoverBroken&) {
+    }
+  }
+}
+
 }  // namespace
 
 int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSettings& settings,
@@ -2115,81 +2218,20 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
                     int threads, const std::function<void()>& alongside,
                     const LocalMoments* leftMoments, const std::function<void()>& afterRegions,
                     const cv::Mat* rightFlatPixels) {
-  // With a second worker, it makes the grey maps, the right view's flat regions and then runs
-  // `alongside`, while this one makes the left flat regions and fills them, waiting for each of
-  // the other's results only when it first needs it (the grey maps come first: the fill needs
-  // them before its first region, the right flat regions only at a region's edges or facets).
-  const auto rightFlatMask = [&] {
-    return rightFlatPixels != nullptr ? *rightFlatPixels : flatMask(right, settings);
-  };
   if (threads > 1 && settings.planeMinRows > 0) {
-    GreyMaps maps;
-    RightFlatRegions rightFlat;
-    Handover mapsReady, rightReady, regionsOffered;
-    RowOrderedTasks* regionTasks = nullptr;
-    bool helped = false;  // the second task has been through regionTasks->help()
-    int filled = 0;
-    // The exception that stopped a task first (the other's HandoverBroken only follows from it).
-    std::exception_ptr failure;
-    std::mutex failureMutex;
-    const auto keepFailure = [&] {
-      const std::lock_guard lock(failureMutex);
-      if (!failure) failure = std::current_exception();
-    };
-    runTasks({[&] {
-                try {
-                  filled = fillRegions(
-                      left, right, settings, dmin, dmax, fillScore, disparity, score,
-                      [&]() -> const GreyMaps& {
-                        mapsReady.take();
-                        return maps;
-                      },
-                      [&]() -> const RightFlatRegions& {
-                        rightReady.take();
-                        return rightFlat;
-                      },
-                      1,
-                      [&](RowOrderedTasks& tasks) {
-                        regionTasks = &tasks;
-                        regionsOffered.give();
-                      },
-                      leftMoments);
-                } catch (const HandoverBroken&) {
-                } catch (...) {
-                  keepFailure();
-                }
-                regionsOffered.breakOff();
-              },
-              [&] {
-                try {
-                  // Reads the disparities before the fill writes any: the fill waits for it first.
-                  maps = greyMaps(left, right, disparity, dmin, dmax);
-                  mapsReady.give();
-                  rightFlat = rightFlatRegions(rightFlatMask(), right);
-                  rightReady.give();
-                  if (alongside) alongside();
-                  // Then it helps with the regions (the rest of the fill's time is theirs).
-                  regionsOffered.take();
-                  helped = true;
-                  regionTasks->help();
-                  if (afterRegions) afterRegions();
-                } catch (const HandoverBroken&) {
-                } catch (...) {
-                  keepFailure();
-                  mapsReady.breakOff();
-                  rightReady.breakOff();
-                  // The regions' owner waits for this helper to leave them: it takes none (they
-                  // are skipped once one failed, or canceled).
-                  try {
-                    regionsOffered.take();
-                    if (!helped) regionTasks->help();
-                  } catch (const HandoverBroken&) {
-                  }
-                }
-              }},
-             threads, TaskDependence::MayWait);
-    if (failure) std::rethrow_exception(failure);
-    return filled;
+    FillOnTwoWorkers fill{.left = left,
+                          .right = right,
+                          .settings = settings,
+                          .dmin = dmin,
+                          .dmax = dmax,
+                          .fillScore = fillScore,
+                          .disparity = disparity,
+                          .score = score,
+                          .alongside = alongside,
+                          .leftMoments = leftMoments,
+                          .afterRegions = afterRegions,
+                          .rightFlatPixels = rightFlatPixels};
+    return fill.run(threads);
   }
   // Else the right view's flat regions only when a region first needs them.
   RightFlatRegions rightFlat;
@@ -2198,8 +2240,10 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
       left, right, settings, dmin, dmax, fillScore, disparity, score,
       [&]() -> const GreyMaps& { return maps; },
       [&]() -> const RightFlatRegions& {
-    if (rightFlat.labels.empty()) rightFlat = rightFlatRegions(rightFlatMask(), right);
-    return rightFlat;
+        if (rightFlat.labels.empty()) {
+          rightFlat = rightFlatRegions(rightFlatMask(right, settings, rightFlatPixels), right);
+        }
+        return rightFlat;
       },
       0, [](RowOrderedTasks&) {}, leftMoments);
   if (alongside) alongside();
