@@ -44,4 +44,46 @@ LeftFlatRegions leftFlatRegions(const cv::Mat& left, const cv::Mat& disparity,
                                 const RegionFillSettings& settings,
                                 const LocalMoments* leftMoments);
 
+// The error of a region's outline ring at a plane's disparity.
+
+// Calls visit(residual) for each pixel of `ring` (over `box`) with data in both views, residual =
+// left − (gain · right + offset) with the right view read at the plane's disparity by linear
+// interpolation (the candidates are sub-pixel); `stopAtRow()` is asked before each row. False
+// when the outline leaves the right image or stopAtRow() said stop.
+template <typename Visit, typename StopAtRow>
+bool visitRingResiduals(const cv::Mat& left, const cv::Mat& right, const cv::Mat& ring,
+                        const cv::Rect& box, const FillPlane& plane,
+                        const std::pair<double, double>& map, Visit&& visit,
+                        StopAtRow&& stopAtRow) {
+  const auto [mapGain, mapOffset] = map;
+  for (int y = 0; y < box.height; ++y) {
+    if (stopAtRow()) return false;
+    const uchar* m = ring.ptr<uchar>(y);
+    const float* a = left.ptr<float>(box.y + y) + box.x;
+    const float* b = right.ptr<float>(box.y + y);
+    for (int x = 0; x < box.width; ++x) {
+      if (!m[x]) continue;
+      const double value = plane.at(box.x + x, box.y + y);
+      const int whole = static_cast<int>(std::floor(value));
+      const float t = static_cast<float>(value - whole);
+      const int xr = box.x + x - whole;  // x − value lies in [xr − 1, xr]
+      if (xr - 1 < 0 || xr >= right.cols) return false;
+      const float bv = (1 - t) * b[xr] + t * b[xr - 1];
+      if (!std::isfinite(a[x]) || !std::isfinite(bv)) continue;
+      visit(a[x] - (mapGain * bv + mapOffset));
+    }
+  }
+  return true;
+}
+
+// The ring's error in the region's own light (see RegionFillSettings::shadowOwnLight): mean
+// |residual − median residual|; 1e30 when the outline leaves the right image or has no data
+// (fill_own_light.cpp).
+double ringErrorInOwnLight(const cv::Mat& left, const cv::Mat& right, const cv::Mat& ring,
+                           const cv::Rect& box, const FillPlane& plane,
+                           const std::pair<double, double>& map);
+
+// The median grey of the valid pixels of `image`, from about 10 000 of them (fill_own_light.cpp).
+double medianGrey(const cv::Mat& image);
+
 }  // namespace delineo::stereo::detail
