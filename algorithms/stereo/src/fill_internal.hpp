@@ -86,4 +86,76 @@ double ringErrorInOwnLight(const cv::Mat& left, const cv::Mat& right, const cv::
 // The median grey of the valid pixels of `image`, from about 10 000 of them (fill_own_light.cpp).
 double medianGrey(const cv::Mat& image);
 
+// A region's row ends, read by its sloped facet's plane and by its edges' disparity
+// (regionRowEnds: fill_sloped_facet.cpp).
+
+// A region's first and last pixel on each of its rows (image coordinates), for the rows it
+// spans 3 px or more (`region` is the mask of `box`).
+struct RowEnds {
+  int y, l0, l1;
+};
+// The rows of `region` (over `box`) whose ends lie at least `minSpan` px apart (a sloped facet's
+// row ends need 2: a tip's rows tell nothing of its slope).
+std::vector<RowEnds> regionRowEnds(const cv::Mat& region, const cv::Rect& box, int minSpan = 2);
+
+// The lowest and highest value of `plane` over the rows `rows` (a plane's extremes on a row are
+// at its ends).
+inline std::pair<double, double> planeRange(const FillPlane& plane,
+                                            const std::vector<RowEnds>& rows) {
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  for (const RowEnds& r : rows) {
+    for (const int x : {r.l0, r.l1}) {
+      lowest = std::min(lowest, plane.at(x, r.y));
+      highest = std::max(highest, plane.at(x, r.y));
+    }
+  }
+  return {lowest, highest};
+}
+
+// A row's search band in the right view (`cols` px wide): the columns its ends can map to.
+inline std::pair<int, int> searchBand(const RowEnds& r, int dmin, int dmax, int cols) {
+  return {std::max(0, r.l0 - dmax), std::min(cols - 1, r.l1 - dmin)};
+}
+
+// The first and last pixel of `label` (in `labels`, CV_32S) on the row's search band; -1 when
+// absent.
+inline std::pair<int, int> labelEndsInBand(const cv::Mat& labels, const RowEnds& r, int label,
+                                           int dmin, int dmax) {
+  const int* l = labels.ptr<int>(r.y);
+  const auto [x0, x1] = searchBand(r, dmin, dmax, labels.cols);
+  int first = -1, last = -1;
+  for (int x = x0; x <= x1; ++x) {
+    if (l[x] != label) continue;
+    if (first < 0) first = x;
+    last = x;
+  }
+  return {first, last};
+}
+
+// A plain region's disparity read from its edges in both views (fill_edge_disparity.cpp).
+
+// Sub-pixel position of a flat region's edge on a row of `row` (`cols` px), walking from its end
+// pixel `start` outwards (`step` −1 or +1); nothing where the edge is not sharp.
+std::optional<double> subpixelEdge(const float* row, int cols, int start, int step, double roof,
+                                   double sigma);
+
+// The plane of a sloped facet (fill_sloped_facet.cpp).
+
+// The two views, when a plane's row ends are read to a fraction of a pixel from their edges.
+struct EdgeViews {
+  const cv::Mat& left;
+  const cv::Mat& right;
+};
+
+// The plane of `region` (the mask of `box`) as a sloped facet (see oneSideAgrees in
+// fill_sloped_facet.cpp), in `plane`; false when no counterpart's plane passes or `constant` wins
+// over it. `oneSided`: only one side's row ends agree with it; `rowSpans`: the span of each row it
+// fills (over `box`); `edgeViews`: the row ends read from the edges (all optional).
+bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFlatRegions& right,
+                      double leftMean, double gain, double offset, double sigma, int dmin, int dmax,
+                      const RegionFillSettings& settings, const std::optional<float>& constant,
+                      FillPlane& plane, bool* oneSided = nullptr,
+                      std::vector<cv::Vec2i>* rowSpans = nullptr,
+                      const EdgeViews* edgeViews = nullptr);
+
 }  // namespace delineo::stereo::detail
