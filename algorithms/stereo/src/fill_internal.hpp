@@ -139,6 +139,22 @@ inline std::pair<int, int> labelEndsInBand(const cv::Mat& labels, const RowEnds&
 std::optional<double> subpixelEdge(const float* row, int cols, int start, int step, double roof,
                                    double sigma);
 
+// The constant disparity of a plain region read from its edges in both views (see
+// RegionFillSettings::edgeMinSamples): the row ends within `reach` of `candidate`, the right
+// view's counterpart being the flat region of the region's grey (within 3 sigma, through the
+// matches' grey map) whose row ends agree with `candidate` on most rows. The mean of the
+// row-end disparities within 0.75 px of their median (samples 0: none).
+struct EdgeReading {
+  double value = 0;
+  int samples = 0;       // row ends within 0.75 px of the median
+  int read = 0;          // row ends read (sharp in both views, within `reach` of the candidate)
+  int fromLeftEnds = 0;  // of `samples`, those at the rows' left ends
+};
+EdgeReading edgeDisparity(const cv::Mat& left, const cv::Mat& right, const cv::Mat& region,
+                          const cv::Rect& box, const RightFlatRegions& rightFlat, double gain,
+                          double offset, double sigma, int dmin, int dmax, float candidate,
+                          double reach);
+
 // The plane of a sloped facet (fill_sloped_facet.cpp).
 
 // The two views, when a plane's row ends are read to a fraction of a pixel from their edges.
