@@ -174,4 +174,13 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
                       std::vector<cv::Vec2i>* rowSpans = nullptr,
                       const EdgeViews* edgeViews = nullptr);
 
+// The fill extended over the unmatched pixels beside a filled region (fill_extension.cpp): from
+// its filled pixels (`grown`, over `box`), over those whose window matches at `plane` on its
+// own; the pixels filled.
+int extendOverUnmatched(const cv::Mat& left, const cv::Mat& right, const cv::Rect& box,
+                        const cv::Mat& grown, const FillPlane& plane, double gain, double offset,
+                        double sigma, int dmin, int dmax, const RegionFillSettings& settings,
+                        float fillScore, const cv::Mat& labels, const std::vector<uchar>& ownFill,
+                        cv::Mat& disparity, cv::Mat& score);
+
 }  // namespace delineo::stereo::detail
