@@ -18,6 +18,17 @@ namespace delineo::stereo::detail {
 // Half-width of the flat test's window (5x5).
 inline constexpr int kFlatReach = 2;
 
+// Appends to `cells` the ids base + ty·tilesX + tx of the tile × tile squares that `rect`
+// (non-empty) meets: a task's cells for RowOrderedTasks.
+inline void addTileCells(const cv::Rect& rect, int tile, int tilesX, int base,
+                         std::vector<int>& cells) {
+  for (int ty = rect.y / tile; ty <= (rect.br().y - 1) / tile; ++ty) {
+    for (int tx = rect.x / tile; tx <= (rect.br().x - 1) / tile; ++tx) {
+      cells.push_back(base + ty * tilesX + tx);
+    }
+  }
+}
+
 // The flat regions of both views (fill_regions.cpp).
 
 // Pixels of `image` whose 5x5 standard deviation is below flatSigmas noise sigmas (CV_8U
