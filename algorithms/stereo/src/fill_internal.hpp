@@ -185,6 +185,45 @@ bool slopedFacetPlane(const cv::Mat& region, const cv::Rect& box, const RightFla
                       std::vector<cv::Vec2i>* rowSpans = nullptr,
                       const EdgeViews* edgeViews = nullptr);
 
+// The decision on each flat region and its fill (fill_region_decision.cpp).
+
+// A region filled by the fill, which it extends over the unmatched pixels beside it.
+struct FilledRegion {
+  cv::Rect box;
+  cv::Mat grown;
+  FillPlane plane;
+};
+
+// What the decisions on the flat regions share (see fillRegions): the views and settings, the
+// maps they write, the left view's flat regions and the grey maps of the right view to the left.
+struct RegionFillShared {
+  const cv::Mat& left;
+  const cv::Mat& right;
+  const RegionFillSettings& settings;
+  int dmin, dmax;
+  float fillScore;
+  cv::Mat& disparity;
+  cv::Mat& score;
+  const std::function<const RightFlatRegions&()>& rightFlatRegionsOf;  // (see fillRegions)
+  double sigma;  // the left view's noise sigma (flatMask)
+  // The flat regions (componentsWithStats), and the same without their thin parts (empty
+  // without coreOpening).
+  const cv::Mat& labels;
+  const cv::Mat& stats;
+  const cv::Mat& centroids;
+  const cv::Mat& flatCores;
+  double leftMedian;                  // the left view's median grey (0 without shadowOwnLight)
+  double gain, offset;                // the images' grey map
+  double matchedGain, matchedOffset;  // the matched pairs' grey map
+  std::pair<double, double> imagesMap, matchesMap;
+};
+
+// The decision on flat region `label` (`box`: its bounding box grown by 4 px, within the image)
+// and its fill (see RegionDecision): the region filled, none when it is left alone; `filled`
+// counts the pixels written.
+std::optional<FilledRegion> decideAndFillRegion(const RegionFillShared& shared, int label,
+                                                const cv::Rect& box, int& filled);
+
 // The fill extended over the unmatched pixels beside a filled region (fill_extension.cpp): from
 // its filled pixels (`grown`, over `box`), over those whose window matches at `plane` on its
 // own; the pixels filled.
