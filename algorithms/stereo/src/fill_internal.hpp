@@ -1,6 +1,9 @@
 #pragma once
 // The flat-region fill's parts, shared by its files (internal to delineo_stereo; see
-// fillFlatRegions in match_fill.hpp).
+// fillFlatRegions in match_fill.hpp). match_fill.cpp runs the stage: the flat regions
+// (fill_regions.cpp), the decision on each and its fill (fill_region_decision.cpp, with
+// fill_own_light.cpp, fill_edge_disparity.cpp and fill_sloped_facet.cpp), then the extension over
+// the unmatched pixels (fill_extension.cpp) in the order fill_extension_footprints.cpp allows.
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -194,8 +197,9 @@ struct FilledRegion {
   FillPlane plane;
 };
 
-// What the decisions on the flat regions share (see fillRegions): the views and settings, the
-// maps they write, the left view's flat regions and the grey maps of the right view to the left.
+// What the decisions on the flat regions share (see fillRegions in match_fill.cpp): the views and
+// settings, the maps they write, the left view's flat regions and the grey maps of the right view
+// to the left.
 struct RegionFillShared {
   const cv::Mat& left;
   const cv::Mat& right;

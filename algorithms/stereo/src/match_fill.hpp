@@ -120,7 +120,7 @@ struct RegionFillSettings {
 // A region that no constant lines up (a gable roof's plain facet, whose disparity changes along
 // its outline) takes a plane instead: the one through the row ends of the region and of its
 // counterpart in the right view (a right flat region of the same grey), when most rows agree
-// with it within `planeInlier` px (see slopedFacetPlane in match_fill.cpp), and when it lines the
+// with it within `planeInlier` px (see fill_sloped_facet.cpp), and when it lines the
 // outline up within planeCandidateRatio × the best cluster candidate's error (a plain roof strip
 // between seams takes the next strip over in the right view as its counterpart: 2000², 16 px
 // off, 1.2 × the candidate's error; roof RMS 1.193 -> 1.128 px). A region a constant
