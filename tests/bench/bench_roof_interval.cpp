@@ -15,8 +15,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -135,88 +135,95 @@ std::vector<int> growsOf(const std::string& list) {
   return out;
 }
 
+struct Options {
+  bench::RealRoofsOptions data;
+  std::vector<int> grows = {8, 15, 30};  // {-1}: the labelled outline itself
+};
+
+// The options, or nothing after the usage line when they are wrong.
+std::optional<Options> parseOptions(int argc, char** argv) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    if (options.data.take(argc, argv, i)) continue;
+    if (!std::strcmp(argv[i], "--grow") && i + 1 < argc && !growsOf(argv[i + 1]).empty()) {
+      options.grows = growsOf(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--outline")) {
+      options.grows = {-1};
+    } else {
+      std::fprintf(stderr, "usage: bench_roof_interval [--data DIR] [--labels real_roofs.json] [--cache DIR] "
+                           "[--grow 8,15,30 | --outline]\n");
+      return std::nullopt;
+    }
+  }
+  return options;
+}
+
+// The roof's ground reference: the median disparity over its labelled ground polygon, from the
+// pair's ground truth when it has one, else from the matcher's map.
+double groundReference(const nlohmann::json& pairFiles, const std::string& dataRoot,
+                       const cv::Mat& map, const core::Polygon& groundPolygon) {
+  if (!pairFiles.contains("ground_truth_disparity")) {
+    return quantile(valuesIn(map, core::rasterize(groundPolygon, map.size())), 0.5);
+  }
+  const cv::Mat gt = readGroundTruth(
+      (fs::path(dataRoot) / pairFiles.at("ground_truth_disparity").get<std::string>()).string(),
+      pairFiles.value("ground_truth_scale", 1.0));
+  return quantile(valuesIn(gt, core::rasterize(groundPolygon, gt.size())), 0.5);
+}
+
+// One row per rectangle around the roof (grow -1: its labelled outline), each counted in `tally`:
+// the former and the proposed interval and ground against the roof's peak and ground reference.
+void runRoof(const nlohmann::json& roof, const cv::Mat& map, double groundRef,
+             const std::vector<int>& grows, const delineation::RoofIntervalParams& params,
+             Tally& tally) {
+  const core::Polygon outline = ringOf(roof.at("outline"));
+  const int peak = mainPeak(map, outline);
+  for (int grow : grows) {
+    const core::Polygon rect = grow < 0 ? outline : bench::grownBox(outline, grow, map.size());
+    const auto [ol, oh] = oldInterval(map, rect);
+    const double og = oldGround(map, rect);
+    const auto p = delineation::proposeRoofInterval(map, rect, params);
+    const bool oldIn = ol <= peak && peak <= oh, newIn = p.found && p.low <= peak && peak <= p.high;
+    const double oe = og - groundRef, ne = p.groundLevel - groundRef;
+    std::printf(
+        "%-18s %4d %5d %6.1f | [%3d,%3d] %3s %6.1f %+5.1f | [%3d,%3d] %3s %6.1f %+5.1f %5.1f\n",
+        roof.at("name").get<std::string>().c_str(), grow, peak, groundRef, ol, oh,
+        oldIn ? "yes" : "NO", og, oe, p.low, p.high, newIn ? "yes" : "NO", p.groundLevel, ne,
+        p.peak);
+    tally.add(oldIn, newIn, oe, ne);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
-  std::string dataRoot = "/work/shared/data";
-  std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = bench::defaultDisparityCache().string();
-  std::vector<int> grows = {8, 15, 30};
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
-      dataRoot = argv[++i];
-    } else if (!std::strcmp(argv[i], "--labels") && i + 1 < argc) {
-      labels = argv[++i];
-    } else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) {
-      cache = argv[++i];
-    } else if (!std::strcmp(argv[i], "--grow") && i + 1 < argc && !growsOf(argv[i + 1]).empty()) {
-      grows = growsOf(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--outline")) {
-      grows = {-1};
-    } else {
-      std::fprintf(stderr, "usage: bench_roof_interval [--data DIR] [--labels real_roofs.json] [--cache DIR] "
-                           "[--grow 8,15,30 | --outline]\n");
-      return 2;
-    }
-  }
-  if (!fs::is_directory(dataRoot)) {
-    std::printf("skipped: no data folder %s\n", dataRoot.c_str());
-    return 0;
-  }
+  const std::optional<Options> options = parseOptions(argc, argv);
+  if (!options) return 2;
+  const std::string& dataRoot = options->data.dataRoot;
+  if (bench::skippedWithoutData(dataRoot)) return 0;
   delineation::RoofIntervalParams params;
   if (const char* json = std::getenv("BENCH_PARAMS")) core::fromJson(params, nlohmann::json::parse(json));
-  std::ifstream in(labels);
-  const nlohmann::json data = nlohmann::json::parse(in);
+  const nlohmann::json data = bench::readLabels(options->data.labels);
   std::printf("%-18s %4s %5s %6s | %-9s %3s %6s %5s | %-9s %3s %6s %5s %5s\n", "roof", "grow", "peak", "ground",
               "before", "in", "ground", "err", "after", "in", "ground", "err", "peak*");
-  Tally sets[2];  // tuning set, held-out set
-  bench::RealPairs pairs(data, dataRoot, cache);
+  std::map<std::string, Tally> sets;  // by bench::roofSet
+  bench::RealPairs pairs(data, dataRoot, options->data.cache);
   bool heldOutShown = false;
   for (const auto& roof : data.at("roofs")) {
-    const std::string pairName = roof.at("pair");
-    const bool heldOut = roof.value("heldOut", false);
-    if (heldOut && !heldOutShown) std::printf("-- held out (see tests/bench/data/README.md) --\n");
-    heldOutShown = heldOutShown || heldOut;
+    const std::string pairName = roof.at("pair"), set = bench::roofSet(roof);
+    if (set == "held-out" && !heldOutShown)
+      std::printf("-- held out (see tests/bench/data/README.md) --\n");
+    heldOutShown = heldOutShown || set == "held-out";
     const bench::RealPair* pair = pairs.get(pairName);
     if (!pair) continue;
-    const cv::Mat& map = pair->disparity;
-    const core::Polygon outline = ringOf(roof.at("outline"));
-    const core::Polygon groundPolygon = ringOf(roof.at("ground"));
-    double groundRef;
-    if (const auto& files = data.at("pairs").at(pairName); files.contains("ground_truth_disparity")) {
-      const cv::Mat gt = readGroundTruth((fs::path(dataRoot) / files.at("ground_truth_disparity").get<std::string>()).string(),
-                                         files.value("ground_truth_scale", 1.0));
-      groundRef = quantile(valuesIn(gt, core::rasterize(groundPolygon, gt.size())), 0.5);
-    } else {
-      groundRef = quantile(valuesIn(map, core::rasterize(groundPolygon, map.size())), 0.5);
-    }
-    const int peak = mainPeak(map, outline);
-    const cv::Rect2d box = core::boundingBox(outline.outer);
-    for (int grow : grows) {
-      const double x0 = std::max(0.0, box.x - grow), y0 = std::max(0.0, box.y - grow);
-      const double x1 = std::min<double>(map.cols, box.x + box.width + grow);
-      const double y1 = std::min<double>(map.rows, box.y + box.height + grow);
-      core::Polygon rect;
-      rect.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-      if (grow < 0) rect = outline;  // the labelled outline itself, as a delineated polygon
-      const auto [ol, oh] = oldInterval(map, rect);
-      const double og = oldGround(map, rect);
-      const auto p = delineation::proposeRoofInterval(map, rect, params);
-      const bool oldIn = ol <= peak && peak <= oh, newIn = p.found && p.low <= peak && peak <= p.high;
-      const double oe = og - groundRef, ne = p.groundLevel - groundRef;
-      std::printf("%-18s %4d %5d %6.1f | [%3d,%3d] %3s %6.1f %+5.1f | [%3d,%3d] %3s %6.1f %+5.1f %5.1f\n",
-                  roof.at("name").get<std::string>().c_str(), grow, peak, groundRef, ol, oh, oldIn ? "yes" : "NO", og,
-                  oe, p.low, p.high, newIn ? "yes" : "NO", p.groundLevel, ne, p.peak);
-      sets[heldOut ? 1 : 0].add(oldIn, newIn, oe, ne);
-    }
+    const double groundRef = groundReference(data.at("pairs").at(pairName), dataRoot,
+                                             pair->disparity, ringOf(roof.at("ground")));
+    runRoof(roof, pair->disparity, groundRef, options->grows, params, sets[set]);
   }
-  if (sets[0].runs + sets[1].runs == 0) {
-    std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
-    return 0;
-  }
+  if (bench::skippedWithoutRoofs(sets["tuning"].runs + sets["held-out"].runs, dataRoot)) return 0;
   std::printf("\n");
-  sets[0].print("tuning set");
-  sets[1].print("held-out set");
+  sets["tuning"].print("tuning set");
+  sets["held-out"].print("held-out set");
   return 0;
 }

@@ -1,7 +1,9 @@
 #pragma once
 // Loading of the hand-labelled real roofs (tests/bench/data/real_roofs.json) shared by the
-// benchmarks that read them: rings from JSON, and each pair's images and matcher's disparity map,
-// loaded once, the map cached as a GeoTIFF.
+// benchmarks that read them: their options (--data, --labels, --cache) and clean skip without the
+// data folder, rings from JSON, the roofs' sets, the operator's rectangle around a roof, and each
+// pair's images and matcher's disparity map, loaded once, the map cached as a GeoTIFF.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,14 +22,73 @@
 
 namespace delineo::bench {
 
+inline std::filesystem::path defaultDisparityCache() {
+  return std::filesystem::temp_directory_path() / "delineo_bench_disparity";
+}
+
+// The options every bench on the labelled real roofs takes: --data DIR (the data folder),
+// --labels FILE (real_roofs.json) and --cache DIR (the matcher's maps).
+struct RealRoofsOptions {
+  std::string dataRoot = "/work/shared/data";
+  std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
+  std::string cache = defaultDisparityCache().string();
+
+  // True, with i moved onto the value, when argv[i] is one of these options and has a value.
+  bool take(int argc, char** argv, int& i) {
+    if (i + 1 >= argc) return false;
+    const std::string option = argv[i];
+    std::string* value = option == "--data"     ? &dataRoot
+                         : option == "--labels" ? &labels
+                         : option == "--cache"  ? &cache
+                                                : nullptr;
+    if (value == nullptr) return false;
+    *value = argv[++i];
+    return true;
+  }
+};
+
+// True, after a "skipped" line, when the data folder is missing: the bench then exits 0 (its
+// ctest smoke run is given a folder that does not exist).
+inline bool skippedWithoutData(const std::string& dataRoot) {
+  if (std::filesystem::is_directory(dataRoot)) return false;
+  std::printf("skipped: no data folder %s\n", dataRoot.c_str());
+  return true;
+}
+
+// True, after a "skipped" line, when no labelled roof could be run (every pair's images absent).
+inline bool skippedWithoutRoofs(int runs, const std::string& dataRoot) {
+  if (runs > 0) return false;
+  std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
+  return true;
+}
+
+inline nlohmann::json readLabels(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+// The set of a labelled roof: "held-out" when marked "heldOut" (not used to choose the methods or
+// their defaults, see data/README.md), else "tuning".
+inline std::string roofSet(const nlohmann::json& roof) {
+  return roof.value("heldOut", false) ? "held-out" : "tuning";
+}
+
+// The operator's rough rectangle around a labelled outline: its bounding box grown by `grow` px
+// on every side, clipped to an image of `size`.
+inline core::Polygon grownBox(const core::Polygon& outline, double grow, cv::Size size) {
+  const cv::Rect2d box = core::boundingBox(outline.outer);
+  const double x0 = std::max(0.0, box.x - grow), y0 = std::max(0.0, box.y - grow);
+  const double x1 = std::min<double>(size.width, box.x + box.width + grow);
+  const double y1 = std::min<double>(size.height, box.y + box.height + grow);
+  core::Polygon rect;
+  rect.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  return rect;
+}
+
 inline core::Polygon ringOf(const nlohmann::json& points) {
   core::Polygon p;
   for (const auto& v : points) p.outer.emplace_back(v.at(0).get<double>(), v.at(1).get<double>());
   return p;
-}
-
-inline std::filesystem::path defaultDisparityCache() {
-  return std::filesystem::temp_directory_path() / "delineo_bench_disparity";
 }
 
 // A digest of the running executable: the cached maps are those of this very build of the
