@@ -15,8 +15,8 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -167,6 +167,32 @@ double medianIn(const cv::Mat& values, const cv::Mat& mask) {
   return v[v.size() / 2];
 }
 
+// Disparities by class: ground interval blue, roof interval green, between them yellow, above the
+// roof red, below the ground magenta, none black.
+cv::Mat disparityClasses(const cv::Mat& d, const delineation::DisparityInterval& ground,
+                         const delineation::DisparityInterval& roof) {
+  cv::Mat out(d.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int y = 0; y < d.rows; ++y) {
+    for (int x = 0; x < d.cols; ++x) {
+      const float v = d.at<float>(y, x);
+      if (!std::isfinite(v)) continue;
+      cv::Vec3b c;
+      if (v < ground.min - 0.5f)
+        c = {255, 0, 255};
+      else if (v <= ground.max + 0.5f)
+        c = {255, 80, 0};
+      else if (v < roof.min - 0.5f)
+        c = {0, 220, 255};
+      else if (v <= roof.max + 0.5f)
+        c = {0, 200, 0};
+      else
+        c = {0, 0, 255};
+      out.at<cv::Vec3b>(y, x) = c;
+    }
+  }
+  return out;
+}
+
 // --diag: the energy of the labelled outline against the delineated one on the same prepared
 // energy, term by term, the estimated intervals against the roof's ground reference, and where
 // they differ (energy_diag.hpp). With --dump, DIR/<roof>_diag.png: the left image, the label
@@ -208,25 +234,8 @@ void diagnoseRoof(const std::string& name, const cv::Mat& left, const cv::Mat& r
                                                           : pe.images.uncappedDifference) > 0;
   cv::cvtColor(better, better, cv::COLOR_GRAY2BGR);
   better.setTo(cv::Scalar(0, 0, 160), pe.excluded);
-  // The matcher's disparities and the cost service's argmin by class: ground interval blue, roof
-  // interval green, between them yellow, above the roof red, below the ground magenta, none black.
-  auto classes = [&](const cv::Mat& d) {
-    cv::Mat out(d.size(), CV_8UC3, cv::Scalar(0, 0, 0));
-    for (int y = 0; y < d.rows; ++y) {
-      for (int x = 0; x < d.cols; ++x) {
-        const float v = d.at<float>(y, x);
-        if (!std::isfinite(v)) continue;
-        cv::Vec3b c;
-        if (v < pe.ground.min - 0.5f) c = {255, 0, 255};
-        else if (v <= pe.ground.max + 0.5f) c = {255, 80, 0};
-        else if (v < request.roof.min - 0.5f) c = {0, 220, 255};
-        else if (v <= request.roof.max + 0.5f) c = {0, 200, 0};
-        else c = {0, 0, 255};
-        out.at<cv::Vec3b>(y, x) = c;
-      }
-    }
-    return out;
-  };
+  // The matcher's disparities and the cost service's argmin by class.
+  auto classes = [&](const cv::Mat& d) { return disparityClasses(d, pe.ground, request.roof); };
   cv::Mat wta;
   costs->bestDisparity().convertTo(wta, CV_32F);
   wta.setTo(std::nanf(""), costs->bestCost() > pe.images.noMatchCost);
@@ -258,242 +267,297 @@ void diagnoseRoof(const std::string& name, const cv::Mat& left, const cv::Mat& r
   }
   bench::writeImage((fs::path(dumpDir) / (name + "_diag.png")).string(), both);
 }
-}  // namespace
 
-int main(int argc, char** argv) {
-  core::tuneAllocatorForLargeImages();
-  std::string dataRoot = "/work/shared/data";
-  std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = bench::defaultDisparityCache().string();
-  std::string dumpDir, montagePath;
-  std::vector<std::pair<std::string, cv::Mat>> panels;
-  int grow = 30;
+// "2,4,6.5" -> {2, 4, 6.5}; stops at the first item that is not a number.
+std::vector<double> numbersOf(const char* list) {
+  std::vector<double> out;
+  for (const char* p = list; *p;) {
+    char* end = nullptr;
+    const double value = std::strtod(p, &end);
+    if (end == p) break;
+    out.push_back(value);
+    p = *end == ',' ? end + 1 : end;
+  }
+  return out;
+}
+
+struct Options {
+  bench::RealRoofsOptions data;
+  std::string dumpDir;      // --dump DIR: a picture of each roof's outlines (and of --diag)
+  std::string montagePath;  // --montage FILE: every roof's picture in one
+  int grow = 30;            // --grow PX: the rectangle is the labelled outline's box grown by PX
   // --ground: the request's ground interval: "estimated" (none given: the active polygon's own
-  // estimate), "proposed" (estimateGroundLevel on the matcher's map ± ground-tolerance) or
-  // "reference" (the labelled ground reference's median ± ground-tolerance, an upper bound).
+  // estimate), "proposed" (estimateGroundLevel on the matcher's map ± ground-tolerance),
+  // "reference" (the labelled ground reference's median ± ground-tolerance, an upper bound) or
+  // "below" (the search range's low end to just under the roof interval).
   std::string groundMode = "estimated";
   bool diag = false;  // --diag: energy of the labelled outline vs the delineated one
   std::vector<double> tolerances;  // --tolerances A,B,...: the raw outline regularized at each too
+};
+
+// The options, or nothing after the usage line when they are wrong.
+std::optional<Options> parseOptions(int argc, char** argv) {
+  Options o;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
-      dataRoot = argv[++i];
-    } else if (!std::strcmp(argv[i], "--labels") && i + 1 < argc) {
-      labels = argv[++i];
-    } else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) {
-      cache = argv[++i];
-    } else if (!std::strcmp(argv[i], "--dump") && i + 1 < argc) {
-      dumpDir = argv[++i];
-    } else if (!std::strcmp(argv[i], "--montage") && i + 1 < argc) {
-      montagePath = argv[++i];
-    } else if (!std::strcmp(argv[i], "--grow") && i + 1 < argc) {
-      grow = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--ground") && i + 1 < argc) {
-      groundMode = argv[++i];
+    if (o.data.take(argc, argv, i)) continue;
+    const bool valued = i + 1 < argc;
+    if (!std::strcmp(argv[i], "--dump") && valued) {
+      o.dumpDir = argv[++i];
+    } else if (!std::strcmp(argv[i], "--montage") && valued) {
+      o.montagePath = argv[++i];
+    } else if (!std::strcmp(argv[i], "--grow") && valued) {
+      o.grow = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--ground") && valued) {
+      o.groundMode = argv[++i];
     } else if (!std::strcmp(argv[i], "--diag")) {
-      diag = true;
-    } else if (!std::strcmp(argv[i], "--tolerances") && i + 1 < argc) {
-      for (const char* p = argv[++i]; *p;) {
-        char* end = nullptr;
-        tolerances.push_back(std::strtod(p, &end));
-        p = *end == ',' ? end + 1 : end;
-      }
+      o.diag = true;
+    } else if (!std::strcmp(argv[i], "--tolerances") && valued) {
+      o.tolerances = numbersOf(argv[++i]);
     } else {
       std::fprintf(
           stderr,
           "usage: bench_real_outlines [--data DIR] [--labels real_roofs.json] [--cache DIR] "
-          "[--grow PX] [--tolerances A,B,...] [--dump DIR] [--montage FILE.png] [--diag] [--ground estimated|proposed|reference]\n");
-      return 2;
+          "[--grow PX] [--tolerances A,B,...] [--dump DIR] [--montage FILE.png] [--diag] "
+          "[--ground estimated|proposed|reference]\n");
+      return std::nullopt;
     }
   }
-  if (!fs::is_directory(dataRoot)) {
-    std::printf("skipped: no data folder %s\n", dataRoot.c_str());
-    return 0;
+  return o;
+}
+
+// The request from the rectangle: the proposed roof interval, the pair's search range and
+// matcher's map (BENCH_NO_MAP=1: none), and the ground interval of --ground.
+delineation::DelineationRequest requestFor(const nlohmann::json& roof, const bench::RealPair& pair,
+                                           const core::Polygon& rect,
+                                           const delineation::RoofIntervalProposal& proposal,
+                                           const std::string& groundMode, int groundTolerance) {
+  const cv::Mat& map = pair.disparity;
+  delineation::DelineationRequest request;
+  request.init = rect;
+  request.roof = {proposal.low, proposal.high};
+  request.searchRange = delineation::DisparityInterval{pair.dmin, pair.dmax};
+  if (!std::getenv("BENCH_NO_MAP")) request.disparity = map;
+  if (groundMode == "below") {
+    request.ground = delineation::DisparityInterval{pair.dmin, proposal.low - 2};
+  } else if (groundMode != "estimated") {
+    const double level =
+        groundMode == "reference"
+            ? medianIn(map, core::rasterize(bench::ringOf(roof.at("ground")), map.size()))
+            : delineation::estimateGroundLevel(map, rect);
+    const int g = static_cast<int>(std::lround(level));
+    request.ground = delineation::DisparityInterval{
+        g - groundTolerance, std::min(g + groundTolerance, proposal.low - 1)};
   }
+  return request;
+}
+
+// BENCH_DUMP_OUTLINES=FILE: one JSON line per roof, the raw outline and the regularization
+// stage's own result (before the energy gate), to check that a change of the stage leaves its
+// results as they were.
+void dumpOutlines(const std::string& name, const delineation::DelineationResult& r,
+                  const delineation::DelineationParams& params, const cv::Mat& left) {
+  const char* path = std::getenv("BENCH_DUMP_OUTLINES");
+  if (!path) return;
+  const auto stage = delineation::regularizeOutline(r.rawPolygon, params.regularization, left);
+  bench::appendJsonLine(path, {{"roof", name},
+                               {"raw", bench::ringsJson(r.rawPolygon)},
+                               {"regularized", bench::ringsJson(stage.polygon)},
+                               {"status", delineation::toString(stage.status)},
+                               {"reason", stage.reason}});
+}
+
+// The regularization stage's outline part (without the energy gate) on the raw outline: CPU time
+// of this thread in ms, best of 3 (the machine may be shared; BENCH_REG_REPS=N repeats it N
+// times, for a profiler). It is run as the stage ran: at the tolerance, then half and a quarter
+// of it down to the one it kept (all three when it kept the raw outline).
+double regularizationMs(const delineation::DelineationResult& r,
+                        const delineation::DelineationParams& params, const cv::Mat& left) {
+  const char* repsText = std::getenv("BENCH_REG_REPS");
+  const int reps = repsText ? std::max(1, std::atoi(repsText)) : 3;
+  const bool kept = r.regularization.status == delineation::RegularizationStatus::Regularized;
+  double ms = 1e300;
+  for (int rep = 0; rep < reps; ++rep) {
+    delineation::RegularizationParams tried = params.regularization;
+    const double t0 = cpuMs();
+    for (int k = 0; k < 3; ++k, tried.tolerance /= 2) {
+      (void)delineation::regularizeOutline(r.rawPolygon, tried, left);
+      if (kept && tried.tolerance <= r.regularization.tolerance) break;
+    }
+    ms = std::min(ms, cpuMs() - t0);
+  }
+  return ms;
+}
+
+// The same raw outline through the public entry point (outline + energy gate) at each tolerance
+// of --tolerances: a line each, and its IoU and vertex count under `tolIou` and `tolVertices`.
+void regularizeAtTolerances(const std::vector<double>& tolerances, const bench::RealPair& pair,
+                            const delineation::DelineationRequest& request,
+                            const delineation::DelineationParams& params,
+                            const delineation::DelineationResult& r, const core::Polygon& truth,
+                            std::map<double, std::vector<double>>& tolIou,
+                            std::map<double, std::vector<double>>& tolVertices) {
+  const cv::Size size = pair.disparity.size();
+  for (double t : tolerances) {
+    delineation::DelineationParams other = params;
+    other.regularization.tolerance = t;
+    const auto g =
+        delineation::regularizeBuildingOutline(pair.left, pair.right, request, other, r.rawPolygon);
+    std::printf("    tolerance %4.1f px: IoU %.3f, %3d vertices, %s%s%s\n", t,
+                iou(g.polygon, truth, size), g.outputVertices,
+                delineation::toString(g.status).c_str(), g.reason.empty() ? "" : ": ",
+                g.reason.c_str());
+    tolIou[t].push_back(iou(g.polygon, truth, size));
+    tolVertices[t].push_back(g.outputVertices);
+  }
+}
+
+// BENCH_VERBOSE: the vertices of the raw and of the regularized outline (the stage's own
+// result, before the energy gate).
+void printVertices(const delineation::DelineationResult& r,
+                   const delineation::DelineationParams& params, const cv::Mat& left) {
+  const auto g = delineation::regularizeOutline(r.rawPolygon, params.regularization, left);
+  for (const auto& [label, poly] :
+       {std::pair{"raw", r.rawPolygon}, std::pair{"regularized", g.polygon}}) {
+    std::printf("    %s:", label);
+    for (const auto& v : poly.outer) std::printf(" (%.1f,%.1f)", v.x, v.y);
+    for (const auto& h : poly.holes) {
+      std::printf(" hole");
+      for (const auto& v : h) std::printf(" (%.1f,%.1f)", v.x, v.y);
+    }
+    std::printf("\n");
+  }
+}
+
+// The scores of one set of roofs (bench::roofSet).
+struct SetScores {
+  std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV;
+  int regularized = 0;
+};
+
+// What the summary needs of every roof run.
+struct Totals {
+  std::map<std::string, SetScores> sets;
+  std::vector<double> regMs;
+  std::map<double, std::vector<double>> tolIou, tolVertices;
+  std::vector<std::pair<std::string, cv::Mat>> panels;  // for --montage
+  int runs = 0;
+};
+
+// One roof's outlines from the rectangle: its row, the extra lines of --tolerances, --diag and
+// BENCH_VERBOSE, its scores in `totals` and its picture (--dump, --montage).
+void runRoof(const nlohmann::json& roof, const bench::RealPair& pair, const Options& options,
+             const delineation::DelineationParams& params, Totals& totals) {
+  const std::string name = roof.at("name");
+  const cv::Mat& map = pair.disparity;
+  const core::Polygon truth = bench::ringOf(roof.at("outline"));
+  const core::Polygon rect = bench::grownBox(truth, options.grow, map.size());
+  const auto proposal =
+      delineation::proposeRoofInterval(map, rect, delineation::RoofIntervalParams{});
+  if (!proposal.found) {
+    std::printf("%-18s no roof interval proposed\n", name.c_str());
+    return;
+  }
+  const core::Polygon naive = naiveOutline(map, rect, proposal.low, proposal.high);
+  const delineation::DelineationRequest request =
+      requestFor(roof, pair, rect, proposal, options.groundMode, params.groundTolerance);
+  try {
+    const auto r = delineation::delineate(pair.left, pair.right, request, params);
+    dumpOutlines(name, r, params, pair.left);
+    const double ms = regularizationMs(r, params, pair.left);
+    const double ni = naive.outer.empty() ? 0.0 : iou(naive, truth, map.size());
+    const double ri = iou(r.rawPolygon, truth, map.size()), gi = iou(r.polygon, truth, map.size());
+    std::printf(
+        "%-18s [%3d,%3d] | %6.3f %5d | %6.3f %5d | %6.3f %5d | %6.2f ms %s%s%s (dF %+.1f, %.1f "
+        "deg)\n",
+        name.c_str(), proposal.low, proposal.high, ni, vertices(naive), ri, vertices(r.rawPolygon),
+        gi, r.vertexCount, ms, delineation::toString(r.regularization.status).c_str(),
+        r.regularization.reason.empty() ? "" : ": ", r.regularization.reason.c_str(),
+        r.regularization.energyChange, r.regularization.orientationDeg);
+    regularizeAtTolerances(options.tolerances, pair, request, params, r, truth, totals.tolIou,
+                           totals.tolVertices);
+    if (options.diag) {
+      diagnoseRoof(name, pair.left, pair.right, map, request, params, r, truth,
+                   bench::ringOf(roof.at("ground")), options.dumpDir);
+    }
+    if (std::getenv("BENCH_VERBOSE")) printVertices(r, params, pair.left);
+    SetScores& set = totals.sets[bench::roofSet(roof)];
+    set.naiveIou.push_back(ni), set.rawIou.push_back(ri), set.regIou.push_back(gi);
+    set.naiveV.push_back(vertices(naive)), set.rawV.push_back(vertices(r.rawPolygon));
+    set.regV.push_back(r.vertexCount);
+    set.regularized += r.regularization.status == delineation::RegularizationStatus::Regularized;
+    totals.regMs.push_back(ms);
+    ++totals.runs;
+    if (options.dumpDir.empty() && options.montagePath.empty()) return;
+    const cv::Point2d from = rect.outer[0], to = rect.outer[2];
+    const cv::Mat panel =
+        drawOutlines(pair.left,
+                     cv::Rect(static_cast<int>(from.x), static_cast<int>(from.y),
+                              static_cast<int>(to.x - from.x), static_cast<int>(to.y - from.y)),
+                     {{rect, {255, 80, 0}},
+                      {truth, {0, 200, 0}},
+                      {naive, {255, 255, 0}},
+                      {r.rawPolygon, {0, 220, 255}},
+                      {r.polygon, {0, 0, 255}}});
+    if (!options.dumpDir.empty()) {
+      bench::writeImage((fs::path(options.dumpDir) / (name + ".png")).string(), panel);
+    }
+    totals.panels.emplace_back(name, panel);
+  } catch (const core::Error& e) {
+    std::printf("%-18s failed: %s\n", name.c_str(), e.what());
+  }
+}
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? std::nan("") : s / static_cast<double>(v.size());
+}
+
+// The means and medians of each set, the montage, the regularization's time and the scores at
+// each tolerance of --tolerances.
+void printSummary(const Totals& totals, const Options& options) {
+  for (const auto& [name, set] : totals.sets) {
+    std::printf(
+        "\n%s, %zu roofs (rectangle = labelled box + %d px): mean IoU naive %.3f, raw %.3f, "
+        "regularized %.3f; median vertices naive %.0f, raw %.0f, regularized %.0f; %d "
+        "regularized",
+        name.c_str(), set.rawIou.size(), options.grow, mean(set.naiveIou), mean(set.rawIou),
+        mean(set.regIou), median(set.naiveV), median(set.rawV), median(set.regV), set.regularized);
+  }
+  if (!options.montagePath.empty()) {
+    bench::writeImage(options.montagePath, montage(totals.panels, 260, 5));
+    std::printf("\nwrote %s\n", options.montagePath.c_str());
+  }
+  std::printf("\nregularization time median %.2f ms, max %.2f ms\n", median(totals.regMs),
+              *std::max_element(totals.regMs.begin(), totals.regMs.end()));
+  for (const auto& [t, v] : totals.tolIou) {
+    std::printf("  tolerance %4.1f px: mean IoU %.3f, median vertices %.0f\n", t, mean(v),
+                median(totals.tolVertices.at(t)));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  core::tuneAllocatorForLargeImages();
+  const std::optional<Options> options = parseOptions(argc, argv);
+  if (!options) return 2;
+  if (bench::skippedWithoutData(options->data.dataRoot)) return 0;
   delineation::DelineationParams params;
   if (const char* json = std::getenv("BENCH_PARAMS"))
     core::fromJson(params, nlohmann::json::parse(json));
-  std::ifstream in(labels);
-  const nlohmann::json data = nlohmann::json::parse(in);
+  const nlohmann::json data = bench::readLabels(options->data.labels);
   std::printf("%-18s %-9s | %-13s | %-13s | %-13s | %-11s %s\n", "roof", "interval", "naive IoU/v",
               "raw IoU/v", "regular. IoU/v", "reg ms", "regularization");
-  bench::RealPairs pairs(data, dataRoot, cache);
-  // Per set: the tuning roofs and the held-out ones (marked "heldOut", labelled afterwards).
-  struct Set {
-    std::vector<double> naiveIou, rawIou, regIou, naiveV, rawV, regV;
-    int regularized = 0;
-  };
-  std::map<std::string, Set> sets;
-  std::vector<double> regMs;
-  std::map<double, std::vector<double>> tolIou, tolVertices;
-  int runs = 0;
+  bench::RealPairs pairs(data, options->data.dataRoot, options->data.cache);
+  Totals totals;
   for (const auto& roof : data.at("roofs")) {
-    const std::string name = roof.at("name"), pairName = roof.at("pair");
+    const std::string name = roof.at("name");
     if (const char* only = std::getenv("BENCH_ONLY"); only && name != only) continue;
-    const bench::RealPair* pair = pairs.get(pairName);
-    if (!pair) continue;
-    const int dmin = pair->dmin, dmax = pair->dmax;
-    const cv::Mat& map = pair->disparity;
-    const core::Polygon truth = bench::ringOf(roof.at("outline"));
-    const cv::Rect2d box = core::boundingBox(truth.outer);
-    const double x0 = std::max(0.0, box.x - grow), y0 = std::max(0.0, box.y - grow);
-    const double x1 = std::min<double>(map.cols, box.x + box.width + grow);
-    const double y1 = std::min<double>(map.rows, box.y + box.height + grow);
-    core::Polygon rect;
-    rect.outer = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-    const auto proposal =
-        delineation::proposeRoofInterval(map, rect, delineation::RoofIntervalParams{});
-    if (!proposal.found) {
-      std::printf("%-18s no roof interval proposed\n", name.c_str());
-      continue;
-    }
-    const core::Polygon naive = naiveOutline(map, rect, proposal.low, proposal.high);
-    delineation::DelineationRequest request;
-    request.init = rect;
-    request.roof = {proposal.low, proposal.high};
-    request.searchRange = delineation::DisparityInterval{dmin, dmax};
-    if (!std::getenv("BENCH_NO_MAP")) request.disparity = map;
-    if (groundMode == "below") {
-      request.ground = delineation::DisparityInterval{dmin, proposal.low - 2};
-    } else if (groundMode != "estimated") {
-      const double level =
-          groundMode == "reference"
-              ? medianIn(map, core::rasterize(bench::ringOf(roof.at("ground")), map.size()))
-              : delineation::estimateGroundLevel(map, rect);
-      const int g = static_cast<int>(std::lround(level)), t = params.groundTolerance;
-      request.ground = delineation::DisparityInterval{g - t, std::min(g + t, proposal.low - 1)};
-    }
-    try {
-      const auto r = delineation::delineate(pair->left, pair->right, request, params);
-      // The stage's outline part (without the energy gate), CPU time of this thread, best of 3
-      // (the machine may be shared; BENCH_REG_REPS=N repeats it N times, for a profiler).
-      double ms = 1e300;
-      if (const char* path = std::getenv("BENCH_DUMP_OUTLINES")) {
-        // One JSON line per roof: the raw outline and the stage's own result (before the
-        // energy gate), to check that a change of the stage leaves its results as they were.
-        auto rings = [](const core::Polygon& p) {
-          nlohmann::json out = nlohmann::json::array();
-          std::vector<const core::Ring*> all{&p.outer};
-          for (const auto& h : p.holes) all.push_back(&h);
-          for (const core::Ring* ring0 : all) {
-            nlohmann::json ring = nlohmann::json::array();
-            for (const auto& v : *ring0) ring.push_back({v.x, v.y});
-            out.push_back(ring);
-          }
-          return out;
-        };
-        const auto stage = delineation::regularizeOutline(r.rawPolygon, params.regularization, pair->left);
-        const nlohmann::json line{{"roof", name}, {"raw", rings(r.rawPolygon)}, {"regularized", rings(stage.polygon)},
-                                  {"status", delineation::toString(stage.status)}, {"reason", stage.reason}};
-        if (FILE* f = std::fopen(path, "a")) {
-          std::fprintf(f, "%s\n", line.dump().c_str());
-          std::fclose(f);
-        }
-      }
-      const int reps = std::getenv("BENCH_REG_REPS") ? std::max(1, std::atoi(std::getenv("BENCH_REG_REPS"))) : 3;
-      for (int rep = 0; rep < reps; ++rep) {
-        // The tries the stage made: the tolerance, then half and a quarter of it down to the one
-        // it kept (all three when it kept the raw outline).
-        delineation::RegularizationParams tried = params.regularization;
-        const bool kept = r.regularization.status == delineation::RegularizationStatus::Regularized;
-        const double t0 = cpuMs();
-        for (int k = 0; k < 3; ++k, tried.tolerance /= 2) {
-          (void)delineation::regularizeOutline(r.rawPolygon, tried, pair->left);
-          if (kept && tried.tolerance <= r.regularization.tolerance) break;
-        }
-        ms = std::min(ms, cpuMs() - t0);
-      }
-      const cv::Size size = map.size();
-      const double ni = naive.outer.empty() ? 0.0 : iou(naive, truth, size);
-      const double ri = iou(r.rawPolygon, truth, size), gi = iou(r.polygon, truth, size);
-      std::printf(
-          "%-18s [%3d,%3d] | %6.3f %5d | %6.3f %5d | %6.3f %5d | %6.2f ms %s%s%s (dF %+.1f, %.1f "
-          "deg)\n",
-          name.c_str(), proposal.low, proposal.high, ni, vertices(naive), ri,
-          vertices(r.rawPolygon), gi, r.vertexCount, ms,
-          delineation::toString(r.regularization.status).c_str(),
-          r.regularization.reason.empty() ? "" : ": ", r.regularization.reason.c_str(),
-          r.regularization.energyChange, r.regularization.orientationDeg);
-      for (double t : tolerances) {
-        // The same raw outline through the public entry point (outline + energy gate) at tolerance
-        // t.
-        delineation::DelineationParams other = params;
-        other.regularization.tolerance = t;
-        const auto g = delineation::regularizeBuildingOutline(pair->left, pair->right,
-                                                              request, other, r.rawPolygon);
-        std::printf("    tolerance %4.1f px: IoU %.3f, %3d vertices, %s%s%s\n", t,
-                    iou(g.polygon, truth, size), g.outputVertices,
-                    delineation::toString(g.status).c_str(), g.reason.empty() ? "" : ": ",
-                    g.reason.c_str());
-        tolIou[t].push_back(iou(g.polygon, truth, size));
-        tolVertices[t].push_back(g.outputVertices);
-      }
-      if (diag) {
-        diagnoseRoof(name, pair->left, pair->right, map, request, params, r, truth,
-                     bench::ringOf(roof.at("ground")), dumpDir);
-      }
-      if (std::getenv("BENCH_VERBOSE")) {
-        const auto g =
-            delineation::regularizeOutline(r.rawPolygon, params.regularization, pair->left);
-        for (const auto& [label, poly] :
-             {std::pair{"raw", r.rawPolygon}, std::pair{"regularized", g.polygon}}) {
-          std::printf("    %s:", label);
-          for (const auto& v : poly.outer) std::printf(" (%.1f,%.1f)", v.x, v.y);
-          for (const auto& h : poly.holes) {
-            std::printf(" hole");
-            for (const auto& v : h) std::printf(" (%.1f,%.1f)", v.x, v.y);
-          }
-          std::printf("\n");
-        }
-      }
-      Set& set = sets[roof.value("heldOut", false) ? "held-out" : "tuning"];
-      set.naiveIou.push_back(ni), set.rawIou.push_back(ri), set.regIou.push_back(gi);
-      set.naiveV.push_back(vertices(naive)), set.rawV.push_back(vertices(r.rawPolygon)),
-          set.regV.push_back(r.vertexCount);
-      set.regularized += r.regularization.status == delineation::RegularizationStatus::Regularized;
-      regMs.push_back(ms);
-      ++runs;
-      if (!dumpDir.empty() || !montagePath.empty()) {
-        const cv::Mat panel = drawOutlines(pair->left,
-                                           cv::Rect(static_cast<int>(x0), static_cast<int>(y0),
-                                                    static_cast<int>(x1 - x0), static_cast<int>(y1 - y0)),
-                                           {{rect, {255, 80, 0}},
-                                            {truth, {0, 200, 0}},
-                                            {naive, {255, 255, 0}},
-                                            {r.rawPolygon, {0, 220, 255}},
-                                            {r.polygon, {0, 0, 255}}});
-        if (!dumpDir.empty()) {
-          bench::writeImage((fs::path(dumpDir) / (name + ".png")).string(), panel);
-        }
-        panels.emplace_back(name, panel);
-      }
-    } catch (const core::Error& e) {
-      std::printf("%-18s failed: %s\n", name.c_str(), e.what());
-    }
+    const bench::RealPair* pair = pairs.get(roof.at("pair"));
+    if (pair) runRoof(roof, *pair, *options, params, totals);
   }
-  if (runs == 0) {
-    std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
-    return 0;
-  }
-  auto mean = [](const std::vector<double>& v) {
-    double s = 0;
-    for (double x : v) s += x;
-    return v.empty() ? std::nan("") : s / static_cast<double>(v.size());
-  };
-  for (const auto& [name, set] : sets) {
-    std::printf("\n%s, %zu roofs (rectangle = labelled box + %d px): mean IoU naive %.3f, raw %.3f, "
-                "regularized %.3f; median vertices naive %.0f, raw %.0f, regularized %.0f; %d regularized",
-                name.c_str(), set.rawIou.size(), grow, mean(set.naiveIou), mean(set.rawIou),
-                mean(set.regIou), median(set.naiveV), median(set.rawV), median(set.regV), set.regularized);
-  }
-  if (!montagePath.empty()) {
-    bench::writeImage(montagePath, montage(panels, 260, 5));
-    std::printf("\nwrote %s\n", montagePath.c_str());
-  }
-  std::printf("\nregularization time median %.2f ms, max %.2f ms\n", median(regMs),
-              *std::max_element(regMs.begin(), regMs.end()));
-  for (const auto& [t, v] : tolIou) {
-    std::printf("  tolerance %4.1f px: mean IoU %.3f, median vertices %.0f\n", t, mean(v),
-                median(tolVertices[t]));
-  }
+  if (bench::skippedWithoutRoofs(totals.runs, options->data.dataRoot)) return 0;
+  printSummary(totals, *options);
   return 0;
 }
