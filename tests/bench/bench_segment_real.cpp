@@ -3,20 +3,22 @@
 //   - Dublin: above-ground vs the LiDAR disparity on the pixels where the LiDAR has a value;
 //   - every pair: how many hand-labelled roofs (tests/bench/data/real_roofs.json) a proposal
 //     covers, how many of them are alone in their proposal (touching buildings merged into one
-//     proposal share it), and an overlay PNG (building red, vegetation green, proposals yellow) to look at;
+//     proposal share it), and an overlay PNG (building red, vegetation green, proposals yellow) to
+//     look at;
 //   - with --delineate, the whole automatic chain: the active polygon run from every proposal (its
 //     roof interval and ground, the matcher's map), each labelled roof scored by the best IoU of
 //     the outlines.
 // Heights come from the matcher's disparity (cached as in bench_real_outlines) through a linear
 // model; the pairs come without camera data, so metres per pixel of disparity is the stated
-// assumption below. Skips cleanly when the data folder is missing.
+// assumption below. Skips cleanly when the data folder is missing (--data, default
+// /work/shared/data).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -100,21 +102,18 @@ void drawOverlay(const std::string& path, const cv::Mat& bgr, const segmentation
 
 // The active polygon from every proposal; per labelled roof of the pair, the best IoU of the
 // outlines (0 when none overlaps it), and the mean over the roofs reached (IoU >= 0.5).
-void delineateProposals(const std::string& name, const nlohmann::json& pair, const nlohmann::json& roofs,
-                        const fs::path& left, const fs::path& right, const cv::Mat& disparity,
+void delineateProposals(const bench::RealPair& pair, const nlohmann::json& roofs,
                         const std::vector<core::Feature>& proposals) {
-  const cv::Mat l = io::readGreyFloat(left.string()), r = io::readGreyFloat(right.string());
-  const delineation::DisparityInterval range{pair.at("disparity_range").at(0).get<int>(),
-                                             pair.at("disparity_range").at(1).get<int>()};
+  const delineation::DisparityInterval range{pair.dmin, pair.dmax};
   const delineation::DelineationParams params;
   std::vector<core::Polygon> outlines;
   for (const auto& f : proposals) {
     try {
       auto req = delineation::featureRequest(f, params.groundTolerance);
       if (!req) continue;
-      req->disparity = disparity;
+      req->disparity = pair.disparity;
       req->searchRange = range;
-      outlines.push_back(delineation::delineate(l, r, *req, params).polygon);
+      outlines.push_back(delineation::delineate(pair.left, pair.right, *req, params).polygon);
     } catch (const std::exception& e) {
       std::printf("  proposal %.0f failed: %s\n", core::numberProperty(f, "id", 9e15).value_or(-1), e.what());
     }
@@ -124,7 +123,7 @@ void delineateProposals(const std::string& name, const nlohmann::json& pair, con
   std::printf("  automatic outlines (%zu from %zu proposals), best IoU per labelled roof:", outlines.size(),
               proposals.size());
   for (const auto& roof : roofs.at("roofs")) {
-    if (roof.at("pair") != name) continue;
+    if (roof.at("pair") != pair.name) continue;
     const core::Polygon truth = bench::ringOf(roof.at("outline"));
     double best = 0;
     for (const auto& o : outlines) best = std::max(best, eval::intersectionOverUnion(o, truth));
@@ -136,112 +135,155 @@ void delineateProposals(const std::string& name, const nlohmann::json& pair, con
               reached > 0 ? sum / reached : std::nan(""));
 }
 
+struct Options {
+  bench::RealRoofsOptions data;
+  std::string out = "/tmp";  // --out DIR: the overlay PNGs
+  bool delineate = false;    // --delineate: the active polygon from every proposal
+};
+
+// The options, or nothing after the usage line when they are wrong.
+std::optional<Options> parseOptions(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    if (o.data.take(argc, argv, i)) continue;
+    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) {
+      o.out = argv[++i];
+    } else if (!std::strcmp(argv[i], "--delineate")) {
+      o.delineate = true;
+    } else {
+      std::fprintf(stderr,
+                   "usage: bench_segment_real [--data DIR] [--labels real_roofs.json] "
+                   "[--out DIR] [--cache DIR] [--delineate]\n");
+      return std::nullopt;
+    }
+  }
+  return o;
+}
+
+// The defaults, with BENCH_PARAMS='{"segment": {...}, "classify": {...}, "objects": {...},
+// "detect": {...}}' overrides.
+segmentation::SceneParams sceneParams() {
+  segmentation::SceneParams params;
+  const char* text = std::getenv("BENCH_PARAMS");
+  if (!text) return params;
+  const nlohmann::json j = nlohmann::json::parse(text);
+  if (j.contains("segment")) core::fromJson(params.ground, j.at("segment"));
+  if (j.contains("classify")) core::fromJson(params.classify, j.at("classify"));
+  if (j.contains("objects")) core::fromJson(params.objects, j.at("objects"));
+  if (j.contains("detect")) core::fromJson(params.detect, j.at("detect"));
+  return params;
+}
+
+// Heights from the matcher's map: its median is the zero, `metresPerPixel` the scale (NaN stays
+// NaN).
+cv::Mat demOf(const cv::Mat& disparity, double metresPerPixel) {
+  std::vector<float> finite;
+  for (auto it = disparity.begin<float>(); it != disparity.end<float>(); ++it) {
+    if (std::isfinite(*it)) finite.push_back(*it);
+  }
+  const double base = percentile(finite, 0.5);
+  return (disparity - base) * metresPerPixel;
+}
+
+// The pair's labelled roofs against the proposals: a roof is proposed when one proposal holds at
+// least half of it, and alone when its proposal holds no other proposed roof. Returns the mask of
+// all the pair's labelled roofs.
+cv::Mat scoreLabelledRoofs(const std::string& pairName, const nlohmann::json& roofs,
+                           const std::vector<core::Feature>& proposals, cv::Size size) {
+  int labelled = 0, covered = 0;
+  cv::Mat allRoofs(size, CV_8U, cv::Scalar(0));
+  std::vector<cv::Mat> proposalMasks;
+  for (const auto& f : proposals) proposalMasks.push_back(core::rasterize(f.polygon, size));
+  std::vector<int> holder;  // per covered roof, the proposal holding it
+  std::vector<std::string> holderRoof;
+  for (const auto& roof : roofs.at("roofs")) {
+    if (roof.at("pair") != pairName) continue;
+    const cv::Mat r = core::rasterize(bench::ringOf(roof.at("outline")), size);
+    allRoofs |= r;
+    double best = 0;
+    int bestProposal = -1;
+    for (size_t k = 0; k < proposalMasks.size(); ++k) {
+      const double cover =
+          cv::countNonZero(r & proposalMasks[k]) / std::max(1.0, double(cv::countNonZero(r)));
+      if (cover > best) best = cover, bestProposal = static_cast<int>(k);
+    }
+    const std::string name = roof.at("name");
+    ++labelled, covered += best >= 0.5;
+    if (best >= 0.5) holder.push_back(bestProposal), holderRoof.push_back(name);
+    if (best < 0.5) std::printf("  roof %s not proposed (best cover %.2f)\n", name.c_str(), best);
+  }
+  int alone = 0;
+  for (size_t i = 0; i < holder.size(); ++i) {
+    const long sharing = std::count(holder.begin(), holder.end(), holder[i]);
+    alone += sharing == 1;
+    if (sharing > 1)
+      std::printf("  roof %s shares proposal %d with %ld other roof(s)\n", holderRoof[i].c_str(),
+                  holder[i], sharing - 1);
+  }
+  std::printf("  hand-labelled roofs proposed: %d of %d\n", covered, labelled);
+  std::printf("  roofs alone in their proposal: %d of %d\n", alone, labelled);
+  return allRoofs;
+}
+
+// The scene analysis of one pair on its DEM from the matcher's map: its summary line, the
+// labelled roofs proposed, the above-ground share on and off them, the LiDAR check (Dublin), the
+// automatic outlines (--delineate) and the overlay picture.
+void runPair(const bench::RealPair& pair, const nlohmann::json& pairFiles,
+             const nlohmann::json& roofs, const Options& options,
+             const segmentation::SceneParams& params) {
+  const PairModel model = modelOf(pair.name);
+  const cv::Mat dem = demOf(pair.disparity, model.metresPerPixel);
+  const cv::Mat image = io::readImage8(pair.leftPath);
+  const auto t0 = cv::getTickCount();
+  const segmentation::SceneAnalysis a =
+      segmentation::analyseScene(dem, image, model.gsd, params, pair.disparity);
+  const double ms = 1e3 * double(cv::getTickCount() - t0) / cv::getTickFrequency();
+  int buildings = 0;
+  for (const auto& o : a.detection.objects.objects)
+    buildings += o.cls == segmentation::kClassBuilding;
+  std::printf(
+      "%s (%.2f m/px of disparity, gsd %.3f m): %d regions, %d rounds, above ground %.1f %%, %d "
+      "building "
+      "and %zu vegetation objects, %zu proposals, %.0f ms\n",
+      pair.name.c_str(), model.metresPerPixel, model.gsd, a.ground.regionCount, a.ground.iterations,
+      100.0 * cv::countNonZero(a.ground.aboveGround) / double(dem.total()), buildings,
+      a.detection.objects.objects.size() - static_cast<size_t>(buildings),
+      a.detection.proposals.size(), ms);
+  const cv::Mat allRoofs = scoreLabelledRoofs(pair.name, roofs, a.detection.proposals, dem.size());
+  // Above-ground outside every labelled roof (shaded streets, alleys, trees, facades, and any
+  // building left unlabelled) against the labelled roofs' pixels found above-ground.
+  const cv::Mat above = a.ground.aboveGround != 0;
+  std::printf(
+      "  above-ground: %.1f %% of the labelled roofs' pixels; outside them %.1f %% of the tile\n",
+      100.0 * cv::countNonZero(above & allRoofs) / std::max(1, cv::countNonZero(allRoofs)),
+      100.0 * cv::countNonZero(above & ~allRoofs) / double(dem.total()));
+  if (pairFiles.contains("ground_truth_disparity")) {
+    const fs::path gt =
+        fs::path(options.data.dataRoot) / pairFiles.at("ground_truth_disparity").get<std::string>();
+    if (fs::exists(gt))
+      scoreAgainstLidar(gt.string(), a.ground.aboveGround, dem == dem, 2.0 / model.metresPerPixel);
+  }
+  if (options.delineate) delineateProposals(pair, roofs, a.detection.proposals);
+  const std::string png = (fs::path(options.out) / ("scene_" + pair.name + ".png")).string();
+  cv::Mat bgr = image;
+  if (bgr.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  drawOverlay(png, bgr, a);
+  std::printf("  overlay %s\n", png.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
-  std::string data = "../shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json", out = "/tmp";
-  std::string cache = bench::defaultDisparityCache().string();
-  bool delineate = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) data = argv[++i];
-    else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-    else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
-    else if (!std::strcmp(argv[i], "--delineate")) delineate = true;
-    else {
-      std::fprintf(stderr, "usage: bench_segment_real [--data DIR] [--out DIR] [--cache DIR] [--delineate]\n");
-      return 2;
-    }
-  }
-  if (!fs::exists(data)) {
-    std::printf("skipped: data folder %s missing\n", data.c_str());
-    return 0;
-  }
-  const nlohmann::json roofs = nlohmann::json::parse(std::ifstream(labels));
-  // BENCH_PARAMS='{"segment": {...}, "classify": {...}, "objects": {...}, "detect": {...}}' overrides.
-  segmentation::SceneParams params;
-  if (const char* text = std::getenv("BENCH_PARAMS")) {
-    const nlohmann::json j = nlohmann::json::parse(text);
-    if (j.contains("segment")) core::fromJson(params.ground, j.at("segment"));
-    if (j.contains("classify")) core::fromJson(params.classify, j.at("classify"));
-    if (j.contains("objects")) core::fromJson(params.objects, j.at("objects"));
-    if (j.contains("detect")) core::fromJson(params.detect, j.at("detect"));
-  }
-  for (const auto& [name, pair] : roofs.at("pairs").items()) {
-    const fs::path left = fs::path(data) / pair.at("left").get<std::string>();
-    const fs::path right = fs::path(data) / pair.at("right").get<std::string>();
-    if (!fs::exists(left) || !fs::exists(right)) {
-      std::printf("%s: skipped, %s missing\n", name.c_str(), left.string().c_str());
-      continue;
-    }
-    const cv::Mat disparity = bench::disparityFor(name, left.string(), right.string(), pair.at("disparity_range").at(0),
-                                                  pair.at("disparity_range").at(1), cache);
-    const PairModel model = modelOf(name);
-    std::vector<float> finite;
-    for (auto it = disparity.begin<float>(); it != disparity.end<float>(); ++it) {
-      if (std::isfinite(*it)) finite.push_back(*it);
-    }
-    const double base = percentile(finite, 0.5);
-    const cv::Mat dem = (disparity - base) * model.metresPerPixel;  // NaN stays NaN
-    const cv::Mat image = io::readImage8(left.string());
-    const auto t0 = cv::getTickCount();
-    const segmentation::SceneAnalysis a =
-        segmentation::analyseScene(dem, image, model.gsd, params, disparity);
-    const double ms = 1e3 * double(cv::getTickCount() - t0) / cv::getTickFrequency();
-    int buildings = 0;
-    for (const auto& o : a.detection.objects.objects) buildings += o.cls == segmentation::kClassBuilding;
-    std::printf("%s (%.2f m/px of disparity, gsd %.3f m): %d regions, %d rounds, above ground %.1f %%, %d building "
-                "and %zu vegetation objects, %zu proposals, %.0f ms\n",
-                name.c_str(), model.metresPerPixel, model.gsd, a.ground.regionCount, a.ground.iterations,
-                100.0 * cv::countNonZero(a.ground.aboveGround) / double(dem.total()), buildings,
-                a.detection.objects.objects.size() - static_cast<size_t>(buildings), a.detection.proposals.size(), ms);
-    // Hand-labelled roofs: covered when one proposal holds at least half of the roof.
-    // Merges: the proposal holding a covered roof is shared when it holds another covered roof.
-    int labelled = 0, covered = 0;
-    cv::Mat allRoofs(dem.size(), CV_8U, cv::Scalar(0));
-    std::vector<cv::Mat> proposalMasks;
-    for (const auto& f : a.detection.proposals) proposalMasks.push_back(core::rasterize(f.polygon, dem.size()));
-    std::vector<int> holder;  // per covered roof, the proposal holding it
-    std::vector<std::string> holderRoof;
-    for (const auto& roof : roofs.at("roofs")) {
-      if (roof.at("pair") != name) continue;
-      const cv::Mat r = core::rasterize(bench::ringOf(roof.at("outline")), dem.size());
-      allRoofs |= r;
-      double best = 0;
-      int bestProposal = -1;
-      for (size_t k = 0; k < proposalMasks.size(); ++k) {
-        const double cover = cv::countNonZero(r & proposalMasks[k]) / std::max(1.0, double(cv::countNonZero(r)));
-        if (cover > best) best = cover, bestProposal = static_cast<int>(k);
-      }
-      ++labelled, covered += best >= 0.5;
-      if (best >= 0.5) holder.push_back(bestProposal), holderRoof.push_back(roof.at("name").get<std::string>());
-      if (best < 0.5) std::printf("  roof %s not proposed (best cover %.2f)\n", roof.at("name").get<std::string>().c_str(), best);
-    }
-    int alone = 0;
-    for (size_t i = 0; i < holder.size(); ++i) {
-      const long sharing = std::count(holder.begin(), holder.end(), holder[i]);
-      alone += sharing == 1;
-      if (sharing > 1) std::printf("  roof %s shares proposal %d with %ld other roof(s)\n", holderRoof[i].c_str(),
-                                   holder[i], sharing - 1);
-    }
-    std::printf("  hand-labelled roofs proposed: %d of %d\n", covered, labelled);
-    std::printf("  roofs alone in their proposal: %d of %d\n", alone, labelled);
-    // Above-ground outside every labelled roof (shaded streets, alleys, trees, facades, and any
-    // building left unlabelled) against the labelled roofs' pixels found above-ground.
-    const cv::Mat above = a.ground.aboveGround != 0;
-    std::printf("  above-ground: %.1f %% of the labelled roofs' pixels; outside them %.1f %% of the tile\n",
-                100.0 * cv::countNonZero(above & allRoofs) / std::max(1, cv::countNonZero(allRoofs)),
-                100.0 * cv::countNonZero(above & ~allRoofs) / double(dem.total()));
-    if (pair.contains("ground_truth_disparity")) {
-      const fs::path gt = fs::path(data) / pair.at("ground_truth_disparity").get<std::string>();
-      if (fs::exists(gt)) scoreAgainstLidar(gt.string(), a.ground.aboveGround, dem == dem, 2.0 / model.metresPerPixel);
-    }
-    if (delineate) delineateProposals(name, pair, roofs, left, right, disparity, a.detection.proposals);
-    const std::string png = (fs::path(out) / ("scene_" + name + ".png")).string();
-    cv::Mat bgr = image;
-    if (bgr.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
-    drawOverlay(png, bgr, a);
-    std::printf("  overlay %s\n", png.c_str());
+  const std::optional<Options> options = parseOptions(argc, argv);
+  if (!options) return 2;
+  if (bench::skippedWithoutData(options->data.dataRoot)) return 0;
+  const nlohmann::json roofs = bench::readLabels(options->data.labels);
+  const segmentation::SceneParams params = sceneParams();
+  bench::RealPairs pairs(roofs, options->data.dataRoot, options->data.cache);
+  for (const auto& [name, files] : roofs.at("pairs").items()) {
+    if (const bench::RealPair* pair = pairs.get(name))
+      runPair(*pair, files, roofs, *options, params);
   }
   return 0;
 }
