@@ -36,6 +36,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -139,8 +140,10 @@ struct SimSpec {
 // 20 scenes: the stereo benchmark's square scenes (1000 x 1000), the simulator's default scene
 // (640 x 480), small scenes where one building is a large part of the image (320 x 240, 4
 // buildings and 3 trees requested, as the CLI's end-to-end tests), steep scenes (heights 2.5x
-// larger in disparity, ground at negative disparity) and strongly sloped terrain with relief.
+// larger in disparity, ground at negative disparity) and strongly sloped terrain with relief;
+// for --tiny, square scenes of 240 x 240.
 sim::SceneParams simParams(const SimSpec& s) {
+  if (s.family == "tiny") return sim::squareSceneParams(240, s.seed);
   sim::SceneParams p = sim::squareSceneParams(1000, s.seed);
   if (s.family == "default") {
     p = sim::SceneParams{};
@@ -243,115 +246,147 @@ Row evaluate(const Case& c, const stereo::RangeEstimateParams& params, int repea
   return row;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  core::tuneAllocatorForLargeImages();
+struct Options {
   std::string data = "/work/shared/data";
   bool useData = true, tiny = false;
   int repeat = 1, seedOffset = 0;
   std::vector<std::string> sceneDirs;
   std::string draw, only;
+  stereo::RangeEstimateParams params;
+};
+
+// The options, or nothing after the usage line (or the parameters' error) when they are wrong.
+std::optional<Options> parseOptions(int argc, char** argv) {
+  Options o;
   nlohmann::json overrides = nlohmann::json::object();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--data" && i + 1 < argc) data = argv[++i];
-    else if (a == "--no-data") useData = false;
-    else if (a == "--tiny") tiny = true;
-    else if (a == "--repeat" && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
+    if (a == "--data" && i + 1 < argc)
+      o.data = argv[++i];
+    else if (a == "--no-data")
+      o.useData = false;
+    else if (a == "--tiny")
+      o.tiny = true;
+    else if (a == "--repeat" && i + 1 < argc)
+      o.repeat = std::max(1, std::atoi(argv[++i]));
     else if (a == "--params" && i + 1 < argc) overrides = nlohmann::json::parse(argv[++i]);
-    else if (a == "--draw" && i + 1 < argc) draw = argv[++i];
-    else if (a == "--only" && i + 1 < argc) only = argv[++i];
-    else if (a == "--seed-offset" && i + 1 < argc) seedOffset = std::atoi(argv[++i]);
-    else if (a == "--scene" && i + 1 < argc) sceneDirs.push_back(argv[++i]);
+    else if (a == "--draw" && i + 1 < argc)
+      o.draw = argv[++i];
+    else if (a == "--only" && i + 1 < argc)
+      o.only = argv[++i];
+    else if (a == "--seed-offset" && i + 1 < argc)
+      o.seedOffset = std::atoi(argv[++i]);
+    else if (a == "--scene" && i + 1 < argc)
+      o.sceneDirs.push_back(argv[++i]);
     else {
       std::fprintf(stderr, "usage: bench_disparity_range [--data DIR] [--no-data] [--tiny] "
                            "[--repeat N] [--params JSON] [--draw DIR] [--only NAME] [--seed-offset N] "
                            "[--scene DIR]\n");
-      return 2;
+      return std::nullopt;
     }
   }
-  stereo::RangeEstimateParams params;
   try {
-    core::fromJson(params, overrides);
+    core::fromJson(o.params, overrides);
   } catch (const core::Error& e) {
     std::fprintf(stderr, "bench_disparity_range: %s\n", e.what());
-    return 2;
+    return std::nullopt;
   }
+  return o;
+}
 
+// The real pairs (unless --no-data or --tiny; a line says when the data folder is missing) and
+// the scenes of --scene.
+std::vector<Case> realAndSceneCases(const Options& o) {
   std::vector<Case> cases;
-  if (useData && !tiny) {
-    if (fs::is_directory(data)) cases = realCases(data);
-    else std::printf("(real data skipped: %s not found)\n", data.c_str());
+  if (o.useData && !o.tiny) {
+    if (fs::is_directory(o.data))
+      cases = realCases(o.data);
+    else
+      std::printf("(real data skipped: %s not found)\n", o.data.c_str());
   }
-  for (const std::string& dir : sceneDirs) {
+  for (const std::string& dir : o.sceneDirs) {
     const fs::path d(dir);
     cases.push_back({"scene " + d.filename().string(), readFloat(d / sim::SceneFiles::left),
                      readFloat(d / sim::SceneFiles::right),
                      readFloat(d / sim::SceneFiles::disparity)});
   }
-  std::vector<SimSpec> specs;
-  if (!sceneDirs.empty()) {
-  } else if (tiny) {
-    specs = {{"tiny", 1}, {"tiny", 2}};
-  } else {
-    const int o = seedOffset;
-    for (int s = 1; s <= 5; ++s) specs.push_back({"square", o + s});
-    for (int s = 1; s <= 4; ++s) specs.push_back({"default", o + s});
-    for (int s = 1; s <= 5; ++s) specs.push_back({"small", o + s});
-    for (int s = 1; s <= 3; ++s) specs.push_back({"steep", o + s});
-    for (int s = 1; s <= 3; ++s) specs.push_back({"slope", o + s});
-  }
+  return cases;
+}
 
+// The simulated scenes: none with --scene, two tiny ones with --tiny, else the 20 of simParams
+// (their seeds moved by --seed-offset).
+std::vector<SimSpec> simSpecs(const Options& o) {
+  std::vector<SimSpec> specs;
+  if (!o.sceneDirs.empty()) return specs;
+  if (o.tiny) return {{"tiny", 1}, {"tiny", 2}};
+  const int offset = o.seedOffset;
+  for (int s = 1; s <= 5; ++s) specs.push_back({"square", offset + s});
+  for (int s = 1; s <= 4; ++s) specs.push_back({"default", offset + s});
+  for (int s = 1; s <= 5; ++s) specs.push_back({"small", offset + s});
+  for (int s = 1; s <= 3; ++s) specs.push_back({"steep", offset + s});
+  for (int s = 1; s <= 3; ++s) specs.push_back({"slope", offset + s});
+  return specs;
+}
+
+// --draw DIR: DIR/<case>.png, the matches over the left image, and DIR/<case>.csv, each match's
+// x, y, d and the true disparity there.
+void drawCase(const std::string& dir, const Case& c, const stereo::RangeEstimate& estimate) {
+  std::string file = c.name;
+  std::replace(file.begin(), file.end(), ' ', '_');
+  drawMatches(fs::path(dir) / (file + ".png"), c, estimate);
+  std::FILE* csv = std::fopen((fs::path(dir) / (file + ".csv")).string().c_str(), "w");
+  if (csv == nullptr) return;
+  std::fprintf(csv, "x,y,d,truth\n");
+  for (const cv::Point3f& p : estimate.points) {
+    const float t = c.truth.at<float>(std::clamp(cvRound(p.y), 0, c.truth.rows - 1),
+                                      std::clamp(cvRound(p.x), 0, c.truth.cols - 1));
+    std::fprintf(csv, "%.1f,%.1f,%.2f,%.2f\n", p.x, p.y, p.z, t);
+  }
+  std::fclose(csv);
+}
+
+bool selected(const std::string& caseName, const std::string& only) {
+  return only.empty() || caseName.find(only) != std::string::npos;
+}
+
+// One case's row (and drawing); false when the estimate failed.
+bool runCase(const Case& c, const Options& o) {
+  if (!selected(c.name, o.only)) return true;
+  const Row r = evaluate(c, o.params, o.repeat);
+  char size[32], est[32], kp[32], span[32], minmax[32];
+  std::snprintf(size, sizeof size, "%dx%d", c.left.cols, c.left.rows);
+  std::snprintf(span, sizeof span, "%.1f..%.1f", r.p005, r.p995);
+  std::snprintf(minmax, sizeof minmax, "%.1f..%.1f", r.tmin, r.tmax);
+  if (!r.ok) {
+    std::printf("%-16s %9s  FAILED: %s\n", c.name.c_str(), size, r.error.c_str());
+    return false;
+  }
+  std::snprintf(est, sizeof est, "%d..%d", r.estimate.dmin, r.estimate.dmax);
+  std::snprintf(kp, sizeof kp, "%d/%d", r.estimate.keypointsLeft, r.estimate.keypointsRight);
+  std::printf("%-16s %9s %11s %6d %11s %15s %15s %8.2f %6.2f %7.0f %7.0f\n", c.name.c_str(), size,
+              est, r.estimate.matches, kp, span, minmax, r.inside, r.ratio, r.ms, r.cpuMs);
+  std::fflush(stdout);
+  if (!o.draw.empty()) drawCase(o.draw, c, r.estimate);
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  core::tuneAllocatorForLargeImages();
+  const std::optional<Options> options = parseOptions(argc, argv);
+  if (!options) return 2;
+  const std::vector<Case> cases = realAndSceneCases(*options);
+  const std::vector<SimSpec> specs = simSpecs(*options);
   std::printf("%-16s %9s %11s %6s %11s %15s %15s %8s %6s %7s %7s\n", "case", "size",
               "estimate", "match", "kp L/R", "true p0.5..99.5", "true min..max", "inside%",
               "width", "ms", "cpu ms");
   int failed = 0;
-  auto run = [&](const Case& c) {
-    if (!only.empty() && c.name.find(only) == std::string::npos) return;
-    const Row r = evaluate(c, params, repeat);
-    char size[32], est[32], kp[32], span[32], minmax[32];
-    std::snprintf(size, sizeof size, "%dx%d", c.left.cols, c.left.rows);
-    std::snprintf(span, sizeof span, "%.1f..%.1f", r.p005, r.p995);
-    std::snprintf(minmax, sizeof minmax, "%.1f..%.1f", r.tmin, r.tmax);
-    if (!r.ok) {
-      ++failed;
-      std::printf("%-16s %9s  FAILED: %s\n", c.name.c_str(), size, r.error.c_str());
-      return;
-    }
-    std::snprintf(est, sizeof est, "%d..%d", r.estimate.dmin, r.estimate.dmax);
-    std::snprintf(kp, sizeof kp, "%d/%d", r.estimate.keypointsLeft, r.estimate.keypointsRight);
-    std::printf("%-16s %9s %11s %6d %11s %15s %15s %8.2f %6.2f %7.0f %7.0f\n", c.name.c_str(),
-                size, est, r.estimate.matches, kp, span, minmax, r.inside, r.ratio, r.ms,
-                r.cpuMs);
-    std::fflush(stdout);
-    if (!draw.empty()) {
-      std::string file = c.name;
-      std::replace(file.begin(), file.end(), ' ', '_');
-      drawMatches(fs::path(draw) / (file + ".png"), c, r.estimate);
-      std::FILE* csv = std::fopen((fs::path(draw) / (file + ".csv")).string().c_str(), "w");
-      if (csv != nullptr) {
-        std::fprintf(csv, "x,y,d,truth\n");
-        for (const cv::Point3f& p : r.estimate.points) {
-          const float t = c.truth.at<float>(std::clamp(cvRound(p.y), 0, c.truth.rows - 1),
-                                            std::clamp(cvRound(p.x), 0, c.truth.cols - 1));
-          std::fprintf(csv, "%.1f,%.1f,%.2f,%.2f\n", p.x, p.y, p.z, t);
-        }
-        std::fclose(csv);
-      }
-    }
-  };
-  for (const Case& c : cases) run(c);
+  for (const Case& c : cases) failed += !runCase(c, *options);
   for (const SimSpec& s : specs) {
-    sim::SceneParams p = simParams(s);
-    if (s.family == "tiny") {
-      p = sim::squareSceneParams(240, s.seed);
-    }
-    if (!only.empty() && ("sim " + s.family + " " + std::to_string(s.seed)).find(only) ==
-                             std::string::npos) {
-      continue;
-    }
-    run(simCase(s, p));
+    // Only the selected scenes are simulated.
+    if (!selected("sim " + s.family + " " + std::to_string(s.seed), options->only)) continue;
+    failed += !runCase(simCase(s, simParams(s)), *options);
   }
   return failed > 0 ? 1 : 0;
 }
