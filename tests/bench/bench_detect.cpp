@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -204,136 +205,183 @@ void realTiles(const std::string& dataDir, const std::string& outDir, const Clas
   }
 }
 
+struct Options {
+  int scenes = 4, firstSeed = 1;
+  bool chain = false;  // --chain: the matcher and the active polygon from each proposal
+  std::string ground = "true-dem";        // --ground true-dem|matcher|truth
+  std::string realDir, realOut = "/tmp";  // --real DIR [--real-out DIR]: overlays on real tiles
+  sim::SceneParams scene = [] {
+    sim::SceneParams p;
+    p.width = 800;
+    p.height = 600;
+    p.buildings = 14;
+    p.trees = 24;
+    p.slope = 10.0;
+    return p;
+  }();
+  DetectParams detect;
+};
+
+// The options, or nothing after the usage line when they are wrong.
+std::optional<Options> parseOptions(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const bool valued = i + 1 < argc;
+    if (!std::strcmp(argv[i], "--tiny")) {
+      o.scenes = 1;
+      o.scene.width = 320;
+      o.scene.height = 240;
+      o.scene.buildings = 3;
+      o.scene.trees = 3;
+    } else if (!std::strcmp(argv[i], "--scenes") && valued) {
+      o.scenes = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--seed") && valued) {
+      o.firstSeed = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--chain")) {
+      o.chain = true;
+    } else if (!std::strcmp(argv[i], "--growth") && valued) {
+      o.detect.growth = std::atof(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--ground") && valued) {
+      o.ground = argv[++i];
+    } else if (!std::strcmp(argv[i], "--real") && valued) {
+      o.realDir = argv[++i];
+    } else if (!std::strcmp(argv[i], "--real-out") && valued) {
+      o.realOut = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: bench_detect [--tiny] [--scenes N] [--seed FIRST] [--chain] [--growth PX] "
+                           "[--ground true-dem|matcher|truth] [--real DATA_DIR [--real-out DIR]]\n");
+      return std::nullopt;
+    }
+  }
+  if (o.ground != "true-dem" && o.ground != "matcher" && o.ground != "truth") {
+    std::fprintf(stderr, "--ground takes true-dem, matcher or truth\n");
+    return std::nullopt;
+  }
+  return o;
+}
+
+// The classification with every rule, then with each switched off in turn.
+struct Variant {
+  const char* name;
+  ClassifyParams params;
+  bool majority;
+};
+std::vector<Variant> ablations(const ClassifyParams& classifyParams) {
+  std::vector<Variant> variants;
+  variants.push_back({"all rules, region majority", classifyParams, true});
+  variants.push_back({"all rules, per pixel", classifyParams, false});
+  ClassifyParams p = classifyParams;
+  p.darkLevel = 0;
+  variants.push_back({"no dark-textured rule", p, true});
+  p = classifyParams;
+  p.darkLevel = 255;
+  variants.push_back({"textured at any brightness", p, true});
+  p = classifyParams;
+  p.minObjectArea = 0;
+  variants.push_back({"no small-piece absorption", p, true});
+  return variants;
+}
+
+// What the tables need of every scene.
+struct Totals {
+  std::vector<Tally> tallies;  // per variant
+  ProposalScore gtScore, chainScore;
+  double classifyMs = 0;  // of the first variant, all scenes
+};
+
+// The automatic chain: the matcher's map gives the intervals, the active polygon starts from
+// each proposal; the outlines scored against the footprints.
+void runChain(const sim::Scene& scene, const cv::Mat& map, const GroundSegmentation& seg,
+              const ClassifyParams& classifyParams, const ObjectParams& objectParams,
+              const DetectParams& detectParams, ProposalScore& score) {
+  cv::Mat left, right;
+  scene.left.convertTo(left, CV_32F);
+  scene.right.convertTo(right, CV_32F);
+  const Detection dm = detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, map,
+                                       seg.regions, classifyParams, objectParams, detectParams);
+  std::vector<core::Polygon> outlines;
+  delineation::DelineationParams params;
+  for (const auto& f : dm.proposals) {
+    try {
+      auto req = delineation::featureRequest(f, params.groundTolerance);
+      if (!req) continue;
+      req->disparity = map;
+      req->searchRange = delineation::DisparityInterval{scene.disparityMin, scene.disparityMax};
+      outlines.push_back(delineation::delineate(left, right, *req, params).polygon);
+    } catch (const std::exception& e) {
+      std::printf("  scene %d proposal %.0f failed: %s\n", scene.seed,
+                  core::numberProperty(f, "id", 9e15).value_or(-1), e.what());
+    }
+  }
+  scoreProposals(outlines, scene, 100.0, score);
+}
+
+// One scene: its segmentation (--ground), each variant's classification, the proposals from the
+// true disparity and, with --chain, the automatic chain.
+void runScene(const sim::Scene& scene, const Options& o, const std::vector<Variant>& variants,
+              const ClassifyParams& classifyParams, Totals& totals) {
+  const ObjectParams objectParams;
+  const bool needMap = o.chain || o.ground == "matcher";
+  const cv::Mat map = needMap ? bench::matchScene(scene) : cv::Mat();
+  const GroundSegmentation seg = o.ground == "truth" ? truthSegmentation(scene)
+                                 : o.ground == "matcher"
+                                     ? demSegmentation(bench::sceneHeights(scene, map), scene.gsd)
+                                     : demSegmentation(scene.dem, scene.gsd);
+  for (size_t v = 0; v < variants.size(); ++v) {
+    const auto t0 = cv::getTickCount();
+    const Classification c =
+        classify(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, variants[v].params, seg.regions);
+    if (v == 0) totals.classifyMs += 1e3 * double(cv::getTickCount() - t0) / cv::getTickFrequency();
+    totals.tallies[v].add(variants[v].majority ? c.labels : c.pixelLabels, scene.labels);
+  }
+  // Proposals with the true disparity (intervals and ground from the truth).
+  const Detection d =
+      detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, scene.disparity,
+                      seg.regions, classifyParams, objectParams, o.detect);
+  std::vector<core::Polygon> polygons;
+  for (const auto& f : d.proposals) polygons.push_back(f.polygon);
+  scoreProposals(polygons, scene, 100.0, totals.gtScore);
+  if (o.chain) runChain(scene, map, seg, classifyParams, objectParams, o.detect, totals.chainScore);
+}
+
+void printTables(const Options& o, const std::vector<Variant>& variants, const Totals& totals) {
+  std::printf(
+      "building vs vegetation on %d scenes %dx%d, slope %.0f %%, above-ground mask and DTM: %s\n",
+      o.scenes, o.scene.width, o.scene.height, o.scene.slope,
+      o.ground == "truth"     ? "true labels"
+      : o.ground == "matcher" ? "segmented matcher DEM"
+                              : "segmented true DEM");
+  std::printf("  %-34s %8s  %8s  %8s  %9s  %9s\n", "variant", "right", "of found", "no facade", "bld->veg",
+              "veg->bld");
+  for (size_t v = 0; v < variants.size(); ++v) totals.tallies[v].print(variants[v].name);
+  std::printf("  classification time %.0f ms per scene\n",
+              totals.classifyMs / std::max(1, o.scenes));
+  std::printf("proposals (buildings >= 100 m2, IoU >= 0.5)\n");
+  printScore("from the true disparity", totals.gtScore);
+  if (o.chain) printScore("matcher + active polygon", totals.chainScore);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
-  int scenes = 4, firstSeed = 1;
-  bool chain = false;
-  std::string realDir, realOut = "/tmp", ground = "true-dem";
-  sim::SceneParams sp;
-  sp.width = 800;
-  sp.height = 600;
-  sp.buildings = 14;
-  sp.trees = 24;
-  sp.slope = 10.0;
+  std::optional<Options> options = parseOptions(argc, argv);
+  if (!options) return 2;
   ClassifyParams classifyParams;
-  ObjectParams objectParams;
-  DetectParams detectParams;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--tiny")) {
-      scenes = 1;
-      sp.width = 320;
-      sp.height = 240;
-      sp.buildings = 3;
-      sp.trees = 3;
-    } else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc) {
-      scenes = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) {
-      firstSeed = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--chain")) {
-      chain = true;
-    } else if (!std::strcmp(argv[i], "--growth") && i + 1 < argc) {
-      detectParams.growth = std::atof(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--ground") && i + 1 < argc) {
-      ground = argv[++i];
-    } else if (!std::strcmp(argv[i], "--real") && i + 1 < argc) {
-      realDir = argv[++i];
-    } else if (!std::strcmp(argv[i], "--real-out") && i + 1 < argc) {
-      realOut = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: bench_detect [--tiny] [--scenes N] [--seed FIRST] [--chain] [--growth PX] "
-                           "[--ground true-dem|matcher|truth] [--real DATA_DIR [--real-out DIR]]\n");
-      return 2;
-    }
-  }
-  if (ground != "true-dem" && ground != "matcher" && ground != "truth") {
-    std::fprintf(stderr, "--ground takes true-dem, matcher or truth\n");
-    return 2;
-  }
-  if (const char* json = std::getenv("BENCH_CLASSIFY")) core::fromJson(classifyParams, nlohmann::json::parse(json));
-  if (!realDir.empty()) {
-    std::printf("real tiles (%s)\n", realDir.c_str());
-    realTiles(realDir, realOut, classifyParams);
+  if (const char* json = std::getenv("BENCH_CLASSIFY"))
+    core::fromJson(classifyParams, nlohmann::json::parse(json));
+  if (!options->realDir.empty()) {
+    std::printf("real tiles (%s)\n", options->realDir.c_str());
+    realTiles(options->realDir, options->realOut, classifyParams);
     return 0;
   }
-  // Ablations: each rule switched off in turn, on the same scenes.
-  struct Variant {
-    const char* name;
-    ClassifyParams params;
-    bool majority;
-  };
-  std::vector<Variant> variants;
-  variants.push_back({"all rules, region majority", classifyParams, true});
-  variants.push_back({"all rules, per pixel", classifyParams, false});
-  {
-    ClassifyParams p = classifyParams;
-    p.darkLevel = 0;
-    variants.push_back({"no dark-textured rule", p, true});
-    p = classifyParams;
-    p.darkLevel = 255;
-    variants.push_back({"textured at any brightness", p, true});
-    p = classifyParams;
-    p.minObjectArea = 0;
-    variants.push_back({"no small-piece absorption", p, true});
+  const std::vector<Variant> variants = ablations(classifyParams);
+  Totals totals;
+  totals.tallies.resize(variants.size());
+  for (int s = 0; s < options->scenes; ++s) {
+    options->scene.seed = options->firstSeed + s;
+    runScene(sim::simulateScene(options->scene), *options, variants, classifyParams, totals);
   }
-  std::vector<Tally> tallies(variants.size());
-  ProposalScore gtScore, chainScore;
-  double classifyMs = 0;
-  for (int s = 0; s < scenes; ++s) {
-    sp.seed = firstSeed + s;
-    const sim::Scene scene = sim::simulateScene(sp);
-    const bool needMap = chain || ground == "matcher";
-    const cv::Mat map = needMap ? bench::matchScene(scene) : cv::Mat();
-    const GroundSegmentation seg = ground == "truth"     ? truthSegmentation(scene)
-                                   : ground == "matcher" ? demSegmentation(bench::sceneHeights(scene, map), scene.gsd)
-                                                         : demSegmentation(scene.dem, scene.gsd);
-    for (size_t v = 0; v < variants.size(); ++v) {
-      const auto t0 = cv::getTickCount();
-      const Classification c =
-          classify(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, variants[v].params, seg.regions);
-      if (v == 0) classifyMs += 1e3 * double(cv::getTickCount() - t0) / cv::getTickFrequency();
-      tallies[v].add(variants[v].majority ? c.labels : c.pixelLabels, scene.labels);
-    }
-    // Proposals with the true disparity (intervals and ground from the truth).
-    const Detection d = detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, scene.disparity,
-                                        seg.regions, classifyParams, objectParams, detectParams);
-    std::vector<core::Polygon> polygons;
-    for (const auto& f : d.proposals) polygons.push_back(f.polygon);
-    scoreProposals(polygons, scene, 100.0, gtScore);
-    if (!chain) continue;
-    // The automatic chain: the matcher's map gives the intervals, the active polygon starts from
-    // each proposal.
-    cv::Mat left, right;
-    scene.left.convertTo(left, CV_32F);
-    scene.right.convertTo(right, CV_32F);
-    const Detection dm = detectBuildings(scene.left, seg.aboveGround, seg.ndsm, scene.gsd, map, seg.regions,
-                                         classifyParams, objectParams, detectParams);
-    std::vector<core::Polygon> outlines;
-    delineation::DelineationParams params;
-    for (const auto& f : dm.proposals) {
-      try {
-        auto req = delineation::featureRequest(f, params.groundTolerance);
-        if (!req) continue;
-        req->disparity = map;
-        req->searchRange = delineation::DisparityInterval{scene.disparityMin, scene.disparityMax};
-        outlines.push_back(delineation::delineate(left, right, *req, params).polygon);
-      } catch (const std::exception& e) {
-        std::printf("  scene %d proposal %.0f failed: %s\n", sp.seed, core::numberProperty(f, "id", 9e15).value_or(-1),
-                    e.what());
-      }
-    }
-    scoreProposals(outlines, scene, 100.0, chainScore);
-  }
-  std::printf("building vs vegetation on %d scenes %dx%d, slope %.0f %%, above-ground mask and DTM: %s\n", scenes,
-              sp.width, sp.height, sp.slope,
-              ground == "truth" ? "true labels" : ground == "matcher" ? "segmented matcher DEM" : "segmented true DEM");
-  std::printf("  %-34s %8s  %8s  %8s  %9s  %9s\n", "variant", "right", "of found", "no facade", "bld->veg",
-              "veg->bld");
-  for (size_t v = 0; v < variants.size(); ++v) tallies[v].print(variants[v].name);
-  std::printf("  classification time %.0f ms per scene\n", classifyMs / std::max(1, scenes));
-  std::printf("proposals (buildings >= 100 m2, IoU >= 0.5)\n");
-  printScore("from the true disparity", gtScore);
-  if (chain) printScore("matcher + active polygon", chainScore);
+  printTables(*options, variants, totals);
   return 0;
 }
