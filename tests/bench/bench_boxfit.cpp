@@ -42,6 +42,7 @@
 #include "delineo/stereo/match.hpp"
 #include "bench_image.hpp"
 #include "real_roofs.hpp"
+#include "shared_data.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
@@ -347,7 +348,7 @@ int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   int scenes = 3, firstSeed = 1, grow = 30;
   bool tiny = false, realMode = false, withMatcher = true, withActive = true;
-  std::string dumpDir, dataRoot = "/work/shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
+  std::string dumpDir, dataRoot = bench::defaultDataRoot(), labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
   std::string cache = bench::defaultDisparityCache().string();
   sim::SceneParams sceneParams;
   for (int i = 1; i < argc; ++i) {

@@ -19,7 +19,7 @@
 //
 // Usage: bench_disparity_range [--data DIR] [--no-data] [--tiny] [--repeat N] [--params JSON]
 //                              [--draw DIR] [--only NAME]
-//   --data DIR    real datasets (default /work/shared/data); skipped cleanly when absent
+//   --data DIR    real datasets (default ../shared/data beside the repository, or DELINEO_DATA_DIR); skipped cleanly when absent
 //   --tiny        two small simulated scenes only (the ctest smoke run)
 //   --params J    RangeEstimateParams overrides, e.g. '{"detector": "orb"}'
 //   --draw DIR    writes DIR/<case>.png: the left image with each match used, coloured from blue
@@ -51,6 +51,7 @@
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/disparity_range.hpp"
 #include "bench_image.hpp"
+#include "shared_data.hpp"
 
 namespace {
 using namespace delineo;
@@ -247,7 +248,7 @@ Row evaluate(const Case& c, const stereo::RangeEstimateParams& params, int repea
 }
 
 struct Options {
-  std::string data = "/work/shared/data";
+  std::string data = bench::defaultDataRoot();
   bool useData = true, tiny = false;
   int repeat = 1, seedOffset = 0;
   std::vector<std::string> sceneDirs;

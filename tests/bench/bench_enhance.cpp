@@ -39,6 +39,7 @@
 #include "bench_image.hpp"
 #include "lidar.hpp"
 #include "real_roofs.hpp"
+#include "shared_data.hpp"
 
 using namespace delineo;
 namespace fs = std::filesystem;
@@ -638,7 +639,7 @@ int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
   SimOptions sim;
   bool tiny = false;
-  std::string dataRoot = "/work/shared/data", labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
+  std::string dataRoot = bench::defaultDataRoot(), labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
   std::string cache = bench::defaultDisparityCache().string(), pngDir;
   dem::EnhanceParams params;
   for (int i = 1; i < argc; ++i) {

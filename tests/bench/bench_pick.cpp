@@ -28,6 +28,7 @@
 #include "delineo/delineation/above_ground.hpp"
 #include "delineo/io/raster.hpp"
 #include "real_roofs.hpp"
+#include "shared_data.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
@@ -88,7 +89,7 @@ double iou(const cv::Mat& a, const cv::Mat& b) {
 
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
-  std::string dataRoot = "/work/shared/data";
+  std::string dataRoot = bench::defaultDataRoot();
   std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
   std::string cache = bench::defaultDisparityCache().string();
   double metresPerPixel = 0.25;

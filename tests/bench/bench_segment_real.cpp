@@ -11,7 +11,7 @@
 // Heights come from the matcher's disparity (cached as in bench_real_outlines) through a linear
 // model; the pairs come without camera data, so metres per pixel of disparity is the stated
 // assumption below. Skips cleanly when the data folder is missing (--data, default
-// /work/shared/data).
+// ../shared/data beside the repository, or DELINEO_DATA_DIR).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -16,7 +16,7 @@
 //                     [--dump DIR] [--params JSON] [--range N] [--repeat N] [--cpu] [--stages]
 //                     [--seed N]
 //   --size N   side of the simulated scene (default 1000; the ctest smoke run uses a tiny one)
-//   --data DIR real datasets (default /work/shared/data); skipped cleanly when absent.
+//   --data DIR real datasets (default ../shared/data beside the repository, or DELINEO_DATA_DIR); skipped cleanly when absent.
 //   --dump DIR write error maps (PNG) of the simulated scene per method: green |e| <= 1,
 //              yellow 1 < |e| <= 2, red worse, blue unmatched, black not scored; outline pixels
 //              white located, magenta roof found inside, cyan outside, orange not found;
@@ -59,6 +59,7 @@
 #include "delineo/stereo/match.hpp"
 #include "bench_image.hpp"
 #include "delineo/sim/scene.hpp"
+#include "shared_data.hpp"
 
 namespace {
 using namespace delineo;
@@ -582,7 +583,7 @@ int main(int argc, char** argv) {
   // As the CLI and the GUI do (architecture.md, "Process set-up").
   delineo::core::tuneAllocatorForLargeImages();
   int size = 1000;
-  std::string data = "/work/shared/data";
+  std::string data = bench::defaultDataRoot();
   bool useData = true;
   std::string dump;
   int range = 0;

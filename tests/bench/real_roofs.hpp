@@ -19,6 +19,7 @@
 #include "delineo/core/geometry.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/stereo/match.hpp"
+#include "shared_data.hpp"
 
 namespace delineo::bench {
 
@@ -29,7 +30,7 @@ inline std::filesystem::path defaultDisparityCache() {
 // The options every bench on the labelled real roofs takes: --data DIR (the data folder),
 // --labels FILE (real_roofs.json) and --cache DIR (the matcher's maps).
 struct RealRoofsOptions {
-  std::string dataRoot = "/work/shared/data";
+  std::string dataRoot = defaultDataRoot();
   std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
   std::string cache = defaultDisparityCache().string();
 
