@@ -14,7 +14,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -89,18 +88,11 @@ double iou(const cv::Mat& a, const cv::Mat& b) {
 
 int main(int argc, char** argv) {
   core::tuneAllocatorForLargeImages();
-  std::string dataRoot = bench::defaultDataRoot();
-  std::string labels = DELINEO_BENCH_DATA_DIR "/real_roofs.json";
-  std::string cache = bench::defaultDisparityCache().string();
+  bench::RealRoofsOptions options;
   double metresPerPixel = 0.25;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
-      dataRoot = argv[++i];
-    } else if (!std::strcmp(argv[i], "--labels") && i + 1 < argc) {
-      labels = argv[++i];
-    } else if (!std::strcmp(argv[i], "--cache") && i + 1 < argc) {
-      cache = argv[++i];
-    } else if (!std::strcmp(argv[i], "--metres-per-pixel") && i + 1 < argc && std::atof(argv[i + 1]) > 0) {
+    if (options.take(argc, argv, i)) continue;
+    if (!std::strcmp(argv[i], "--metres-per-pixel") && i + 1 < argc && std::atof(argv[i + 1]) > 0) {
       metresPerPixel = std::atof(argv[++i]);
     } else {
       std::fprintf(stderr, "usage: bench_pick [--data DIR] [--labels real_roofs.json] [--cache DIR] "
@@ -108,16 +100,12 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (!fs::is_directory(dataRoot)) {
-    std::printf("skipped: no data folder %s\n", dataRoot.c_str());
-    return 0;
-  }
+  if (bench::skippedWithoutData(options.dataRoot)) return 0;
   delineation::AboveGroundParams params;
   if (const char* json = std::getenv("BENCH_PARAMS")) core::fromJson(params, nlohmann::json::parse(json));
   const double margin = params.heightMargin / metresPerPixel;
-  std::ifstream in(labels);
-  const nlohmann::json data = nlohmann::json::parse(in);
-  bench::RealPairs pairs(data, dataRoot, cache);
+  const nlohmann::json data = bench::readLabels(options.labels);
+  bench::RealPairs pairs(data, options.dataRoot, options.cache);
   std::printf("%-18s %9s %6s | %-6s %6s %6s | %-6s %6s %6s %4s %4s %7s %6s\n", "roof", "click", "ground",
               "before", "ground", "err", "after", "ground", "err", "ref", "vtx", "px", "ms");
   int runs = 0, beforeGood = 0, afterGood = 0;
@@ -145,10 +133,7 @@ int main(int argc, char** argv) {
     beforeGood += before >= 0.8 ? 1 : 0;
     afterGood += after >= 0.8 ? 1 : 0;
   }
-  if (runs == 0) {
-    std::printf("skipped: no labelled roof found under %s\n", dataRoot.c_str());
-    return 0;
-  }
+  if (bench::skippedWithoutRoofs(runs, options.dataRoot)) return 0;
   std::printf("\n%d roofs: IoU >= 0.8 before %d, after %d; mean IoU before %.3f, after %.3f\n", runs, beforeGood,
               afterGood, beforeSum / runs, afterSum / runs);
   return 0;
