@@ -83,18 +83,30 @@ RowRenderer::RowRenderer(const SceneParams& params, const Layout& layout)
 }
 
 void RowRenderer::buildProfile(double y, Profile& prof) const {
+  std::vector<double> cuts;  // px, where the row crosses a footprint or superstructure edge
+  groundProfile(y, prof);
+  raiseBuildings(y, prof, cuts);
+  raiseTrees(y, prof);
+  insertWalls(y, cuts, prof);
+  castShadows(prof);
+}
+
+void RowRenderer::sampleRange(double xa, double xb, std::int64_t* i0, std::int64_t* i1) const {
+  *i0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil((xa - gridX0_) * ss_ - 0.5)));
+  *i1 = std::min<std::int64_t>(samples_,
+                               static_cast<std::int64_t>(std::ceil((xb - gridX0_) * ss_ - 0.5)));
+}
+
+void RowRenderer::groundProfile(double y, Profile& prof) const {
   const size_t n = static_cast<size_t>(samples_);
   prof.z.resize(n);
   prof.obj.assign(n, encode(kGround, 0));
   const Terrain& ter = layout_.terrain;
   for (size_t i = 0; i < n; ++i) prof.z[i] = ter.z(groundX(static_cast<std::int64_t>(i)), y);
+}
 
-  auto sampleRange = [&](double xa, double xb, std::int64_t* i0, std::int64_t* i1) {
-    *i0 = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil((xa - gridX0_) * ss_ - 0.5)));
-    *i1 = std::min<std::int64_t>(samples_,
-                                 static_cast<std::int64_t>(std::ceil((xb - gridX0_) * ss_ - 0.5)));
-  };
-  std::vector<double> xs, cuts;
+void RowRenderer::raiseBuildings(double y, Profile& prof, std::vector<double>& cuts) const {
+  std::vector<double> xs;
   for (size_t b = 0; b < layout_.buildings.size(); ++b) {
     const cv::Rect2d& bb = buildingBounds_[b];
     if (y < bb.y || y > bb.y + bb.height) continue;
@@ -129,6 +141,9 @@ void RowRenderer::buildProfile(double y, Profile& prof) const {
       }
     }
   }
+}
+
+void RowRenderer::raiseTrees(double y, Profile& prof) const {
   for (size_t k = 0; k < layout_.trees.size(); ++k) {
     const Tree& tree = layout_.trees[k];
     const double r = tree.maxRadius();
@@ -143,47 +158,51 @@ void RowRenderer::buildProfile(double y, Profile& prof) const {
       }
     }
   }
+}
 
-  // Grid positions, then the vertical walls: at each polygon edge crossing insert the surface
-  // just outside and just inside, at the same X.
+// Grid positions, then the vertical walls: at each polygon edge crossing insert the surface
+// just outside and just inside, at the same X.
+void RowRenderer::insertWalls(double y, std::vector<double>& cuts, Profile& prof) const {
+  const size_t n = static_cast<size_t>(samples_);
   prof.x.resize(n);
   for (size_t i = 0; i < n; ++i) prof.x[i] = groundX(static_cast<std::int64_t>(i));
-  if (!cuts.empty()) {
-    std::sort(cuts.begin(), cuts.end());
-    std::vector<double> mx, mz;
-    std::vector<std::int32_t> mobj;
-    mx.reserve(n + 2 * cuts.size());
-    mz.reserve(n + 2 * cuts.size());
-    mobj.reserve(n + 2 * cuts.size());
-    constexpr double kSide = 1e-7;  // px: far below any feature, far above rounding at 1e4 px
-    size_t c = 0;
-    for (size_t i = 0; i < n; ++i) {
-      while (c < cuts.size() && cuts[c] <= prof.x[i]) {
-        if (cuts[c] > prof.x[0]) {
-          for (double side : {-kSide, kSide}) {
-            double z;
-            std::int32_t obj;
-            surfaceAt(cuts[c] + side, y, &z, &obj);
-            mx.push_back(cuts[c]);
-            mz.push_back(z);
-            mobj.push_back(obj);
-          }
+  if (cuts.empty()) return;
+  std::sort(cuts.begin(), cuts.end());
+  std::vector<double> mx, mz;
+  std::vector<std::int32_t> mobj;
+  mx.reserve(n + 2 * cuts.size());
+  mz.reserve(n + 2 * cuts.size());
+  mobj.reserve(n + 2 * cuts.size());
+  constexpr double kSide = 1e-7;  // px: far below any feature, far above rounding at 1e4 px
+  size_t c = 0;
+  for (size_t i = 0; i < n; ++i) {
+    while (c < cuts.size() && cuts[c] <= prof.x[i]) {
+      if (cuts[c] > prof.x[0]) {
+        for (double side : {-kSide, kSide}) {
+          double z;
+          std::int32_t obj;
+          surfaceAt(cuts[c] + side, y, &z, &obj);
+          mx.push_back(cuts[c]);
+          mz.push_back(z);
+          mobj.push_back(obj);
         }
-        ++c;
       }
-      mx.push_back(prof.x[i]);
-      mz.push_back(prof.z[i]);
-      mobj.push_back(prof.obj[i]);
+      ++c;
     }
-    prof.x.swap(mx);
-    prof.z.swap(mz);
-    prof.obj.swap(mobj);
+    mx.push_back(prof.x[i]);
+    mz.push_back(prof.z[i]);
+    mobj.push_back(prof.obj[i]);
   }
+  prof.x.swap(mx);
+  prof.z.swap(mz);
+  prof.obj.swap(mobj);
+}
+
+// The sun lies in the plane of the row: sweep along the light direction keeping the height of
+// the highest shadow ray reaching the current vertex.
+void RowRenderer::castShadows(Profile& prof) const {
   const size_t m = prof.x.size();
   prof.shadow.assign(m, 0.0f);
-
-  // Cast shadows with the sun in the plane of the row: sweep along the light direction
-  // keeping the height of the highest shadow ray reaching the current vertex.
   const double dropPerPx = std::tan(layout_.sunElevation) * p_.gsd;
   double ray = -std::numeric_limits<double>::max();
   const bool fromWest = layout_.sunSide < 0;

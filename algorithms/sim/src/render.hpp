@@ -52,7 +52,20 @@ class RowRenderer {
     std::uint8_t label;
   };
 
+  // The row's profile at sub-row y: the steps below, in this order.
   void buildProfile(double y, Profile& prof) const;
+  // Terrain heights at the grid samples, every sample ground.
+  void groundProfile(double y, Profile& prof) const;
+  // Roofs, then superstructures where higher; appends the row's edge crossings to `cuts`.
+  void raiseBuildings(double y, Profile& prof, std::vector<double>& cuts) const;
+  // Tree crowns where higher than what is there.
+  void raiseTrees(double y, Profile& prof) const;
+  // Sample positions, and a wall (outside and inside surface) at each of `cuts` (sorted here).
+  void insertWalls(double y, std::vector<double>& cuts, Profile& prof) const;
+  // Cast shadow of every vertex, and the profile's highest point.
+  void castShadows(Profile& prof) const;
+  // Grid samples whose centre lies in [xa, xb), clamped to the grid: [*i0, *i1).
+  void sampleRange(double xa, double xb, std::int64_t* i0, std::int64_t* i1) const;
   // Height and object of the surface at one point (the same max rule as buildProfile).
   void surfaceAt(double x, double y, double* z, std::int32_t* obj) const;
   void renderView(const ViewGeometry& view, const Profile& prof, ZBuffer& zb) const;
