@@ -300,106 +300,142 @@ core::Ring Box::cornersWithin(cv::Size size) const {
   return ring.size() >= 3 ? ring : core::Ring{};
 }
 
-BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges, const std::vector<Seed>& seeds,
-                        const BoxFitParams& params, const cv::Vec4b& imageBorder, core::Progress* progress) {
-  BoxFitting out;
-  if (seeds.empty()) return out;
-  const cv::Mat inside = segment / 255;
-  const cv::Mat cost = edgeCost(edges, imageBorder, params.edgeCap);
-  const double resolution = params.angleResolution > 0 ? std::min(params.angleResolution, params.angleStep) : params.angleStep;
-  // Per seed: the fit at every evaluated angle (key on the resolution grid).
-  std::vector<std::map<int, Fitted>> fits(seeds.size());
-  std::set<int> done;
-  auto evaluate = [&](const std::set<int>& keys, const std::vector<std::vector<size_t>>& who, double from, double to) {
-    size_t k = 0;
-    for (int key : keys) {
-      if (core::isCanceled(progress)) return false;
-      const Frame frame(inside, cost, params.edgeCap, key * resolution);
-      ++out.anglesEvaluated;
-      done.insert(key);
-      for (size_t s : who[k]) {
-        const SeedFit fit = fitInFrame(frame, seeds[s], params);
-        fits[s][key] = {fit.ok ? toBox(frame, fit.box, fit.energy, seeds[s]) : Box{}, fit.ok};
-      }
-      ++k;
-      core::report(progress, from + (to - from) * static_cast<double>(k) / static_cast<double>(keys.size()));
-    }
-    return true;
-  };
-  auto everySeed = [&](size_t count) {
-    std::vector<size_t> all(seeds.size());
-    for (size_t s = 0; s < all.size(); ++s) all[s] = s;
-    return std::vector<std::vector<size_t>>(count, all);
-  };
-  // Sweep over a quarter turn (a box at θ + 90° is the same box).
-  std::set<int> sweep;
-  for (double a = 0; a < 90.0 - 1e-9; a += params.angleStep) sweep.insert(angleKey(a, resolution));
-  if (!evaluate(sweep, everySeed(sweep.size()), 0.0, 0.6)) {
-    out.status = core::RunStatus::Canceled;
-    return out;
+namespace {
+
+// The sweep over orientations of fitSeedBoxes: every seed fitted in one frame per angle, the
+// angles kept per seed, and the choice of each seed's box.
+class SeedBoxSweep {
+ public:
+  SeedBoxSweep(const cv::Mat& segment, const cv::Mat& edges, const std::vector<Seed>& seeds,
+               const BoxFitParams& params, const cv::Vec4b& imageBorder, core::Progress* progress,
+               BoxFitting& out)
+      : seeds_(seeds), params_(params), progress_(progress), out_(out), fits_(seeds.size()) {
+    inside_ = segment / 255;
+    cost_ = edgeCost(edges, imageBorder, params.edgeCap);
+    resolution_ = params.angleResolution > 0 ? std::min(params.angleResolution, params.angleStep) : params.angleStep;
   }
-  // A seed's best angle: the box of lowest energy, the largest among equals (without edges every
-  // angle costs the cap, and the box that fills the segment wins).
-  auto bestKey = [&](size_t s) {
-    double lowest = 1e300;
-    for (const auto& [k, fit] : fits[s]) {
-      if (fit.ok) lowest = std::min(lowest, fit.box.energy);
-    }
-    int key = -1;
-    double area = -1;
-    for (const auto& [k, fit] : fits[s]) {
-      if (fit.ok && fit.box.energy <= lowest && fit.box.area() > area) area = fit.box.area(), key = k;
-    }
-    return key;
-  };
-  // Refinement around each seed's best angle on the resolution grid.
-  if (params.angleResolution > 0 && resolution < params.angleStep) {
+
+  // Sweep over a quarter turn (a box at θ + 90° is the same box). False when canceled.
+  bool quarterTurn() {
+    std::set<int> sweep;
+    for (double a = 0; a < 90.0 - 1e-9; a += params_.angleStep) sweep.insert(angleKey(a, resolution_));
+    return evaluate(sweep, everySeed(sweep.size()), 0.0, 0.6);
+  }
+
+  // Refinement around each seed's best angle on the resolution grid. False when canceled.
+  bool refineBestAngles() {
+    if (!(params_.angleResolution > 0 && resolution_ < params_.angleStep)) return true;
     std::map<int, std::vector<size_t>> wanted;
-    const int reach = static_cast<int>(std::ceil(params.angleStep / resolution)) - 1;
-    for (size_t s = 0; s < seeds.size(); ++s) {
+    const int reach = static_cast<int>(std::ceil(params_.angleStep / resolution_)) - 1;
+    for (size_t s = 0; s < seeds_.size(); ++s) {
       const int key = bestKey(s);
       if (key < 0) continue;
       for (int d = -reach; d <= reach; ++d) {
-        const int k = angleKey((key + d) * resolution, resolution);
-        if (!done.count(k)) wanted[k].push_back(s);
+        const int k = angleKey((key + d) * resolution_, resolution_);
+        if (!done_.count(k)) wanted[k].push_back(s);
       }
     }
     std::set<int> keys;
     std::vector<std::vector<size_t>> who;
     for (auto& [k, list] : wanted) keys.insert(k), who.push_back(list);
-    if (!evaluate(keys, who, 0.6, 0.9)) {
-      out.status = core::RunStatus::Canceled;
-      return out;
-    }
+    return evaluate(keys, who, 0.6, 0.9);
   }
+
   // Each seed's best box; the building's main orientation (reported, and counted among the boxes).
-  std::vector<int> chosen(seeds.size(), -1);
-  std::vector<Box> best;
-  for (size_t s = 0; s < seeds.size(); ++s) {
-    chosen[s] = bestKey(s);
-    if (chosen[s] >= 0) best.push_back(fits[s][chosen[s]].box);
-  }
-  if (best.empty()) return out;
-  out.mainOrientationDeg = mainOrientation(best);
-  const int mainKey = angleKey(out.mainOrientationDeg, resolution);
-  // Deepest seeds first; a seed inside an earlier box adds nothing (skip-covered).
-  for (size_t s = 0; s < seeds.size(); ++s) {
-    if (chosen[s] < 0) continue;
-    const Box& box = fits[s][chosen[s]].box;
-    if (params.skipCovered) {
-      const cv::Point2d p = box.seed;
-      const bool covered = std::any_of(out.boxes.begin(), out.boxes.end(), [&](const Box& b) {
-        const core::Ring c = b.corners();
-        return cv::pointPolygonTest(std::vector<cv::Point2f>(c.begin(), c.end()), cv::Point2f(p), false) > 0;
-      });
-      if (covered) {
-        ++out.seedsSkipped;
-        continue;
-      }
+  void keepBestBoxes() {
+    std::vector<int> chosen(seeds_.size(), -1);
+    std::vector<Box> best;
+    for (size_t s = 0; s < seeds_.size(); ++s) {
+      chosen[s] = bestKey(s);
+      if (chosen[s] >= 0) best.push_back(fits_[s][chosen[s]].box);
     }
-    out.boxes.push_back(box);
-    out.boxesAtMainOrientation += chosen[s] == mainKey;
+    if (best.empty()) return;
+    out_.mainOrientationDeg = mainOrientation(best);
+    const int mainKey = angleKey(out_.mainOrientationDeg, resolution_);
+    // Deepest seeds first; a seed inside an earlier box adds nothing (skip-covered).
+    for (size_t s = 0; s < seeds_.size(); ++s) {
+      if (chosen[s] < 0) continue;
+      const Box& box = fits_[s][chosen[s]].box;
+      if (params_.skipCovered) {
+        const cv::Point2d p = box.seed;
+        const bool covered = std::any_of(out_.boxes.begin(), out_.boxes.end(), [&](const Box& b) {
+          const core::Ring c = b.corners();
+          return cv::pointPolygonTest(std::vector<cv::Point2f>(c.begin(), c.end()), cv::Point2f(p), false) > 0;
+        });
+        if (covered) {
+          ++out_.seedsSkipped;
+          continue;
+        }
+      }
+      out_.boxes.push_back(box);
+      out_.boxesAtMainOrientation += chosen[s] == mainKey;
+    }
   }
+
+ private:
+  // Fits the seeds `who[k]` in the frame of the k-th of `keys`, progress going from `from` to
+  // `to`. False when canceled.
+  bool evaluate(const std::set<int>& keys, const std::vector<std::vector<size_t>>& who, double from, double to) {
+    size_t k = 0;
+    for (int key : keys) {
+      if (core::isCanceled(progress_)) return false;
+      const Frame frame(inside_, cost_, params_.edgeCap, key * resolution_);
+      ++out_.anglesEvaluated;
+      done_.insert(key);
+      for (size_t s : who[k]) {
+        const SeedFit fit = fitInFrame(frame, seeds_[s], params_);
+        fits_[s][key] = {fit.ok ? toBox(frame, fit.box, fit.energy, seeds_[s]) : Box{}, fit.ok};
+      }
+      ++k;
+      core::report(progress_, from + (to - from) * static_cast<double>(k) / static_cast<double>(keys.size()));
+    }
+    return true;
+  }
+
+  std::vector<std::vector<size_t>> everySeed(size_t count) const {
+    std::vector<size_t> all(seeds_.size());
+    for (size_t s = 0; s < all.size(); ++s) all[s] = s;
+    return std::vector<std::vector<size_t>>(count, all);
+  }
+
+  // A seed's best angle: the box of lowest energy, the largest among equals (without edges every
+  // angle costs the cap, and the box that fills the segment wins).
+  int bestKey(size_t s) const {
+    double lowest = 1e300;
+    for (const auto& [k, fit] : fits_[s]) {
+      if (fit.ok) lowest = std::min(lowest, fit.box.energy);
+    }
+    int key = -1;
+    double area = -1;
+    for (const auto& [k, fit] : fits_[s]) {
+      if (fit.ok && fit.box.energy <= lowest && fit.box.area() > area) area = fit.box.area(), key = k;
+    }
+    return key;
+  }
+
+  const std::vector<Seed>& seeds_;
+  const BoxFitParams& params_;
+  core::Progress* progress_;
+  BoxFitting& out_;
+  cv::Mat inside_, cost_;    // the segment as 0/1, the capped edge distance
+  double resolution_ = 0.0;  // degrees between angle keys
+  // Per seed: the fit at every evaluated angle (key on the resolution grid).
+  std::vector<std::map<int, Fitted>> fits_;
+  std::set<int> done_;  // the angle keys evaluated
+};
+
+}  // namespace
+
+BoxFitting fitSeedBoxes(const cv::Mat& segment, const cv::Mat& edges, const std::vector<Seed>& seeds,
+                        const BoxFitParams& params, const cv::Vec4b& imageBorder, core::Progress* progress) {
+  BoxFitting out;
+  if (seeds.empty()) return out;
+  SeedBoxSweep sweep(segment, edges, seeds, params, imageBorder, progress, out);
+  if (!sweep.quarterTurn() || !sweep.refineBestAngles()) {
+    out.status = core::RunStatus::Canceled;
+    return out;
+  }
+  sweep.keepBestBoxes();
   return out;
 }
 
