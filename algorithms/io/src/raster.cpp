@@ -155,22 +155,26 @@ void checkDeclaredSize(GDALDatasetH ds, int width, int height, int bands, int de
   }
 }
 
-}  // namespace
-
-Raster readRaster(const std::string& path, const ReadOptions& options) {
-  detail::ensureGdalRegistered();
-  if (!detail::isVirtualPath(path)) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw Error(ErrorCode::FileNotFound, "no such file", path);
-    if (std::filesystem::is_directory(path, ec)) {
-      throw Error(ErrorCode::UnreadableFile, "is a directory, not a raster file", path);
-    }
+// A path on disk must name a file; GDAL's virtual paths (/vsizip/...) are left to GDAL.
+void requireFileOnDisk(const std::string& path) {
+  if (detail::isVirtualPath(path)) return;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw Error(ErrorCode::FileNotFound, "no such file", path);
+  if (std::filesystem::is_directory(path, ec)) {
+    throw Error(ErrorCode::UnreadableFile, "is a directory, not a raster file", path);
   }
-  detail::ScopedGdalErrors errors;
-  DatasetPtr dataset(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr, nullptr, nullptr));
-  if (!dataset) throw Error(ErrorCode::UnreadableFile, errors.describe("not a readable raster"), path);
-  GDALDatasetH ds = dataset.get();
+}
 
+// What the file declares: its size, its band count and how its pixels are decoded.
+struct RasterShape {
+  int width = 0, height = 0, bands = 0;
+  ReadLayout layout{};
+};
+
+// The file's shape; throws on what readRaster refuses: no band, 2 bands, more than OpenCV's
+// channels, a pixel type it does not decode in the first band or a complex or 64-bit one in
+// another.
+RasterShape checkedShape(GDALDatasetH ds, const std::string& path) {
   const int width = GDALGetRasterXSize(ds);
   const int height = GDALGetRasterYSize(ds);
   const int bands = GDALGetRasterCount(ds);
@@ -190,65 +194,105 @@ Raster readRaster(const std::string& path, const ReadOptions& options) {
     const GDALDataType type = GDALGetRasterDataType(GDALGetRasterBand(ds, b));
     if (GDALDataTypeIsComplex(type) || GDALGetDataTypeSizeBytes(type) > 4) layoutFor(type, path);
   }
+  return {width, height, bands, layout};
+}
 
-  checkDeclaredSize(ds, width, height, bands, layout.depth, options.maxBytes, path);
-
-  Raster raster;
-  raster.path = path;
-  cv::Mat data(height, width, CV_MAKETYPE(layout.depth, bands));
+// Every band's pixels, interleaved, decoded as `shape.layout` says.
+cv::Mat readPixels(GDALDatasetH ds, const RasterShape& shape, detail::ScopedGdalErrors& errors,
+                   const std::string& path) {
+  const int width = shape.width, height = shape.height, bands = shape.bands;
+  cv::Mat data(height, width, CV_MAKETYPE(shape.layout.depth, bands));
   const auto elementBytes = static_cast<GSpacing>(data.elemSize1());
   errors.reset();
   const CPLErr readStatus = GDALDatasetRasterIOEx(
-      ds, GF_Read, 0, 0, width, height, data.data, width, height, layout.gdalType, bands, nullptr,
-      elementBytes * bands, static_cast<GSpacing>(data.step[0]), elementBytes, nullptr);
+      ds, GF_Read, 0, 0, width, height, data.data, width, height, shape.layout.gdalType, bands,
+      nullptr, elementBytes * bands, static_cast<GSpacing>(data.step[0]), elementBytes, nullptr);
   // A truncated TIFF often opens fine (the header is intact) and only fails here.
   if (readStatus != CE_None || errors.failed()) {
     throw Error(ErrorCode::UnreadableFile, errors.describe("pixel data cannot be read (truncated or corrupt)"),
                 path);
   }
+  return data;
+}
 
+// Each band's declared nodata value, if any.
+std::vector<std::optional<double>> bandNodataOf(GDALDatasetH ds, int bands) {
   std::vector<std::optional<double>> bandNodata(static_cast<size_t>(bands));
   for (int b = 1; b <= bands; ++b) {
     int hasNodata = 0;
     const double value = GDALGetRasterNoDataValue(GDALGetRasterBand(ds, b), &hasNodata);
     if (hasNodata) bandNodata[static_cast<size_t>(b - 1)] = value;
   }
-  raster.nodata = bandNodata[0];
+  return bandNodata;
+}
 
+GeoReference georeferenceOf(GDALDatasetH ds) {
+  GeoReference geo;
   double geoTransform[6];
   if (GDALGetGeoTransform(ds, geoTransform) == CE_None) {
-    std::copy(geoTransform, geoTransform + 6, raster.geo.geoTransform.begin());
-    raster.geo.hasTransform = true;
+    std::copy(geoTransform, geoTransform + 6, geo.geoTransform.begin());
+    geo.hasTransform = true;
   }
-  if (const char* wkt = GDALGetProjectionRef(ds); wkt != nullptr) raster.geo.crsWkt = wkt;
+  if (const char* wkt = GDALGetProjectionRef(ds); wkt != nullptr) geo.crsWkt = wkt;
+  return geo;
+}
 
-  // An indexed-colour band only means something as colours when converting to grey; kept as
-  // indices otherwise (label images and masks are often paletted).
-  if (options.toGrey && bands == 1 && layout.depth == CV_8U &&
+// An indexed-colour band only means something as colours when converting to grey; kept as
+// indices otherwise (label images and masks are often paletted). When expanded, the three
+// channels have no nodata value.
+void expandPaletteForGrey(GDALDatasetH ds, const RasterShape& shape, const ReadOptions& options,
+                          cv::Mat& data, std::vector<std::optional<double>>& bandNodata) {
+  GDALRasterBandH first = GDALGetRasterBand(ds, 1);
+  if (options.toGrey && shape.bands == 1 && shape.layout.depth == CV_8U &&
       GDALGetRasterColorInterpretation(first) == GCI_PaletteIndex) {
     if (GDALColorTableH table = GDALGetRasterColorTable(first); table != nullptr) {
       data = expandPalette(data, table);
       bandNodata.assign(3, std::nullopt);
     }
   }
+}
 
+// The decoded pixels as `options` asks: as they are, as float (each band's nodata as NaN), or as
+// grey (float, or at the source depth).
+cv::Mat convertedPixels(const cv::Mat& data, const std::vector<std::optional<double>>& bandNodata,
+                        const std::optional<double>& nodata, const ReadOptions& options,
+                        int depth) {
   const bool wantFloat = options.type == PixelType::Float32;
   const bool needsGrey = options.toGrey && data.channels() > 1;
-  if (!wantFloat && !needsGrey) {
-    raster.data = data;
-    return raster;
-  }
+  if (!wantFloat && !needsGrey) return data;
   cv::Mat asFloat = toFloatWithNaN(data, bandNodata);
   if (needsGrey) asFloat = greyFromFloat(asFloat);
-  if (wantFloat) {
-    raster.data = asFloat;
-    return raster;
-  }
+  if (wantFloat) return asFloat;
   // Keep the source depth for grey output: nodata pixels get the nodata value back.
-  if (raster.nodata && !std::isnan(*raster.nodata)) {
-    asFloat.setTo(*raster.nodata, core::nanMask(asFloat));
+  if (nodata && !std::isnan(*nodata)) {
+    asFloat.setTo(*nodata, core::nanMask(asFloat));
   }
-  asFloat.convertTo(raster.data, layout.depth);
+  cv::Mat grey;
+  asFloat.convertTo(grey, depth);
+  return grey;
+}
+
+}  // namespace
+
+Raster readRaster(const std::string& path, const ReadOptions& options) {
+  detail::ensureGdalRegistered();
+  requireFileOnDisk(path);
+  detail::ScopedGdalErrors errors;
+  DatasetPtr dataset(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr, nullptr, nullptr));
+  if (!dataset) throw Error(ErrorCode::UnreadableFile, errors.describe("not a readable raster"), path);
+  GDALDatasetH ds = dataset.get();
+  const RasterShape shape = checkedShape(ds, path);
+  checkDeclaredSize(ds, shape.width, shape.height, shape.bands, shape.layout.depth,
+                    options.maxBytes, path);
+
+  Raster raster;
+  raster.path = path;
+  cv::Mat data = readPixels(ds, shape, errors, path);
+  std::vector<std::optional<double>> bandNodata = bandNodataOf(ds, shape.bands);
+  raster.nodata = bandNodata[0];
+  raster.geo = georeferenceOf(ds);
+  expandPaletteForGrey(ds, shape, options, data, bandNodata);
+  raster.data = convertedPixels(data, bandNodata, raster.nodata, options, shape.layout.depth);
   return raster;
 }
 
