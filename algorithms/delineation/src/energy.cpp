@@ -515,97 +515,142 @@ double PolygonEnergy::delta(const Change& c) const {
   return d;
 }
 
-bool PolygonEnergy::valid(const Change& c) const {
-  const IntRing& ring = polygon_.ring(c.ring);
-  const int n = static_cast<int>(ring.size());
-  const int m = static_cast<int>(c.inserted.size());
-  const int newN = n - c.removeCount + m;
-  if (newN < 3) return false;
-  for (const auto& v : c.inserted) {
-    if (v.x < 0 || v.y < 0 || v.x > size_.width || v.y > size_.height) return false;
-    if (!images_.allowed.empty()) {
+namespace {
+
+// The steps of PolygonEnergy::valid(), in the order it runs them. `nr` is the changed ring of
+// `after`, its changed edges start at the vertices `changedEdges`.
+
+// Every inserted vertex within [0, W] x [0, H] and, with a mask, at a corner of an allowed pixel.
+inline bool insertedVerticesAllowed(const std::vector<cv::Point>& inserted, cv::Size size,
+                                    const cv::Mat& allowed) {
+  for (const auto& v : inserted) {
+    if (v.x < 0 || v.y < 0 || v.x > size.width || v.y > size.height) return false;
+    if (!allowed.empty()) {
       bool near = false;
-      for (int y = std::max(v.y - 1, 0); y <= std::min(v.y, size_.height - 1) && !near; ++y) {
-        for (int x = std::max(v.x - 1, 0); x <= std::min(v.x, size_.width - 1) && !near; ++x) {
-          near = images_.allowed.at<uchar>(y, x) != 0;
+      for (int y = std::max(v.y - 1, 0); y <= std::min(v.y, size.height - 1) && !near; ++y) {
+        for (int x = std::max(v.x - 1, 0); x <= std::min(v.x, size.width - 1) && !near; ++x) {
+          near = allowed.at<uchar>(y, x) != 0;
         }
       }
       if (!near) return false;
     }
   }
-  const IntPolygon after = changed(c);
-  const IntRing& nr = after.ring(c.ring);
-  // In `nr` the inserted run starts at `start`; the changed edges start at start-1 .. start+m-1.
-  const int start = c.first + c.removeCount <= n ? c.first : 0;
-  std::vector<int> changedEdges;
-  for (int i = -1; i < m; ++i) changedEdges.push_back(((start + i) % newN + newN) % newN);
+  return true;
+}
+
+// A changed edge that is empty, folds back on a neighbour or touches another edge of any ring.
+inline bool changedEdgesTouch(const IntPolygon& after, int changedRing,
+                              const std::vector<int>& changedEdges) {
+  const IntRing& nr = after.ring(changedRing);
+  const int newN = static_cast<int>(nr.size());
   for (int e : changedEdges) {
     const cv::Point a = nr[e], b = nr[(e + 1) % newN];
-    if (a == b) return false;
+    if (a == b) return true;
     for (int j = 0; j < newN; ++j) {
       if (j == e) continue;
       const cv::Point p = nr[j], q = nr[(j + 1) % newN];
       if (j == (e + 1) % newN) {  // shares b
-        if (adjacentOverlap(b, a, q)) return false;
+        if (adjacentOverlap(b, a, q)) return true;
       } else if ((j + 1) % newN == e) {  // shares a
-        if (adjacentOverlap(a, b, p)) return false;
+        if (adjacentOverlap(a, b, p)) return true;
       } else if (segmentsTouch(a, b, p, q)) {
-        return false;
+        return true;
       }
     }
     for (size_t r = 0; r < after.ringCount(); ++r) {
-      if (static_cast<int>(r) == c.ring) continue;
+      if (static_cast<int>(r) == changedRing) continue;
       const IntRing& other = after.ring(r);
       for (size_t j = 0; j < other.size(); ++j) {
-        if (segmentsTouch(a, b, other[j], other[(j + 1) % other.size()])) return false;
+        if (segmentsTouch(a, b, other[j], other[(j + 1) % other.size()])) return true;
       }
     }
   }
-  const double before = ringArea2(ring), now = ringArea2(nr);
-  if (now == 0 || (before > 0) != (now > 0)) return false;
-  // Shape limits: no spike tip sharper than minAngle (unless the sharpest angle around the
-  // change gets blunter, so that a sharp initial polygon can still improve) and no finger or
-  // slit narrower than minGap.
-  if (weights_.minAngle > 0) {
-    double oldMin = CV_PI, newMin = CV_PI;
-    for (int i = -1; i <= c.removeCount; ++i) {
-      const int k = ((c.first + i) % n + n) % n;
-      oldMin = std::min(oldMin, vertexAngle(ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n]));
-    }
-    for (int i = -1; i <= m; ++i) {
-      const int k = ((start + i) % newN + newN) % newN;
-      newMin = std::min(newMin, vertexAngle(nr[(k + newN - 1) % newN], nr[k], nr[(k + 1) % newN]));
-    }
-    if (newMin < weights_.minAngle * CV_PI / 180.0 && newMin < oldMin) return false;
+  return false;
+}
+
+// The change leaves a vertex around it sharper than `minAngle` degrees and sharper than the
+// sharpest one there before (a sharp initial polygon can still improve). The inserted run
+// starts at `start` in `nr`.
+inline bool sharperSpike(const IntRing& ring, const PolygonEnergy::Change& c, const IntRing& nr,
+                         int start, double minAngle) {
+  const int n = static_cast<int>(ring.size());
+  const int m = static_cast<int>(c.inserted.size());
+  const int newN = static_cast<int>(nr.size());
+  double oldMin = CV_PI, newMin = CV_PI;
+  for (int i = -1; i <= c.removeCount; ++i) {
+    const int k = ((c.first + i) % n + n) % n;
+    oldMin = std::min(oldMin, vertexAngle(ring[(k + n - 1) % n], ring[k], ring[(k + 1) % n]));
   }
-  if (weights_.minGap > 0) {
-    for (int e : changedEdges) {
-      const cv::Point a = nr[e], b = nr[(e + 1) % newN];
-      for (size_t r = 0; r < after.ringCount(); ++r) {
-        const IntRing& other = after.ring(r);
-        const int k = static_cast<int>(other.size());
-        for (int j = 0; j < k; ++j) {
-          if (static_cast<int>(r) == c.ring && (j == e || j == (e + 1) % newN || (j + 1) % newN == e)) continue;
-          if (antiparallelWithin(a, b, other[j], other[(j + 1) % k], weights_.minGap)) return false;
-        }
+  for (int i = -1; i <= m; ++i) {
+    const int k = ((start + i) % newN + newN) % newN;
+    newMin = std::min(newMin, vertexAngle(nr[(k + newN - 1) % newN], nr[k], nr[(k + 1) % newN]));
+  }
+  return newMin < minAngle * CV_PI / 180.0 && newMin < oldMin;
+}
+
+// A changed edge closer than `minGap` to a non-adjacent edge pointing the opposite way: a
+// finger or slit.
+inline bool narrowGap(const IntPolygon& after, int changedRing,
+                      const std::vector<int>& changedEdges, double minGap) {
+  const IntRing& nr = after.ring(changedRing);
+  const int newN = static_cast<int>(nr.size());
+  for (int e : changedEdges) {
+    const cv::Point a = nr[e], b = nr[(e + 1) % newN];
+    for (size_t r = 0; r < after.ringCount(); ++r) {
+      const IntRing& other = after.ring(r);
+      const int k = static_cast<int>(other.size());
+      for (int j = 0; j < k; ++j) {
+        if (static_cast<int>(r) == changedRing && (j == e || j == (e + 1) % newN || (j + 1) % newN == e)) continue;
+        if (antiparallelWithin(a, b, other[j], other[(j + 1) % k], minGap)) return true;
       }
     }
   }
-  // A ring may jump over a whole small ring without crossing it: keep holes inside the outer
-  // ring and outside each other.
-  if (c.ring == 0) {
+  return false;
+}
+
+// A ring may jump over a whole small ring without crossing it: keep holes inside the outer
+// ring and outside each other.
+inline bool ringsStayNested(const IntPolygon& after, int changedRing) {
+  const IntRing& nr = after.ring(changedRing);
+  if (changedRing == 0) {
     for (const auto& h : after.holes) {
       if (!insideRing(nr, cv::Point2d(h[0]))) return false;
     }
   } else {
     if (!insideRing(after.outer, cv::Point2d(nr[0]))) return false;
     for (size_t r = 1; r < after.ringCount(); ++r) {
-      if (static_cast<int>(r) == c.ring) continue;
+      if (static_cast<int>(r) == changedRing) continue;
       if (insideRing(nr, cv::Point2d(after.ring(r)[0]))) return false;
       if (insideRing(after.ring(r), cv::Point2d(nr[0]))) return false;
     }
   }
   return true;
+}
+
+}  // namespace
+
+bool PolygonEnergy::valid(const Change& c) const {
+  const IntRing& ring = polygon_.ring(c.ring);
+  const int n = static_cast<int>(ring.size());
+  const int m = static_cast<int>(c.inserted.size());
+  const int newN = n - c.removeCount + m;
+  if (newN < 3) return false;
+  if (!insertedVerticesAllowed(c.inserted, size_, images_.allowed)) return false;
+  const IntPolygon after = changed(c);
+  const IntRing& nr = after.ring(c.ring);
+  // In `nr` the inserted run starts at `start`; the changed edges start at start-1 .. start+m-1.
+  const int start = c.first + c.removeCount <= n ? c.first : 0;
+  std::vector<int> changedEdges;
+  for (int i = -1; i < m; ++i) changedEdges.push_back(((start + i) % newN + newN) % newN);
+  if (changedEdgesTouch(after, c.ring, changedEdges)) return false;
+  const double before = ringArea2(ring), now = ringArea2(nr);
+  if (now == 0 || (before > 0) != (now > 0)) return false;
+  // Shape limits: no spike tip sharper than minAngle (unless the sharpest angle around the
+  // change gets blunter, so that a sharp initial polygon can still improve) and no finger or
+  // slit narrower than minGap.
+  if (weights_.minAngle > 0 && sharperSpike(ring, c, nr, start, weights_.minAngle)) return false;
+  if (weights_.minGap > 0 && narrowGap(after, c.ring, changedEdges, weights_.minGap)) return false;
+  return ringsStayNested(after, c.ring);
 }
 
 void PolygonEnergy::apply(const Change& c) {
