@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace delineo::delineation {
 
@@ -426,51 +427,46 @@ IntPolygon PolygonEnergy::changed(const Change& c) const {
   return out;
 }
 
-double PolygonEnergy::delta(const Change& c) const {
-  const IntRing& ring = polygon_.ring(c.ring);
-  const int n = static_cast<int>(ring.size());
-  const int m = static_cast<int>(c.inserted.size());
-  if (n - c.removeCount + m < 3) return std::numeric_limits<double>::infinity();
-  auto at = [&](int i) { return ring[((c.first + i) % n + n) % n]; };
-  const int offset = ringOffset_[c.ring];
-  auto idOf = [&](int i) { return offset + ((c.first + i) % n + n) % n; };
+namespace {
 
-  // New local chain: prev2, prev, inserted..., next, next2.
-  DeltaScratch& s = scratch_;
-  std::vector<cv::Point>& chain = s.chain;
+// The steps of PolygonEnergy::delta() that need none of its state, in the order it runs them.
+
+// The change's new local chain: prev2, prev, inserted..., next, next2.
+inline void newLocalChain(const IntRing& ring, const PolygonEnergy::Change& c,
+                          std::vector<cv::Point>& chain) {
+  const int n = static_cast<int>(ring.size());
+  auto at = [&](int i) { return ring[((c.first + i) % n + n) % n]; };
   chain.clear();
   chain.push_back(at(-2));
   chain.push_back(at(-1));
   for (const auto& v : c.inserted) chain.push_back(v);
   chain.push_back(at(c.removeCount));
   chain.push_back(at(c.removeCount + 1));
+}
 
-  double d = 0.0;
-  // Old edges: first vertex at -1 .. removeCount-1; old priors at -1 .. removeCount.
-  std::vector<int>& oldEdges = s.oldEdges;
+// Ids of the old edges (first vertex at -1 .. removeCount-1) and of the vertices whose prior
+// changes (-1 .. removeCount), each sorted without repeats. `offset`: the ring's first id.
+inline void replacedIds(const PolygonEnergy::Change& c, int n, int offset,
+                        std::vector<int>& oldEdges, std::vector<int>& oldVertices) {
+  auto idOf = [&](int i) { return offset + ((c.first + i) % n + n) % n; };
   oldEdges.clear();
   for (int i = -1; i < c.removeCount; ++i) oldEdges.push_back(idOf(i));
   std::sort(oldEdges.begin(), oldEdges.end());
   oldEdges.erase(std::unique(oldEdges.begin(), oldEdges.end()), oldEdges.end());
-  std::vector<int>& oldVertices = s.oldVertices;
   oldVertices.clear();
   for (int i = -1; i <= c.removeCount; ++i) oldVertices.push_back(idOf(i));
   std::sort(oldVertices.begin(), oldVertices.end());
   oldVertices.erase(std::unique(oldVertices.begin(), oldVertices.end()), oldVertices.end());
-  for (int e : oldEdges) d -= edgeTerms_[e][0] + edgeTerms_[e][1];
-  for (int v : oldVertices) d -= vertexPriors_[v];
-  // New edges chain[1]→chain[2] ... chain[m+1]→chain[m+2]; new priors at chain[1..m+2].
-  for (int i = 1; i <= m + 1; ++i) {
-    const auto& e = edgeTerms(chain[i], chain[i + 1], ringInwardLeft_[c.ring]);
-    d += e[0] + e[1];
-  }
-  for (int i = 1; i <= m + 2; ++i) {
-    d += weights_.rigidity * anglePrior(vertexAngle(chain[i - 1], chain[i], chain[i + 1]));
-  }
+}
 
-  // Area terms: rows crossed by an old or a new edge. Both chains run from at(-1) to
-  // at(removeCount) without a break, so together they cross exactly the rows between the lowest
-  // and the highest of their vertices.
+// Rows crossed by an old or a new edge, [yLow, yHigh) within the image. Both chains run from
+// at(-1) to at(removeCount) without a break, so together they cross exactly the rows between
+// the lowest and the highest of their vertices.
+inline std::pair<int, int> changedRows(const IntRing& ring, const PolygonEnergy::Change& c,
+                                       const std::vector<cv::Point>& chain, int height) {
+  const int n = static_cast<int>(ring.size());
+  const int m = static_cast<int>(c.inserted.size());
+  auto at = [&](int i) { return ring[((c.first + i) % n + n) % n]; };
   int yLow = chain[1].y, yHigh = chain[1].y;
   for (int i = 0; i <= c.removeCount; ++i) {
     yLow = std::min(yLow, at(i).y);
@@ -481,24 +477,63 @@ double PolygonEnergy::delta(const Change& c) const {
     yHigh = std::max(yHigh, chain[i].y);
   }
   yLow = std::max(yLow, 0);
-  yHigh = std::min(yHigh, size_.height);
-  if (yLow >= yHigh) return d;
-  // New crossings bucketed by row (counting sort: start offsets per row, then fill).
+  yHigh = std::min(yHigh, height);
+  return {yLow, yHigh};
+}
+
+// The new edges' crossings with rows [yLow, yHigh), bucketed by row (counting sort: start
+// offsets per row, then fill). On return start[r] points past row r's crossings in `addedX`;
+// row r's begin at start[r - 1] (0 for r = 0).
+inline void bucketNewCrossings(const std::vector<cv::Point>& chain, int m, int yLow, int yHigh,
+                               int height, std::vector<int>& start, std::vector<double>& addedX) {
   const int rowCount = yHigh - yLow;
-  std::vector<int>& start = s.addedCount;
   start.assign(static_cast<size_t>(rowCount) + 1, 0);
   for (int i = 1; i <= m + 1; ++i) {
-    forEachCrossing(chain[i], chain[i + 1], size_.height, [&](int y, double) { ++start[y - yLow + 1]; });
+    forEachCrossing(chain[i], chain[i + 1], height, [&](int y, double) { ++start[y - yLow + 1]; });
   }
   for (int r = 0; r < rowCount; ++r) start[r + 1] += start[r];
-  std::vector<double>& addedX = s.addedX;
   addedX.resize(static_cast<size_t>(start[rowCount]));
   for (int i = 1; i <= m + 1; ++i) {
-    forEachCrossing(chain[i], chain[i + 1], size_.height, [&](int y, double x) {
+    forEachCrossing(chain[i], chain[i + 1], height, [&](int y, double x) {
       addedX[static_cast<size_t>(start[y - yLow]++)] = x;
     });
   }
-  // start[r] now points past row r's crossings; row r's begin at start[r - 1] (0 for r = 0).
+}
+
+}  // namespace
+
+// The two steps of delta() that use its state are always inlined into it, as when they were its
+// body: delta() runs for every candidate of the optimiser.
+
+// Edge terms and priors: the old ones out, the new ones in. Old edges and priors from
+// scratch_'s ids; new edges chain[1]→chain[2] ... chain[m+1]→chain[m+2]; new priors at
+// chain[1..m+2].
+__attribute__((always_inline)) inline double PolygonEnergy::contourDelta(const Change& c) const {
+  const DeltaScratch& s = scratch_;
+  const std::vector<cv::Point>& chain = s.chain;
+  const int m = static_cast<int>(c.inserted.size());
+  double d = 0.0;
+  for (int e : s.oldEdges) d -= edgeTerms_[e][0] + edgeTerms_[e][1];
+  for (int v : s.oldVertices) d -= vertexPriors_[v];
+  for (int i = 1; i <= m + 1; ++i) {
+    const auto& e = edgeTerms(chain[i], chain[i + 1], ringInwardLeft_[c.ring]);
+    d += e[0] + e[1];
+  }
+  for (int i = 1; i <= m + 2; ++i) {
+    d += weights_.rigidity * anglePrior(vertexAngle(chain[i - 1], chain[i], chain[i + 1]));
+  }
+  return d;
+}
+
+// Each row of [yLow, yHigh) re-evaluated with its old crossings of the replaced edges swapped
+// for the new ones, its change added to `d` (row by row, in this order: the sum's rounding is
+// part of the result).
+__attribute__((always_inline)) inline void PolygonEnergy::addRowChanges(int yLow, int yHigh,
+                                                                        double& d) const {
+  DeltaScratch& s = scratch_;
+  const std::vector<int>& oldEdges = s.oldEdges;
+  const std::vector<int>& start = s.addedCount;
+  const std::vector<double>& addedX = s.addedX;
   std::vector<double>& xs = s.xs;
   for (int y = yLow; y < yHigh; ++y) {
     xs.clear();
@@ -512,6 +547,22 @@ double PolygonEnergy::delta(const Change& c) const {
     const RowTerms& before = rowTerms_[y];
     d += (now.roof - before.roof) + (now.ground - before.ground) + (now.band - before.band);
   }
+}
+
+double PolygonEnergy::delta(const Change& c) const {
+  const IntRing& ring = polygon_.ring(c.ring);
+  const int n = static_cast<int>(ring.size());
+  const int m = static_cast<int>(c.inserted.size());
+  if (n - c.removeCount + m < 3) return std::numeric_limits<double>::infinity();
+  DeltaScratch& s = scratch_;
+  newLocalChain(ring, c, s.chain);
+  replacedIds(c, n, ringOffset_[c.ring], s.oldEdges, s.oldVertices);
+  double d = contourDelta(c);
+  // Area terms: rows crossed by an old or a new edge.
+  const auto [yLow, yHigh] = changedRows(ring, c, s.chain, size_.height);
+  if (yLow >= yHigh) return d;
+  bucketNewCrossings(s.chain, m, yLow, yHigh, size_.height, s.addedCount, s.addedX);
+  addRowChanges(yLow, yHigh, d);
   return d;
 }
 

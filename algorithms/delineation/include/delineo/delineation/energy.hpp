@@ -146,6 +146,10 @@ class PolygonEnergy {
   const std::array<double, 2>& edgeTerms(cv::Point a, cv::Point b, bool inwardLeft) const;
   double vertexPrior(const IntRing& ring, int i) const;
   void rebuild();
+  // Steps of delta() on scratch_: the change of the edge terms and priors, and the rows'
+  // changes added to `d`.
+  double contourDelta(const Change& c) const;
+  void addRowChanges(int yLow, int yHigh, double& d) const;
 
   EnergyImages images_;
   EnergyWeights weights_;
