@@ -79,7 +79,9 @@ void appendBoxes(const boxfit::BoxFitBuilding& b, long long id, cv::Size size, s
   }
 }
 
-int run(const std::vector<std::string>& args) {
+// The command's flags: the image, the heights (a DEM, or a disparity map and its scale), the
+// initial polygons (or rectangle), the outputs, and every box-fitting parameter.
+cli::Options boxfitOptions() {
   cli::Options opts("boxfit",
                     "Delineates buildings by box-fitting: the building segment from a DEM on the left "
                     "image's grid, chains of boxes fitted to the image's edges, merged into one outline.\n"
@@ -97,6 +99,76 @@ int run(const std::vector<std::string>& args) {
       .value("boxes", "FILE", "also write the fitted boxes (one polygon each, with building_id)")
       .flag("quiet", "no progress on stderr")
       .params(boxfit::BoxFitParams{});
+  return opts;
+}
+
+// What every building is fitted on.
+struct Fitting {
+  const cv::Mat& heights;
+  const cv::Mat& image;
+  const boxfit::BoxFitParams& params;
+};
+
+// The outlines and boxes to write, and how the run went.
+struct Results {
+  std::vector<core::Feature> outlines, boxes;
+  int failed = 0;
+  bool canceled = false;
+};
+
+// Whole image: every segment; nothing found is a processing failure.
+void fitWholeImage(const Fitting& fitting, const std::string& imagePath, core::Progress* progress,
+                   Results& results) {
+  const auto r = boxfit::fitBoxes(fitting.heights, fitting.image, {}, fitting.params, progress);
+  results.canceled = r.status == core::RunStatus::Canceled;
+  if (r.buildings.empty() && !results.canceled) {
+    throw core::Error(core::ErrorCode::ProcessingFailed, r.message, imagePath);
+  }
+  long long id = 0;
+  for (const auto& b : r.buildings) {
+    results.outlines.push_back(outlineFeature(b, ++id));
+    appendBoxes(b, id, fitting.image.size(), results.boxes);
+  }
+}
+
+// One building of --init or --roi: its outline and boxes or, in a batch (`single` false), its
+// init marked failed with the error.
+void fitBuilding(const Fitting& fitting, const core::Feature& init, long long id, bool single,
+                 const std::string& initFile, core::Progress* progress, Results& results) {
+  boxfit::BoxFitRequest request;
+  request.init = init.polygon;
+  request.init.holes.clear();
+  std::string error;
+  try {
+    const auto r =
+        boxfit::fitBoxes(fitting.heights, fitting.image, request, fitting.params, progress);
+    results.canceled = r.status == core::RunStatus::Canceled;
+    if (!r.buildings.empty()) {
+      results.outlines.push_back(outlineFeature(r.buildings.front(), id));
+      appendBoxes(r.buildings.front(), id, fitting.image.size(), results.boxes);
+      return;
+    }
+    error = results.canceled ? "canceled" : r.message;
+  } catch (const core::Error& e) {
+    if (single) throw;  // a single building reports its error
+    error = e.detail();
+  }
+  if (results.canceled) return;
+  if (single) throw core::Error(core::ErrorCode::ProcessingFailed, error, initFile);
+  // One building without an outline does not stop the batch: its init is written, marked.
+  ++results.failed;
+  core::Feature f;
+  f.polygon = request.init;
+  f.attributes["id"] = id;
+  f.attributes["method"] = std::string("box-fitting");
+  f.attributes["status"] = std::string("failed");
+  f.attributes["error"] = error;
+  results.outlines.push_back(std::move(f));
+  std::fprintf(stderr, "building %lld: %s\n", id, error.c_str());
+}
+
+int run(const std::vector<std::string>& args) {
+  cli::Options opts = boxfitOptions();
   if (!opts.parse(args)) return cli::kExitOk;
   boxfit::BoxFitParams params;
   opts.apply(params);
@@ -115,65 +187,26 @@ int run(const std::vector<std::string>& args) {
   std::vector<long long> ids;
   for (size_t i = 0; i < inits.size(); ++i) ids.push_back(cli::featureId(inits[i], i, initFile));
 
-  std::vector<core::Feature> outlines, boxes;
-  int failed = 0;
-  bool canceled = false;
-  if (inits.empty()) {
-    // Whole image: every segment; nothing found is a processing failure.
-    const auto r = boxfit::fitBoxes(heights, image, {}, params, &progress);
-    canceled = r.status == core::RunStatus::Canceled;
-    if (r.buildings.empty() && !canceled) throw core::Error(core::ErrorCode::ProcessingFailed, r.message, opts.get("image"));
-    long long id = 0;
-    for (const auto& b : r.buildings) {
-      outlines.push_back(outlineFeature(b, ++id));
-      appendBoxes(b, id, image.size(), boxes);
-    }
-  }
+  const Fitting fitting{heights, image, params};
+  Results results;
+  if (inits.empty()) fitWholeImage(fitting, opts.get("image"), &progress, results);
   const size_t count = inits.size();
-  for (size_t i = 0; i < count && !canceled; ++i) {
-    const long long id = ids[i];
+  for (size_t i = 0; i < count && !results.canceled; ++i) {
     progress.setStage("building " + std::to_string(i + 1) + "/" + std::to_string(count));
     core::Progress::Range range(&progress, double(i) / count, double(i + 1) / count);
-    boxfit::BoxFitRequest request;
-    request.init = inits[i].polygon;
-    request.init.holes.clear();
-    std::string error;
-    try {
-      const auto r = boxfit::fitBoxes(heights, image, request, params, &range);
-      canceled = r.status == core::RunStatus::Canceled;
-      if (!r.buildings.empty()) {
-        outlines.push_back(outlineFeature(r.buildings.front(), id));
-        appendBoxes(r.buildings.front(), id, image.size(), boxes);
-        continue;
-      }
-      error = canceled ? "canceled" : r.message;
-    } catch (const core::Error& e) {
-      if (count == 1) throw;  // a single building reports its error
-      error = e.detail();
-    }
-    if (canceled) break;
-    if (count == 1) throw core::Error(core::ErrorCode::ProcessingFailed, error, initFile);
-    // One building without an outline does not stop the batch: its init is written, marked.
-    ++failed;
-    core::Feature f;
-    f.polygon = request.init;
-    f.attributes["id"] = id;
-    f.attributes["method"] = std::string("box-fitting");
-    f.attributes["status"] = std::string("failed");
-    f.attributes["error"] = error;
-    outlines.push_back(std::move(f));
-    std::fprintf(stderr, "building %lld: %s\n", id, error.c_str());
+    fitBuilding(fitting, inits[i], ids[i], count == 1, initFile, &range, results);
   }
-  io::writeFeatures(opts.get("out"), outlines, geo, "buildings");
-  if (opts.has("boxes")) io::writeFeatures(opts.get("boxes"), boxes, geo, "boxes");
+  io::writeFeatures(opts.get("out"), results.outlines, geo, "buildings");
+  if (opts.has("boxes")) io::writeFeatures(opts.get("boxes"), results.boxes, geo, "boxes");
   progress.report(1.0);
   progress.finish();
-  if (canceled) throw cli::Canceled();
+  if (results.canceled) throw cli::Canceled();
   if (!quiet) {
-    std::fprintf(stderr, "boxfit: %zu outline(s), %zu box(es), %d failed, written to %s\n", outlines.size() - failed,
-                 boxes.size(), failed, opts.get("out").c_str());
+    std::fprintf(stderr, "boxfit: %zu outline(s), %zu box(es), %d failed, written to %s\n",
+                 results.outlines.size() - results.failed, results.boxes.size(), results.failed,
+                 opts.get("out").c_str());
   }
-  return failed > 0 ? cli::kExitProcessing : cli::kExitOk;
+  return results.failed > 0 ? cli::kExitProcessing : cli::kExitOk;
 }
 
 const bool registered =
