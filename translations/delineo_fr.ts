@@ -231,10 +231,6 @@
         <translation>Tolérance de la région</translation>
     </message>
     <message>
-        <source>Region right angles</source>
-        <translation>Angles droits de la région</translation>
-    </message>
-    <message>
         <source>Cost aggregation</source>
         <translation>Agrégation des coûts</translation>
     </message>
@@ -293,10 +289,6 @@
     <message>
         <source>Disparity map cost</source>
         <translation>Coût de la carte de disparité</translation>
-    </message>
-    <message>
-        <source>Band best cost</source>
-        <translation>Coût de bande selon l’appariement</translation>
     </message>
     <message>
         <source>Square windows on one surface</source>

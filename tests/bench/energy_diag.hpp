@@ -113,8 +113,7 @@ inline void diagnose(const EnergyImages& im, const cv::Mat& excluded, const IntP
       const int a = lt.at<uchar>(y, x), b = lr.at<uchar>(y, x);
       if (a == b) continue;
       const double cr = im.roofCost.at<float>(y, x), cg = im.groundCost.at<float>(y, x);
-      const double cb = im.bandCost.empty() ? nmc : im.bandCost.at<float>(y, x);
-      auto cost = [&](int l) { return l == kRoof ? cr : l == kBand ? cb : cg; };
+      auto cost = [&](int l) { return l == kRoof ? cr : l == kBand ? nmc : cg; };
       const double d = cost(a) - cost(b);
       const bool in = inside.at<uchar>(y, x) != 0;
       // Distance in px from the pixel centre to the true outline (approx: transform value - 0.5).

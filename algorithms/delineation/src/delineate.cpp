@@ -104,62 +104,6 @@ void normaliseBy99(cv::Mat& gx, cv::Mat& gy) {
   }
 }
 
-// The outline with every edge snapped to the dominant orientation or its perpendicular (length
-// weighted mean of 4·angle): consecutive edges along the same axis merge into one line at their
-// length-weighted mean offset; vertices are the intersections of consecutive lines. Empty when
-// fewer than four lines remain. Buildings are mostly right-angled; a noisy region outline is not.
-core::Ring rightAngled(const std::vector<cv::Point>& outline) {
-  const size_t n = outline.size();
-  if (n < 4) return {};
-  double s4 = 0, c4 = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const cv::Point2d e = cv::Point2d(outline[(i + 1) % n] - outline[i]);
-    const double len = std::hypot(e.x, e.y);
-    s4 += len * std::sin(4 * std::atan2(e.y, e.x));
-    c4 += len * std::cos(4 * std::atan2(e.y, e.x));
-  }
-  const double theta = 0.25 * std::atan2(s4, c4), ct = std::cos(theta), st = std::sin(theta);
-  struct Line {
-    int axis;  // 0: along u (v constant), 1: along v (u constant)
-    double weight, sum;
-  };
-  std::vector<Line> edges;
-  for (size_t i = 0; i < n; ++i) {
-    const cv::Point2d a(outline[i]), b(outline[(i + 1) % n]);
-    const double du = (b.x - a.x) * ct + (b.y - a.y) * st, dv = -(b.x - a.x) * st + (b.y - a.y) * ct;
-    const double len = std::hypot(du, dv);
-    if (len < 1e-9) continue;
-    const int axis = std::abs(du) >= std::abs(dv) ? 0 : 1;
-    const cv::Point2d mid = 0.5 * (a + b);
-    const double offset = axis == 0 ? -mid.x * st + mid.y * ct : mid.x * ct + mid.y * st;
-    edges.push_back({axis, len, len * offset});
-  }
-  // Start at an axis change so that no group wraps around.
-  size_t start = 0;
-  while (start < edges.size() && edges[start].axis == edges[(start + edges.size() - 1) % edges.size()].axis) ++start;
-  if (start == edges.size()) return {};
-  std::vector<Line> lines;
-  for (size_t k = 0; k < edges.size(); ++k) {
-    const Line& e = edges[(start + k) % edges.size()];
-    if (!lines.empty() && lines.back().axis == e.axis) {
-      lines.back().weight += e.weight;
-      lines.back().sum += e.sum;
-    } else {
-      lines.push_back(e);
-    }
-  }
-  if (lines.size() < 4 || lines.size() % 2 != 0) return {};
-  core::Ring ring;
-  for (size_t g = 0; g < lines.size(); ++g) {
-    const Line& a = lines[g];
-    const Line& b = lines[(g + 1) % lines.size()];
-    const double u = a.axis == 1 ? a.sum / a.weight : b.sum / b.weight;
-    const double v = a.axis == 0 ? a.sum / a.weight : b.sum / b.weight;
-    ring.emplace_back(u * ct - v * st, u * st + v * ct);
-  }
-  return ring;
-}
-
 // Region stage: inside the initial contour, the pixels whose roof interval matches better than
 // the ground's on average over 9x9 pixels (opened 3x3, closed 7x7); the outline of the largest
 // component, simplified at a few tolerances and polygonised. Carves the notches of concave
@@ -193,18 +137,10 @@ std::vector<IntPolygon> regionStageCandidates(const EnergyImages& im, const cv::
     core::Ring ring;
     // Contour points are pixel centres of border pixels: their corners are half a pixel out.
     for (const auto& v : simplified) ring.emplace_back(v.x + 0.5, v.y + 0.5);
-    std::vector<core::Ring> rings{ring};
-    if (params.regionRightAngles) {
-      core::Ring snapped = rightAngled(simplified);
-      for (auto& v : snapped) v += cv::Point2d(0.5, 0.5);
-      if (!snapped.empty() && core::isSimple(snapped)) rings.push_back(std::move(snapped));
-    }
-    for (const auto& r : rings) {
-      IntPolygon p;
-      p.outer = polygonise(r, params.initialSpacing, im.roofCost.size());
-      if (p.outer.size() < 3 || !isValidPolygon(p) || core::area(toPolygon(p)) < 4.0) continue;
-      candidates.push_back(std::move(p));
-    }
+    IntPolygon p;
+    p.outer = polygonise(ring, params.initialSpacing, im.roofCost.size());
+    if (p.outer.size() < 3 || !isValidPolygon(p) || core::area(toPolygon(p)) < 4.0) continue;
+    candidates.push_back(std::move(p));
   }
   return candidates;
 }
@@ -631,14 +567,6 @@ PreparedEnergy prepareEnergy(const stereo::CorrelationCostService& costs, const 
   cv::Mat width = cv::abs(dxy - out.groundDisparity);
   width.convertTo(im.occlusionWidth, CV_32S);  // rounds to nearest
   edgeImages(left, right, out.roi, dxy, im);
-  if (params.bandBestCost) {
-    // The band says "this pixel cannot be matched": that must not make a pixel cheaper than its
-    // best explanation as roof or ground. With the constant NoMatchCost alone, the band is a
-    // sink wherever both costs exceed it (textureless roofs, trees, shadowed or neighbouring
-    // ground): the outline shifts so that its band covers them (docs/delineation.md, "Where the
-    // true outline pays more"). Pre-integrable like the other terms (one more prefix sum).
-    im.bandCost = cv::max(cv::min(im.roofCost, im.groundCost), im.noMatchCost);
-  }
   if (params.regionInit) regionStage(initMask, params, out);
   if (params.costCap > 0) capCosts(params, im);
   return out;

@@ -240,7 +240,7 @@ EnergyTerms referenceEnergy(const EnergyImages& im, const EnergyWeights& w,
     const float* cg = im.groundCost.ptr<float>(y);
     for (int x = 0; x < size.width; ++x) {
       if (m[x]) t.term[0] += cr[x];
-      else if (b[x]) t.term[2] += im.bandCost.empty() ? im.noMatchCost : im.bandCost.at<float>(y, x);
+      else if (b[x]) t.term[2] += im.noMatchCost;
       else t.term[1] += cg[x];
     }
   }
@@ -277,15 +277,6 @@ PolygonEnergy::PolygonEnergy(const EnergyImages& images, const EnergyWeights& we
       pg[x + 1] = pg[x] + cg[x];
     }
   }
-  if (!images.bandCost.empty()) {
-    CV_Assert(images.bandCost.type() == CV_32F && images.bandCost.size() == size_);
-    bandPrefix_.assign(roofPrefix_.size(), 0.0);
-    for (int y = 0; y < size_.height; ++y) {
-      const float* cb = images.bandCost.ptr<float>(y);
-      double* pb = &bandPrefix_[static_cast<size_t>(y) * (w + 1)];
-      for (int x = 0; x < w; ++x) pb[x + 1] = pb[x] + cb[x];
-    }
-  }
 }
 
 PolygonEnergy::RowTerms PolygonEnergy::rowTerms(int y, const std::vector<double>& xs) const {
@@ -310,9 +301,8 @@ PolygonEnergy::RowTerms PolygonEnergy::rowTerms(int y, const std::vector<double>
     ++count;
   }
   RowTerms t;
-  double groundOut = 0.0, bandSum = 0.0;
+  double groundOut = 0.0;
   int bandPixels = 0;
-  const double* pb = bandPrefix_.empty() ? nullptr : &bandPrefix_[static_cast<size_t>(y) * (w + 1)];
   for (int k = 0; k < count; ++k) {
     const int l = run[2 * k], r = run[2 * k + 1];
     t.roof += pr[r] - pr[l];
@@ -328,11 +318,10 @@ PolygonEnergy::RowTerms PolygonEnergy::rowTerms(int y, const std::vector<double>
     if (b1 > b0) {
       groundOut += pg[b1] - pg[b0];
       bandPixels += b1 - b0;
-      if (pb) bandSum += pb[b1] - pb[b0];
     }
   }
   t.ground = pg[w] - groundOut;
-  t.band = pb ? bandSum : static_cast<double>(images_.noMatchCost) * bandPixels;
+  t.band = static_cast<double>(images_.noMatchCost) * bandPixels;
   return t;
 }
 

@@ -141,7 +141,6 @@ TEST(Delineate, DoesNotFollowAStrongLineLeavingTheRoof) {
   // The paper's plain terms and moves (per-pixel costs, constant band cost; no gate, shape limits,
   // shortcuts, leash or region stage): the defect is there.
   DelineationParams plain = unleashed;
-  plain.bandBestCost = false;
   plain.edgeContrast = 0;
   plain.minAngle = 0;
   plain.minGap = 0;
@@ -542,31 +541,6 @@ TEST(Delineate, CostCapClipsTheAreaCostsAndKeepsThePlainDifference) {
   EXPECT_GT(maxRoof, cap + 0.05);
   EXPECT_LE(maxRoof, 0.3 + 1e-6);
   EXPECT_EQ(cv::countNonZero((floored.images.roofCost != off.images.roofCost) & (off.images.roofCost < 0.3)), 0);
-}
-
-TEST(Delineate, BandCostIsTheBetterIntervalFlooredAtNoMatchCost) {
-  DelineationParams params;
-  ASSERT_FALSE(params.bandBestCost);  // the default: the paper's constant band cost
-  params.bandBestCost = true;
-  params.costCap = 0;  // the band cost is compared with the uncapped costs below
-  const RaisedRoofCosts c = raisedRoofCosts(params);
-  const PreparedEnergy on = c.prepare(params);
-  ASSERT_FALSE(on.images.bandCost.empty());
-  const cv::Mat expected = cv::max(cv::min(on.images.roofCost, on.images.groundCost), on.images.noMatchCost);
-  EXPECT_EQ(cv::norm(on.images.bandCost, expected, cv::NORM_INF), 0.0);
-  // The wall strip matches neither interval: there the band costs more than NoMatchCost.
-  double maxBand = 0;
-  cv::minMaxLoc(on.images.bandCost, nullptr, &maxBand);
-  EXPECT_GT(maxBand, on.images.noMatchCost);
-  params.bandBestCost = false;
-  const PreparedEnergy off = c.prepare(params);
-  EXPECT_TRUE(off.images.bandCost.empty());
-  // Both runs still find the roof.
-  for (const bool best : {true, false}) {
-    params.bandBestCost = best;
-    const auto result = delineate(c.pair.left, c.pair.right, c.req, params);
-    EXPECT_GT(iou(result.polygon, c.pair.truth, c.pair.left.size()), 0.9) << "band-best-cost " << best;
-  }
 }
 
 TEST(Delineate, RegularizesTheOutlineAsItsLastStage) {

@@ -36,9 +36,6 @@ struct EnergyImages {
   cv::Mat roofCost;       // CV_32F, c_roof = min over the roof interval of Crit
   cv::Mat groundCost;     // CV_32F, c_ground, same size
   float noMatchCost = 1;  // cost of each pixel of the wall/occlusion band
-  // CV_32F, optional: per-pixel cost of the band instead of the constant noMatchCost (see
-  // `band-cost`); empty = noMatchCost everywhere.
-  cv::Mat bandCost;
   // CV_32F, optional: c_ground - c_roof before the costs were capped (`cost-cap`). The edge
   // gate, the region stage and the courtyard seeds read it (a wall or a shadowed floor is told
   // apart by values above the cap); empty = groundCost - roofCost.
@@ -154,7 +151,7 @@ class PolygonEnergy {
   EnergyImages images_;
   EnergyWeights weights_;
   cv::Size size_;
-  std::vector<double> roofPrefix_, groundPrefix_, bandPrefix_;  // (W + 1) per row (band: when bandCost)
+  std::vector<double> roofPrefix_, groundPrefix_;  // (W + 1) per row
   IntPolygon polygon_;
   std::vector<int> ringOffset_;
   std::vector<bool> ringInwardLeft_;  // per ring: the interior is on the (-dy, dx) side

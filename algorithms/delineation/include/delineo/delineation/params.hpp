@@ -32,14 +32,12 @@ struct DelineationParams {
   double maxExcursion = 8.0;       // px: farthest a vertex may go outside the initial contour
   bool regionInit = true;          // start from the roof-like region inside the init when lower F
   double regionTolerance = 8.0;    // px: coarsest outline simplification of the region stage
-  bool regionRightAngles = false;  // region stage also tries its outlines with right angles
   int costAggregation = 5;         // px, side of the box filter applied to c_roof and c_ground (1 = off)
   double costCap = 1.6;            // × NoMatchCost: c_roof and c_ground capped there for the terms (0 = off)
   double costCapFloor = 0.35;      // Crit units: the cap is never below this
   double intermediateMargin = 0.1; // Crit units: in-between match this much better: not roof (0 = off)
   int intermediateGuard = 1;       // disparities kept off each interval when looking between them
   double mapCost = 0.6;            // Crit units: where the matcher's map has a value, cost of the class it rules out (0 = off)
-  bool bandBestCost = false;       // band pixel costs max(NoMatchCost, min(c_roof, c_ground)) (false = NoMatchCost, the paper)
   RegularizationParams regularization;  // the outline's last stage (its keys start with regularize)
   template <class V>
   void visit(V&& v) {
@@ -151,10 +149,6 @@ struct DelineationParams {
                       "each doubling up to this are tried, the lowest energy is kept",
                       0.5, 64},
       regionTolerance);
-    v(core::ParamInfo{"region-right-angles", "Region right angles", "",
-                      "Region stage also tries each outline with its edges snapped to the dominant "
-                      "orientation or its perpendicular (kept only when its energy is lower)"},
-      regionRightAngles);
     v(core::ParamInfo{"cost-aggregation", "Cost aggregation", "px",
                       "Side of the box filter applied to c_roof and c_ground before the area "
                       "terms (on a textureless roof each pixel's cost is noise, its mean is not; "
@@ -191,11 +185,6 @@ struct DelineationParams {
                       "it: 0 for the class it shows, this for the other (0 = correlation costs only)",
                       0, 1},
       mapCost);
-    v(core::ParamInfo{"band-best-cost", "Band best cost", "",
-                      "A pixel of the occlusion band costs NoMatchCost or, when higher, the lower of "
-                      "c_roof and c_ground there, so that the band is never cheaper than the pixel's "
-                      "best explanation as roof or ground (false = NoMatchCost everywhere, the paper)"},
-      bandBestCost);
     regularization.visit(v);
   }
   void validate() const;
