@@ -28,6 +28,8 @@ namespace {
 constexpr double kMetreScale = 0.001;   // transform unit of x, y in metres and of z: 1 mm
 constexpr double kDegreeScale = 1e-8;   // transform unit of x, y in degrees: about 1 mm
 constexpr double kMaxRoofHeight = 1e4;  // m; a larger "roof height" is not one
+constexpr double kMaxZOffset = 1e5;     // m; a larger elevation of the ground level is not one
+constexpr double kMaxTerrainPoints = 1e7;  // grid points of the terrain; more is a mistaken step
 
 using GridPoint = std::array<long long, 3>;  // a vertex in transform units
 using GridRing = std::vector<std::array<long long, 2>>;
@@ -69,7 +71,9 @@ struct Block {
   std::string name;                       // "building 7", for messages
   std::string key;                        // its City Object id
   std::vector<std::vector<cv::Point2d>> rings;  // outline first, then the holes
-  double height = 0.0;                    // m above the ground
+  double height = 0.0;                    // m, the roof above the ground level
+  double base = 0.0;                      // m, the block's foot above the ground level
+  bool hasBase = false;                   // the base came from the feature (else 0)
 };
 
 std::string formatNumber(double value) {
@@ -87,28 +91,37 @@ std::string buildingNumber(const core::Feature& feature, size_t index) {
   return std::to_string(index + 1);
 }
 
+// A height attribute of the feature (m); nullopt when absent or NaN (the project's "unknown").
+std::optional<double> heightOf(const core::Feature& feature, const std::string& attribute, const std::string& name) {
+  const auto stored = feature.attributes.find(attribute);
+  const bool unknown = stored != feature.attributes.end() && std::holds_alternative<double>(stored->second) &&
+                       std::isnan(std::get<double>(stored->second));
+  if (unknown) return std::nullopt;
+  try {
+    return core::numberProperty(feature, attribute, kMaxRoofHeight);
+  } catch (const Error& e) {
+    throw Error(ErrorCode::InvalidParameter, name + ": " + e.detail());
+  }
+}
+
 // The block of a feature, or the reason it is left out.
 std::optional<Block> blockOf(const core::Feature& feature, size_t index, const OutputFrame& frame,
-                             const std::string& heightAttribute, std::string& leftOutBecause) {
+                             const CityJsonOptions& options, std::string& leftOutBecause) {
   Block block;
   block.feature = &feature;
   block.name = "building " + buildingNumber(feature, index);
   block.key = "building-" + buildingNumber(feature, index);
-  std::optional<double> height;
-  const auto stored = feature.attributes.find(heightAttribute);
-  const bool unknown = stored != feature.attributes.end() && std::holds_alternative<double>(stored->second) &&
-                       std::isnan(std::get<double>(stored->second));  // NaN: the project's "unknown"
-  try {
-    if (!unknown) height = core::numberProperty(feature, heightAttribute, kMaxRoofHeight);
-  } catch (const Error& e) {
-    throw Error(ErrorCode::InvalidParameter, block.name + ": " + e.detail());
-  }
+  const std::optional<double> height = heightOf(feature, options.heightAttribute, block.name);
+  const std::optional<double> base = heightOf(feature, options.baseAttribute, block.name);
   if (!height) {
     leftOutBecause = block.name + ": no roof height";
     return std::nullopt;
   }
-  if (!(std::llround(*height / kMetreScale) > 0)) {
-    leftOutBecause = block.name + ": roof height " + formatNumber(*height) + " m is not above the ground";
+  block.hasBase = base.has_value();
+  block.base = base.value_or(0.0);
+  if (!(std::llround(*height / kMetreScale) > std::llround(block.base / kMetreScale))) {
+    leftOutBecause = block.name + ": roof height " + formatNumber(*height) + " m is not above " +
+                     (base ? "its ground height " + formatNumber(*base) + " m" : std::string("the ground"));
     return std::nullopt;
   }
   block.height = *height;
@@ -176,6 +189,11 @@ class VertexPool {
   std::vector<GridPoint> vertices_;
 };
 
+// The z of a block's foot and top in transform units, the ground level's elevation added.
+struct BlockLevels {
+  long long bottom = 0, top = 0;
+};
+
 // One surface of the solid: `rings` at height `z` (transform units), in their order or reversed.
 Json horizontalSurface(const std::vector<GridRing>& rings, long long z, bool reversed, VertexPool& pool) {
   Json surface = Json::array();
@@ -194,9 +212,10 @@ Json horizontalSurface(const std::vector<GridRing>& rings, long long z, bool rev
 // above, so the material is on the left of every edge: the roof (as is) faces up, the ground
 // (reversed) faces down, and the wall a0 b0 b1 a1 under edge a → b faces to the edge's right,
 // out of the material.
-Json shellOf(const std::vector<GridRing>& rings, long long top, VertexPool& pool, Json& semanticValues) {
+Json shellOf(const std::vector<GridRing>& rings, BlockLevels z, VertexPool& pool, Json& semanticValues) {
+  const long long bottom = z.bottom, top = z.top;
   Json shell = Json::array();
-  shell.push_back(horizontalSurface(rings, 0, true, pool));
+  shell.push_back(horizontalSurface(rings, bottom, true, pool));
   semanticValues.push_back(0);
   shell.push_back(horizontalSurface(rings, top, false, pool));
   semanticValues.push_back(1);
@@ -205,7 +224,7 @@ Json shellOf(const std::vector<GridRing>& rings, long long top, VertexPool& pool
       const auto& a = ring[i];
       const auto& b = ring[(i + 1) % ring.size()];
       Json corners = Json::array();
-      for (const GridPoint& corner : {GridPoint{a[0], a[1], 0}, GridPoint{b[0], b[1], 0}, GridPoint{b[0], b[1], top},
+      for (const GridPoint& corner : {GridPoint{a[0], a[1], bottom}, GridPoint{b[0], b[1], bottom}, GridPoint{b[0], b[1], top},
                                       GridPoint{a[0], a[1], top}}) {
         corners.push_back(pool.indexOf(corner));
       }
@@ -218,14 +237,15 @@ Json shellOf(const std::vector<GridRing>& rings, long long top, VertexPool& pool
   return shell;
 }
 
-Json solidOf(const Block& block, const Grid& grid, VertexPool& pool) {
+Json solidOf(const Block& block, const Grid& grid, double zOffset, VertexPool& pool) {
   std::vector<GridRing> rings;
   for (size_t r = 0; r < block.rings.size(); ++r) {
     const std::string what = block.name + (r == 0 ? "'s outline" : "'s hole " + std::to_string(r));
     rings.push_back(gridRing(block.rings[r], grid, r == 0, what));
   }
   Json values = Json::array();
-  Json shell = shellOf(rings, grid.unitsOf(block.height, 2), pool, values);
+  const BlockLevels levels{grid.unitsOf(block.base + zOffset, 2), grid.unitsOf(block.height + zOffset, 2)};
+  Json shell = shellOf(rings, levels, pool, values);
   Json surfaces = Json::array();
   for (const char* type : {"GroundSurface", "RoofSurface", "WallSurface"}) surfaces.push_back({{"type", type}});
   Json solid;
@@ -252,28 +272,70 @@ Json attributesOf(const Block& block) {
       attributes[name] = nullptr;
     }
   }
-  attributes["measuredHeight"] = block.height;  // CityGML's name: ground to the highest point
+  attributes["measuredHeight"] = block.height - block.base;  // CityGML's name: ground to the highest point
   return attributes;
 }
 
-// The transform's origin: the lower corner of the blocks, on whole units of the frame.
-Grid gridFor(const std::vector<Block>& blocks, bool geographic) {
+// The terrain's grid points: rows and columns 0, step, 2 step, ... of the DTM, at pixel centres.
+struct TerrainGrid {
+  const CityJsonTerrain& terrain;
+  int rows() const { return terrain.heights.empty() ? 0 : (terrain.heights.rows - 1) / terrain.step + 1; }
+  int cols() const { return terrain.heights.empty() ? 0 : (terrain.heights.cols - 1) / terrain.step + 1; }
+  cv::Point2d pixel(int col, int row) const { return {col * terrain.step + 0.5, row * terrain.step + 0.5}; }
+  float height(int col, int row) const { return terrain.heights.at<float>(row * terrain.step, col * terrain.step); }
+  // The grid's four corners in left-image pixels (for the extent of a rotated frame).
+  std::array<cv::Point2d, 4> corners() const {
+    return {pixel(0, 0), pixel(cols() - 1, 0), pixel(0, rows() - 1), pixel(cols() - 1, rows() - 1)};
+  }
+};
+
+void checkTerrain(const CityJsonTerrain& terrain) {
+  if (terrain.heights.empty()) return;
+  if (terrain.heights.type() != CV_32FC1) throw Error(ErrorCode::InvalidParameter, "the terrain's heights must be one float32 band");
+  if (terrain.step < 1) throw Error(ErrorCode::InvalidParameter, "the terrain step must be at least 1 px");
+  const TerrainGrid grid{terrain};
+  const double points = static_cast<double>(grid.rows()) * static_cast<double>(grid.cols());
+  if (points > kMaxTerrainPoints) {
+    throw Error(ErrorCode::InvalidParameter, "a terrain step of " + std::to_string(terrain.step) + " px gives " +
+                                                 formatNumber(points) + " grid points (at most 1e7): take a larger step");
+  }
+}
+
+// The transform's origin: the lower corner of the blocks and the terrain, on whole units of the frame.
+Grid gridFor(const std::vector<Block>& blocks, const TerrainGrid& terrain, const OutputFrame& frame, bool geographic) {
   Grid grid;
   if (geographic) grid.scale[0] = grid.scale[1] = kDegreeScale;
   double minX = INFINITY, minY = INFINITY;
-  for (const auto& block : blocks) {
-    for (const auto& p : block.rings.front()) {
-      if (std::isfinite(p.x)) minX = std::min(minX, p.x);
-      if (std::isfinite(p.y)) minY = std::min(minY, p.y);
-    }
+  std::vector<cv::Point2d> points;
+  for (const auto& block : blocks) points.insert(points.end(), block.rings.front().begin(), block.rings.front().end());
+  if (terrain.rows() > 0) {
+    for (const auto& corner : terrain.corners()) points.push_back(frame.fromPixel(corner));
+  }
+  for (const auto& p : points) {
+    if (std::isfinite(p.x)) minX = std::min(minX, p.x);
+    if (std::isfinite(p.y)) minY = std::min(minY, p.y);
   }
   if (std::isfinite(minX)) grid.translate[0] = std::floor(minX);
   if (std::isfinite(minY)) grid.translate[1] = std::floor(minY);
   return grid;
 }
 
-std::string titleFor(const OutputFrame& frame, const CrsDescription& crs) {
-  std::string title = "Buildings as LoD1 blocks (Delineo): heights in metres above the ground, base at z = 0";
+// What the file holds and what its z are.
+struct ContentDescription {
+  bool bases = false;   // some block stands on its own ground height
+  double zOffset = 0.0;
+  int terrainStep = 0;  // px, 0 without terrain
+};
+
+std::string titleFor(const OutputFrame& frame, const CrsDescription& crs, const ContentDescription& content) {
+  std::string title = "Buildings as LoD1 blocks (Delineo)";
+  title += content.bases ? ", each from the ground next to it to its roof"
+                         : ", each from the ground level to its roof (no ground heights: bases at the ground level)";
+  title += "; z in metres above the height model's ground level";
+  if (content.zOffset != 0.0) title += " + " + formatNumber(content.zOffset) + " m, the ground level's elevation";
+  if (content.terrainStep > 0) {
+    title += "; terrain: TIN of the DTM, one vertex every " + std::to_string(content.terrainStep) + " px";
+  }
   if (!frame.geo.valid()) {
     const std::string size = formatNumber(frame.pixelSize);
     return title + "; local frame in metres, not georeferenced: x = column × " + size + ", y = −row × " + size +
@@ -283,9 +345,10 @@ std::string titleFor(const OutputFrame& frame, const CrsDescription& crs) {
   return title;
 }
 
-Json metadataFor(const OutputFrame& frame, const CrsDescription& crs, const Grid& grid, const VertexPool& pool) {
+Json metadataFor(const OutputFrame& frame, const CrsDescription& crs, const ContentDescription& content,
+                 const Grid& grid, const VertexPool& pool) {
   Json metadata;
-  metadata["title"] = titleFor(frame, crs);
+  metadata["title"] = titleFor(frame, crs, content);
   if (!crs.referenceSystem.empty()) metadata["referenceSystem"] = crs.referenceSystem;
   if (pool.vertices().empty()) return metadata;
   GridPoint low = pool.vertices().front(), high = low;
@@ -305,12 +368,75 @@ Json metadataFor(const OutputFrame& frame, const CrsDescription& crs, const Grid
   return metadata;
 }
 
-Json cityObjectOf(const Block& block, const Grid& grid, VertexPool& pool) {
+Json cityObjectOf(const Block& block, const Grid& grid, double zOffset, VertexPool& pool) {
   Json object;
   object["type"] = "Building";
   object["attributes"] = attributesOf(block);
   object["geometry"] = Json::array();
-  object["geometry"].push_back(solidOf(block, grid, pool));
+  object["geometry"].push_back(solidOf(block, grid, zOffset, pool));
+  return object;
+}
+
+// The grid point's vertex; nullopt where the DTM has no height.
+std::optional<GridPoint> terrainVertex(const TerrainGrid& terrain, int col, int row, const OutputFrame& frame,
+                                       const Grid& grid, double zOffset) {
+  const float height = terrain.height(col, row);
+  if (!std::isfinite(height)) return std::nullopt;
+  const cv::Point2d p = frame.fromPixel(terrain.pixel(col, row));
+  return GridPoint{grid.unitsOf(p.x, 0), grid.unitsOf(p.y, 1), grid.unitsOf(height + zOffset, 2)};
+}
+
+// Twice the area of triangle a b c seen from above: positive when counter-clockwise (facing up).
+double twiceAreaFromAbove(const GridPoint& a, const GridPoint& b, const GridPoint& c) {
+  return static_cast<double>(b[0] - a[0]) * static_cast<double>(c[1] - a[1]) -
+         static_cast<double>(c[0] - a[0]) * static_cast<double>(b[1] - a[1]);
+}
+
+// The terrain's triangles, each facing up: two per grid cell whose four corners have a height.
+Json terrainTriangles(const TerrainGrid& terrain, const OutputFrame& frame, const Grid& grid, double zOffset,
+                      VertexPool& pool, CityJsonSummary& summary) {
+  const int cols = terrain.cols(), rows = terrain.rows();
+  std::vector<std::optional<GridPoint>> vertices;
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < cols; ++col) vertices.push_back(terrainVertex(terrain, col, row, frame, grid, zOffset));
+  }
+  std::vector<bool> used(vertices.size(), false);
+  Json surfaces = Json::array();
+  for (int row = 0; row + 1 < rows; ++row) {
+    for (int col = 0; col + 1 < cols; ++col) {
+      const std::array<size_t, 4> cell{static_cast<size_t>(row * cols + col), static_cast<size_t>(row * cols + col + 1),
+                                       static_cast<size_t>((row + 1) * cols + col + 1), static_cast<size_t>((row + 1) * cols + col)};
+      if (!std::all_of(cell.begin(), cell.end(), [&](size_t i) { return vertices[i].has_value(); })) continue;
+      for (const std::array<size_t, 3>& t : {std::array<size_t, 3>{cell[0], cell[1], cell[2]}, std::array<size_t, 3>{cell[0], cell[2], cell[3]}}) {
+        const double area = twiceAreaFromAbove(*vertices[t[0]], *vertices[t[1]], *vertices[t[2]]);
+        if (area == 0.0) continue;
+        const std::array<size_t, 3> up = area > 0.0 ? t : std::array<size_t, 3>{t[0], t[2], t[1]};
+        Json ring = Json::array();
+        for (size_t i : up) {
+          ring.push_back(pool.indexOf(*vertices[i]));
+          used[i] = true;
+        }
+        Json triangle = Json::array();
+        triangle.push_back(std::move(ring));
+        surfaces.push_back(std::move(triangle));
+      }
+    }
+  }
+  summary.terrainTriangles = static_cast<int>(surfaces.size());
+  summary.terrainVertices = static_cast<int>(std::count(used.begin(), used.end(), true));
+  return surfaces;
+}
+
+Json terrainObjectOf(Json triangles, int step) {
+  Json surface;
+  surface["type"] = "CompositeSurface";
+  surface["lod"] = "1";
+  surface["boundaries"] = std::move(triangles);
+  Json object;
+  object["type"] = "TINRelief";
+  object["attributes"] = {{"grid_step_px", step}};
+  object["geometry"] = Json::array();
+  object["geometry"].push_back(std::move(surface));
   return object;
 }
 
@@ -325,30 +451,54 @@ bool isCityJsonPath(const std::string& path) {
   return endsWith(".city.json") || endsWith(".cityjson");
 }
 
-CityJsonSummary writeCityJson(const std::string& path, const std::vector<core::Feature>& buildings,
-                              const CityJsonOptions& options) {
-  const OutputFrame frame{options.geo, options.localPixelSize};
+namespace {
+// The checks of the options that do not depend on the buildings; a problem names `path`.
+void checkOptions(const CityJsonOptions& options, const OutputFrame& frame, const std::string& path) {
   if (!frame.geo.valid() && !(std::isfinite(frame.pixelSize) && frame.pixelSize > 0.0)) {
     throw Error(ErrorCode::InvalidParameter, "the local frame's pixel size must be a positive number of metres", path);
   }
-  const CrsDescription crs = frame.geo.valid() ? describeCrs(frame.geo.crsWkt) : CrsDescription{};
-  CityJsonSummary summary;
+  if (!(std::abs(options.zOffset) <= kMaxZOffset)) {
+    throw Error(ErrorCode::InvalidParameter, "the ground level's elevation must be a number within +-1e5 m", path);
+  }
+  try {
+    checkTerrain(options.terrain);
+  } catch (const Error& e) {
+    throw Error(e.code(), e.detail(), path);
+  }
+}
+
+// The blocks of the buildings, in their order; those left out listed in the summary.
+std::vector<Block> blocksOf(const std::vector<core::Feature>& buildings, const OutputFrame& frame,
+                            const CityJsonOptions& options, CityJsonSummary& summary) {
   std::vector<Block> blocks;
-  // The problems of a building are the file's: its path goes into the error.
-  auto naming = [&](const Error& e) { return Error(e.code(), e.detail(), path); };
   for (size_t i = 0; i < buildings.size(); ++i) {
     std::string leftOutBecause;
-    try {
-      if (auto block = blockOf(buildings[i], i, frame, options.heightAttribute, leftOutBecause)) {
-        blocks.push_back(std::move(*block));
-      } else {
-        summary.leftOut.push_back(leftOutBecause);
-      }
-    } catch (const Error& e) {
-      throw naming(e);
+    if (auto block = blockOf(buildings[i], i, frame, options, leftOutBecause)) {
+      blocks.push_back(std::move(*block));
+    } else {
+      summary.leftOut.push_back(leftOutBecause);
     }
   }
-  const Grid grid = gridFor(blocks, crs.geographic);
+  return blocks;
+}
+}  // namespace
+
+CityJsonSummary writeCityJson(const std::string& path, const std::vector<core::Feature>& buildings,
+                              const CityJsonOptions& options) {
+  const OutputFrame frame{options.geo, options.localPixelSize};
+  checkOptions(options, frame, path);
+  const CrsDescription crs = frame.geo.valid() ? describeCrs(frame.geo.crsWkt) : CrsDescription{};
+  CityJsonSummary summary;
+  // The problems of a building are the file's: its path goes into the error.
+  auto naming = [&](const Error& e) { return Error(e.code(), e.detail(), path); };
+  std::vector<Block> blocks;
+  try {
+    blocks = blocksOf(buildings, frame, options, summary);
+  } catch (const Error& e) {
+    throw naming(e);
+  }
+  const TerrainGrid terrain{options.terrain};
+  const Grid grid = gridFor(blocks, terrain, frame, crs.geographic);
   VertexPool pool;
   Json cityObjects = Json::object();
   for (const auto& block : blocks) {
@@ -356,16 +506,26 @@ CityJsonSummary writeCityJson(const std::string& path, const std::vector<core::F
       throw Error(ErrorCode::InvalidParameter, "two buildings have the id of " + block.name, path);
     }
     try {
-      cityObjects[block.key] = cityObjectOf(block, grid, pool);
+      cityObjects[block.key] = cityObjectOf(block, grid, options.zOffset, pool);
     } catch (const Error& e) {
       throw naming(e);
+    }
+  }
+  ContentDescription content;
+  content.bases = std::any_of(blocks.begin(), blocks.end(), [](const Block& b) { return b.hasBase; });
+  content.zOffset = options.zOffset;
+  if (terrain.rows() > 0) {
+    Json triangles = terrainTriangles(terrain, frame, grid, options.zOffset, pool, summary);
+    if (!triangles.empty()) {
+      cityObjects["terrain"] = terrainObjectOf(std::move(triangles), options.terrain.step);
+      content.terrainStep = options.terrain.step;
     }
   }
   Json document;
   document["type"] = "CityJSON";
   document["version"] = "1.1";
   document["transform"] = {{"scale", grid.scale}, {"translate", grid.translate}};
-  document["metadata"] = metadataFor(frame, crs, grid, pool);
+  document["metadata"] = metadataFor(frame, crs, content, grid, pool);
   document["CityObjects"] = std::move(cityObjects);
   document["vertices"] = pool.vertices();
   writeTextFile(path, document.dump() + "\n");

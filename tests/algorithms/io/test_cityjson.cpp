@@ -107,12 +107,15 @@ bool insideRings(const std::vector<std::vector<cv::Point2d>>& rings, double x, d
 // The block the test expects, independent of the file: footprint in the output frame, 0..roof.
 struct ExpectedBlock {
   std::vector<std::vector<cv::Point2d>> rings;
+  double base = 0;
   double roof = 0;
-  bool contains(const Vec3& p) const { return p[2] > 0 && p[2] < roof && insideRings(rings, p[0], p[1]); }
+  bool contains(const Vec3& p) const { return p[2] > base && p[2] < roof && insideRings(rings, p[0], p[1]); }
 };
 
-ExpectedBlock expectedBlock(const core::Polygon& polygon, double roof, const std::function<cv::Point2d(cv::Point2d)>& toFrame) {
+ExpectedBlock expectedBlock(const core::Polygon& polygon, double roof, const std::function<cv::Point2d(cv::Point2d)>& toFrame,
+                            double base = 0.0) {
   ExpectedBlock block;
+  block.base = base;
   block.roof = roof;
   auto ring = [&](const core::Ring& r) {
     std::vector<cv::Point2d> out;
@@ -317,6 +320,173 @@ TEST(CityJson, FileNamesOfCityJson) {
   EXPECT_FALSE(isCityJsonPath("buildings.json"));
   EXPECT_FALSE(isCityJsonPath("buildings.geojson"));
   EXPECT_FALSE(isCityJsonPath(".cityjson"));
+}
+
+// ---- blocks on their own ground, the ground level's elevation, the terrain ----
+
+core::Feature onGround(core::Feature feature, double ground) {
+  feature.attributes["ground_height_m"] = ground;
+  return feature;
+}
+
+// The z of every vertex a Building's solid uses, at 1 mm.
+std::set<double> solidHeights(const nlohmann::json& object, const std::vector<Vec3>& vertices) {
+  std::set<double> heights;
+  for (const auto& surface : object["geometry"][0]["boundaries"][0]) {
+    for (const auto& ring : surface) {
+      for (const auto& index : ring) heights.insert(std::round(vertices.at(index.get<size_t>())[2] * 1000) / 1000);
+    }
+  }
+  return heights;
+}
+
+TEST(CityJson, ABlockStandsOnItsGroundHeightAndMeasuresFromIt) {
+  TempDir dir;
+  const std::string path = dir.file("ground.city.json");
+  const std::vector<core::Feature> buildings{onGround(building(1, square(), 10.0), 3.0),
+                                             onGround(building(2, lShapeWithCourtyard(), 14.0), -1.5)};
+  EXPECT_EQ(writeCityJson(path, buildings, localFrame()).written, 2);
+  const nlohmann::json city = readJson(path);
+  const std::vector<Vec3> vertices = decodedVertices(city);
+  const auto toFrame = [](cv::Point2d p) { return cv::Point2d(p.x * kPixelSize, -p.y * kPixelSize); };
+  struct Case {
+    const char* key;
+    core::Polygon polygon;
+    double ground, roof;
+  };
+  for (const Case& c : {Case{"building-1", square(), 3.0, 10.0}, Case{"building-2", lShapeWithCourtyard(), -1.5, 14.0}}) {
+    SCOPED_TRACE(c.key);
+    const auto& object = city["CityObjects"].at(c.key);
+    EXPECT_EQ(solidHeights(object, vertices), (std::set<double>{c.ground, c.roof}));
+    EXPECT_DOUBLE_EQ(object["attributes"]["measuredHeight"].get<double>(), c.roof - c.ground);
+    EXPECT_DOUBLE_EQ(object["attributes"]["roof_height_m"].get<double>(), c.roof);
+    EXPECT_DOUBLE_EQ(object["attributes"]["ground_height_m"].get<double>(), c.ground);
+    expectClosedShell(object["geometry"][0]["boundaries"][0]);
+    expectOutwardSurfaces(object["geometry"][0]["boundaries"][0], vertices, expectedBlock(c.polygon, c.roof, toFrame, c.ground));
+  }
+  EXPECT_NE(city["metadata"]["title"].get<std::string>().find("from the ground next to it"), std::string::npos);
+}
+
+TEST(CityJson, ARoofNotAboveItsGroundIsLeftOutWithTheReason) {
+  TempDir dir;
+  const std::string path = dir.file("sunk.city.json");
+  const CityJsonSummary summary = writeCityJson(
+      path, {onGround(building(1, square(), 10.0), 3.0), onGround(building(5, square(), 4.0), 6.0)}, localFrame());
+  EXPECT_EQ(summary.written, 1);
+  EXPECT_EQ(summary.leftOut, std::vector<std::string>{"building 5: roof height 4 m is not above its ground height 6 m"});
+  EXPECT_FALSE(readJson(path)["CityObjects"].contains("building-5"));
+}
+
+TEST(CityJson, TheGroundLevelsElevationRaisesEveryZButNotTheAttributes) {
+  TempDir dir;
+  const std::string path = dir.file("elevated.city.json");
+  CityJsonOptions options = localFrame();
+  options.zOffset = 146.25;
+  options.terrain.heights = cv::Mat(5, 5, CV_32F, cv::Scalar(2.0f));
+  options.terrain.step = 2;
+  writeCityJson(path, {onGround(building(1, square(), 10.0), 3.0)}, options);
+  const nlohmann::json city = readJson(path);
+  const std::vector<Vec3> vertices = decodedVertices(city);
+  std::set<double> heights;
+  for (const Vec3& v : vertices) heights.insert(std::round(v[2] * 1000) / 1000);
+  EXPECT_EQ(heights, (std::set<double>{148.25, 149.25, 156.25}));  // terrain, base, roof
+  const auto& attributes = city["CityObjects"]["building-1"]["attributes"];
+  EXPECT_DOUBLE_EQ(attributes["measuredHeight"].get<double>(), 7.0);
+  EXPECT_DOUBLE_EQ(attributes["roof_height_m"].get<double>(), 10.0);
+  EXPECT_NE(city["metadata"]["title"].get<std::string>().find("+ 146.25 m, the ground level's elevation"), std::string::npos);
+  EXPECT_NEAR(city["metadata"]["geographicalExtent"][2].get<double>(), 148.25, 1e-9);
+
+  options.zOffset = std::nan("");
+  EXPECT_EQ(captureError([&] { writeCityJson(path, {}, options); }).code(), ErrorCode::InvalidParameter);
+}
+
+// A sloped DTM, z = 0.1 col + 0.2 row + 5 m on a 9 x 7 px grid, with no height at pixel (4, 2).
+cv::Mat slopedDtm() {
+  cv::Mat dtm(7, 9, CV_32F);
+  for (int row = 0; row < dtm.rows; ++row) {
+    for (int col = 0; col < dtm.cols; ++col) dtm.at<float>(row, col) = static_cast<float>(0.1 * col + 0.2 * row + 5.0);
+  }
+  dtm.at<float>(2, 4) = NAN;  // a grid point at step 2: its four cells are left out
+  dtm.at<float>(1, 1) = NAN;  // between grid points: changes nothing
+  return dtm;
+}
+
+// The terrain's checks: triangles only, each facing up, every index a vertex, each vertex on the DTM.
+void expectUpwardTerrain(const nlohmann::json& city, const std::function<cv::Point2d(Vec3)>& toPixel) {
+  const nlohmann::json& terrain = city["CityObjects"].at("terrain");
+  EXPECT_EQ(terrain["type"], "TINRelief");
+  ASSERT_EQ(terrain["geometry"].size(), 1u);
+  const auto& surface = terrain["geometry"][0];
+  EXPECT_EQ(surface["type"], "CompositeSurface");
+  EXPECT_EQ(surface["lod"], "1");
+  const std::vector<Vec3> vertices = decodedVertices(city);
+  // 4 x 3 cells of 2 px, less the 4 around the point without height: 8 cells of 2 triangles.
+  ASSERT_EQ(surface["boundaries"].size(), 16u);
+  std::set<size_t> used;
+  for (const auto& triangle : surface["boundaries"]) {
+    ASSERT_EQ(triangle.size(), 1u);  // no inner ring
+    ASSERT_EQ(triangle[0].size(), 3u);
+    for (const auto& index : triangle[0]) {
+      ASSERT_LT(index.get<size_t>(), vertices.size());
+      used.insert(index.get<size_t>());
+    }
+    EXPECT_GT(newellNormal(triangle[0], vertices)[2], 0.0) << triangle.dump() << " faces down";
+  }
+  // 5 x 4 grid points, less the one without height and the one whose cells all touch it.
+  EXPECT_EQ(used.size(), 18u);
+  for (size_t index : used) {
+    const cv::Point2d pixel = toPixel(vertices[index]);
+    EXPECT_NEAR(vertices[index][2], 0.1 * (pixel.x - 0.5) + 0.2 * (pixel.y - 0.5) + 5.0, 1e-3) << "vertex " << index;
+  }
+}
+
+TEST(CityJson, TheTerrainIsAnUpwardTinOfTheDtmsGridWithoutItsHoles) {
+  TempDir dir;
+  const std::string path = dir.file("terrain.city.json");
+  CityJsonOptions options = localFrame();
+  options.terrain.heights = slopedDtm();
+  options.terrain.step = 2;
+  const CityJsonSummary summary = writeCityJson(path, {}, options);
+  EXPECT_EQ(summary.terrainTriangles, 16);
+  EXPECT_EQ(summary.terrainVertices, 18);
+  const nlohmann::json city = readJson(path);
+  EXPECT_EQ(city["vertices"].size(), 18u);
+  expectUpwardTerrain(city, [](Vec3 v) { return cv::Point2d(v[0] / kPixelSize, -v[1] / kPixelSize); });
+  EXPECT_NE(city["metadata"]["title"].get<std::string>().find("one vertex every 2 px"), std::string::npos);
+}
+
+TEST(CityJson, TheTerrainFacesUpUnderAMirroringGeotransformAndSharesVerticesWithTheBlocks) {
+  TempDir dir;
+  const std::string path = dir.file("mirrored-terrain.city.json");
+  CityJsonOptions options;
+  options.geo.hasTransform = true;
+  options.geo.geoTransform = {1000.0, 2.0, 0.0, 2000.0, 0.0, 2.0};  // y grows with the rows
+  options.terrain.heights = slopedDtm();
+  options.terrain.step = 2;
+  // A block whose corner (0.5, 0.5) px is the terrain's first vertex, at the same height.
+  const core::Polygon square{{{0.5, 0.5}, {2.5, 0.5}, {2.5, 2.5}, {0.5, 2.5}}, {}};
+  const CityJsonSummary summary = writeCityJson(path, {onGround(building(1, square, 9.0), 5.0)}, options);
+  const nlohmann::json city = readJson(path);
+  expectUpwardTerrain(city, [](Vec3 v) { return cv::Point2d((v[0] - 1000.0) / 2.0, (v[1] - 2000.0) / 2.0); });
+  std::set<std::vector<long long>> distinct;
+  for (const auto& v : city["vertices"]) distinct.insert(v.get<std::vector<long long>>());
+  EXPECT_EQ(distinct.size(), city["vertices"].size()) << "a vertex is written twice";
+  EXPECT_EQ(city["vertices"].size(), static_cast<size_t>(summary.terrainVertices) + 8 - 1);  // one corner shared
+}
+
+TEST(CityJson, ATerrainWithoutAnyHeightWritesNoReliefAndABadStepIsRefused) {
+  TempDir dir;
+  const std::string path = dir.file("flat.city.json");
+  CityJsonOptions options = localFrame();
+  options.terrain.heights = cv::Mat(6, 6, CV_32F, cv::Scalar(NAN));
+  options.terrain.step = 1;
+  const CityJsonSummary summary = writeCityJson(path, {building(1, square(), 5.0)}, options);
+  EXPECT_EQ(summary.terrainTriangles, 0);
+  EXPECT_FALSE(readJson(path)["CityObjects"].contains("terrain"));
+  options.terrain.step = 0;
+  const core::Error error = captureError([&] { writeCityJson(path, {}, options); });
+  EXPECT_EQ(error.code(), ErrorCode::InvalidParameter);
+  EXPECT_NE(std::string(error.what()).find("terrain step"), std::string::npos) << error.what();
 }
 
 }  // namespace
