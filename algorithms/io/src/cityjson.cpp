@@ -28,7 +28,7 @@ namespace {
 constexpr double kMetreScale = 0.001;   // transform unit of x, y in metres and of z: 1 mm
 constexpr double kDegreeScale = 1e-8;   // transform unit of x, y in degrees: about 1 mm
 constexpr double kMaxRoofHeight = 1e4;  // m; a larger "roof height" is not one
-constexpr double kMaxZOffset = 1e5;     // m; a larger elevation of the ground level is not one
+constexpr double kMaxZOffset = 1e4;     // m; a larger elevation of the ground level is not one
 constexpr double kMaxTerrainPoints = 1e7;  // grid points of the terrain; more is a mistaken step
 
 using GridPoint = std::array<long long, 3>;  // a vertex in transform units
@@ -458,7 +458,7 @@ void checkOptions(const CityJsonOptions& options, const OutputFrame& frame, cons
     throw Error(ErrorCode::InvalidParameter, "the local frame's pixel size must be a positive number of metres", path);
   }
   if (!(std::abs(options.zOffset) <= kMaxZOffset)) {
-    throw Error(ErrorCode::InvalidParameter, "the ground level's elevation must be a number within +-1e5 m", path);
+    throw Error(ErrorCode::InvalidParameter, "the ground level's elevation must be a number within +-1e4 m", path);
   }
   try {
     checkTerrain(options.terrain);

@@ -147,6 +147,7 @@ json polygonToJson(const core::Polygon& polygon) {
 constexpr double kMaxCoordinate = 1e7;    // px
 constexpr int kMaxDisparity = 100000;     // px
 constexpr double kMaxMetresPerPixel = 1e4;
+constexpr double kMaxElevation = 1e4;     // m, of the ground level above the vertical datum
 
 // [low, high] integers within +-kMaxDisparity with low <= high.
 DisparityInterval intervalFromJson(const json& in, const std::string& field) {
@@ -265,7 +266,8 @@ json toJson(const Project& project, const std::string& baseDir) {
                               : json(nullptr);
   out["heightModel"] = {{"groundDisparity", project.height.groundDisparity},
                         {"metresPerPixel", project.height.metresPerPixel},
-                        {"gsd", project.height.gsd}};
+                        {"gsd", project.height.gsd},
+                        {"groundElevation", project.height.groundElevation}};
   out["method"] = project.method;
   out["parameters"] = project.parameters.is_null() ? json::object() : project.parameters;
   json buildings = json::array();
@@ -340,6 +342,7 @@ void readHeightModel(const json& model, HeightModel& height) {
   height.groundDisparity = get<double>(model, "groundDisparity", 0.0, "heightModel.");
   height.metresPerPixel = get<double>(model, "metresPerPixel", 0.0, "heightModel.");
   height.gsd = get<double>(model, "gsd", 1.0, "heightModel.");
+  height.groundElevation = get<double>(model, "groundElevation", 0.0, "heightModel.");
   if (!(height.gsd > 0 && height.gsd <= kMaxMetresPerPixel)) {
     badField("heightModel.gsd", "must be positive, at most " + std::to_string(kMaxMetresPerPixel) + " m");
   }
@@ -348,6 +351,9 @@ void readHeightModel(const json& model, HeightModel& height) {
   }
   if (!(std::abs(height.groundDisparity) <= kMaxDisparity)) {
     badField("heightModel.groundDisparity", "must be within +-" + std::to_string(kMaxDisparity) + " px");
+  }
+  if (!(std::abs(height.groundElevation) <= kMaxElevation)) {
+    badField("heightModel.groundElevation", "must be within +-" + std::to_string(static_cast<int>(kMaxElevation)) + " m");
   }
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "delineo/core/error.hpp"
 #include "delineo/io/cityjson.hpp"
@@ -51,31 +52,78 @@ io::GeoReference leftGeoReference(const Project& project) {
   }
 }
 
+std::string buildingName(const core::Feature& feature) {
+  const auto id = feature.attributes.find("id");
+  const auto* number = id != feature.attributes.end() ? std::get_if<long long>(&id->second) : nullptr;
+  return number != nullptr ? "building " + std::to_string(*number) : std::string("a building");
+}
+
+// Each feature with a roof height gets its base, ground_height_m: the ground next to it on
+// `heights` (the 3D view's estimate). Without heights, or without ground next to a building, the
+// block stands on the ground level: `summary.notes` says so.
+std::vector<core::Feature> withGroundHeights(const Project& project, const cv::Mat& heights,
+                                             std::vector<core::Feature> features, ExportSummary& summary) {
+  if (heights.empty()) {
+    summary.notes.push_back("no heights: every block stands on the height model's ground level (z = 0)");
+    return features;
+  }
+  summary.onLocalGround = true;
+  for (auto& feature : features) {
+    if (feature.attributes.count("roof_height_m") == 0) continue;
+    const std::optional<double> ground = groundHeightNextTo(project, heights, feature.polygon);
+    if (ground) {
+      feature.attributes["ground_height_m"] = *ground;
+    } else {
+      summary.notes.push_back(buildingName(feature) + ": no ground next to it: its block stands on the ground level");
+    }
+  }
+  return features;
+}
+
+// The CityJSON of `features`: blocks on the ground next to each, the terrain when there is a DTM.
+ExportSummary writeCityModel(const Project& project, const std::string& path, const std::vector<core::Feature>& features,
+                             const io::GeoReference& geo, const CityModelInputs& model) {
+  ExportSummary summary;
+  io::CityJsonOptions options;
+  options.geo = geo;
+  options.localPixelSize = project.height.gsd;
+  options.zOffset = project.height.groundElevation;
+  if (!model.dtm.empty()) {
+    model.terrain.validate();
+    options.terrain = {model.dtm, model.terrain.resolvedStep(project.height.gsd)};
+  }
+  const io::CityJsonSummary blocks =
+      io::writeCityJson(path, withGroundHeights(project, model.heights, features, summary), options);
+  summary.written = blocks.written;
+  summary.leftOut = blocks.leftOut;
+  summary.terrainVertices = blocks.terrainVertices;
+  summary.terrainTriangles = blocks.terrainTriangles;
+  return summary;
+}
+
 // Writes `features` (the project's buildings) to `path` in the format its name says.
 ExportSummary writeBuildingFeatures(const Project& project, const std::string& path,
-                                    const std::vector<core::Feature>& features) {
+                                    const std::vector<core::Feature>& features, const CityModelInputs& model = {}) {
   const io::GeoReference geo = leftGeoReference(project);
   std::error_code mk;
   fs::create_directories(fs::absolute(path).parent_path(), mk);
+  if (io::isCityJsonPath(path)) return writeCityModel(project, path, features, geo, model);
   ExportSummary summary;
-  if (io::isCityJsonPath(path)) {
-    io::CityJsonOptions options;
-    options.geo = geo;
-    options.localPixelSize = project.height.gsd;
-    const io::CityJsonSummary blocks = io::writeCityJson(path, features, options);
-    summary.written = blocks.written;
-    summary.leftOut = blocks.leftOut;
-    return summary;
-  }
   io::writeFeatures(path, features, geo);
   summary.written = static_cast<int>(features.size());
   return summary;
 }
 }  // namespace
 
+int TerrainParams::resolvedStep(double gsd) const {
+  if (step > 0) return step;
+  if (!(gsd > 0.0)) return 1;
+  return static_cast<int>(std::clamp(std::round(1.0 / gsd), 1.0, 10000.0));
+}
+
 ExportSummary exportBuildings(const Project& project, const std::string& path,
-                              const std::vector<BuildingStatus>& statuses) {
-  return writeBuildingFeatures(project, path, buildingFeatures(project, statuses));
+                              const std::vector<BuildingStatus>& statuses, const CityModelInputs& model) {
+  return writeBuildingFeatures(project, path, buildingFeatures(project, statuses), model);
 }
 
 namespace {
@@ -122,7 +170,7 @@ namespace {
 // run --detect: the scene analysis on `heights`, its rasters and objects written into
 // `outputDir`, its proposals added as pending buildings. False when canceled.
 bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& disparity, const io::GeoReference& geo,
-                     const std::string& outputDir, core::Progress* progress, RunSummary& summary) {
+                     const std::string& outputDir, core::Progress* progress, RunSummary& summary, cv::Mat& dtm) {
   if (heights.empty()) {
     throw Error(ErrorCode::InvalidParameter,
                 "detecting buildings needs heights: the project names no DEM and has no height model");
@@ -135,6 +183,7 @@ bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& di
   }
   const fs::path out(outputDir);
   io::writeFloatGeoTiff((out / "dtm.tif").string(), analysis.dtm, geo);
+  dtm = analysis.dtm;
   io::writeFloatGeoTiff((out / "ndsm.tif").string(), analysis.ndsm, geo);
   io::writeGeoTiff((out / "labels.tif").string(), analysis.classes, geo);
   io::writeFeatures((out / "objects.geojson").string(), analysis.objects, geo, "objects");
@@ -147,9 +196,11 @@ bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& di
 
 namespace {
 // run's exports: the outlines to buildings.geojson, and the LoD1 blocks to buildings.city.json
-// when any building has a roof height. A degenerate outline stops the blocks only: the outlines
-// and the project's work are kept, the problem is in the summary.
-void exportRunOutputs(const Project& project, const std::string& outputDir, RunSummary& summary) {
+// when any building has a roof height, on the ground next to each (`model.heights`) with the
+// terrain of `model.dtm` when there is one. A degenerate outline stops the blocks only: the
+// outlines and the project's work are kept, the problem is in the summary.
+void exportRunOutputs(const Project& project, const std::string& outputDir, const CityModelInputs& model,
+                      RunSummary& summary) {
   const std::vector<BuildingStatus> statuses{BuildingStatus::Automatic, BuildingStatus::Corrected,
                                              BuildingStatus::Accepted};
   const auto features = buildingFeatures(project, statuses);
@@ -161,13 +212,30 @@ void exportRunOutputs(const Project& project, const std::string& outputDir, RunS
   if (!anyHeight) return;
   const std::string blocksPath = (fs::path(outputDir) / "buildings.city.json").string();
   try {
-    const ExportSummary blocks = writeBuildingFeatures(project, blocksPath, features);
+    const ExportSummary blocks = writeBuildingFeatures(project, blocksPath, features, model);
     summary.exportedBlocks = blocksPath;
+    summary.terrainTriangles = blocks.terrainTriangles;
     for (const auto& line : blocks.leftOut) summary.messages.push_back("not in buildings.city.json: " + line);
+    for (const auto& line : blocks.notes) summary.messages.push_back("buildings.city.json: " + line);
   } catch (const Error& e) {
     if (e.code() != ErrorCode::InvalidParameter) throw;
     summary.blocksFailed = true;
     summary.messages.push_back("buildings.city.json not written: " + e.detail());
+  }
+}
+}  // namespace
+
+namespace {
+// The heights the blocks stand on: `heights` when read already, else projectHeights(). A DEM
+// that cannot be read now leaves the blocks on the ground level, said in the summary: the run's
+// work is kept.
+cv::Mat heightsForBases(const Project& project, const cv::Mat& heights, const cv::Mat& disparity, RunSummary& summary) {
+  if (!heights.empty()) return heights;
+  try {
+    return projectHeights(project, disparity);
+  } catch (const Error& e) {
+    summary.messages.push_back(std::string("buildings.city.json: heights not read: ") + e.what());
+    return {};
   }
 }
 }  // namespace
@@ -224,12 +292,13 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
     disparity = readDisparity(project, pair.left.size());
   }
   pair.disparity = disparity;
-  cv::Mat heights;  // for box-fitting and the scene analysis, read when asked for
+  cv::Mat heights;  // for box-fitting, the scene analysis and the blocks' bases, read when asked for
+  cv::Mat dtm;      // the scene analysis's, the CityJSON's terrain
   std::vector<int> pending = project.pendingBuildings();
   if (options.detect) {
     core::Progress::Range range(progress, matchShare, matchShare + 0.3 * (1.0 - matchShare));
     heights = projectHeights(project, disparity);
-    if (!detectBuildings(project, heights, disparity, pair.geo, outputDir, &range, summary)) return summary;
+    if (!detectBuildings(project, heights, disparity, pair.geo, outputDir, &range, summary, dtm)) return summary;
     pending = project.pendingBuildings();
     matchShare += 0.3 * (1.0 - matchShare);
   }
@@ -257,7 +326,7 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
       }
     }
   }
-  exportRunOutputs(project, outputDir, summary);
+  exportRunOutputs(project, outputDir, {heightsForBases(project, heights, disparity, summary), dtm, {}}, summary);
   core::report(progress, 1.0);
   return summary;
 }

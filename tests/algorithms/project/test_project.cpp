@@ -346,6 +346,7 @@ TEST(ProjectExport, ACityJsonNameWritesLod1BlocksInTheHeightModelsMetres) {
   const project::ExportSummary blocks = project::exportBuildings(p, dir.file("out/accepted.city.json"));
   EXPECT_EQ(blocks.written, 1);
   EXPECT_EQ(blocks.leftOut, std::vector<std::string>{"building 5: no roof height"});
+  EXPECT_EQ(blocks.notes.size(), 1u) << "no heights given: the blocks stand on z = 0, said in the notes";
   std::ifstream in(dir.file("out/accepted.city.json"));
   const nlohmann::json city = nlohmann::json::parse(in);
   EXPECT_EQ(city["type"], "CityJSON");

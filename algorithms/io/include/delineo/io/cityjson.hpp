@@ -37,7 +37,7 @@ struct CityJsonOptions {
   double localPixelSize = 1.0;      // m per pixel of the local frame (the height model's gsd)
   std::string heightAttribute = "roof_height_m";  // the roof height, m above the ground level
   std::string baseAttribute = "ground_height_m";  // the block's base, m; absent: base at 0
-  double zOffset = 0.0;             // m added to every z (the ground level's elevation), within ±1e5
+  double zOffset = 0.0;             // m added to every z (the ground level's elevation), within ±1e4
   CityJsonTerrain terrain;
 };
 

@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "delineo/core/params.hpp"
 #include "delineo/core/progress.hpp"
 #include "delineo/dem/heights.hpp"
 #include "delineo/io/raster.hpp"
@@ -265,12 +266,15 @@ struct RunSummary {
   std::vector<std::string> messages;
   std::string exported;  // path of the written GeoJSON, empty when nothing was written
   std::string exportedBlocks;  // path of the written CityJSON, empty when nothing was written
+  int terrainTriangles = 0;    // of the CityJSON's terrain (RunOptions::detect), 0 without
   bool blocksFailed = false;   // the CityJSON was not written: a building's outline is degenerate (in `messages`)
   core::RunStatus status = core::RunStatus::Completed;
 };
 // With `detect`, the scene analysis runs after matching on projectHeights() (analyseScene(),
 // writing dtm.tif, ndsm.tif, labels.tif and objects.geojson into `outputDir`) and its proposals
-// become pending buildings (addProposedBuildings()) before the outlines are made.
+// become pending buildings (addProposedBuildings()) before the outlines are made; its DTM is
+// the terrain of buildings.city.json. The blocks stand on the ground next to each building
+// (exportBuildings() with projectHeights()).
 struct RunOptions {
   bool detect = false;
 };
@@ -284,14 +288,49 @@ std::vector<core::Feature> buildingFeatures(const Project& project,
 struct ExportSummary {
   int written = 0;                   // buildings written
   std::vector<std::string> leftOut;  // CityJSON: "building 3: no roof height", one per building left out
+  // CityJSON: what the operator should know about the bases ("no heights: ..."), one per line.
+  std::vector<std::string> notes;
+  bool onLocalGround = false;        // CityJSON: the blocks stand on the ground next to each building
+  int terrainVertices = 0, terrainTriangles = 0;  // CityJSON: the terrain's, 0 without
 };
-// Writes the accepted buildings, georeferenced like the left image when it has a geotransform:
-// their outlines as GeoJSON or GeoPackage by extension, or for "*.city.json" / "*.cityjson"
-// CityJSON LoD1 blocks from the ground to the roof height (io/cityjson.hpp; local metres of the
-// height model's gsd without georeferencing), leaving out the buildings without a roof height
-// above 0. Throws WriteFailed, and InvalidParameter naming a building whose outline is degenerate.
+
+// The terrain grid of the CityJSON export.
+struct TerrainParams {
+  int step = 0;  // px between neighbouring vertices; 0: about 1 m, round(1 m / gsd)
+
+  template <class V>
+  void visit(V&& v) {
+    v(core::ParamInfo{"terrain-step", "Terrain step", "px",
+                      "Pixels between neighbouring vertices of the terrain (0: about 1 m at the height model's gsd)",
+                      0, 10000},
+      step);
+  }
+  void validate() const { core::checkDeclaredRanges(*this); }
+  // The step in px: `step`, or for 0 the one nearest to 1 m at `gsd` (m per px), at least 1.
+  int resolvedStep(double gsd) const;
+};
+
+// What the CityJSON export stands the blocks on, and its terrain.
+struct CityModelInputs {
+  // CV_32F m on the left image's grid (projectHeights()): each block's base is the ground next to
+  // it, groundHeightNextTo() as the 3D view draws it. Empty: every block stands on the ground level.
+  cv::Mat heights;
+  cv::Mat dtm;  // CV_32F m on the left image's grid (analyseScene()'s DTM): the terrain; empty: none
+  TerrainParams terrain;
+};
+
+// Writes the buildings with the given statuses, georeferenced like the left image when it has a
+// geotransform: their outlines as GeoJSON or GeoPackage by extension, or for "*.city.json" /
+// "*.cityjson" CityJSON LoD1 blocks from the ground next to each building (ground_height_m, on
+// `model.heights`) to its roof height, with the DTM's TIN as terrain when `model.dtm` is given,
+// every z raised by the height model's groundElevation (io/cityjson.hpp; local metres of the
+// height model's gsd without georeferencing). A building without a roof height, or whose roof is
+// not above its base, is left out; without heights (or without ground next to a building) a block
+// stands on the ground level, said in `notes`. Throws WriteFailed, and InvalidParameter naming a
+// building whose outline is degenerate or for a bad terrain step.
 ExportSummary exportBuildings(const Project& project, const std::string& path,
-                              const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted});
+                              const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted},
+                              const CityModelInputs& model = {});
 
 // ---- the bundled sample (src/pipeline.cpp) ----
 

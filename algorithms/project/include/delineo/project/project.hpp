@@ -89,6 +89,7 @@ struct HeightModel {
   double groundDisparity = 0.0;  // px, disparity of the ground plane
   double metresPerPixel = 0.0;   // m per px of disparity above the ground
   double gsd = 1.0;              // m, ground sample distance of one image pixel (hillshade, 3D)
+  double groundElevation = 0.0;  // m, elevation of the ground level (height 0) above the vertical datum
   bool known() const { return metresPerPixel != 0.0; }
   double heightAt(double disparity) const { return (disparity - groundDisparity) * metresPerPixel; }
   bool operator==(const HeightModel&) const = default;
