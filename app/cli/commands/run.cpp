@@ -2,8 +2,8 @@
 // (delineo::project): dense matching when the project has no disparity yet, the outline of every
 // pending building with its method (the active polygon, or box-fitting), with --detect first the
 // scene analysis and its building proposals, export of the
-// delineated outlines (and of their LoD1 blocks when they have roof heights), then an atomic
-// save of the project. `--sample DIR` first creates (or reuses) the bundled sample project in DIR.
+// delineated outlines (and of their LoD1 blocks on the ground next to each when they have roof
+// heights, with --detect's DTM as terrain), then an atomic save of the project. `--sample DIR` first creates (or reuses) the bundled sample project in DIR.
 #include <cstdio>
 
 #include "cli_support.hpp"
@@ -20,7 +20,8 @@ int run(const std::vector<std::string>& args) {
                     "missing, the outline of pending buildings with their method (the project's "
                     "or the building's \"method\": active-polygon or box-fitting), export of the "
                     "outlines to <outputDir>/buildings.geojson and, for the buildings with a roof "
-                    "height, of their LoD1 blocks to <outputDir>/buildings.city.json; then saves the project.\n"
+                    "height, of their LoD1 blocks (on the ground next to each; with --detect, with the terrain) to "
+                    "<outputDir>/buildings.city.json; then saves the project.\n"
                     "Usage: delineo-cli run PROJECT [options]");
   opts.value("project", "FILE", "project file (may also be given as the first argument)", "")
       .value("sample", "DIR", "create (or reuse) the sample project in DIR and run it", "")
@@ -84,7 +85,9 @@ int run(const std::vector<std::string>& args) {
                summary.exported.empty() ? "" : "; outlines written to ",
                summary.exported.c_str());
   if (!summary.exportedBlocks.empty()) {
-    std::fprintf(stderr, "run: LoD1 blocks written to %s\n", summary.exportedBlocks.c_str());
+    std::fprintf(stderr, "run: LoD1 blocks written to %s", summary.exportedBlocks.c_str());
+    if (summary.terrainTriangles > 0) std::fprintf(stderr, " with the terrain (%d triangles)", summary.terrainTriangles);
+    std::fprintf(stderr, "\n");
   }
   return summary.skipped > 0 || summary.blocksFailed ? cli::kExitProcessing : cli::kExitOk;
 }
