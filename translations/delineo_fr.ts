@@ -1263,6 +1263,17 @@
             <numerusform>%n laissés de côté : pas de hauteur de toit au-dessus du sol.</numerusform>
         </translation>
     </message>
+    <message numerus="yes">
+        <source>%n on the ground level: no ground next to them.</source>
+        <translation>
+            <numerusform>%n posé au niveau du sol : pas de sol à côté.</numerusform>
+            <numerusform>%n posés au niveau du sol : pas de sol à côté.</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>The blocks stand on the ground level: no heights.</source>
+        <translation>Les blocs sont posés au niveau du sol : pas de hauteurs.</translation>
+    </message>
     <message>
         <source>Cannot export</source>
         <translation>Impossible d’exporter</translation>
@@ -2049,6 +2060,14 @@
     <message>
         <source>Ground sample distance</source>
         <translation>Taille du pixel au sol</translation>
+    </message>
+    <message>
+        <source>Elevation of the ground level above the vertical datum, added to the z of the CityJSON export</source>
+        <translation>Altitude du niveau du sol au-dessus de la référence verticale, ajoutée aux z de l’export CityJSON</translation>
+    </message>
+    <message>
+        <source>Ground elevation</source>
+        <translation>Altitude du sol</translation>
     </message>
     <message>
         <source>Give B, H and f.</source>

@@ -410,8 +410,11 @@ void Document::autosave() {
   project::saveProject(project_, project::autosavePath(path_.toStdString()));
 }
 
-project::ExportSummary Document::exportAccepted(const QString& path) const {
-  return project::exportBuildings(project_, path.toStdString());
+project::ExportSummary Document::exportAccepted(const QString& path, const cv::Mat& dtm) const {
+  project::CityModelInputs model;
+  model.heights = dem_;  // the 3D view's ground next to each building
+  model.dtm = dtm;
+  return project::exportBuildings(project_, path.toStdString(), {project::BuildingStatus::Accepted}, model);
 }
 
 void Document::setExtraDirty(bool dirty) {

@@ -115,9 +115,10 @@ class Document : public QObject {
   void save(const QString& path);
   // Writes the autosave companion file when modified; no-op otherwise.
   void autosave();
-  // Exports the accepted buildings (outlines, or LoD1 blocks for a CityJSON name); returns how
-  // many were written and which were left out.
-  project::ExportSummary exportAccepted(const QString& path) const;
+  // Exports the accepted buildings (outlines, or LoD1 blocks for a CityJSON name, on the ground
+  // next to each in dem(), with `dtm` as terrain when not empty); returns how many were written
+  // and which were left out.
+  project::ExportSummary exportAccepted(const QString& path, const cv::Mat& dtm = {}) const;
 
  signals:
   void buildingChanged(int id);  // added, modified or removed

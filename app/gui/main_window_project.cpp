@@ -293,11 +293,18 @@ bool MainWindow::saveAs(const QString& path) {
 int MainWindow::exportAccepted(const QString& path) {
   if (!document_) return -1;
   try {
-    const project::ExportSummary exported = document_->exportAccepted(path);
+    // The scene analysis's DTM, when it has run, is the CityJSON's terrain.
+    const project::ExportSummary exported = document_->exportAccepted(path, scene_ ? scene_->dtm : cv::Mat());
     QString text = tr("%n accepted building(s) exported to %1", nullptr, exported.written).arg(path);
     if (!exported.leftOut.empty()) {
       text += QStringLiteral(" ") + tr("%n left out: no roof height above the ground.", nullptr,
                                        static_cast<int>(exported.leftOut.size()));
+    }
+    if (!exported.notes.empty()) {
+      text += QStringLiteral(" ") + (exported.onLocalGround
+                                         ? tr("%n on the ground level: no ground next to them.", nullptr,
+                                              static_cast<int>(exported.notes.size()))
+                                         : tr("The blocks stand on the ground level: no heights."));
     }
     statusBar()->showMessage(text, 8000);
     return exported.written;

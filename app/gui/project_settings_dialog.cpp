@@ -120,6 +120,10 @@ ProjectSettingsDialog::ProjectSettingsDialog(const project::Project& project,
                  tr("Ground size of one image pixel (hillshade and 3D view)"));
   gsd_->setValue(project.height.gsd);
   gsdForm->addRow(tr("Ground sample distance"), gsd_);
+  groundElevation_ = spinBox(QStringLiteral("groundElevation"), -10000, 10000, 2, tr(" m"),
+                             tr("Elevation of the ground level above the vertical datum, added to the z of the CityJSON export"));
+  groundElevation_->setValue(project.height.groundElevation);
+  gsdForm->addRow(tr("Ground elevation"), groundElevation_);
   heightLayout->addLayout(gsdForm);
   layout->addWidget(heightBox);
 
@@ -182,6 +186,7 @@ project::HeightModel ProjectSettingsDialog::heightModel() const {
           ? metresPerPixel_->value()
           : metresPerPixelFromCamera(base_->value(), flyingHeight_->value(), focal_->value());
   model.gsd = gsd_->value();
+  model.groundElevation = groundElevation_->value();
   return model;
 }
 

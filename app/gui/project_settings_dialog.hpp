@@ -48,6 +48,7 @@ class ProjectSettingsDialog : public QDialog {
   QDoubleSpinBox* focal_ = nullptr;
   QLabel* cameraResult_ = nullptr;
   QDoubleSpinBox* gsd_ = nullptr;
+  QDoubleSpinBox* groundElevation_ = nullptr;
 };
 
 }  // namespace delineo::gui

@@ -30,6 +30,7 @@
 #include <fstream>
 #include <map>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "buildings_model.hpp"
@@ -613,7 +614,14 @@ class MainWindowTest : public QObject {
     QCOMPARE(reopened.exportAccepted(blocks), 1);
     QFile blocksFile(blocks);
     QVERIFY(blocksFile.open(QIODevice::ReadOnly));
-    QVERIFY(blocksFile.readAll().contains("\"type\":\"CityJSON\""));
+    const QByteArray blocksText = blocksFile.readAll();
+    QVERIFY(blocksText.contains("\"type\":\"CityJSON\""));
+    // Its base is the ground the 3D view draws it from (on the document's DEM).
+    const std::optional<double> base =
+        project::groundHeightNextTo(loaded, reopened.document()->dem(), loaded.buildings[0].outline);
+    QVERIFY(base.has_value());
+    const QByteArray expectedBase = "\"ground_height_m\":" + QByteArray::fromStdString(nlohmann::json(*base).dump());
+    QVERIFY2(blocksText.contains(expectedBase), expectedBase.constData());
   }
 
   void badInputsShowAMessageAndChangeNothing() {

@@ -132,6 +132,7 @@ class ProjectSettingsTest : public QObject {
     QCOMPARE(gui::metresPerPixelFromCamera(0, 1000, 10000), 0.0);
     window_->setProjectSettingsHandler([](gui::ProjectSettingsDialog& dialog) {
       dialog.findChild<QDoubleSpinBox*>(QStringLiteral("groundDisparity"))->setValue(8.0);
+      dialog.findChild<QDoubleSpinBox*>(QStringLiteral("groundElevation"))->setValue(146.5);
       dialog.setCamera(100, 1000, 10000);
       return true;
     });
@@ -140,6 +141,7 @@ class ProjectSettingsTest : public QObject {
     QCOMPARE(doc->undoStack()->count(), entries + 1);
     QCOMPARE(doc->project().height.metresPerPixel, 1.0);
     QCOMPARE(doc->project().height.gsd, 0.1);
+    QCOMPARE(doc->project().height.groundElevation, 146.5);
     QCOMPARE(doc->project().find(id)->roofHeight, 22.0);
     QVERIFY(before != 22.0);
     doc->undoStack()->undo();
