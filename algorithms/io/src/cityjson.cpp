@@ -72,7 +72,8 @@ struct Block {
   std::string key;                        // its City Object id
   std::vector<std::vector<cv::Point2d>> rings;  // outline first, then the holes
   double height = 0.0;                    // m, the roof above the ground level
-  double base = 0.0;                      // m, the block's foot above the ground level
+  double base = 0.0;                      // m, its ground above the ground level
+  double foot = 0.0;                      // m, the solid's bottom: the base, or lower to meet the terrain
   bool hasBase = false;                   // the base came from the feature (else 0)
 };
 
@@ -119,6 +120,7 @@ std::optional<Block> blockOf(const core::Feature& feature, size_t index, const O
   }
   block.hasBase = base.has_value();
   block.base = base.value_or(0.0);
+  block.foot = block.base;
   if (!(std::llround(*height / kMetreScale) > std::llround(block.base / kMetreScale))) {
     leftOutBecause = block.name + ": roof height " + formatNumber(*height) + " m is not above " +
                      (base ? "its ground height " + formatNumber(*base) + " m" : std::string("the ground"));
@@ -244,7 +246,7 @@ Json solidOf(const Block& block, const Grid& grid, double zOffset, VertexPool& p
     rings.push_back(gridRing(block.rings[r], grid, r == 0, what));
   }
   Json values = Json::array();
-  const BlockLevels levels{grid.unitsOf(block.base + zOffset, 2), grid.unitsOf(block.height + zOffset, 2)};
+  const BlockLevels levels{grid.unitsOf(block.foot + zOffset, 2), grid.unitsOf(block.height + zOffset, 2)};
   Json shell = shellOf(rings, levels, pool, values);
   Json surfaces = Json::array();
   for (const char* type : {"GroundSurface", "RoofSurface", "WallSurface"}) surfaces.push_back({{"type", type}});
@@ -287,7 +289,48 @@ struct TerrainGrid {
   std::array<cv::Point2d, 4> corners() const {
     return {pixel(0, 0), pixel(cols() - 1, 0), pixel(0, rows() - 1), pixel(cols() - 1, rows() - 1)};
   }
+  // The TIN's height at a left-image pixel position (clamped into the grid), interpolated in the
+  // cell's triangle as terrainTriangles() splits it; none when a corner of the cell has no height.
+  std::optional<double> surfaceAt(cv::Point2d p) const {
+    if (rows() < 2 || cols() < 2) return std::nullopt;
+    const double u = std::clamp((p.x - 0.5) / terrain.step, 0.0, cols() - 1.0);
+    const double v = std::clamp((p.y - 0.5) / terrain.step, 0.0, rows() - 1.0);
+    const int col = std::min(static_cast<int>(u), cols() - 2), row = std::min(static_cast<int>(v), rows() - 2);
+    const double du = u - col, dv = v - row;
+    const double z00 = height(col, row), z10 = height(col + 1, row), z11 = height(col + 1, row + 1),
+                 z01 = height(col, row + 1);
+    if (!std::isfinite(z00) || !std::isfinite(z10) || !std::isfinite(z11) || !std::isfinite(z01)) return std::nullopt;
+    return du >= dv ? z00 + du * (z10 - z00) + dv * (z11 - z10) : z00 + dv * (z01 - z00) + du * (z11 - z01);
+  }
 };
+
+// The terrain's lowest height along the rings of `polygon` (left-image pixels), sampled at least
+// every pixel; none when no sample has a height.
+std::optional<double> lowestTerrainAlong(const TerrainGrid& terrain, const core::Polygon& polygon) {
+  std::optional<double> lowest;
+  auto visit = [&](const core::Ring& ring) {
+    for (size_t i = 0; i < ring.size(); ++i) {
+      const cv::Point2d a = ring[i], b = ring[(i + 1) % ring.size()];
+      const int samples = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a))));
+      for (int k = 0; k < samples; ++k) {
+        const std::optional<double> z = terrain.surfaceAt(a + (b - a) * (static_cast<double>(k) / samples));
+        if (z && (!lowest || *z < *lowest)) lowest = z;
+      }
+    }
+  };
+  visit(polygon.outer);
+  for (const auto& hole : polygon.holes) visit(hole);
+  return lowest;
+}
+
+// With a terrain, each block's solid reaches down to the terrain's lowest point along its
+// outline when that is below its base, so that no wall floats above the terrain.
+void reachDownToTerrain(std::vector<Block>& blocks, const TerrainGrid& terrain) {
+  for (Block& block : blocks) {
+    const std::optional<double> lowest = lowestTerrainAlong(terrain, block.feature->polygon);
+    if (lowest) block.foot = std::min(block.base, *lowest);
+  }
+}
 
 void checkTerrain(const CityJsonTerrain& terrain) {
   if (terrain.heights.empty()) return;
@@ -334,7 +377,8 @@ std::string titleFor(const OutputFrame& frame, const CrsDescription& crs, const 
   title += "; z in metres above the height model's ground level";
   if (content.zOffset != 0.0) title += " + " + formatNumber(content.zOffset) + " m, the ground level's elevation";
   if (content.terrainStep > 0) {
-    title += "; terrain: TIN of the DTM, one vertex every " + std::to_string(content.terrainStep) + " px";
+    title += "; terrain: TIN of the DTM, one vertex every " + std::to_string(content.terrainStep) +
+             " px; a block's walls reach down to the terrain where it is lower than the block's ground";
   }
   if (!frame.geo.valid()) {
     const std::string size = formatNumber(frame.pixelSize);
@@ -498,6 +542,7 @@ CityJsonSummary writeCityJson(const std::string& path, const std::vector<core::F
     throw naming(e);
   }
   const TerrainGrid terrain{options.terrain};
+  reachDownToTerrain(blocks, terrain);
   const Grid grid = gridFor(blocks, terrain, frame, crs.geographic);
   VertexPool pool;
   Json cityObjects = Json::object();

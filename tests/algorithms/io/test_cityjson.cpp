@@ -389,7 +389,8 @@ TEST(CityJson, TheGroundLevelsElevationRaisesEveryZButNotTheAttributes) {
   const std::vector<Vec3> vertices = decodedVertices(city);
   std::set<double> heights;
   for (const Vec3& v : vertices) heights.insert(std::round(v[2] * 1000) / 1000);
-  EXPECT_EQ(heights, (std::set<double>{148.25, 149.25, 156.25}));  // terrain, base, roof
+  // The terrain (2 m, under the block's 3 m ground: its walls reach down to it) and the roof.
+  EXPECT_EQ(heights, (std::set<double>{148.25, 156.25}));
   const auto& attributes = city["CityObjects"]["building-1"]["attributes"];
   EXPECT_DOUBLE_EQ(attributes["measuredHeight"].get<double>(), 7.0);
   EXPECT_DOUBLE_EQ(attributes["roof_height_m"].get<double>(), 10.0);
@@ -472,6 +473,28 @@ TEST(CityJson, TheTerrainFacesUpUnderAMirroringGeotransformAndSharesVerticesWith
   for (const auto& v : city["vertices"]) distinct.insert(v.get<std::vector<long long>>());
   EXPECT_EQ(distinct.size(), city["vertices"].size()) << "a vertex is written twice";
   EXPECT_EQ(city["vertices"].size(), static_cast<size_t>(summary.terrainVertices) + 8 - 1);  // one corner shared
+}
+
+TEST(CityJson, ABlockReachesDownToTheTerrainWhereItIsLowerThanItsGround) {
+  TempDir dir;
+  const std::string path = dir.file("reach.city.json");
+  CityJsonOptions options = localFrame();
+  options.terrain.heights = slopedDtm();
+  options.terrain.step = 2;
+  // Two squares on the slope; along the first one's outline the terrain rises from 5.8 m at its
+  // corner (0.5, 4.5) px to 6.4 m: below its 7 m ground. The second stands below the terrain.
+  const core::Polygon onSlope{{{0.5, 4.5}, {2.5, 4.5}, {2.5, 6.5}, {0.5, 6.5}}, {}};
+  const core::Polygon sunk{{{4.5, 4.5}, {6.5, 4.5}, {6.5, 6.5}, {4.5, 6.5}}, {}};
+  EXPECT_EQ(writeCityJson(path, {onGround(building(1, onSlope, 12.0), 7.0), onGround(building(2, sunk, 12.0), 5.0)}, options).written, 2);
+  const nlohmann::json city = readJson(path);
+  const std::vector<Vec3> vertices = decodedVertices(city);
+  const auto& reaching = city["CityObjects"]["building-1"];
+  EXPECT_EQ(solidHeights(reaching, vertices), (std::set<double>{5.8, 12.0}));
+  EXPECT_DOUBLE_EQ(reaching["attributes"]["ground_height_m"].get<double>(), 7.0);
+  EXPECT_DOUBLE_EQ(reaching["attributes"]["measuredHeight"].get<double>(), 5.0);  // from its ground, not the foot
+  expectClosedShell(reaching["geometry"][0]["boundaries"][0]);
+  EXPECT_EQ(solidHeights(city["CityObjects"]["building-2"], vertices), (std::set<double>{5.0, 12.0}));
+  EXPECT_NE(city["metadata"]["title"].get<std::string>().find("walls reach down to the terrain"), std::string::npos);
 }
 
 TEST(CityJson, ATerrainWithoutAnyHeightWritesNoReliefAndABadStepIsRefused) {

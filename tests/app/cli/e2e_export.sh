@@ -26,10 +26,11 @@ jq_true buildings '[.CityObjects[] | select(.type == "Building")] | length > 0'
 jq_true bases '[.CityObjects[] | select(.type == "Building") | .attributes | has("ground_height_m")] | all'
 jq_true measured_height '[.CityObjects[] | select(.type == "Building") | .attributes
   | (.measuredHeight - (.roof_height_m - .ground_height_m)) | fabs < 1e-6] | all'
-# The blocks' lowest z is their base (transform applied, 1 mm).
-jq_true base_is_foot '. as $c | [.CityObjects[] | select(.type == "Building")
+# The blocks' lowest z is their base or, where the terrain along the outline is lower, below it
+# (transform applied, 1 mm); never above the base.
+jq_true foot_not_above_base '. as $c | [.CityObjects[] | select(.type == "Building")
   | ([.geometry[0].boundaries[][][][] | $c.vertices[.][2] * $c.transform.scale[2] + $c.transform.translate[2]] | min)
-    - .attributes.ground_height_m | fabs < 0.001] | all'
+    - .attributes.ground_height_m < 0.001] | all'
 jq_true terrain_type '.CityObjects.terrain.type == "TINRelief" and .CityObjects.terrain.geometry[0].type == "CompositeSurface"'
 jq_true terrain_triangles '[.CityObjects.terrain.geometry[0].boundaries[] | length == 1 and (.[0] | length) == 3] | all'
 jq_true indices_valid '(.vertices | length) as $n | [.CityObjects[].geometry[0].boundaries | .. | numbers | . >= 0 and . < $n] | all'

@@ -11,7 +11,9 @@
 //
 // The terrain: one "TINRelief" City Object, a "CompositeSurface" of "lod": "1" whose surfaces are
 // triangles: a regular grid of the DTM every `step` px (vertices at pixel centres), two
-// triangles per cell whose four corners have a height, each facing up.
+// triangles per cell whose four corners have a height, each facing up. With a terrain, a block
+// whose outline crosses terrain lower than its base reaches down to the lowest such point, so
+// that no wall floats above the terrain; its base (and measuredHeight) stay as given.
 //
 // x and y: the map coordinates of the GeoReference when it is valid (metadata.referenceSystem
 // names its EPSG code when the CRS has one); otherwise a local frame in metres, x = column ×
