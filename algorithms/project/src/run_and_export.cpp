@@ -181,12 +181,8 @@ bool detectBuildings(Project& project, const cv::Mat& heights, const cv::Mat& di
     summary.status = core::RunStatus::Canceled;
     return false;
   }
-  const fs::path out(outputDir);
-  io::writeFloatGeoTiff((out / "dtm.tif").string(), analysis.dtm, geo);
+  writeElevationRasters(outputDir, geo, sceneAnalysisLayers(analysis));
   dtm = analysis.dtm;
-  io::writeFloatGeoTiff((out / "ndsm.tif").string(), analysis.ndsm, geo);
-  io::writeGeoTiff((out / "labels.tif").string(), analysis.classes, geo);
-  io::writeFeatures((out / "objects.geojson").string(), analysis.objects, geo, "objects");
   summary.objects = static_cast<int>(analysis.objects.size());
   summary.proposed =
       static_cast<int>(addProposedBuildings(project, analysis.proposals, "delineo-cli run", &summary.messages).size());
@@ -253,10 +249,8 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
     outputs.push_back({(out / "disparity.tif").string(), io::OutputFormat::GeoTiff});
   }
   if (options.detect) {
-    for (const char* name : {"dtm.tif", "ndsm.tif", "labels.tif"}) {
-      outputs.push_back({(out / name).string(), io::OutputFormat::GeoTiff});
-    }
-    outputs.push_back({(out / "objects.geojson").string(), io::OutputFormat::Vector});
+    const std::vector<ElevationLayer> scene(std::begin(kSceneAnalysisLayers), std::end(kSceneAnalysisLayers));
+    for (const io::OutputFile& file : elevationFiles(outputDir, scene)) outputs.push_back(file);
   }
   io::checkOutputs(outputs, {project.left, project.right, project.disparity, project.dem, project.labels,
                              project.exclude});

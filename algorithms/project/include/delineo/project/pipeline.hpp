@@ -13,6 +13,7 @@
 #include "delineo/core/params.hpp"
 #include "delineo/core/progress.hpp"
 #include "delineo/dem/heights.hpp"
+#include "delineo/io/output_file.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/project/project.hpp"
 
@@ -234,6 +235,51 @@ SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights
 std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
                                       const std::string& origin = {}, std::vector<std::string>* problems = nullptr);
 
+// ---- elevation rasters (src/elevation_rasters.cpp) ----
+
+// The elevation data of a project as files of one folder (File → Export elevation rasters, and
+// `run --detect` for the scene analysis's), in this order.
+enum class ElevationLayer { Disparity, Dem, EnhancedDem, Dtm, Ndsm, Labels, Objects };
+inline constexpr ElevationLayer kSceneAnalysisLayers[] = {ElevationLayer::Dtm, ElevationLayer::Ndsm,
+                                                          ElevationLayer::Labels, ElevationLayer::Objects};
+struct ElevationLayers {
+  cv::Mat disparity;    // CV_32F px, NaN = none                         → disparity.tif
+  cv::Mat dem;          // CV_32F m (projectHeights())                    → dem.tif
+  cv::Mat enhancedDem;  // CV_32F m (enhanceHeights())                    → enhanced_dem.tif
+  cv::Mat dtm, ndsm;    // CV_32F m (SceneAnalysisOutcome)                → dtm.tif, ndsm.tif
+  cv::Mat labels;       // CV_8U: 0 ground, 1 building, 2 vegetation      → labels.tif
+  std::optional<std::vector<core::Feature>> objects;  // left-image px    → objects.geojson
+  // The layers there are (a non-empty raster, objects set even when none), in the order above.
+  std::vector<ElevationLayer> present() const;
+  void leaveOut(ElevationLayer layer);
+};
+// The scene analysis's layers: its DTM, nDSM, classes (labels.tif) and objects.
+ElevationLayers sceneAnalysisLayers(const SceneAnalysisOutcome& analysis);
+// The file of each layer in `dir` ("disparity.tif", "dem.tif", "enhanced_dem.tif", "dtm.tif",
+// "ndsm.tif", "labels.tif", "objects.geojson") with its format, for io::checkOutputs.
+std::vector<io::OutputFile> elevationFiles(const std::string& dir, const std::vector<ElevationLayer>& layers);
+// Leaves out of `layers` the disparity and the DEM when their file in `dir` is the project's own
+// (its disparity or DEM raster is already that file: it is not replaced by itself). Returns the
+// names of the files left out.
+std::vector<std::string> leaveOutProjectSources(const Project& project, const std::string& dir,
+                                                ElevationLayers& layers);
+
+struct ElevationRastersWritten {
+  std::vector<std::string> files;  // paths written, in the order of ElevationLayer
+  int rasters = 0;                 // GeoTIFFs among them
+  bool objects = false;            // objects.geojson among them
+  core::RunStatus status = core::RunStatus::Completed;
+};
+// Writes the layers there are into the folder `dir`, the rasters as GeoTIFF (float32 with NaN as
+// nodata; labels 8-bit) and the objects as GeoJSON, georeferenced by `geo` (the left image's)
+// when valid. The outputs are checked first (io::checkOutputs against `inputs`). Each layer is
+// written to a temporary file beside its target, and once all are complete they are moved over
+// their targets: a failure or a cancel (polled between layers) leaves the folder as it was.
+// Throws UnusableOutput, WriteFailed.
+ElevationRastersWritten writeElevationRasters(const std::string& dir, const io::GeoReference& geo,
+                                              const ElevationLayers& layers, core::Progress* progress = nullptr,
+                                              const std::vector<std::string>& inputs = {});
+
 // ---- run and export (src/run_and_export.cpp) ----
 
 // One pending building outlined with its method (Project::methodOf), as `run` and the GUI's
@@ -271,10 +317,10 @@ struct RunSummary {
   core::RunStatus status = core::RunStatus::Completed;
 };
 // With `detect`, the scene analysis runs after matching on projectHeights() (analyseScene(),
-// writing dtm.tif, ndsm.tif, labels.tif and objects.geojson into `outputDir`) and its proposals
-// become pending buildings (addProposedBuildings()) before the outlines are made; its DTM is
-// the terrain of buildings.city.json. The blocks stand on the ground next to each building
-// (exportBuildings() with projectHeights()).
+// writing dtm.tif, ndsm.tif, labels.tif and objects.geojson into `outputDir` with
+// writeElevationRasters()) and its proposals become pending buildings (addProposedBuildings())
+// before the outlines are made; its DTM is the terrain of buildings.city.json. The blocks stand
+// on the ground next to each building (exportBuildings() with projectHeights()).
 struct RunOptions {
   bool detect = false;
 };
