@@ -127,7 +127,8 @@ void ImageView::clearImage() {
 
 cv::Size ImageView::imageSize() const { return pyramid_.empty() ? cv::Size() : pyramid_.front().size(); }
 
-void ImageView::setOverlay(const cv::Mat& labels, double opacity, std::function<QColor(int)> palette) {
+void ImageView::setOverlay(const cv::Mat& labels, double opacity, std::function<QColor(int)> palette,
+                           const OverlayHatch& hatch) {
   const int depth = labels.depth();
   if (labels.empty() || labels.channels() != 1 || !(depth == CV_8U || depth == CV_16U || depth == CV_32S)) {
     clearOverlay();
@@ -135,6 +136,7 @@ void ImageView::setOverlay(const cv::Mat& labels, double opacity, std::function<
   }
   overlayPyramid_ = buildPyramid(labels, true);
   palette_ = palette ? std::move(palette) : hashPalette;
+  hatch_ = hatch;
   overlayOpacity_ = std::clamp(opacity, 0.0, 1.0);
   invalidateTiles(Layer::Overlay);
   update();
@@ -209,17 +211,27 @@ QImage ImageView::convertBaseTile(const cv::Mat& region, cv::Point origin) const
   return out;
 }
 
-QImage ImageView::convertOverlayTile(const cv::Mat& region) const {
+QImage ImageView::convertOverlayTile(const cv::Mat& region, cv::Point origin) const {
+  // Hatching: stripes 3 level pixels wide every 8, along the anti-diagonals of the level's grid.
+  constexpr int kHatchPeriod = 8, kHatchWidth = 3;
   cv::Mat labels;
   region.convertTo(labels, CV_32S);
   QImage out(labels.cols, labels.rows, QImage::Format_ARGB32_Premultiplied);
+  const QRgb hatchColour = hatch_.colour.rgb() | 0xff000000u;
   int lastLabel = 0;
   QRgb lastColour = 0;
   for (int y = 0; y < labels.rows; ++y) {
     const int* src = labels.ptr<int>(y);
     auto* dst = reinterpret_cast<QRgb*>(out.scanLine(y));
     for (int x = 0; x < labels.cols; ++x) {
-      const int label = src[x];
+      int label = src[x];
+      if (hatch_.bit != 0 && (label & hatch_.bit) != 0) {
+        if ((origin.x + x + origin.y + y) % kHatchPeriod < kHatchWidth) {
+          dst[x] = hatchColour;
+          continue;
+        }
+        label &= ~hatch_.bit;
+      }
       if (label == 0) {
         dst[x] = 0;
         continue;
@@ -244,7 +256,7 @@ const QImage& ImageView::tile(Layer layer, int level, int tx, int ty) {
   const cv::Rect rect = cv::Rect(tx * kTileSize, ty * kTileSize, kTileSize, kTileSize) &
                         cv::Rect(0, 0, source.cols, source.rows);
   const cv::Mat region = source(rect);  // a view, no copy
-  QImage image = layer == Layer::Base ? convertBaseTile(region, rect.tl()) : convertOverlayTile(region);
+  QImage image = layer == Layer::Base ? convertBaseTile(region, rect.tl()) : convertOverlayTile(region, rect.tl());
   ++tilesConverted_;
   cacheList_.push_front(CachedTile{key, std::move(image)});
   cacheIndex_[key] = cacheList_.begin();

@@ -8,6 +8,7 @@
 //
 // Coordinates: image pixels, x right, y down, pixel (i, j) covers [i, i+1) x [j, j+1) (the same
 // frame as core::Polygon). zoom = widget pixels per image pixel.
+#include <QColor>
 #include <QElapsedTimer>
 #include <QImage>
 #include <QPointF>
@@ -37,6 +38,14 @@ enum class InteractionMode {
   PickPolygon,    // left-clicks add vertices; double-click or Enter closes → polygonPicked
   PickPoint,      // left-click → pointPicked
   EditPolygon,    // edit the selected polygon of polygons() (see PolygonOverlay)
+};
+
+// Labels of an overlay drawn hatched: those with `bit` set (0: none) show diagonal stripes of
+// `colour` over the colour of the label without the bit (nothing for 0). The stripes are fixed on
+// the pixels of the pyramid level drawn, so they stay 8 to 16 screen pixels apart when zoomed out.
+struct OverlayHatch {
+  int bit = 0;
+  QColor colour;
 };
 
 // How a single-channel raster becomes colours. NaN limits = automatic (finite min/max of the
@@ -70,9 +79,9 @@ class ImageView : public QWidget {
 
   // Label raster (CV_8U, CV_16U or CV_32S, same size as the image) drawn over the base with the
   // given opacity; label 0 is transparent. `palette` maps labels to colours (default: a fixed
-  // hash palette).
+  // hash palette); `hatch` marks labels drawn hatched.
   void setOverlay(const cv::Mat& labels, double opacity = 0.45,
-                  std::function<QColor(int)> palette = {});
+                  std::function<QColor(int)> palette = {}, const OverlayHatch& hatch = {});
   void setOverlayOpacity(double opacity);
   void setOverlayVisible(bool visible);
   bool overlayVisible() const { return overlayVisible_; }
@@ -161,7 +170,7 @@ class ImageView : public QWidget {
   static std::vector<cv::Mat> buildPyramid(const cv::Mat& level0, bool nearest);
   const QImage& tile(Layer layer, int level, int tx, int ty);
   QImage convertBaseTile(const cv::Mat& region, cv::Point origin) const;
-  QImage convertOverlayTile(const cv::Mat& region) const;
+  QImage convertOverlayTile(const cv::Mat& region, cv::Point origin) const;
   void drawLayer(QPainter& painter, Layer layer, const QRectF& exposed);
   void invalidateTiles(Layer layer);
   void clampView();
@@ -179,6 +188,7 @@ class ImageView : public QWidget {
   double overlayOpacity_ = 0.45;
   bool overlayVisible_ = true;
   std::function<QColor(int)> palette_;
+  OverlayHatch hatch_;
 
   std::list<CachedTile> cacheList_;  // most recently used first
   std::unordered_map<TileKey, std::list<CachedTile>::iterator, TileKeyHash> cacheIndex_;
