@@ -385,7 +385,15 @@ class MainWindow : public QMainWindow {
   QLabel* classesLegendTitle_ = nullptr;
   QWidget* wallLegend_ = nullptr;
   QWidget* objectsLegend_ = nullptr;
-  const uchar* overlayShows_ = nullptr;  // the raster of the left view's overlay
+  QWidget* maskLegend_ = nullptr;
+  // What the left view's overlay was made of: the labels or classes raster, the exclusion mask
+  // hatched over them (null when not shown).
+  struct OverlaySources {
+    const uchar* labels = nullptr;
+    const uchar* mask = nullptr;
+    bool operator==(const OverlaySources&) const = default;
+  };
+  OverlaySources overlayShows_;
   double rightShift_ = 0.0;
   bool linkingRight_ = false;
 };

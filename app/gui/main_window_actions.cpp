@@ -244,6 +244,18 @@ void MainWindow::createViewActions() {
     refreshLabelOverlay();
     QSettings().setValue(QStringLiteral("view/showLabels"), on);
   });
+  // The project's exclusion mask (images.exclude, e.g. vegetation: never roof) hatched over the
+  // left image and whatever overlay it has: checking the mask where it matters, on the roofs.
+  auto* mask = makeAction(this, QStringLiteral("actionShowExclusionMask"), tr("E&xclusion mask"));
+  mask->setCheckable(true);
+  mask->setChecked(QSettings().value(QStringLiteral("view/showExclusionMask"), false).toBool());
+  mask->setEnabled(false);
+  mask->setStatusTip(tr("Hatch the pixels the project's exclusion mask keeps out of every outline (only when the "
+                        "project has one)"));
+  connect(mask, &QAction::toggled, this, [this](bool on) {
+    refreshLabelOverlay();
+    QSettings().setValue(QStringLiteral("view/showExclusionMask"), on);
+  });
   // The DEM sharpened with the current outlines (walls vertical, roofs median-filtered), in the
   // DEM view and the 3D view; off shows the DEM as computed.
   QAction* enhanced = makeAction(this, QStringLiteral("actionEnhancedDem"), tr("En&hanced DEM"));
@@ -309,6 +321,7 @@ void MainWindow::createMenus() {
   view->addAction(action(QStringLiteral("actionShowLabels")));
   view->addAction(action(QStringLiteral("actionShowClasses")));
   view->addAction(action(QStringLiteral("actionShowObjects")));
+  view->addAction(action(QStringLiteral("actionShowExclusionMask")));
   view->addAction(action(QStringLiteral("actionEnhancedDem")));
   QMenu* demLayers = view->addMenu(tr("DEM &view shows"));
   for (const char* name : {"actionDemLayerDem", "actionDemLayerDtm", "actionDemLayerNdsm"}) {

@@ -128,11 +128,12 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   leftView_->setImage(doc->leftDisplay());
   rightView_->setImage(doc->rightDisplay());
   action(QStringLiteral("actionShowLabels"))->setEnabled(!doc->labels().empty());
+  action(QStringLiteral("actionShowExclusionMask"))->setEnabled(!doc->pair().exclude.empty());
   // The scene analysis was of the previous document's heights.
   scene_.reset();
   sceneJob_ = 0;
   detectAfterAnalysis_ = false;
-  overlayShows_ = nullptr;
+  overlayShows_ = {};
   leftView_->clearOverlay();
   for (const char* name : {"actionShowClasses", "actionShowObjects"}) {
     const QSignalBlocker block(action(QString::fromLatin1(name)));

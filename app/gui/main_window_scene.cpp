@@ -2,7 +2,8 @@
 // building / vegetation and the above-ground objects of the current heights, computed in the
 // background and kept until the heights or the analysis's parameters change; its layers (the
 // classes over the left image, the objects' outlines, the DTM or nDSM in the DEM view) with their
-// legend; and Detect buildings, which adds the building proposals as pending buildings.
+// legend, and the project's exclusion mask hatched over the left image; and Detect buildings,
+// which adds the building proposals as pending buildings.
 #include <QAction>
 #include <QActionGroup>
 #include <QComboBox>
@@ -38,6 +39,11 @@ const QColor kWallColour(200, 80, 220);  // label 3 of a simulated ground truth
 // The objects' outlines: lighter than the fills so they read over them.
 const QColor kBuildingObjectColour(120, 170, 255);
 const QColor kVegetationObjectColour(140, 255, 110);
+// The exclusion mask (images.exclude): cyan stripes, apart from the classes and the outlines, over
+// the labels or classes shown. The overlay is a little more opaque with it, for the stripes to read.
+const QColor kMaskColour(0, 230, 230);
+constexpr int kMaskedBit = 0x100;  // above every 8-bit label
+constexpr double kMaskOverlayOpacity = 0.55;
 
 QColor classColour(int label) {
   switch (label) {
@@ -72,6 +78,34 @@ QWidget* legendEntry(const QColor& colour, bool line, Qt::PenStyle style, const 
   layout->addWidget(swatch);
   layout->addWidget(new QLabel(text));
   return entry;
+}
+
+// The legend entry of a hatched layer: a square with the layer's stripes.
+QWidget* hatchedLegendEntry(const QColor& colour, const QString& text) {
+  QPixmap pixmap(12, 12);
+  pixmap.fill(Qt::transparent);
+  QPainter painter(&pixmap);
+  painter.fillRect(0, 0, 12, 12, QBrush(colour, Qt::BDiagPattern));
+  painter.setPen(QColor(0, 0, 0, 160));
+  painter.drawRect(0, 0, 11, 11);
+  auto* entry = new QWidget;
+  auto* layout = new QHBoxLayout(entry);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->setSpacing(3);
+  auto* swatch = new QLabel;
+  swatch->setPixmap(pixmap);
+  layout->addWidget(swatch);
+  layout->addWidget(new QLabel(text));
+  return entry;
+}
+
+// The overlay with the exclusion mask: `labels` (CV_8U, may be empty: none shown) as 16-bit labels,
+// kMaskedBit added where the mask is non-zero (drawn hatched over the label's colour).
+cv::Mat withMaskHatched(const cv::Mat& labels, const cv::Mat& mask) {
+  cv::Mat overlay(mask.size(), CV_16U, cv::Scalar(0));
+  if (!labels.empty()) labels.convertTo(overlay, CV_16U);
+  cv::bitwise_or(overlay, cv::Scalar(kMaskedBit), overlay, mask);
+  return overlay;
 }
 
 bool isBuildingObject(const core::Feature& object) {
@@ -156,10 +190,18 @@ QWidget* MainWindow::createLayerLegend() {
   objects->addWidget(new QLabel(tr("Objects:")));
   objects->addWidget(legendEntry(kBuildingObjectColour, true, Qt::SolidLine, tr("building")));
   objects->addWidget(legendEntry(kVegetationObjectColour, true, Qt::DashLine, tr("vegetation")));
+  maskLegend_ = new QWidget;
+  maskLegend_->setObjectName(QStringLiteral("maskLegend"));
+  auto* mask = new QHBoxLayout(maskLegend_);
+  mask->setContentsMargins(0, 0, 0, 0);
+  mask->addWidget(new QLabel(tr("Exclusion mask:")));
+  mask->addWidget(hatchedLegendEntry(kMaskColour, tr("not roof")));
   layout->addWidget(classesLegend_);
   layout->addWidget(objectsLegend_);
+  layout->addWidget(maskLegend_);
   classesLegend_->hide();
   objectsLegend_->hide();
+  maskLegend_->hide();
   layerLegend_->hide();
   return layerLegend_;
 }
@@ -341,27 +383,39 @@ const cv::Mat& MainWindow::demViewRaster() const {
 }
 
 // The left view's overlay: the analysis's classes or the project's label raster (one at a time),
-// in the classes' colours, with the legend.
+// in the classes' colours, and the exclusion mask hatched over them, with the legend. Without the
+// mask a hidden label raster stays in the view (turned on without making its tiles again).
 void MainWindow::refreshLabelOverlay() {
   const bool classes = action(QStringLiteral("actionShowClasses"))->isChecked() && scene_;
   const bool labels = !classes && document_ && !document_->labels().empty();
-  const cv::Mat wanted = classes ? scene_->classes : labels ? document_->labels() : cv::Mat();
-  if (wanted.data != overlayShows_) {  // a new overlay raster: its tiles are made again
-    if (wanted.empty()) leftView_->clearOverlay();
-    else leftView_->setOverlay(wanted, classes ? 0.45 : 0.3, classColour);
-    overlayShows_ = wanted.data;
+  const bool labelsShown = classes || (labels && action(QStringLiteral("actionShowLabels"))->isChecked());
+  const cv::Mat& mask = document_ ? document_->pair().exclude : cv::Mat();
+  const bool maskShown = !mask.empty() && action(QStringLiteral("actionShowExclusionMask"))->isChecked();
+  const cv::Mat base = classes ? scene_->classes : labels ? document_->labels() : cv::Mat();
+  const OverlaySources wanted{maskShown && !labelsShown ? nullptr : base.data, maskShown ? mask.data : nullptr};
+  if (!(wanted == overlayShows_)) {  // a new overlay raster: its tiles are made again
+    if (maskShown) {
+      leftView_->setOverlay(withMaskHatched(labelsShown ? base : cv::Mat(), mask), kMaskOverlayOpacity, classColour,
+                            {kMaskedBit, kMaskColour});
+    } else if (base.empty()) {
+      leftView_->clearOverlay();
+    } else {
+      leftView_->setOverlay(base, classes ? 0.45 : 0.3, classColour);
+    }
+    overlayShows_ = wanted;
   }
-  const bool visible = classes || (labels && action(QStringLiteral("actionShowLabels"))->isChecked());
-  leftView_->setOverlayVisible(visible);
+  leftView_->setOverlayVisible(labelsShown || maskShown);
   classesLegendTitle_->setText(classes ? tr("Classes:") : tr("Labels:"));
   wallLegend_->setVisible(!classes);
-  classesLegend_->setVisible(visible);
+  classesLegend_->setVisible(labelsShown);
+  maskLegend_->setVisible(maskShown);
   refreshLayerLegend();
 }
 
 void MainWindow::refreshLayerLegend() {
   objectsLegend_->setVisible(action(QStringLiteral("actionShowObjects"))->isChecked() && scene_);
-  layerLegend_->setVisible(classesLegend_->isVisibleTo(layerLegend_) || objectsLegend_->isVisibleTo(layerLegend_));
+  layerLegend_->setVisible(classesLegend_->isVisibleTo(layerLegend_) || objectsLegend_->isVisibleTo(layerLegend_) ||
+                           maskLegend_->isVisibleTo(layerLegend_));
 }
 
 // The analysis's objects, outlined in their class's colour (vegetation dashed).
