@@ -121,12 +121,16 @@ void ElevationLayers::leaveOut(ElevationLayer layer) {
   }
 }
 
+void ElevationLayers::setSceneAnalysis(const SceneAnalysisOutcome& analysis) {
+  dtm = analysis.dtm;
+  ndsm = analysis.ndsm;
+  labels = analysis.classes;
+  objects = analysis.objects;
+}
+
 ElevationLayers sceneAnalysisLayers(const SceneAnalysisOutcome& analysis) {
   ElevationLayers layers;
-  layers.dtm = analysis.dtm;
-  layers.ndsm = analysis.ndsm;
-  layers.labels = analysis.classes;
-  layers.objects = analysis.objects;
+  layers.setSceneAnalysis(analysis);
   return layers;
 }
 

@@ -252,8 +252,10 @@ struct ElevationLayers {
   // The layers there are (a non-empty raster, objects set even when none), in the order above.
   std::vector<ElevationLayer> present() const;
   void leaveOut(ElevationLayer layer);
+  // The scene analysis's layers: its DTM, nDSM, classes (labels.tif) and objects.
+  void setSceneAnalysis(const SceneAnalysisOutcome& analysis);
 };
-// The scene analysis's layers: its DTM, nDSM, classes (labels.tif) and objects.
+// The scene analysis's layers alone.
 ElevationLayers sceneAnalysisLayers(const SceneAnalysisOutcome& analysis);
 // The file of each layer in `dir` ("disparity.tif", "dem.tif", "enhanced_dem.tif", "dtm.tif",
 // "ndsm.tif", "labels.tif", "objects.geojson") with its format, for io::checkOutputs.
