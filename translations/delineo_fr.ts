@@ -1958,6 +1958,82 @@
         <source>Some roof intervals could not be read: set them on the histogram (%1).</source>
         <translation>Certains intervalles de toit n’ont pas pu être lus : définissez-les sur l’histogramme (%1).</translation>
     </message>
+    <message>
+        <source>Export e&amp;levation rasters…</source>
+        <translation>Exporter les rasters d’&amp;altitude…</translation>
+    </message>
+    <message>
+        <source>E&amp;xclusion mask</source>
+        <translation>Masque d’e&amp;xclusion</translation>
+    </message>
+    <message>
+        <source>Hatch the pixels the project&apos;s exclusion mask keeps out of every outline (only when the project has one)</source>
+        <translation>Hachurer les pixels que le masque d’exclusion du projet tient hors de tout contour (seulement quand le projet en a un)</translation>
+    </message>
+    <message>
+        <source>Write the disparity, the DEM and the scene analysis&apos;s DTM, nDSM, labels and objects into a folder, georeferenced like the left image</source>
+        <translation>Écrire la disparité, le MNE et les MNT, MNH, étiquettes et objets de l’analyse de la scène dans un dossier, géoréférencés comme l’image gauche</translation>
+    </message>
+    <message>
+        <source>Nothing to export yet: compute the disparity (Processing → Compute disparity) or give the project a DEM</source>
+        <translation>Rien à exporter pour l’instant : calculez la disparité (Traitements → Calculer la disparité) ou donnez un MNE au projet</translation>
+    </message>
+    <message>
+        <source>Export elevation rasters into</source>
+        <translation>Exporter les rasters d’altitude dans</translation>
+    </message>
+    <message>
+        <source>Replace files</source>
+        <translation>Remplacer les fichiers</translation>
+    </message>
+    <message>
+        <source>%1 already holds %2. Replace them?</source>
+        <translation>%1 contient déjà %2. Les remplacer ?</translation>
+    </message>
+    <message>
+        <source>Export elevation rasters</source>
+        <translation>Export des rasters d’altitude</translation>
+    </message>
+    <message>
+        <source>Nothing exported: the files in %1 are kept.</source>
+        <translation>Rien n’a été exporté : les fichiers de %1 sont conservés.</translation>
+    </message>
+    <message>
+        <source>Writing the files</source>
+        <translation>Écriture des fichiers</translation>
+    </message>
+    <message>
+        <source>%1 raster and the objects written to %2</source>
+        <translation>%1 raster et les objets écrits dans %2</translation>
+    </message>
+    <message>
+        <source>%1 rasters and the objects written to %2</source>
+        <translation>%1 rasters et les objets écrits dans %2</translation>
+    </message>
+    <message>
+        <source>%1 raster written to %2</source>
+        <translation>%1 raster écrit dans %2</translation>
+    </message>
+    <message>
+        <source>%1 rasters written to %2</source>
+        <translation>%1 rasters écrits dans %2</translation>
+    </message>
+    <message>
+        <source>%1 is the project&apos;s own file: left as it is.</source>
+        <translation>%1 est le fichier du projet : laissé tel quel.</translation>
+    </message>
+    <message>
+        <source>%1 are the project&apos;s own files: left as they are.</source>
+        <translation>%1 sont les fichiers du projet : laissés tels quels.</translation>
+    </message>
+    <message>
+        <source>Exclusion mask:</source>
+        <translation>Masque d’exclusion :</translation>
+    </message>
+    <message>
+        <source>not roof</source>
+        <translation>pas un toit</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::ProjectSettingsDialog</name>

@@ -133,8 +133,16 @@ class MainWindow : public QMainWindow {
   enum class DemLayer { Dem = 0, Dtm = 1, Ndsm = 2 };
   void setDemLayer(DemLayer layer);
   DemLayer demLayer() const;
-  // The legend of the coloured layers over the left image (classes, labels, objects).
+  // The legend of the coloured layers over the left image (classes, labels, objects, exclusion mask).
   QWidget* layerLegend() const { return layerLegend_; }
+
+  // ---- elevation rasters (main_window_rasters.cpp) ----
+  // File → Export elevation rasters into `dir` (key "rasters"): the disparity, the DEM, the
+  // enhanced DEM while it is shown and the scene analysis's DTM, nDSM, labels and objects
+  // (analysed first when missing and computable), georeferenced like the left image, all written
+  // or none (project::writeElevationRasters). Existing files are replaced only when the operator
+  // agrees. Returns the job id, or 0 with a message saying why nothing started.
+  widgets::JobId exportElevationRasters(const QString& dir);
 
   // ---- accessors for tests and the screenshot tour ----
   widgets::ImageView* leftView() const { return leftView_; }
@@ -174,6 +182,8 @@ class MainWindow : public QMainWindow {
   void setRelocateHandler(std::function<QString(const QString& missing)> handler) {
     relocate_ = std::move(handler);
   }
+  // Answers "replace the existing files?" of an export when not interactive (default: yes).
+  void setReplaceFilesPolicy(bool replace) { replaceFiles_ = replace; }
   // Fills and answers the project settings dialog when not interactive (true = OK).
   void setProjectSettingsHandler(std::function<bool(ProjectSettingsDialog&)> handler) {
     projectSettingsHandler_ = std::move(handler);
@@ -200,6 +210,7 @@ class MainWindow : public QMainWindow {
   void sceneAnalysed();                         // a new scene analysis is shown
   void buildingsDetected(int added, int present);  // Detect buildings has added its proposals
   void pendingOutlined(int outlined, int skipped);  // Outline the pending buildings has ended
+  void elevationRastersExported(const QStringList& files);  // written into the folder, all of them
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -306,6 +317,14 @@ class MainWindow : public QMainWindow {
   std::vector<widgets::OverlayGuide> sceneObjectGuides() const;
   void showInformation(const QString& title, const QString& text);
 
+  // main_window_rasters.cpp: File → Export elevation rasters.
+  void chooseRasterFolder();
+  project::ElevationLayers shownElevationLayers() const;
+  bool agreeToReplace(const QString& dir, const std::vector<io::OutputFile>& files);
+  void onElevationRastersWritten(const QString& dir, const project::ElevationRastersWritten& written,
+                                 const QStringList& leftOut);
+  void refreshRasterExportAction();
+
   std::unique_ptr<Document> document_;
   widgets::JobRunner* jobs_ = nullptr;
   widgets::ImageView* leftView_ = nullptr;
@@ -341,6 +360,7 @@ class MainWindow : public QMainWindow {
   int selectedId_ = -1;
   bool interactive_ = true;
   bool restoreAutosave_ = false;
+  bool replaceFiles_ = true;
   bool updatingForms_ = false;
   bool updatingSelection_ = false;
   QString lastMessage_;

@@ -101,6 +101,8 @@ void MainWindow::createFileActions() {
                 tr("GeoJSON (*.geojson);;GeoPackage (*.gpkg);;CityJSON 3D blocks (*.city.json *.cityjson)"));
             if (!path.isEmpty()) exportAccepted(path);
           });
+  connect(makeAction(this, QStringLiteral("actionExportRasters"), tr("Export e&levation rasters…")),
+          &QAction::triggered, this, &MainWindow::chooseRasterFolder);
   connect(makeAction(this, QStringLiteral("actionQuit"), tr("&Quit"), QKeySequence::Quit),
           &QAction::triggered, this, &QWidget::close);
 }
@@ -276,6 +278,8 @@ void MainWindow::createMenus() {
   file->addAction(action(QStringLiteral("actionSave")));
   file->addAction(action(QStringLiteral("actionSaveAs")));
   file->addAction(action(QStringLiteral("actionExport")));
+  file->addAction(action(QStringLiteral("actionExportRasters")));
+  file->setToolTipsVisible(true);  // why Export elevation rasters is disabled
   file->addAction(action(QStringLiteral("actionProjectSettings")));
   file->addSeparator();
   file->addAction(action(QStringLiteral("actionQuit")));
@@ -369,6 +373,7 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionSave"))->setEnabled(hasDoc);
   action(QStringLiteral("actionSaveAs"))->setEnabled(hasDoc);
   action(QStringLiteral("actionExport"))->setEnabled(hasDoc);
+  refreshRasterExportAction();
   action(QStringLiteral("actionMatch"))->setEnabled(hasDoc);
   action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr);
   action(QStringLiteral("actionRegularize"))->setEnabled(b != nullptr && b->hasOutline());
