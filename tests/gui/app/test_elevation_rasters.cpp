@@ -9,6 +9,10 @@
 #include <QApplication>
 #include <QDir>
 #include <QFileInfo>
+#include <QHelpEvent>
+#include <QMenu>
+#include <QMenuBar>
+#include <QScreen>
 #include <QFileDialog>
 #include <QMessageBox>
 #include <QPushButton>
@@ -154,6 +158,22 @@ class ElevationRastersTest : public QObject {
     shot(window_->leftView(), name);
   }
 
+  // The File menu open on the disabled Export elevation rasters with its tooltip (the whole
+  // screen: the tooltip is a window of its own).
+  void shotDisabledEntry() {
+    if (screenshotDir().isEmpty()) return;
+    QDir().mkpath(screenshotDir());
+    QMenu* file = window_->menuBar()->actions().first()->menu();
+    file->popup(window_->mapToGlobal(QPoint(0, window_->menuBar()->height())));
+    QTest::qWait(300);
+    const QRect entry = file->actionGeometry(act("actionExportRasters"));
+    QHelpEvent hover(QEvent::ToolTip, entry.center(), file->mapToGlobal(entry.center()));
+    QApplication::sendEvent(file, &hover);
+    QTest::qWait(500);
+    QVERIFY(window_->screen()->grabWindow(0).save(QDir(screenshotDir()).filePath(QStringLiteral("rasters-disabled.png"))));
+    file->close();
+  }
+
   // A pair without heights: no disparity, no DEM, no mask.
   bool openBarePair() {
     cv::Mat left(120, 160, CV_8U);
@@ -197,6 +217,7 @@ class ElevationRastersTest : public QObject {
     QVERIFY(!act("actionExportRasters")->isEnabled());
     QVERIFY2(act("actionExportRasters")->toolTip().contains(QStringLiteral("Nothing to export")),
              qPrintable(act("actionExportRasters")->toolTip()));
+    shotDisabledEntry();
     const QString out = freshFolder(QStringLiteral("bare"));
     QCOMPARE(window_->exportElevationRasters(out), widgets::JobId(0));
     QVERIFY(window_->jobs()->waitForIdle(5000));
