@@ -29,6 +29,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "delineo/core/nan_mask.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
@@ -55,7 +56,7 @@ bool sameValues(const cv::Mat& a, const cv::Mat& b) {
   cv::Mat fa, fb;
   a.convertTo(fa, CV_32F);
   b.convertTo(fb, CV_32F);
-  const cv::Mat nanA = fa != fa, nanB = fb != fb;
+  const cv::Mat nanA = core::nanMask(fa), nanB = core::nanMask(fb);
   if (cv::countNonZero(nanA != nanB) != 0) return false;
   cv::Mat diff;
   cv::absdiff(fa, fb, diff);
