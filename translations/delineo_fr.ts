@@ -2034,6 +2034,18 @@
         <source>not roof</source>
         <translation>pas un toit</translation>
     </message>
+    <message>
+        <source>Not estimated: %1. Enter the range above, then compute the disparity (Ctrl+M).</source>
+        <translation>Non estimé : %1. Saisissez l’intervalle ci-dessus, puis calculez la disparité (Ctrl+M).</translation>
+    </message>
+    <message>
+        <source>The disparity range could not be estimated from the images: %1.
+
+Enter the smallest and largest disparity of the pair (x_right = x_left − d) on the Matching tab of the Parameters dock, then compute the disparity (Ctrl+M).</source>
+        <translation>L’intervalle de disparité n’a pas pu être estimé à partir des images : %1.
+
+Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_gauche − d) dans l’onglet Appariement du panneau Paramètres, puis calculez la disparité (Ctrl+M).</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::ProjectSettingsDialog</name>

@@ -45,7 +45,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   QSettings settings;
   autosaveTimer_.start(std::max(5, settings.value(QStringLiteral("autosaveSeconds"), 60).toInt()) * 1000);
   connect(jobs_, &widgets::JobRunner::failed, this,
-          [this](widgets::JobId, core::ErrorCode code, const QString& message) {
+          [this](widgets::JobId id, core::ErrorCode code, const QString& message) {
+            if (id == rangeJob_ && code == core::ErrorCode::ProcessingFailed) return onRangeEstimateFailed(message);
             showMessage(tr("Job failed"), errorSentence(code) + QStringLiteral("\n\n") + message);
           });
   connect(jobs_, &widgets::JobRunner::activeCountChanged, this, [this](int count) {

@@ -216,6 +216,8 @@ class MainWindow : public QMainWindow {
   void closeEvent(QCloseEvent* event) override;
 
  private:
+  // The range could not be read from the images: says so and shows where to enter it.
+  void onRangeEstimateFailed(const QString& message);
   // The private functions, grouped by the file that defines them.
   // main_window.cpp: the window's settings, messages and title, the 3D view's content, the pick
   // of an above-ground object.
@@ -376,6 +378,7 @@ class MainWindow : public QMainWindow {
   std::map<int, core::Polygon> energyAsked_;
   int awaitingDisparity_ = -1;  // picked while matching ran: delineated when the disparity arrives
   widgets::JobId matchingJob_ = 0;
+  widgets::JobId rangeJob_ = 0;
   cv::Mat edgeMap_;
   // Box-fitting results shown beside a building's outline until kept or dropped, by building.
   struct BoxFitProposal {

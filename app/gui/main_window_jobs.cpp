@@ -2,10 +2,13 @@
 // pending buildings outlined in turn, the energy and the regularization of an outline, the edge
 // map. Each copies its inputs into a job of the window's JobRunner and applies the result on the
 // GUI thread, provided the document it was started on is still the open one.
+#include <QDockWidget>
 #include <QLabel>
 #include <QMetaObject>
 #include <QPointer>
+#include <QSpinBox>
 #include <QStatusBar>
+#include <QTabWidget>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -65,7 +68,7 @@ widgets::JobId MainWindow::startRangeEstimate(bool thenMatch) {
   const project::StereoPair pair = document_->pair();
   QPointer<Document> doc(document_.get());
   rangeNote_->setText(tr("Estimating the range from feature matches…"));
-  return jobs_->run<project::RangeOutcome>(
+  rangeJob_ = jobs_->run<project::RangeOutcome>(
       tr("Disparity range"),
       [projectCopy, pair](core::Progress& p) { return project::estimateDisparityRange(projectCopy, pair, &p); },
       [this, doc, thenMatch](project::RangeOutcome outcome) {
@@ -83,6 +86,28 @@ widgets::JobId MainWindow::startRangeEstimate(bool thenMatch) {
         if (thenMatch) startMatching();
       },
       QStringLiteral("range"));
+  return rangeJob_;
+}
+
+void MainWindow::onRangeEstimateFailed(const QString& message) {
+  loadRangeFromDocument();
+  rangeNote_->setText(tr("Not estimated: %1. Enter the range above, then compute the disparity (Ctrl+M).").arg(message));
+  // The Matching tab of the Parameters dock, its range in view and focused.
+  if (auto* dock = findChild<QDockWidget*>(QStringLiteral("parametersDock"))) {
+    dock->show();
+    dock->raise();
+  }
+  for (QWidget* w = rangeMin_; w != nullptr; w = w->parentWidget()) {
+    if (auto* tabs = qobject_cast<QTabWidget*>(w->parentWidget() ? w->parentWidget()->parentWidget() : nullptr)) {
+      tabs->setCurrentWidget(w);
+      break;
+    }
+  }
+  rangeMin_->setFocus();
+  showMessage(tr("Disparity range"),
+              tr("The disparity range could not be estimated from the images: %1.\n\nEnter the smallest and largest "
+                 "disparity of the pair (x_right = x_left − d) on the Matching tab of the Parameters dock, then "
+                 "compute the disparity (Ctrl+M).").arg(message));
 }
 
 widgets::JobId MainWindow::startMatching() {

@@ -78,7 +78,8 @@ JobId JobRunner::start(const QString& name, const QString& key,
     } catch (const core::Error& error) {
       job->failed = true;
       job->errorCode = error.code();
-      job->errorMessage = QString::fromStdString(error.what());
+      // The code is said apart (its translated sentence): the message is the detail and its file.
+      job->errorMessage = QString::fromStdString(error.path().empty() ? error.detail() : error.path() + ": " + error.detail());
     } catch (const std::bad_alloc&) {
       job->failed = true;
       job->errorMessage = QStringLiteral("out of memory");

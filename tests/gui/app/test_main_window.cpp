@@ -925,6 +925,31 @@ class MainWindowTest : public QObject {
     tabs->setCurrentIndex(0);
   }
 
+  void aPairWithoutFeaturesAsksForTheRangeOnTheMatchingTab() {
+    // Two flat images: no feature to match, so no range can be read from them.
+    const cv::Mat flat(120, 160, CV_8U, cv::Scalar(100));
+    const QString left = dir_.filePath(QStringLiteral("flat_left.tif"));
+    const QString right = dir_.filePath(QStringLiteral("flat_right.tif"));
+    io::writeGeoTiff(left.toStdString(), flat);
+    io::writeGeoTiff(right.toStdString(), flat);
+    QVERIFY(window_->openPair(left, right));
+    auto* tabs = window_->findChild<QTabWidget*>(QStringLiteral("parameterTabs"));
+    QVERIFY(tabs != nullptr);
+    tabs->setCurrentIndex(0);
+    QVERIFY(window_->startMatching() != 0);
+    QVERIFY(window_->jobs()->waitForIdle(30000));
+    const QString message = window_->lastMessage();
+    QVERIFY2(message.contains(QStringLiteral("could not be estimated from the images: the left image is blank")),
+             qPrintable(message));
+    QVERIFY2(message.contains(QStringLiteral("Matching tab")), qPrintable(message));
+    QVERIFY2(!message.contains(QStringLiteral("processing failed")), qPrintable(message));
+    QVERIFY(window_->rangeNote()->text().startsWith(QStringLiteral("Not estimated: the left image is blank")));
+    QCOMPARE(tabs->tabText(tabs->currentIndex()), QStringLiteral("Matching"));
+    QVERIFY(!window_->document()->project().disparityRange);
+    QVERIFY(window_->document()->disparity().empty());
+    tabs->setCurrentIndex(0);
+  }
+
   void colourPairIsShownInColourAndMatchedInGrey() {
     QVERIFY(openSyntheticPair(QStringLiteral("colour"), true));
     gui::Document* doc = window_->document();

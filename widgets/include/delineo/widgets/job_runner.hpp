@@ -85,6 +85,8 @@ class JobRunner : public QObject {
   void progressChanged(delineo::widgets::JobId id, double fraction, const QString& stage);
   void finished(delineo::widgets::JobId id);
   void canceled(delineo::widgets::JobId id);
+  // `message`: a core::Error's detail, after the file it names ("path: detail"), without the
+  // code's words (the caller says the code in its own sentence); what() of other exceptions.
   void failed(delineo::widgets::JobId id, delineo::core::ErrorCode code, const QString& message);
   // Any outcome; emitted after the specific signal.
   void ended(delineo::widgets::JobId id, delineo::widgets::JobOutcome outcome);
