@@ -42,7 +42,24 @@ ProjectSettingsDialog::ProjectSettingsDialog(const project::Project& project,
   setObjectName(QStringLiteral("projectSettingsDialog"));
   setWindowTitle(tr("Project settings"));
   auto* layout = new QVBoxLayout(this);
+  layout->addWidget(createOutputBox(project));
+  layout->addWidget(createHeightModelBox(project, groundSuggestion));
 
+  direct_->setChecked(true);
+  for (QDoubleSpinBox* box : {base_, flyingHeight_, focal_}) {
+    connect(box, &QDoubleSpinBox::valueChanged, this, [this] { updateCameraResult(); });
+  }
+  connect(direct_, &QRadioButton::toggled, this, [this] { updateEnabled(); });
+  updateCameraResult();
+  updateEnabled();
+
+  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
+  connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
+  connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
+  layout->addWidget(buttons);
+}
+
+QGroupBox* ProjectSettingsDialog::createOutputBox(const project::Project& project) {
   auto* outputBox = new QGroupBox(tr("Outputs"));
   auto* outputRow = new QHBoxLayout(outputBox);
   outputDir_ = new QLineEdit(QString::fromStdString(project.outputDir));
@@ -64,28 +81,17 @@ ProjectSettingsDialog::ProjectSettingsDialog(const project::Project& project,
     outputDir_->setText(!relative.isEmpty() && !relative.startsWith(QStringLiteral("..")) ? relative
                                                                                           : chosen);
   });
-  layout->addWidget(outputBox);
+  return outputBox;
+}
 
+// The height model: the ground disparity, metres per pixel given directly or from the camera,
+// then the ground sample distance and the ground level's elevation.
+QGroupBox* ProjectSettingsDialog::createHeightModelBox(const project::Project& project,
+                                                       std::optional<double> groundSuggestion) {
   auto* heightBox =
       new QGroupBox(tr("Height model: height = (disparity − ground disparity) × metres per pixel"));
   auto* heightLayout = new QVBoxLayout(heightBox);
-  auto* common = new QFormLayout;
-  groundDisparity_ = spinBox(QStringLiteral("groundDisparity"), -100000, 100000, 2, tr(" px"),
-                             tr("Disparity of the ground (height 0)"));
-  groundDisparity_->setValue(project.height.groundDisparity);
-  auto* groundRow = new QHBoxLayout;
-  groundRow->addWidget(groundDisparity_, 1);
-  if (groundSuggestion) {
-    auto* fromMap =
-        new QPushButton(tr("From the disparity map (%1 px)").arg(*groundSuggestion, 0, 'f', 1));
-    fromMap->setObjectName(QStringLiteral("groundFromMap"));
-    fromMap->setToolTip(tr("The ground level read from the disparity map"));
-    connect(fromMap, &QPushButton::clicked, this,
-            [this, g = *groundSuggestion] { groundDisparity_->setValue(g); });
-    groundRow->addWidget(fromMap);
-  }
-  common->addRow(tr("Ground disparity"), groundRow);
-  heightLayout->addLayout(common);
+  heightLayout->addLayout(createGroundDisparityForm(project, groundSuggestion));
 
   direct_ = new QRadioButton(tr("Metres of height per pixel of disparity"));
   direct_->setObjectName(QStringLiteral("modelDirect"));
@@ -100,6 +106,43 @@ ProjectSettingsDialog::ProjectSettingsDialog(const project::Project& project,
   camera_ = new QRadioButton(tr("From the camera: k = H² / (B · f)"));
   camera_->setObjectName(QStringLiteral("modelCamera"));
   heightLayout->addWidget(camera_);
+  heightLayout->addLayout(createCameraForm());
+
+  auto* gsdForm = new QFormLayout;
+  gsd_ = spinBox(QStringLiteral("gsd"), 0.0001, 1000, 4, tr(" m"),
+                 tr("Ground size of one image pixel (hillshade and 3D view)"));
+  gsd_->setValue(project.height.gsd);
+  gsdForm->addRow(tr("Ground sample distance"), gsd_);
+  groundElevation_ = spinBox(QStringLiteral("groundElevation"), -10000, 10000, 2, tr(" m"),
+                             tr("Elevation of the ground level above the vertical datum, added to the z of the CityJSON export"));
+  groundElevation_->setValue(project.height.groundElevation);
+  gsdForm->addRow(tr("Ground elevation"), groundElevation_);
+  heightLayout->addLayout(gsdForm);
+  return heightBox;
+}
+
+QFormLayout* ProjectSettingsDialog::createGroundDisparityForm(const project::Project& project,
+                                                              std::optional<double> groundSuggestion) {
+  auto* form = new QFormLayout;
+  groundDisparity_ = spinBox(QStringLiteral("groundDisparity"), -100000, 100000, 2, tr(" px"),
+                             tr("Disparity of the ground (height 0)"));
+  groundDisparity_->setValue(project.height.groundDisparity);
+  auto* groundRow = new QHBoxLayout;
+  groundRow->addWidget(groundDisparity_, 1);
+  if (groundSuggestion) {
+    auto* fromMap =
+        new QPushButton(tr("From the disparity map (%1 px)").arg(*groundSuggestion, 0, 'f', 1));
+    fromMap->setObjectName(QStringLiteral("groundFromMap"));
+    fromMap->setToolTip(tr("The ground level read from the disparity map"));
+    connect(fromMap, &QPushButton::clicked, this,
+            [this, g = *groundSuggestion] { groundDisparity_->setValue(g); });
+    groundRow->addWidget(fromMap);
+  }
+  form->addRow(tr("Ground disparity"), groundRow);
+  return form;
+}
+
+QFormLayout* ProjectSettingsDialog::createCameraForm() {
   base_ = spinBox(QStringLiteral("cameraBase"), 0, 1e6, 2, tr(" m"),
                   tr("Distance between the two exposures"));
   flyingHeight_ = spinBox(QStringLiteral("cameraHeight"), 0, 1e7, 1, tr(" m"),
@@ -113,32 +156,7 @@ ProjectSettingsDialog::ProjectSettingsDialog(const project::Project& project,
   cameraResult_ = new QLabel;
   cameraResult_->setObjectName(QStringLiteral("cameraResult"));
   cameraForm->addRow(QString(), cameraResult_);
-  heightLayout->addLayout(cameraForm);
-
-  auto* gsdForm = new QFormLayout;
-  gsd_ = spinBox(QStringLiteral("gsd"), 0.0001, 1000, 4, tr(" m"),
-                 tr("Ground size of one image pixel (hillshade and 3D view)"));
-  gsd_->setValue(project.height.gsd);
-  gsdForm->addRow(tr("Ground sample distance"), gsd_);
-  groundElevation_ = spinBox(QStringLiteral("groundElevation"), -10000, 10000, 2, tr(" m"),
-                             tr("Elevation of the ground level above the vertical datum, added to the z of the CityJSON export"));
-  groundElevation_->setValue(project.height.groundElevation);
-  gsdForm->addRow(tr("Ground elevation"), groundElevation_);
-  heightLayout->addLayout(gsdForm);
-  layout->addWidget(heightBox);
-
-  direct_->setChecked(true);
-  for (QDoubleSpinBox* box : {base_, flyingHeight_, focal_}) {
-    connect(box, &QDoubleSpinBox::valueChanged, this, [this] { updateCameraResult(); });
-  }
-  connect(direct_, &QRadioButton::toggled, this, [this] { updateEnabled(); });
-  updateCameraResult();
-  updateEnabled();
-
-  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
-  connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
-  connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
-  layout->addWidget(buttons);
+  return cameraForm;
 }
 
 void ProjectSettingsDialog::setCamera(double base, double flyingHeight, double focalPx) {

@@ -8,6 +8,8 @@
 
 class QButtonGroup;
 class QDoubleSpinBox;
+class QFormLayout;
+class QGroupBox;
 class QLabel;
 class QLineEdit;
 class QPushButton;
@@ -34,6 +36,10 @@ class ProjectSettingsDialog : public QDialog {
   void setCamera(double base, double flyingHeight, double focalPx);
 
  private:
+  QGroupBox* createOutputBox(const project::Project& project);
+  QGroupBox* createHeightModelBox(const project::Project& project, std::optional<double> groundSuggestion);
+  QFormLayout* createGroundDisparityForm(const project::Project& project, std::optional<double> groundSuggestion);
+  QFormLayout* createCameraForm();
   void updateCameraResult();
   void updateEnabled();
 
