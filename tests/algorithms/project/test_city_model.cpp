@@ -14,6 +14,7 @@
 #include "delineo/core/error.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/project/project.hpp"
+#include "temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace delineo;
@@ -23,23 +24,7 @@ using project::Project;
 
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() / ("delineo_city_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using project::testing::TempDir;
 
 constexpr double kSlope = 0.02;      // m of ground per px of column
 constexpr double kBuildingTall = 9;  // m above the ground at its centre

@@ -14,6 +14,7 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "temp_dir.hpp"
 
 namespace {
 using namespace delineo;
@@ -21,32 +22,7 @@ namespace fs = std::filesystem;
 using project::ElevationLayer;
 using project::ElevationLayers;
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("delineo_rasters_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  std::string dir() const { return path_.string(); }
-  // The names in the folder, sorted, hidden ones included.
-  std::vector<std::string> names() const {
-    std::vector<std::string> out;
-    for (const auto& entry : fs::directory_iterator(path_)) out.push_back(entry.path().filename().string());
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
- private:
-  fs::path path_;
-};
+using project::testing::TempDir;
 
 io::GeoReference lambertLikeGeo() {
   io::GeoReference geo;
