@@ -188,6 +188,25 @@ StderrProgress& commandProgress() {
   return progress;
 }
 
+std::string positionalArgument(const std::vector<std::string>& args, const std::vector<std::string>& valueOptions,
+                               std::vector<std::string>& rest) {
+  std::string positional;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool takesValue =
+        std::find(valueOptions.begin(), valueOptions.end(), a) != valueOptions.end() && i + 1 < args.size();
+    if (a.rfind("-", 0) == 0) {
+      rest.push_back(a);
+      if (takesValue) rest.push_back(args[++i]);
+    } else if (positional.empty()) {
+      positional = a;
+    } else {
+      throw UsageError("unexpected argument '" + a + "': give one PROJECT");
+    }
+  }
+  return positional;
+}
+
 void throwIfCanceled(const core::Progress& p) {
   if (p.canceled()) throw Canceled();
 }

@@ -147,6 +147,12 @@ StderrProgress& commandProgress();
 // Throws Canceled when the progress was canceled (to unwind a command cleanly).
 void throwIfCanceled(const core::Progress& p);
 
+// A command's one positional argument (a PROJECT), which may stand anywhere among the options:
+// the one argument that is neither an option nor the value of one of `valueOptions` ("--out").
+// The options are left in `rest`; empty when there is none. Throws UsageError naming a second one.
+std::string positionalArgument(const std::vector<std::string>& args, const std::vector<std::string>& valueOptions,
+                               std::vector<std::string>& rest);
+
 // The output policy (io/output_file.hpp) before any work: the files of the `outputs` options
 // given, against those of the `inputs` options given.
 void checkOutputs(const Options& opts, const std::vector<std::pair<std::string, io::OutputFormat>>& outputs,

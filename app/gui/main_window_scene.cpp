@@ -54,6 +54,19 @@ QColor classColour(int label) {
   }
 }
 
+// A legend entry: its swatch and its name.
+QWidget* legendEntryOf(const QPixmap& swatch, const QString& text) {
+  auto* entry = new QWidget;
+  auto* layout = new QHBoxLayout(entry);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->setSpacing(3);
+  auto* swatchLabel = new QLabel;
+  swatchLabel->setPixmap(swatch);
+  layout->addWidget(swatchLabel);
+  layout->addWidget(new QLabel(text));
+  return entry;
+}
+
 // A legend entry: a filled square (a class) or a short line (an outline) and its name.
 QWidget* legendEntry(const QColor& colour, bool line, Qt::PenStyle style, const QString& text) {
   QPixmap pixmap(line ? 22 : 12, 12);
@@ -69,15 +82,8 @@ QWidget* legendEntry(const QColor& colour, bool line, Qt::PenStyle style, const 
     painter.setPen(QColor(0, 0, 0, 160));
     painter.drawRect(0, 0, 11, 11);
   }
-  auto* entry = new QWidget;
-  auto* layout = new QHBoxLayout(entry);
-  layout->setContentsMargins(0, 0, 0, 0);
-  layout->setSpacing(3);
-  auto* swatch = new QLabel;
-  swatch->setPixmap(pixmap);
-  layout->addWidget(swatch);
-  layout->addWidget(new QLabel(text));
-  return entry;
+  painter.end();
+  return legendEntryOf(pixmap, text);
 }
 
 // The legend entry of a hatched layer: a square with the layer's stripes.
@@ -88,15 +94,8 @@ QWidget* hatchedLegendEntry(const QColor& colour, const QString& text) {
   painter.fillRect(0, 0, 12, 12, QBrush(colour, Qt::BDiagPattern));
   painter.setPen(QColor(0, 0, 0, 160));
   painter.drawRect(0, 0, 11, 11);
-  auto* entry = new QWidget;
-  auto* layout = new QHBoxLayout(entry);
-  layout->setContentsMargins(0, 0, 0, 0);
-  layout->setSpacing(3);
-  auto* swatch = new QLabel;
-  swatch->setPixmap(pixmap);
-  layout->addWidget(swatch);
-  layout->addWidget(new QLabel(text));
-  return entry;
+  painter.end();
+  return legendEntryOf(pixmap, text);
 }
 
 // The overlay with the exclusion mask: `labels` (CV_8U, may be empty: none shown) as 16-bit labels,

@@ -16,25 +16,6 @@ namespace {
 using namespace delineo;
 using project::BuildingStatus;
 
-// PROJECT may stand anywhere among the options: the one argument that is neither an option nor
-// an option's value. Returns it and leaves the options in `rest`.
-std::string projectArgument(const std::vector<std::string>& args, std::vector<std::string>& rest) {
-  std::string projectPath;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    const bool takesValue = (a == "--out" || a == "--status" || a == "--terrain-step") && i + 1 < args.size();
-    if (a.rfind("-", 0) == 0) {
-      rest.push_back(a);
-      if (takesValue) rest.push_back(args[++i]);
-    } else if (projectPath.empty()) {
-      projectPath = a;
-    } else {
-      throw cli::UsageError("unexpected argument '" + a + "': give one PROJECT");
-    }
-  }
-  return projectPath;
-}
-
 // --status: comma-separated status names, "all" for every delineated building not rejected.
 std::vector<BuildingStatus> statusesOf(const std::string& list) {
   std::vector<BuildingStatus> statuses;
@@ -102,7 +83,7 @@ int run(const std::vector<std::string>& args) {
       .params(project::TerrainParams{})
       .flag("quiet", "no progress on stderr");
   std::vector<std::string> rest;
-  const std::string projectPath = projectArgument(args, rest);
+  const std::string projectPath = cli::positionalArgument(args, {"--out", "--status", "--terrain-step"}, rest);
   if (!opts.parse(rest)) return cli::kExitOk;
   if (projectPath.empty()) throw cli::UsageError("missing PROJECT (see --help)");
   const std::string out = opts.get("out");

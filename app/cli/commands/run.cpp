@@ -31,19 +31,7 @@ int run(const std::vector<std::string>& args) {
   // PROJECT may stand anywhere among the options: the one argument that is neither an option
   // nor an option's value.
   std::vector<std::string> rest;
-  std::string projectPath;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    const bool takesValue = (a == "--project" || a == "--sample") && i + 1 < args.size();
-    if (a.rfind("-", 0) == 0) {
-      rest.push_back(a);
-      if (takesValue) rest.push_back(args[++i]);
-    } else if (projectPath.empty()) {
-      projectPath = a;
-    } else {
-      throw cli::UsageError("unexpected argument '" + a + "': give one PROJECT");
-    }
-  }
+  std::string projectPath = cli::positionalArgument(args, {"--project", "--sample"}, rest);
   if (!opts.parse(rest)) return cli::kExitOk;
   if (!projectPath.empty() && opts.has("project")) throw cli::UsageError("give PROJECT or --project, not both");
   if (projectPath.empty()) projectPath = opts.get("project");
