@@ -1127,7 +1127,8 @@ double dominantOrientation(const core::Polygon& outline, const cv::Mat& image,
 }
 
 RegularizationOutcome regularizeOutline(const core::Polygon& outline,
-                                        const RegularizationParams& params, const cv::Mat& image) {
+                                        const RegularizationParams& params, const cv::Mat& image,
+                                        std::optional<double> orientation) {
   params.validate();
   const RegularizationMode mode = regularizationMode(params.mode);
   core::Polygon input{cleaned(outline.outer), {}};
@@ -1151,10 +1152,10 @@ RegularizationOutcome regularizeOutline(const core::Polygon& outline,
   if (mode == RegularizationMode::None) return out;
   out.tolerance = params.tolerance;
 
-  RingContext ctx{mode,
-                  dominantOrientation(input, image, params.imageEdgeWeight,
-                                      std::max(0.5, 0.5 * params.tolerance)),
-                  image.size()};
+  const double theta = orientation ? mod90(*orientation)
+                                   : dominantOrientation(input, image, params.imageEdgeWeight,
+                                                         std::max(0.5, 0.5 * params.tolerance));
+  RingContext ctx{mode, theta, image.size()};
   out.orientationDeg = ctx.theta * 180.0 / kPi;
   auto keep = [&](const std::string& reason) {
     out.status = RegularizationStatus::KeptRaw;

@@ -4,6 +4,7 @@
 // diagonals, or any angles), few vertices and a bounded distance from the input. Qt-free; the
 // energy check of the acceptance gate needs the stereo pair and lives in delineate.hpp.
 // docs/delineation.md, "Regularization", explains each stage.
+#include <optional>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -110,9 +111,12 @@ double dominantOrientation(const core::Polygon& outline, const cv::Mat& image,
 // image the outline was drawn on) adds its edges to the orientation and bounds the result: edges
 // running along the image border stay on it. Throws core::Error(InvalidParameter) for bad
 // parameters or an outline that is not a polygon (fewer than 3 vertices, non-finite
-// coordinates, zero area).
+// coordinates, zero area). `orientation` (radians), when given, is the building's dominant
+// orientation instead of the one read from the outline: a part of a building squared like the
+// building (project::roofParts).
 RegularizationOutcome regularizeOutline(const core::Polygon& outline,
                                         const RegularizationParams& params,
-                                        const cv::Mat& image = {});
+                                        const cv::Mat& image = {},
+                                        std::optional<double> orientation = std::nullopt);
 
 }  // namespace delineo::delineation
