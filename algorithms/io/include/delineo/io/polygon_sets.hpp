@@ -1,0 +1,27 @@
+#pragma once
+// Boolean operations on sets of polygons (left-image pixels, holes kept) through OGR's GEOS:
+// the tiling of a building's outline into its roof parts (project::roofParts). A set is a list of
+// polygons that do not overlap; results come back as such a list, without the lines and points
+// an operation may leave where two polygons only touch.
+#include <vector>
+
+#include "delineo/core/geometry.hpp"
+
+namespace delineo::io {
+
+using PolygonSet = std::vector<core::Polygon>;
+
+// The parts of `a` inside `b`, of `a` outside `b`, and of either. An invalid input polygon (a
+// self-touching ring after rounding) is made valid first. Throws core::Error(ProcessingFailed)
+// when GDAL is built without GEOS.
+PolygonSet intersectionOf(const PolygonSet& a, const PolygonSet& b);
+PolygonSet differenceOf(const PolygonSet& a, const PolygonSet& b);
+PolygonSet unionOf(const PolygonSet& a, const PolygonSet& b);
+
+// Length (px) of the border of `a` that runs along the border of `b` (within `tolerance` px).
+double sharedBorderLength(const core::Polygon& a, const core::Polygon& b, double tolerance = 0.01);
+
+// Length (px) of the rings of `polygon`, holes included.
+double perimeter(const core::Polygon& polygon);
+
+}  // namespace delineo::io
