@@ -65,13 +65,24 @@ CrsDescription describeCrs(const std::string& wkt) {
   return crs;
 }
 
+using Rings = std::vector<std::vector<cv::Point2d>>;  // outline first, then the holes, in the output frame
+
+// A part of a building's roof, in the output frame.
+struct PartBlock {
+  std::string name;  // "building 7 part 2", for messages
+  std::string key;   // its City Object id
+  Rings rings;
+  double height = 0.0;  // m, its roof above the ground level
+};
+
 // One building to extrude, in the output frame.
 struct Block {
   const core::Feature* feature = nullptr;
   std::string name;                       // "building 7", for messages
   std::string key;                        // its City Object id
-  std::vector<std::vector<cv::Point2d>> rings;  // outline first, then the holes
+  Rings rings;                            // outline first, then the holes
   double height = 0.0;                    // m, the roof above the ground level
+  std::vector<PartBlock> parts;           // two or more: written as BuildingParts
   double base = 0.0;                      // m, its ground above the ground level
   double foot = 0.0;                      // m, the solid's bottom: the base, or lower to meet the terrain
   bool hasBase = false;                   // the base came from the feature (else 0)
@@ -105,6 +116,39 @@ std::optional<double> heightOf(const core::Feature& feature, const std::string& 
   }
 }
 
+Rings ringsInFrame(const core::Polygon& polygon, const OutputFrame& frame) {
+  auto toFrame = [&](const core::Ring& ring) {
+    std::vector<cv::Point2d> out;
+    for (const auto& p : ring) out.push_back(frame.fromPixel(p));
+    return out;
+  };
+  Rings rings{toFrame(polygon.outer)};
+  for (const auto& hole : polygon.holes) rings.push_back(toFrame(hole));
+  return rings;
+}
+
+// The parts of a building whose roof is above its base; the others listed in `leftOut`.
+std::vector<PartBlock> partBlocksOf(const Block& block, const std::vector<CityJsonPart>& parts, const OutputFrame& frame,
+                                    std::vector<std::string>& leftOut) {
+  std::vector<PartBlock> out;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    PartBlock part;
+    part.name = block.name + " part " + std::to_string(i + 1);
+    part.key = block.key + "-part-" + std::to_string(i + 1);
+    if (!(std::abs(parts[i].height) <= kMaxRoofHeight)) {
+      throw Error(ErrorCode::InvalidParameter, part.name + ": its roof height is not a number within +-1e4 m");
+    }
+    if (!(std::llround(parts[i].height / kMetreScale) > std::llround(block.base / kMetreScale))) {
+      leftOut.push_back(part.name + ": roof height " + formatNumber(parts[i].height) + " m is not above its building's base");
+      continue;
+    }
+    part.height = parts[i].height;
+    part.rings = ringsInFrame(parts[i].polygon, frame);
+    out.push_back(std::move(part));
+  }
+  return out;
+}
+
 // The block of a feature, or the reason it is left out.
 std::optional<Block> blockOf(const core::Feature& feature, size_t index, const OutputFrame& frame,
                              const CityJsonOptions& options, std::string& leftOutBecause) {
@@ -127,13 +171,7 @@ std::optional<Block> blockOf(const core::Feature& feature, size_t index, const O
     return std::nullopt;
   }
   block.height = *height;
-  auto toFrame = [&](const core::Ring& ring) {
-    std::vector<cv::Point2d> out;
-    for (const auto& p : ring) out.push_back(frame.fromPixel(p));
-    return out;
-  };
-  block.rings.push_back(toFrame(feature.polygon.outer));
-  for (const auto& hole : feature.polygon.holes) block.rings.push_back(toFrame(hole));
+  block.rings = ringsInFrame(feature.polygon, frame);
   return block;
 }
 
@@ -239,14 +277,16 @@ Json shellOf(const std::vector<GridRing>& rings, BlockLevels z, VertexPool& pool
   return shell;
 }
 
-Json solidOf(const Block& block, const Grid& grid, double zOffset, VertexPool& pool) {
+// The LoD1 solid of `frameRings` (outline first) from `foot` to `height` (m); `name` for messages.
+Json solidOf(const Rings& frameRings, const std::string& name, double foot, double height, const Grid& grid,
+             double zOffset, VertexPool& pool) {
   std::vector<GridRing> rings;
-  for (size_t r = 0; r < block.rings.size(); ++r) {
-    const std::string what = block.name + (r == 0 ? "'s outline" : "'s hole " + std::to_string(r));
-    rings.push_back(gridRing(block.rings[r], grid, r == 0, what));
+  for (size_t r = 0; r < frameRings.size(); ++r) {
+    const std::string what = name + (r == 0 ? "'s outline" : "'s hole " + std::to_string(r));
+    rings.push_back(gridRing(frameRings[r], grid, r == 0, what));
   }
   Json values = Json::array();
-  const BlockLevels levels{grid.unitsOf(block.foot + zOffset, 2), grid.unitsOf(block.height + zOffset, 2)};
+  const BlockLevels levels{grid.unitsOf(foot + zOffset, 2), grid.unitsOf(height + zOffset, 2)};
   Json shell = shellOf(rings, levels, pool, values);
   Json surfaces = Json::array();
   for (const char* type : {"GroundSurface", "RoofSurface", "WallSurface"}) surfaces.push_back({{"type", type}});
@@ -416,8 +456,24 @@ Json cityObjectOf(const Block& block, const Grid& grid, double zOffset, VertexPo
   Json object;
   object["type"] = "Building";
   object["attributes"] = attributesOf(block);
+  if (!block.parts.empty()) {
+    object["children"] = Json::array();
+    for (const auto& part : block.parts) object["children"].push_back(part.key);
+    return object;
+  }
   object["geometry"] = Json::array();
-  object["geometry"].push_back(solidOf(block, grid, zOffset, pool));
+  object["geometry"].push_back(solidOf(block.rings, block.name, block.foot, block.height, grid, zOffset, pool));
+  return object;
+}
+
+// A BuildingPart of `block`: its solid from the building's foot, its roof height and measuredHeight.
+Json partObjectOf(const Block& block, const PartBlock& part, const Grid& grid, double zOffset, VertexPool& pool) {
+  Json object;
+  object["type"] = "BuildingPart";
+  object["attributes"] = {{"roof_height_m", part.height}, {"measuredHeight", part.height - block.base}};
+  object["parents"] = Json::array({block.key});
+  object["geometry"] = Json::array();
+  object["geometry"].push_back(solidOf(part.rings, part.name, block.foot, part.height, grid, zOffset, pool));
   return object;
 }
 
@@ -512,12 +568,18 @@ void checkOptions(const CityJsonOptions& options, const OutputFrame& frame, cons
 }
 
 // The blocks of the buildings, in their order; those left out listed in the summary.
-std::vector<Block> blocksOf(const std::vector<core::Feature>& buildings, const OutputFrame& frame,
+std::vector<Block> blocksOf(const std::vector<CityJsonBuilding>& buildings, const OutputFrame& frame,
                             const CityJsonOptions& options, CityJsonSummary& summary) {
   std::vector<Block> blocks;
   for (size_t i = 0; i < buildings.size(); ++i) {
     std::string leftOutBecause;
-    if (auto block = blockOf(buildings[i], i, frame, options, leftOutBecause)) {
+    if (auto block = blockOf(buildings[i].feature, i, frame, options, leftOutBecause)) {
+      std::vector<std::string> partsLeftOut;
+      std::vector<PartBlock> parts = partBlocksOf(*block, buildings[i].parts, frame, partsLeftOut);
+      if (parts.size() >= 2) {  // else one block, as without parts
+        block->parts = std::move(parts);
+        summary.leftOut.insert(summary.leftOut.end(), partsLeftOut.begin(), partsLeftOut.end());
+      }
       blocks.push_back(std::move(*block));
     } else {
       summary.leftOut.push_back(leftOutBecause);
@@ -528,6 +590,13 @@ std::vector<Block> blocksOf(const std::vector<core::Feature>& buildings, const O
 }  // namespace
 
 CityJsonSummary writeCityJson(const std::string& path, const std::vector<core::Feature>& buildings,
+                              const CityJsonOptions& options) {
+  std::vector<CityJsonBuilding> blocks;
+  for (const auto& feature : buildings) blocks.push_back({feature, {}});
+  return writeCityJson(path, blocks, options);
+}
+
+CityJsonSummary writeCityJson(const std::string& path, const std::vector<CityJsonBuilding>& buildings,
                               const CityJsonOptions& options) {
   const OutputFrame frame{options.geo, options.localPixelSize};
   checkOptions(options, frame, path);
@@ -552,6 +621,10 @@ CityJsonSummary writeCityJson(const std::string& path, const std::vector<core::F
     }
     try {
       cityObjects[block.key] = cityObjectOf(block, grid, options.zOffset, pool);
+      for (const auto& part : block.parts) {
+        cityObjects[part.key] = partObjectOf(block, part, grid, options.zOffset, pool);
+        ++summary.parts;
+      }
     } catch (const Error& e) {
       throw naming(e);
     }

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -367,6 +368,75 @@ TEST(CityJson, ABlockStandsOnItsGroundHeightAndMeasuresFromIt) {
   EXPECT_NE(city["metadata"]["title"].get<std::string>().find("from the ground next to it"), std::string::npos);
 }
 
+// A 40 x 20 px building split into a 20 x 20 px part at 10 m and one at 14 m, on ground at 2 m.
+CityJsonBuilding twoLevelBuilding() {
+  const core::Polygon outline{{{10, 10}, {50, 10}, {50, 30}, {10, 30}}, {}};
+  CityJsonBuilding b{onGround(building(5, outline, 14.0), 2.0), {}};
+  b.parts.push_back({{{{10, 10}, {30, 10}, {30, 30}, {10, 30}}, {}}, 10.0});
+  b.parts.push_back({{{{30, 10}, {50, 10}, {50, 30}, {30, 30}}, {}}, 14.0});
+  return b;
+}
+
+TEST(CityJson, ABuildingWithRoofPartsIsAParentOfBuildingPartSolids) {
+  TempDir dir;
+  const std::string path = dir.file("parts.city.json");
+  const CityJsonBuilding split = twoLevelBuilding();
+  const CityJsonSummary summary = writeCityJson(path, std::vector<CityJsonBuilding>{split, {building(6, square(), 7.0), {}}}, localFrame());
+  EXPECT_EQ(summary.written, 2);
+  EXPECT_EQ(summary.parts, 2);
+  const nlohmann::json city = readJson(path);
+  const std::vector<Vec3> vertices = decodedVertices(city);
+  const auto toFrame = [](cv::Point2d p) { return cv::Point2d(p.x * kPixelSize, -p.y * kPixelSize); };
+  const auto& parent = city["CityObjects"].at("building-5");
+  EXPECT_EQ(parent["type"], "Building");
+  EXPECT_FALSE(parent.contains("geometry")) << "the parts carry the geometry";
+  EXPECT_DOUBLE_EQ(parent["attributes"]["roof_height_m"].get<double>(), 14.0);
+  EXPECT_DOUBLE_EQ(parent["attributes"]["ground_height_m"].get<double>(), 2.0);
+  EXPECT_EQ(parent["attributes"]["status"], "accepted");
+  ASSERT_EQ(parent["children"], nlohmann::json::array({"building-5-part-1", "building-5-part-2"}));
+  for (size_t i = 0; i < split.parts.size(); ++i) {
+    const std::string key = parent["children"][i];
+    SCOPED_TRACE(key);
+    const auto& child = city["CityObjects"].at(key);
+    EXPECT_EQ(child["type"], "BuildingPart");
+    EXPECT_EQ(child["parents"], nlohmann::json::array({"building-5"}));
+    EXPECT_DOUBLE_EQ(child["attributes"]["roof_height_m"].get<double>(), split.parts[i].height);
+    EXPECT_DOUBLE_EQ(child["attributes"]["measuredHeight"].get<double>(), split.parts[i].height - 2.0);
+    ASSERT_EQ(child["geometry"].size(), 1u);
+    EXPECT_EQ(child["geometry"][0]["type"], "Solid");
+    EXPECT_EQ(child["geometry"][0]["lod"], "1");
+    EXPECT_EQ(solidHeights(child, vertices), (std::set<double>{2.0, split.parts[i].height}));
+    expectClosedShell(child["geometry"][0]["boundaries"][0]);
+    expectOutwardSurfaces(child["geometry"][0]["boundaries"][0], vertices,
+                          expectedBlock(split.parts[i].polygon, split.parts[i].height, toFrame, 2.0));
+  }
+  // Every BuildingPart names a parent that lists it; a building without parts is one block.
+  for (const auto& [key, object] : city["CityObjects"].items()) {
+    if (object["type"] != "BuildingPart") continue;
+    const auto& children = city["CityObjects"].at(object["parents"][0].get<std::string>())["children"];
+    EXPECT_NE(std::find(children.begin(), children.end(), key), children.end()) << key;
+  }
+  EXPECT_EQ(city["CityObjects"]["building-6"]["geometry"].size(), 1u);
+  EXPECT_FALSE(city["CityObjects"]["building-6"].contains("children"));
+}
+
+TEST(CityJson, APartNotAboveTheBaseIsLeftOutAndOnePartLeftIsOneBlock) {
+  TempDir dir;
+  const std::string path = dir.file("low-part.city.json");
+  CityJsonBuilding split = twoLevelBuilding();
+  split.parts[0].height = 1.0;  // below the building's ground at 2 m
+  const CityJsonSummary summary = writeCityJson(path, std::vector<CityJsonBuilding>{split}, localFrame());
+  EXPECT_EQ(summary.parts, 0);
+  EXPECT_TRUE(summary.leftOut.empty());
+  const nlohmann::json city = readJson(path);
+  EXPECT_EQ(city["CityObjects"]["building-5"]["geometry"].size(), 1u);
+  split.parts.push_back({{{{10, 30}, {50, 30}, {50, 40}, {10, 40}}, {}}, 5.0});
+  const CityJsonSummary three = writeCityJson(path, std::vector<CityJsonBuilding>{split}, localFrame());
+  EXPECT_EQ(three.parts, 2);
+  ASSERT_EQ(three.leftOut.size(), 1u);
+  EXPECT_NE(three.leftOut[0].find("building 5 part 1"), std::string::npos) << three.leftOut[0];
+}
+
 TEST(CityJson, ARoofNotAboveItsGroundIsLeftOutWithTheReason) {
   TempDir dir;
   const std::string path = dir.file("sunk.city.json");
@@ -398,7 +468,7 @@ TEST(CityJson, TheGroundLevelsElevationRaisesEveryZButNotTheAttributes) {
   EXPECT_NEAR(city["metadata"]["geographicalExtent"][2].get<double>(), 148.25, 1e-9);
 
   options.zOffset = std::nan("");
-  EXPECT_EQ(captureError([&] { writeCityJson(path, {}, options); }).code(), ErrorCode::InvalidParameter);
+  EXPECT_EQ(captureError([&] { writeCityJson(path, std::vector<core::Feature>{}, options); }).code(), ErrorCode::InvalidParameter);
 }
 
 // A sloped DTM, z = 0.1 col + 0.2 row + 5 m on a 9 x 7 px grid, with no height at pixel (4, 2).
@@ -447,7 +517,7 @@ TEST(CityJson, TheTerrainIsAnUpwardTinOfTheDtmsGridWithoutItsHoles) {
   CityJsonOptions options = localFrame();
   options.terrain.heights = slopedDtm();
   options.terrain.step = 2;
-  const CityJsonSummary summary = writeCityJson(path, {}, options);
+  const CityJsonSummary summary = writeCityJson(path, std::vector<core::Feature>{}, options);
   EXPECT_EQ(summary.terrainTriangles, 16);
   EXPECT_EQ(summary.terrainVertices, 18);
   const nlohmann::json city = readJson(path);
@@ -507,7 +577,7 @@ TEST(CityJson, ATerrainWithoutAnyHeightWritesNoReliefAndABadStepIsRefused) {
   EXPECT_EQ(summary.terrainTriangles, 0);
   EXPECT_FALSE(readJson(path)["CityObjects"].contains("terrain"));
   options.terrain.step = 0;
-  const core::Error error = captureError([&] { writeCityJson(path, {}, options); });
+  const core::Error error = captureError([&] { writeCityJson(path, std::vector<core::Feature>{}, options); });
   EXPECT_EQ(error.code(), ErrorCode::InvalidParameter);
   EXPECT_NE(std::string(error.what()).find("terrain step"), std::string::npos) << error.what();
 }

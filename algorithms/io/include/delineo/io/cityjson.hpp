@@ -9,6 +9,11 @@
 // the roof height was measured from; `zOffset` (the elevation of that level above a vertical
 // datum) is added to every z, not to the attributes.
 //
+// A building with roof parts (several roof levels) is a "Building" without geometry whose
+// "children" are its "BuildingPart"s, each naming it in its "parents": one Solid per part, from
+// the building's base (and foot) to the part's roof height, attributes roof_height_m and
+// measuredHeight. The parts tile the outline; their shared walls are written once per part.
+//
 // The terrain: one "TINRelief" City Object, a "CompositeSurface" of "lod": "1" whose surfaces are
 // triangles: a regular grid of the DTM every `step` px (vertices at pixel centres), two
 // triangles per cell whose four corners have a height, each facing up. With a terrain, a block
@@ -43,8 +48,21 @@ struct CityJsonOptions {
   CityJsonTerrain terrain;
 };
 
+// A part of a building's roof: its polygon (left-image pixels) and roof height, m.
+struct CityJsonPart {
+  core::Polygon polygon;
+  double height = 0.0;
+};
+
+// A building and its parts: none (or one) for one block.
+struct CityJsonBuilding {
+  core::Feature feature;
+  std::vector<CityJsonPart> parts;
+};
+
 struct CityJsonSummary {
   int written = 0;                   // Building objects written
+  int parts = 0;                     // BuildingPart objects written
   std::vector<std::string> leftOut;  // one line per building left out: "building 3: no roof height"
   int terrainVertices = 0;           // of the TINRelief (0 without terrain)
   int terrainTriangles = 0;
@@ -58,6 +76,11 @@ struct CityJsonSummary {
 // vertex) or a roof or base height that is not a number, for a terrain step below 1 or of more
 // than 10⁷ grid points, and WriteFailed naming the file.
 CityJsonSummary writeCityJson(const std::string& path, const std::vector<core::Feature>& buildings,
+                              const CityJsonOptions& options = {});
+// The same with roof parts: a building with two parts or more is written as its BuildingParts. A
+// part whose roof is not above the building's base is left out (listed in the summary); a part's
+// degenerate polygon or non-finite height throws like a building's.
+CityJsonSummary writeCityJson(const std::string& path, const std::vector<CityJsonBuilding>& buildings,
                               const CityJsonOptions& options = {});
 
 // True for the file names CityJSON is written to: "*.city.json" and "*.cityjson" (any case).
