@@ -1,4 +1,5 @@
 #include "delineo/project/pipeline.hpp"
+#include "delineo/project/roof_parts.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "delineo/delineation/params.hpp"
 #include "delineo/delineation/roof_interval.hpp"
 #include "delineo/dem/enhance.hpp"
+#include "delineo/segmentation/roof_levels.hpp"
 #include "delineo/segmentation/scene.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/disparity_range.hpp"
@@ -44,6 +46,7 @@ void validateParameters(const Project& project) {
   validateGroup<segmentation::ClassifyParams>(project, kClassifyGroup);
   validateGroup<segmentation::ObjectParams>(project, kObjectsGroup);
   validateGroup<segmentation::DetectParams>(project, kDetectGroup);
+  validateGroup<segmentation::RoofLevelParams>(project, kRoofLevelsGroup);
 }
 
 StereoPair readStereoPair(const Project& project) {
