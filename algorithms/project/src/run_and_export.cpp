@@ -12,6 +12,7 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/project/roof_parts.hpp"
 
 namespace delineo::project {
 
@@ -80,6 +81,24 @@ std::vector<core::Feature> withGroundHeights(const Project& project, const cv::M
   return features;
 }
 
+// Each feature with a roof height and its roof parts on `heights` (roofParts(), the project's
+// "roof-levels" group): none when its roof has one level, without heights, or with roof levels off.
+std::vector<io::CityJsonBuilding> withRoofParts(const Project& project, const cv::Mat& heights,
+                                                const std::vector<core::Feature>& features) {
+  std::vector<io::CityJsonBuilding> buildings;
+  for (const auto& feature : features) {
+    io::CityJsonBuilding building{feature, {}};
+    if (!heights.empty() && feature.attributes.count("roof_height_m") > 0) {
+      const std::vector<RoofPart> parts = roofParts(project, heights, feature.polygon);
+      if (parts.size() >= 2) {
+        for (const auto& part : parts) building.parts.push_back({part.polygon, part.height});
+      }
+    }
+    buildings.push_back(std::move(building));
+  }
+  return buildings;
+}
+
 // The CityJSON of `features`: blocks on the ground next to each, the terrain when there is a DTM.
 ExportSummary writeCityModel(const Project& project, const std::string& path, const std::vector<core::Feature>& features,
                              const io::GeoReference& geo, const CityModelInputs& model) {
@@ -93,8 +112,9 @@ ExportSummary writeCityModel(const Project& project, const std::string& path, co
     options.terrain = {model.dtm, model.terrain.resolvedStep(project.height.gsd)};
   }
   const io::CityJsonSummary blocks =
-      io::writeCityJson(path, withGroundHeights(project, model.heights, features, summary), options);
+      io::writeCityJson(path, withRoofParts(project, model.heights, withGroundHeights(project, model.heights, features, summary)), options);
   summary.written = blocks.written;
+  summary.parts = blocks.parts;
   summary.leftOut = blocks.leftOut;
   summary.terrainVertices = blocks.terrainVertices;
   summary.terrainTriangles = blocks.terrainTriangles;

@@ -1,6 +1,7 @@
 // delineo-cli export PROJECT --out FILE: a project's buildings written as the GUI's export writes
 // them (project::exportBuildings): outlines to GeoJSON / GeoPackage, or CityJSON LoD1 blocks on
-// the ground next to each building, with --terrain the TIN of the scene analysis's DTM.
+// the ground next to each building (a roof with several levels as one part per level, unless
+// --roof-levels off), with --terrain the TIN of the scene analysis's DTM.
 #include <cstdio>
 #include <sstream>
 
@@ -11,6 +12,8 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/project/project.hpp"
+#include "delineo/project/roof_parts.hpp"
+#include "delineo/segmentation/roof_levels.hpp"
 
 namespace {
 using namespace delineo;
@@ -66,6 +69,7 @@ void printSummary(const project::ExportSummary& summary, const std::string& out,
   std::printf("export: %d building(s) written to %s", summary.written, out.c_str());
   if (cityJson) {
     std::printf("%s", summary.onLocalGround ? ", on the ground next to each" : ", on the ground level");
+    if (summary.parts > 0) std::printf("; %d roof parts", summary.parts);
     if (summary.terrainTriangles > 0) {
       std::printf("; terrain: %d vertices, %d triangles", summary.terrainVertices, summary.terrainTriangles);
     }
@@ -81,9 +85,13 @@ int run(const std::vector<std::string>& args) {
       .value("status", "LIST", "statuses to write, comma-separated: accepted, automatic, corrected, rejected, pending, or all (the delineated buildings not rejected)", "accepted")
       .flag("terrain", "add the terrain: the scene analysis's DTM of the project's heights, as a TIN (CityJSON only)")
       .params(project::TerrainParams{})
+      .params(segmentation::RoofLevelParams{})
       .flag("quiet", "no progress on stderr");
   std::vector<std::string> rest;
-  const std::string projectPath = cli::positionalArgument(args, {"--out", "--status", "--terrain-step"}, rest);
+  const std::string projectPath = cli::positionalArgument(
+      args, {"--out", "--status", "--terrain-step", "--roof-levels", "--roof-level-step", "--roof-level-min-area",
+             "--roof-level-clean-width"},
+      rest);
   if (!opts.parse(rest)) return cli::kExitOk;
   if (projectPath.empty()) throw cli::UsageError("missing PROJECT (see --help)");
   const std::string out = opts.get("out");
@@ -92,7 +100,10 @@ int run(const std::vector<std::string>& args) {
   const std::vector<BuildingStatus> statuses = statusesOf(opts.get("status"));
   cli::commandProgress().setQuiet(opts.has("quiet"));
 
-  const project::Project proj = project::loadProject(projectPath);
+  project::Project proj = project::loadProject(projectPath);
+  auto roofLevels = project::parameters<segmentation::RoofLevelParams>(proj, project::kRoofLevelsGroup);
+  opts.apply(roofLevels);  // the flags given override the project's group
+  project::setParameters(proj, project::kRoofLevelsGroup, roofLevels);
   for (const auto& missing : proj.missingFiles()) {
     throw core::Error(core::ErrorCode::FileNotFound, "referenced by the project " + projectPath, missing);
   }

@@ -2,10 +2,11 @@
 # End-to-end check of `delineo-cli export PROJECT --out FILE`: on the sample project after
 # `run --detect`, CityJSON blocks on the ground next to each building (measuredHeight = roof -
 # base) with the terrain (every triangle facing up, every index a vertex), the ground level's
-# elevation added to every z, outlines by extension; bad input (missing or corrupt project, an
-# output folder that does not exist, a wrong extension, a terrain step out of its domain) exits 3
-# naming the file (a bad step has none), bad usage (unknown status, --terrain with outlines, no
-# --out) exits 2.
+# elevation added to every z, --roof-levels off (one block per building, the same file on the
+# sample's one-level roofs), outlines by extension; bad input (missing or corrupt project, an
+# output folder that does not exist, a wrong extension, a terrain step or roof-levels value out of
+# its domain) exits 3 naming the file (a bad step has none), bad usage (unknown status, --terrain
+# with outlines, no --out) exits 2.
 # Usage: e2e_export.sh PATH/TO/delineo-cli WORKDIR      (needs jq)
 E2E_NAME=e2e_export
 source "$(dirname "$0")/e2e_lib.sh"
@@ -40,6 +41,20 @@ jq_true terrain_up '.vertices as $v | [.CityObjects.terrain.geometry[0].boundari
   | ($b[0] - $a[0]) * ($c[1] - $a[1]) - ($c[0] - $a[0]) * ($b[1] - $a[1]) > 0] | all'
 triangles=$(jq '.CityObjects.terrain.geometry[0].boundaries | length' "$city")
 expect_in "$WORK/export_city.out" " $triangles triangles" "the printed triangle count is the file's"
+
+# ---- roof levels: off writes one block per building; the sample's roofs have one level each -----
+off="$WORK/sample/off.city.json"
+expect_rc export_off 0 "$CLI" export "$project" --out "$off" --status all --terrain --roof-levels off --quiet
+[[ $(jq '[.CityObjects[] | select(.type == "BuildingPart" or has("children"))] | length' "$off") == 0 ]] \
+  || fail "--roof-levels off wrote BuildingParts"
+[[ $(jq '[.CityObjects[] | select(.type == "Building") | has("geometry")] | all' "$off") == true ]] \
+  || fail "--roof-levels off left a building without its block"
+cmp -s "$city" "$off" || fail "roof levels on changed the blocks of one-level roofs"
+jq '.parameters["roof-levels"] = {"roof-levels": "off"}' "$project" >"$WORK/sample/off.delineo.json"
+expect_rc export_off_project 0 "$CLI" export "$WORK/sample/off.delineo.json" --out "$WORK/sample/off2.city.json" --status all --terrain --quiet
+cmp -s "$off" "$WORK/sample/off2.city.json" || fail "the project's roof-levels off differs from --roof-levels off"
+expect_rc bad_roof_levels 3 "$CLI" export "$project" --out "$WORK/x.city.json" --roof-levels maybe
+expect_in "$WORK/bad_roof_levels.err" "roof-levels = 'maybe' is not one of on\|off" "the bad value is named"
 
 # ---- the ground level's elevation raises every z, not the attributes ----------------------------
 jq '.heightModel.groundElevation = 250' "$project" >"$WORK/sample/elevated.delineo.json"

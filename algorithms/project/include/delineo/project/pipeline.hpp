@@ -19,7 +19,7 @@
 
 namespace delineo::project {
 
-// Checks every parameter group the steps read ("range", "matching", "delineation", "boxfit",
+// Checks every parameter group the steps read ("range", "matching", "delineation", "boxfit", "roof-levels",
 // "enhance", and the scene analysis's): a bad value is found when the project is loaded, not after matching.
 // Throws core::Error(InvalidParameter) naming the group and the parameter.
 void validateParameters(const Project& project);
@@ -335,6 +335,7 @@ std::vector<core::Feature> buildingFeatures(const Project& project,
                                             const std::vector<BuildingStatus>& statuses);
 struct ExportSummary {
   int written = 0;                   // buildings written
+  int parts = 0;                     // CityJSON: BuildingParts of the buildings with several roof levels
   std::vector<std::string> leftOut;  // CityJSON: "building 3: no roof height", one per building left out
   // CityJSON: what the operator should know about the bases ("no heights: ..."), one per line.
   std::vector<std::string> notes;
@@ -374,7 +375,9 @@ struct CityModelInputs {
 // every z raised by the height model's groundElevation (io/cityjson.hpp; local metres of the
 // height model's gsd without georeferencing). A building without a roof height, or whose roof is
 // not above its base, is left out; without heights (or without ground next to a building) a block
-// stands on the ground level, said in `notes`. Throws WriteFailed, and InvalidParameter naming a
+// stands on the ground level, said in `notes`. With heights, a building whose roof has several
+// levels is written as its parts (roofParts(), the project's "roof-levels" group; CityJSON
+// BuildingParts), each from the building's base to its own height. Throws WriteFailed, and InvalidParameter naming a
 // building whose outline is degenerate or for a bad terrain step.
 ExportSummary exportBuildings(const Project& project, const std::string& path,
                               const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted},
