@@ -626,6 +626,38 @@
         <source>Growth</source>
         <translation>Élargissement</translation>
     </message>
+    <message>
+        <source>Roof levels</source>
+        <translation>Niveaux de toit</translation>
+    </message>
+    <message>
+        <source>A roof with several levels becomes one block per level (CityJSON BuildingParts, the 3D view), or one block per building</source>
+        <translation>Un toit à plusieurs niveaux devient un bloc par niveau (BuildingParts CityJSON, vue 3D), ou un bloc par bâtiment</translation>
+    </message>
+    <message>
+        <source>Roof level step</source>
+        <translation>Écart entre niveaux de toit</translation>
+    </message>
+    <message>
+        <source>Least height between two roof levels</source>
+        <translation>Plus petite hauteur entre deux niveaux de toit</translation>
+    </message>
+    <message>
+        <source>Roof level minimum area</source>
+        <translation>Aire minimale d’un niveau de toit</translation>
+    </message>
+    <message>
+        <source>A roof level or part smaller than this joins its neighbour</source>
+        <translation>Un niveau ou une partie de toit plus petit rejoint son voisin</translation>
+    </message>
+    <message>
+        <source>Roof level clean width</source>
+        <translation>Largeur de nettoyage des niveaux</translation>
+    </message>
+    <message>
+        <source>Strips of a level narrower than this go to the levels around them</source>
+        <translation>Les bandes d’un niveau plus étroites vont aux niveaux qui les entourent</translation>
+    </message>
 </context>
 <context>
     <name>Stages</name>
@@ -1782,6 +1814,14 @@
     <message>
         <source>Building → Detect buildings: which building objects become pending buildings.</source>
         <translation>Bâtiment → Détecter les bâtiments : quels objets bâtiments deviennent des bâtiments en attente.</translation>
+    </message>
+    <message>
+        <source>Roof levels</source>
+        <translation>Niveaux de toit</translation>
+    </message>
+    <message>
+        <source>A roof with several levels as one block per level in the 3D view and the CityJSON export.</source>
+        <translation>Un toit à plusieurs niveaux comme un bloc par niveau dans la vue 3D et l’export CityJSON.</translation>
     </message>
     <message>
         <source>Analyse the &amp;scene</source>

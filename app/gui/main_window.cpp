@@ -18,6 +18,7 @@
 
 #include "delineo/core/error.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/project/roof_parts.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "delineo/widgets/terrain3d_view.hpp"
@@ -133,7 +134,22 @@ void MainWindow::refreshTitle() {
 // ------------------------------------------------------------------------------------------
 // 3D view
 
-// The DEM, its texture and the extruded outlines of the buildings with a roof height.
+namespace {
+// The roof parts of a building with several roof levels, or none (one level, roof levels off, or
+// a parameter out of its domain: the block is then drawn whole, the form says what is wrong).
+std::vector<project::RoofPart> roofPartsOrNone(const project::Project& project, const cv::Mat& dem,
+                                               const core::Polygon& outline) {
+  try {
+    std::vector<project::RoofPart> parts = project::roofParts(project, dem, outline);
+    if (parts.size() >= 2) return parts;
+  } catch (const core::Error&) {
+  }
+  return {};
+}
+}  // namespace
+
+// The DEM, its texture and the extruded outlines of the buildings with a roof height: one block
+// per roof part (project::roofParts on the DEM shown, as the CityJSON export writes them).
 void MainWindow::refresh3D() {
   if (view3D_ == nullptr || !document_) return;
   if (document_->dem().empty()) return;
@@ -155,7 +171,9 @@ void MainWindow::refresh3D() {
     if (!b.hasOutline() || b.status == BuildingStatus::Rejected || !std::isfinite(b.roofHeight)) continue;
     // The ground next to the building, as the histogram's ground line reads it.
     const double base = project::groundHeightNextTo(document_->project(), dem, b.outline).value_or(0.0);
-    outlines.push_back({b.outline, base, b.roofHeight});
+    const std::vector<project::RoofPart> parts = roofPartsOrNone(document_->project(), dem, b.outline);
+    if (parts.size() < 2) outlines.push_back({b.outline, base, b.roofHeight});
+    for (const auto& part : parts) outlines.push_back({part.polygon, base, part.height});
   }
   view3D_->setBuildings(outlines);
   if (newDem) frame3D();

@@ -17,6 +17,8 @@
 
 #include "delineo/core/error.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/project/roof_parts.hpp"
+#include "delineo/segmentation/roof_levels.hpp"
 #include "delineo/widgets/disparity_histogram.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/parameter_form.hpp"
@@ -104,6 +106,9 @@ QTabWidget* MainWindow::createParameterTabs() {
   addParameterGroup<segmentation::DetectParams>(
       tabs, project::kDetectGroup, tr("Detection"),
       tr("Building → Detect buildings: which building objects become pending buildings."));
+  addParameterGroup<segmentation::RoofLevelParams>(
+      tabs, project::kRoofLevelsGroup, tr("Roof levels"),
+      tr("A roof with several levels as one block per level in the 3D view and the CityJSON export."));
   return tabs;
 }
 

@@ -16,6 +16,7 @@
 #include "buildings_model.hpp"
 #include "delineo/core/error.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "delineo/project/roof_parts.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "delineo/widgets/polygon_overlay.hpp"
 #include "document.hpp"
@@ -214,6 +215,7 @@ void MainWindow::connectDocument(Document* doc) {
   connect(doc, &Document::parametersChanged, this, [this, demChanged](const QString& group) {
     loadFormsFromDocument();
     if (group == QLatin1String("enhance")) demChanged();  // the enhanced DEM is made with them
+    if (group == QLatin1String(project::kRoofLevelsGroup)) refresh3D();  // the blocks' parts
   });
   connect(doc, &Document::settingsChanged, this, [this] {
     loadFormsFromDocument();  // the method choice

@@ -162,5 +162,16 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Minimum building area"),
     QT_TRANSLATE_NOOP("Parameters", "Minimum height"),
     QT_TRANSLATE_NOOP("Parameters", "Growth"),
+    // segmentation::RoofLevelParams
+    QT_TRANSLATE_NOOP("Parameters", "Roof levels"),
+    QT_TRANSLATE_NOOP("Parameters",
+                      "A roof with several levels becomes one block per level (CityJSON BuildingParts, the 3D view), "
+                      "or one block per building"),
+    QT_TRANSLATE_NOOP("Parameters", "Roof level step"),
+    QT_TRANSLATE_NOOP("Parameters", "Least height between two roof levels"),
+    QT_TRANSLATE_NOOP("Parameters", "Roof level minimum area"),
+    QT_TRANSLATE_NOOP("Parameters", "A roof level or part smaller than this joins its neighbour"),
+    QT_TRANSLATE_NOOP("Parameters", "Roof level clean width"),
+    QT_TRANSLATE_NOOP("Parameters", "Strips of a level narrower than this go to the levels around them"),
 };
 }  // namespace

@@ -643,6 +643,8 @@ void Terrain3DView::setBuildings(const std::vector<BuildingOutline>& buildings) 
   sceneChanged();
 }
 
+const std::vector<BuildingOutline>& Terrain3DView::buildings() const { return scene_->buildings; }
+
 void Terrain3DView::setVerticalExaggeration(double factor) {
   scene_->exaggeration = factor > 0 ? factor : 1.0;
   scene_->rebuildSurface();

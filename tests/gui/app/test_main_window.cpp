@@ -44,6 +44,7 @@
 #include "delineo/segmentation/classify.hpp"
 #include "delineo/segmentation/detect.hpp"
 #include "delineo/segmentation/ground.hpp"
+#include "delineo/segmentation/roof_levels.hpp"
 #include "delineo/segmentation/objects.hpp"
 #include "delineo/stereo/match.hpp"
 #include "delineo/widgets/disparity_histogram.hpp"
@@ -817,6 +818,8 @@ class MainWindowTest : public QObject {
     objects.visit(check);
     delineo::segmentation::DetectParams detect;
     detect.visit(check);
+    delineo::segmentation::RoofLevelParams roofLevels;
+    roofLevels.visit(check);
     QCOMPARE(translator.translate("delineo::gui::MainWindow", "De&tect buildings"), QStringLiteral("Dé&tecter les bâtiments"));
     QVERIFY2(untranslated.isEmpty(), qPrintable(untranslated.join(QStringLiteral(", "))));
     // The reusable widgets' strings are in the same translation.

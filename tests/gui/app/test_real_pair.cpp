@@ -22,6 +22,7 @@
 #include <QPixmap>
 #include <QFile>
 #include <QPushButton>
+#include <algorithm>
 #include <QSettings>
 #include <QSignalSpy>
 #include <QStandardPaths>
@@ -102,6 +103,7 @@ class RealPairTest : public QObject {
   std::unique_ptr<MainWindow> window_;
   int actions_ = 0;  // operator actions after opening the pair
   int bigRoof_ = -1;
+  int middle_ = -1;
 
   void shot(const QString& name) {
     const QString out = qEnvironmentVariable("DELINEO_SCREENSHOT_DIR");
@@ -311,6 +313,32 @@ class RealPairTest : public QObject {
     QVERIFY(window_->document()->project().find(id)->status == project::BuildingStatus::Accepted);
     qInfo("middle building: %d operator actions", actions_);
     QVERIFY(iou >= 0.85);
+    middle_ = id;
+  }
+
+  // The middle building's lower inner roof (about 72 px, 16 m) inside its raised ring (80-83 px,
+  // 18 m): the 3D view draws one block per roof level, at their heights.
+  void showsTheMiddleBuildingsRoofLevelsIn3D() {
+    if (qEnvironmentVariableIsEmpty("DISPLAY")) QSKIP("the 3D view needs an X server");
+    QVERIFY(middle_ > 0);
+    window_->selectBuilding(middle_);
+    window_->showDock(QStringLiteral("view3DDock"));
+    QTRY_VERIFY_WITH_TIMEOUT(window_->view3D() != nullptr, 10000);
+    const core::Polygon outline = window_->document()->project().find(middle_)->outline;
+    const cv::Rect2d box = core::boundingBox(outline.outer);
+    std::vector<double> tops;
+    for (const widgets::BuildingOutline& block : window_->view3D()->buildings()) {
+      const cv::Rect2d blockBox = core::boundingBox(block.polygon.outer);
+      if ((blockBox & box).area() > 0.9 * blockBox.area()) tops.push_back(block.topHeight);
+    }
+    std::sort(tops.begin(), tops.end());
+    QString list;
+    for (double top : tops) list += QString::number(top, 'f', 1) + QStringLiteral(" m ");
+    qInfo("middle building: %zu blocks in the 3D view: %s", tops.size(), qPrintable(list));
+    QVERIFY2(tops.size() >= 2, qPrintable(list));
+    QVERIFY2(tops.front() > 14.5 && tops.front() < 17.0 && tops.back() > 17.0 && tops.back() < 19.5, qPrintable(list));
+    window_->findChild<QPushButton*>(QStringLiteral("view3DFrame"))->click();  // on the selected building
+    shot(QStringLiteral("16-3d-roof-levels"));
   }
 
   // Box-fitting beside the active polygon on the big roof (accepted above), then the choice to keep

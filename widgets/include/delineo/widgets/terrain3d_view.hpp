@@ -49,6 +49,8 @@ class Terrain3DView : public QWidget {
   void setTexture(const cv::Mat& grey);
   void setColourMap(ColourMap map);
   void setBuildings(const std::vector<BuildingOutline>& buildings);
+  // The blocks shown (one per building, or per roof part), as last set.
+  const std::vector<BuildingOutline>& buildings() const;
   void setVerticalExaggeration(double factor);
   double verticalExaggeration() const;
   // A vertical exaggeration that makes the relief readable: 1 when the height range (lowest to
