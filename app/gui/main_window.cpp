@@ -134,20 +134,6 @@ void MainWindow::refreshTitle() {
 // ------------------------------------------------------------------------------------------
 // 3D view
 
-namespace {
-// The roof parts of a building with several roof levels, or none (one level, roof levels off, or
-// a parameter out of its domain: the block is then drawn whole, the form says what is wrong).
-std::vector<project::RoofPart> roofPartsOrNone(const project::Project& project, const cv::Mat& dem,
-                                               const core::Polygon& outline) {
-  try {
-    std::vector<project::RoofPart> parts = project::roofParts(project, dem, outline);
-    if (parts.size() >= 2) return parts;
-  } catch (const core::Error&) {
-  }
-  return {};
-}
-}  // namespace
-
 // The DEM, its texture and the extruded outlines of the buildings with a roof height: one block
 // per roof part (project::roofParts on the DEM shown, as the CityJSON export writes them).
 void MainWindow::refresh3D() {
@@ -166,16 +152,7 @@ void MainWindow::refresh3D() {
   view3D_->setDem(dem, document_->project().height.gsd);
   // Height colours by default: a grey drape is low-contrast and repeats the 2D view.
   view3D_->setTexture(view3DColour_->currentIndex() == 1 ? document_->leftGrey() : cv::Mat());
-  std::vector<widgets::BuildingOutline> outlines;
-  for (const Building& b : document_->project().buildings) {
-    if (!b.hasOutline() || b.status == BuildingStatus::Rejected || !std::isfinite(b.roofHeight)) continue;
-    // The ground next to the building, as the histogram's ground line reads it.
-    const double base = project::groundHeightNextTo(document_->project(), dem, b.outline).value_or(0.0);
-    const std::vector<project::RoofPart> parts = roofPartsOrNone(document_->project(), dem, b.outline);
-    if (parts.size() < 2) outlines.push_back({b.outline, base, b.roofHeight});
-    for (const auto& part : parts) outlines.push_back({part.polygon, base, part.height});
-  }
-  view3D_->setBuildings(outlines);
+  view3D_->setBuildings(buildingBlocks_.of(document_->project(), dem));
   if (newDem) frame3D();
 }
 

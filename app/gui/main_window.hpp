@@ -17,6 +17,7 @@
 #include "delineo/project/pipeline.hpp"
 #include "delineo/project/project.hpp"
 #include "delineo/widgets/job_runner.hpp"
+#include "building_blocks.hpp"
 
 class QAction;
 class QActionGroup;
@@ -342,6 +343,7 @@ class MainWindow : public QMainWindow {
   QComboBox* view3DColour_ = nullptr;
   QDoubleSpinBox* view3DExaggeration_ = nullptr;
   cv::Mat view3DDem_;  // the DEM the 3D view's exaggeration was chosen for
+  BuildingBlocks buildingBlocks_;  // the 3D view's blocks, kept between refreshes
   widgets::DisparityHistogramWidget* histogram_ = nullptr;
   QLabel* intervalLabel_ = nullptr;
   // One form per parameter group of the project file, and how it reads and writes the group.
