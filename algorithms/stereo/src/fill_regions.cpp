@@ -12,7 +12,7 @@
 
 namespace delineo::stereo::detail {
 
-LocalMoments localMoments(const cv::Mat& image) {
+LocalMoments localMoments(const cv::Mat& image, double noise) {
   // Nodata as 0, and the squares, in one pass; then the two 5x5 means.
   cv::Mat finite(image.size(), CV_32F), squares(image.size(), CV_32F);
   for (int y = 0; y < image.rows; ++y) {
@@ -25,7 +25,7 @@ LocalMoments localMoments(const cv::Mat& image) {
     }
   }
   LocalMoments out;
-  out.noise = noiseSigma(finite);
+  out.noise = noise >= 0 ? noise : noiseSigma(finite);
   const cv::Size window(2 * kFlatReach + 1, 2 * kFlatReach + 1);
   cv::blur(finite, out.mean, window);
   cv::blur(squares, out.meanSquare, window);
@@ -108,7 +108,9 @@ LeftFlatRegions leftFlatRegions(const cv::Mat& left, const cv::Mat& disparity,
       if (l[x] != 0 && !std::isfinite(d[x])) ++unmatched[static_cast<size_t>(l[x])];
     }
   }
-  const double maxArea = settings.maxShare * static_cast<double>(left.total());
+  const double pixels =
+      settings.wholePixels > 0 ? settings.wholePixels : static_cast<double>(left.total());
+  const double maxArea = settings.maxShare * pixels;
   regions.ownFill.assign(static_cast<size_t>(count), 0);
   for (int r = 1; r < count; ++r) {
     regions.ownFill[static_cast<size_t>(r)] =

@@ -24,6 +24,7 @@
 #include "match_levels.hpp"
 #include "match_snap.hpp"
 #include "match_snap_rows.hpp"
+#include "match_tiles.hpp"
 #include "ordering.hpp"
 #include "roof_planes.hpp"
 #include "slanted_facets.hpp"
@@ -41,6 +42,7 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr double kCoarsestRange = 20.0;  // ΔP_N of the paper, px
 constexpr int kMinLevelSide = 32;        // px, coarsest level kept at least this large
+constexpr int kMinTile = 64;             // px, smallest kept part of a tile
 
 int floorDiv(int a, int b) {
   return a >= 0 ? a / b : -((-a + b - 1) / b);
@@ -162,6 +164,17 @@ int threadCount(const MatchParams& p) {
   return std::max(1U, std::thread::hardware_concurrency());
 }
 
+// The fill's settings, with the whole pair's statistics for a tile (null: the pair is whole).
+detail::RegionFillSettings fillSettingsFor(const detail::WholePairStatistics* whole) {
+  detail::RegionFillSettings s;
+  if (whole != nullptr) {
+    s.wholePixels = whole->pixels;
+    s.wholeLeftMedianGrey = whole->leftMedianGrey;
+    s.wholeGreyMap = whole->greyMap;
+  }
+  return s;
+}
+
 // The pyramid's levels: as asked or from the range, the coarsest kept at least kMinLevelSide.
 int levelCount(const cv::Mat& image, const MatchParams& p) {
   int levels = p.levels > 0 ? p.levels : autoLevels(p.dmin, p.dmax);
@@ -174,7 +187,7 @@ int levelCount(const cv::Mat& image, const MatchParams& p) {
 // The adaptive matcher's state from the pyramids to the final map; runStages() lists its stages.
 struct AdaptiveMatch {
   AdaptiveMatch(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                core::Progress* progress, int threads);
+                core::Progress* progress, int threads, const detail::WholePairStatistics* whole);
   bool runStages();
   void buildPyramids();
   void buildPyramidSide(bool isLeft, const GreyMapping& g);
@@ -199,9 +212,10 @@ struct AdaptiveMatch {
   const cv::Mat& right;
   const MatchParams& p;
   core::Progress* const progress;
+  const detail::WholePairStatistics* const whole;  // a tile's; null: the pair is whole
   const int threads, levels;
   const bool plainPass;  // the weak-match passes over plain pixels run (they read `plain`)
-  const detail::RegionFillSettings fillSettings;
+  const detail::RegionFillSettings fillSettings;  // with a tile's whole-pair statistics
   MatchResult result;
   std::vector<detail::PyramidLevel> pyramid;
   detail::LocalMoments leftMoments;  // for the steps after the levels
@@ -212,14 +226,17 @@ struct AdaptiveMatch {
 };
 
 AdaptiveMatch::AdaptiveMatch(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                             core::Progress* progress, int threads)
+                             core::Progress* progress, int threads,
+                             const detail::WholePairStatistics* whole)
     : left(left),
       right(right),
       p(p),
       progress(progress),
+      whole(whole),
       threads(threads),
       levels(levelCount(left, p)),
-      plainPass(p.adaptive && (p.plainStepMinScore > 0 || p.unmatchedPlainMinScore > 0)) {
+      plainPass(p.adaptive && (p.plainStepMinScore > 0 || p.unmatchedPlainMinScore > 0)),
+      fillSettings(fillSettingsFor(whole)) {
   result.levelsUsed = levels;
 }
 
@@ -263,7 +280,8 @@ bool AdaptiveMatch::runStages() {
 // to the matching: each side's preparation and pyramid is one task.
 void AdaptiveMatch::buildPyramids() {
   core::setStage(progress, core::StageId::PreparingPyramids);
-  const GreyMapping g = greyMapping(left, right, threads);
+  const GreyMapping g = whole != nullptr ? GreyMapping{whole->greyOffset, whole->greyScale}
+                                         : greyMapping(left, right, threads);
   pyramid.resize(static_cast<size_t>(levels));
   runTasks({[&] { buildPyramidSide(true, g); }, [&] { buildPyramidSide(false, g); }}, threads);
   for (int k = 0; k < levels; ++k) {
@@ -308,11 +326,16 @@ void AdaptiveMatch::findEdgesAndFlatPixels() {
     // finest edge map's time) right after the finest level's edges, not last, where they ran
     // alone on one worker (~10 ms at 1000²).
     if (k == 0 && afterSteps) {
-      edgeTasks.emplace_back([this] { leftMoments = detail::localMoments(left); });
+      edgeTasks.emplace_back([this] {
+        leftMoments = detail::localMoments(left, whole != nullptr ? whole->leftNoise : -1);
+      });
     }
     if (k == 0 && fillsRegions) {
-      edgeTasks.emplace_back(
-          [this] { rightFlat = detail::plainPixels(right, fillSettings.flatSigmas); });
+      edgeTasks.emplace_back([this] {
+        const detail::LocalMoments moments =
+            detail::localMoments(right, whole != nullptr ? whole->rightNoise : -1);
+        rightFlat = detail::plainPixels(right, fillSettings.flatSigmas, &moments);
+      });
     }
   }
   runTasks(edgeTasks, threads);
@@ -491,22 +514,24 @@ void AdaptiveMatch::fitRoofPlanes() {
 }
 
 MatchResult matchAdaptiveSteps(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                               core::Progress* progress) {
+                               core::Progress* progress,
+                               const detail::WholePairStatistics* whole) {
   const int threads = threadCount(p);
   // Its helpers serve the match's parallel steps (see WorkerPool).
   detail::WorkerPool workerPool(threads - 1);
   const detail::WorkerPool::Scope poolScope(workerPool);
-  AdaptiveMatch match(left, right, p, progress, threads);
+  AdaptiveMatch match(left, right, p, progress, threads, whole);
   if (match.runStages()) core::report(progress, 1.0);
   return std::move(match.result);
 }
 
 // The steps poll the cancel within (workers.hpp): a cancel ends the match from any of them.
 MatchResult matchAdaptive(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                          core::Progress* progress) {
+                          core::Progress* progress,
+                          const detail::WholePairStatistics* whole = nullptr) {
   const detail::CancelScope cancelScope(progress);
   try {
-    return matchAdaptiveSteps(left, right, p, progress);
+    return matchAdaptiveSteps(left, right, p, progress, whole);
   } catch (const detail::Canceled&) {
     MatchResult canceled;
     canceled.status = core::RunStatus::Canceled;
@@ -550,7 +575,8 @@ cv::Mat squareScore(const cv::Mat& left, const cv::Mat& right, const cv::Mat& di
 }
 
 MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchParams& p,
-                      core::Progress* progress) {
+                      core::Progress* progress,
+                      const detail::WholePairStatistics* whole = nullptr) {
   MatchResult result;
   core::setStage(progress, core::StageId::MatchingSgbm);
   core::report(progress, 0.0);
@@ -558,7 +584,8 @@ MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchPara
     result.status = core::RunStatus::Canceled;
     return result;
   }
-  const GreyMapping g = greyMapping(left, right, threadCount(p));
+  const GreyMapping g = whole != nullptr ? GreyMapping{whole->greyOffset, whole->greyScale}
+                                         : greyMapping(left, right, threadCount(p));
   cv::Mat lv, rv, lvalid, rvalid, l8, r8;
   prepare(left, g, lv, lvalid);
   prepare(right, g, rv, rvalid);
@@ -597,6 +624,32 @@ MatchResult matchSgbm(const cv::Mat& left, const cv::Mat& right, const MatchPara
   return result;
 }
 
+// Tile by tile with the whole pair's grey mapping, noise and pyramid depth, so that each tile's
+// kept part is matched as in the whole pair as far as its crop allows (docs/stereo.md, "Large
+// pairs: tiles").
+MatchResult matchTiled(const cv::Mat& left, const cv::Mat& right, const MatchParams& params,
+                       core::Progress* progress) {
+  detail::WholePairStatistics whole =
+      detail::wholePairStatistics(left, right, params.dmin, params.dmax, threadCount(params));
+  const GreyMapping grey = greyMapping(left, right, threadCount(params));
+  whole.greyOffset = grey.offset;
+  whole.greyScale = grey.scale;
+  MatchParams tileParams = params;
+  tileParams.levels = levelCount(left, params);
+  const int alignment = 1 << (tileParams.levels - 1);  // the coarsest level's pixel
+  const int context = detail::matchTileContext(tileParams.levels);
+  const std::vector<detail::MatchTile> tiles = detail::matchTileGrid(
+      left.size(), params.tile, context, params.dmin, params.dmax, alignment);
+  const bool sgbm = params.method == "sgbm";
+  return detail::matchInTiles(
+      left, right, tiles,
+      [&](const cv::Mat& l, const cv::Mat& r, core::Progress* share) {
+        return sgbm ? matchSgbm(l, r, tileParams, share, &whole)
+                    : matchAdaptive(l, r, tileParams, share, &whole);
+      },
+      progress);
+}
+
 }  // namespace
 
 void MatchParams::validate() const {
@@ -616,6 +669,9 @@ void MatchParams::validate() const {
   if (smoothWindow != 0 && (smoothWindow < 3 || smoothWindow % 2 == 0)) {
     throw Error(ErrorCode::InvalidParameter, "smooth-window = " + std::to_string(smoothWindow) +
                                                  " must be 0 (off) or odd and >= 3");
+  }
+  if (tile != 0 && tile < kMinTile) {
+    throw Error(ErrorCode::InvalidParameter, "tile = " + std::to_string(tile) + " must be 0 (whole image) or at least " + std::to_string(kMinTile));
   }
   if (edgeLow > edgeHigh) {
     throw Error(ErrorCode::InvalidParameter, "edge-low must not exceed edge-high");
@@ -640,6 +696,9 @@ MatchResult matchStereo(const cv::Mat& left, const cv::Mat& right, const MatchPa
                 "left image is " + std::to_string(left.cols) + "x" + std::to_string(left.rows) +
                     " but right image is " + std::to_string(right.cols) + "x" +
                     std::to_string(right.rows));
+  }
+  if (detail::matchesInTiles(left.size(), params.tile)) {
+    return matchTiled(left, right, params, progress);
   }
   if (params.method == "sgbm") return matchSgbm(left, right, params, progress);
   return matchAdaptive(left, right, params, progress);

@@ -29,9 +29,10 @@ struct GreyMaps {
 };
 
 GreyMaps greyMaps(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity, int dmin,
-                  int dmax) {
+                  int dmax, const RegionFillSettings& settings) {
   GreyMaps maps;
-  maps.images = radiometricMap(left, right, dmin, dmax);
+  maps.images = settings.wholeGreyMap ? *settings.wholeGreyMap
+                                      : radiometricMap(left, right, dmin, dmax);
   maps.matches = radiometricMapOfMatches(left, right, disparity, maps.images);
   return maps;
 }
@@ -140,7 +141,9 @@ int fillRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillSetti
                 const GreyMapsOf& greyMapsOf, const RightFlat& rightFlatRegionsOf, int helpers,
                 const OfferRegions& offerRegions, const LocalMoments* leftMoments) {
   const LeftFlatRegions flat = leftFlatRegions(left, disparity, settings, leftMoments);
-  const double leftMedian = settings.shadowOwnLight ? medianGrey(left) : 0;
+  const double leftMedian = !settings.shadowOwnLight                     ? 0
+                            : std::isnan(settings.wholeLeftMedianGrey) ? medianGrey(left)
+                                                                       : settings.wholeLeftMedianGrey;
   const GreyMaps& greyMaps = greyMapsOf();
   const auto [gain, offset] = greyMaps.images;
   // A sloped facet's counterpart is chosen by its grey level, so the map must hold at that level:
@@ -280,7 +283,7 @@ void FillOnTwoWorkers::fill() {
 void FillOnTwoWorkers::prepareAndHelp() {
   try {
     // Reads the disparities before the fill writes any: the fill waits for it first.
-    maps = greyMaps(left, right, disparity, dmin, dmax);
+    maps = greyMaps(left, right, disparity, dmin, dmax, settings);
     mapsReady.give();
     rightFlat = rightFlatRegions(rightFlatMask(right, settings, rightFlatPixels), right);
     rightReady.give();
@@ -329,7 +332,7 @@ int fillFlatRegions(const cv::Mat& left, const cv::Mat& right, const RegionFillS
   }
   // Else the right view's flat regions only when a region first needs them.
   RightFlatRegions rightFlat;
-  const GreyMaps maps = greyMaps(left, right, disparity, dmin, dmax);
+  const GreyMaps maps = greyMaps(left, right, disparity, dmin, dmax, settings);
   const int filled = fillRegions(
       left, right, settings, dmin, dmax, fillScore, disparity, score,
       [&]() -> const GreyMaps& { return maps; },

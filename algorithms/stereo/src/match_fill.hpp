@@ -2,6 +2,9 @@
 // Disparity of flat (textureless) regions from the matches along their outline (internal to
 // delineo_stereo).
 #include <functional>
+#include <limits>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -100,6 +103,11 @@ struct RegionFillSettings {
                                     //   are replaced (≤ 0: off)
   double inRegionRatio = 1.25;      //   when the fill's window error is below this × their own
   int inRegionWindow = 5;           // px: side of that window
+  // What a tile of a larger pair takes from the whole pair instead of its crops (docs/stereo.md,
+  // "Large pairs: tiles"); unset: from the images filled.
+  double wholePixels = 0;                // px: the image maxShare is a share of (0: unset)
+  double wholeLeftMedianGrey = std::numeric_limits<double>::quiet_NaN();  // for shadowOwnLight
+  std::optional<std::pair<double, double>> wholeGreyMap;  // the images' map (radiometricMap)
 };
 
 // Flat regions: 4-connected components of the valid left pixels whose 5x5 standard deviation is
@@ -210,7 +218,9 @@ struct LocalMoments {
   cv::Mat mean, meanSquare;  // CV_32F
   double noise = 0;          // noiseSigma (radiometry.hpp)
 };
-LocalMoments localMoments(const cv::Mat& image);
+// `noise` >= 0: taken as the image's noise sigma instead of its own estimate (a tile of a larger
+// image takes the whole image's, docs/stereo.md, "Large pairs: tiles").
+LocalMoments localMoments(const cv::Mat& image, double noise = -1);
 
 // `leftMoments` (optional): localMoments(left), made beforehand; `rightFlatPixels` (optional):
 // the right view's flat pixels, plainPixels(right, settings.flatSigmas), made beforehand (the

@@ -58,6 +58,9 @@ struct MatchParams {
   double planeResidual = 0.4;        // px, a raised surface planar within this RMS takes its
                                      // fitted plane (0 = off)
   int planeMinArea = 300;            // px, smallest surface fitted with a plane
+  int tile = 2048;                   // px, side of a tile's kept part: a larger image is matched
+                                     // in overlapping tiles one after another, in the memory of
+                                     // one tile (0 = always whole, else at least 64)
   int threads = 0;                   // worker threads, 0 = all cores
 
   template <class V>
@@ -218,6 +221,13 @@ struct MatchParams {
     v(core::ParamInfo{"plane-min-area", "Roof plane area", "px",
                       "Smallest surface fitted with a plane", 10, 100000},
       planeMinArea);
+    v(core::ParamInfo{"tile", "Tile size", "px",
+                      "An image wider or taller than this is matched in overlapping tiles, one "
+                      "after another, each keeping a part of at most this side: the memory is "
+                      "that of one tile instead of the whole image's; 0 = always whole (at least "
+                      "64 otherwise)",
+                      0, 1000000},
+      tile);
     v(core::ParamInfo{"threads", "Threads", "", "Worker threads, 0 = all cores", 0, 256},
       threads);
   }
