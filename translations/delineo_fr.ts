@@ -327,6 +327,10 @@
         <translation>Surface minimale d’un plan de toit</translation>
     </message>
     <message>
+        <source>Tile size</source>
+        <translation>Taille des tuiles</translation>
+    </message>
+    <message>
         <source>Coarse-check score</source>
         <translation>Score du contrôle au niveau grossier</translation>
     </message>

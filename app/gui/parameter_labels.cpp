@@ -81,6 +81,7 @@ namespace {
     QT_TRANSLATE_NOOP("Parameters", "Smoothing tolerance"),
     QT_TRANSLATE_NOOP("Parameters", "Roof planes"),
     QT_TRANSLATE_NOOP("Parameters", "Roof plane area"),
+    QT_TRANSLATE_NOOP("Parameters", "Tile size"),
     QT_TRANSLATE_NOOP("Parameters", "Regularize"),
     QT_TRANSLATE_NOOP("Parameters", "Regularize tolerance"),
     QT_TRANSLATE_NOOP("Parameters", "Regularize min edge"),
