@@ -14,6 +14,7 @@
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/project/project.hpp"
+#include "delineo/stereo/match.hpp"
 #include "temp_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -188,6 +189,25 @@ TEST(ProjectFile, ARangeAmongTheMatcherParametersBecomesTheProjectRange) {
   EXPECT_EQ(*loaded.disparityRange, (project::DisparityInterval{-2, 90}));
   EXPECT_FALSE(loaded.parameters["matching"].contains("dmin"));
   EXPECT_EQ(loaded.parameters["matching"]["window"], 11);
+}
+
+// The matcher's tile size (large pairs, docs/stereo.md) is kept by the file like any parameter;
+// a file without it matches in tiles of the default size.
+TEST(ProjectFile, TheMatchersTileSizeRoundTrips) {
+  TempDir dir;
+  Project p = sampleProject(dir);
+  stereo::MatchParams match;
+  match.tile = 512;
+  project::setParameters(p, "matching", match);
+  project::saveProject(p, dir.file("tiles.delineo.json"));
+  const Project loaded = project::loadProject(dir.file("tiles.delineo.json"));
+  EXPECT_EQ(loaded.parameters["matching"]["tile"], 512);
+  EXPECT_EQ(project::parameters<stereo::MatchParams>(loaded, "matching").tile, 512);
+  nlohmann::json j = project::toJson(p, dir.path().string());
+  j["parameters"]["matching"].erase("tile");
+  const Project old = project::fromJson(j, dir.path().string());
+  EXPECT_EQ(project::parameters<stereo::MatchParams>(old, "matching").tile,
+            stereo::MatchParams{}.tile);
 }
 
 TEST(ProjectFile, MissingFilesNamesEachAbsentImage) {
