@@ -14,6 +14,7 @@
 #include "delineo/core/progress.hpp"
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
+#include "simulated_views.hpp"
 
 namespace delineo::stereo {
 namespace {
@@ -241,20 +242,8 @@ class PollingProgress : public core::Progress {
   mutable int total_ = 0;
 };
 
-struct SceneViews {
-  cv::Mat left, right;
-  MatchParams params;
-};
-SceneViews sceneViews(int size, int seed) {
-  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(size, seed));
-  SceneViews v;
-  scene.left.convertTo(v.left, CV_32F);
-  scene.right.convertTo(v.right, CV_32F);
-  v.params.dmin = scene.disparityMin;
-  v.params.dmax = scene.disparityMax;
-  v.params.threads = 2;
-  return v;
-}
+using testing::SceneViews;
+using testing::sceneViews;
 
 // Ctrl-C acts within a second on a 2000² pair only if no stage runs long without polling: every
 // stage polls the cancel throughout, at least once per 32 rows of the image (before each step

@@ -14,6 +14,7 @@
 #include "delineo/sim/scene.hpp"
 #include "delineo/stereo/match.hpp"
 #include "match_tiles.hpp"
+#include "simulated_views.hpp"
 
 namespace delineo::stereo {
 namespace {
@@ -78,20 +79,8 @@ TEST(MatchTileGrid, ASmallTileIsRejected) {
   EXPECT_NO_THROW(p.validate());
 }
 
-struct SceneViews {
-  cv::Mat left, right;
-  MatchParams params;
-};
-SceneViews sceneViews(int size, int seed) {
-  const sim::Scene scene = sim::simulateScene(sim::squareSceneParams(size, seed));
-  SceneViews v;
-  scene.left.convertTo(v.left, CV_32F);
-  scene.right.convertTo(v.right, CV_32F);
-  v.params.dmin = scene.disparityMin;
-  v.params.dmax = scene.disparityMax;
-  v.params.threads = 2;
-  return v;
-}
+using testing::SceneViews;
+using testing::sceneViews;
 
 double matchedShare(const cv::Mat& d) {
   long n = 0;

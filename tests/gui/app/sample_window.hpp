@@ -1,6 +1,6 @@
 #pragma once
 // Set-up shared by the GUI tests that drive the real main window on the generated sample
-// project: settings of their own, the sample project, the window shown.
+// project: settings of their own, the sample project, the window shown, a pair without heights.
 #include <QCoreApplication>
 #include <QSettings>
 #include <QStandardPaths>
@@ -10,6 +10,9 @@
 #include <string>
 #include <thread>
 
+#include <opencv2/core.hpp>
+
+#include "delineo/io/raster.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "main_window.hpp"
 
@@ -43,6 +46,18 @@ inline std::unique_ptr<gui::MainWindow> showMainWindow() {
   window->resize(1300, 850);
   window->show();
   return window;
+}
+
+// Opens in `window` a pair without heights (no disparity, no DEM, no height model) written into
+// `dir`: two copies of one noise image.
+inline bool openPairWithoutHeights(gui::MainWindow& window, const QTemporaryDir& dir) {
+  cv::Mat left(120, 160, CV_8U);
+  cv::randu(left, 0, 255);
+  const QString l = dir.filePath(QStringLiteral("bare_left.tif"));
+  const QString r = dir.filePath(QStringLiteral("bare_right.tif"));
+  io::writeGeoTiff(l.toStdString(), left);
+  io::writeGeoTiff(r.toStdString(), left);
+  return window.openPair(l, r);
 }
 
 }  // namespace delineo::guitest

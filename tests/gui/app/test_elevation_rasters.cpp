@@ -175,17 +175,6 @@ class ElevationRastersTest : public QObject {
     file->close();
   }
 
-  // A pair without heights: no disparity, no DEM, no mask.
-  bool openBarePair() {
-    cv::Mat left(120, 160, CV_8U);
-    cv::randu(left, 0, 255);
-    const QString l = dir_.filePath(QStringLiteral("bare_left.tif"));
-    const QString r = dir_.filePath(QStringLiteral("bare_right.tif"));
-    io::writeGeoTiff(l.toStdString(), left);
-    io::writeGeoTiff(r.toStdString(), left);
-    return window_->openPair(l, r);
-  }
-
   QString freshFolder(const QString& name) {
     const QString path = dir_.filePath(name);
     QDir().mkpath(path);
@@ -214,7 +203,7 @@ class ElevationRastersTest : public QObject {
   }
 
   void nothingToExportWithoutElevationData() {
-    QVERIFY(openBarePair());
+    QVERIFY(guitest::openPairWithoutHeights(*window_, dir_));
     QVERIFY(!act("actionExportRasters")->isEnabled());
     QVERIFY2(act("actionExportRasters")->toolTip().contains(QStringLiteral("Nothing to export")),
              qPrintable(act("actionExportRasters")->toolTip()));

@@ -62,17 +62,6 @@ class SceneAnalysisTest : public QObject {
     return detected.at(0).at(0).toInt();
   }
 
-  // A project with no DEM, no disparity and no height model: no heights at all.
-  bool openPairWithoutHeights() {
-    cv::Mat left(120, 160, CV_8U);
-    cv::randu(left, 0, 255);
-    const QString l = dir_.filePath(QStringLiteral("bare_left.tif"));
-    const QString r = dir_.filePath(QStringLiteral("bare_right.tif"));
-    io::writeGeoTiff(l.toStdString(), left);
-    io::writeGeoTiff(r.toStdString(), left);
-    return window_->openPair(l, r);
-  }
-
  private slots:
   void initTestCase() {
     guitest::isolateSettings(QStringLiteral("DelineoSceneTest"), false);
@@ -83,7 +72,7 @@ class SceneAnalysisTest : public QObject {
   }
 
   void missingHeightsGiveAMessageAndNoLayer() {
-    QVERIFY(openPairWithoutHeights());
+    QVERIFY(guitest::openPairWithoutHeights(*window_, dir_));
     QVERIFY(doc()->dem().empty());
     QCOMPARE(window_->startSceneAnalysis(), widgets::JobId(0));
     QVERIFY2(window_->lastMessage().contains(QStringLiteral("needs heights")), qPrintable(window_->lastMessage()));
