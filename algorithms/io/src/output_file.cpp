@@ -7,6 +7,8 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <string_view>
+#include <utility>
 
 #include "delineo/core/error.hpp"
 #include "gdal_support.hpp"
@@ -20,6 +22,20 @@ namespace {
 
 // Symlinks are followed this many times at most (a loop gives up, as the system does).
 constexpr int kMaxSymlinkHops = 40;
+
+// The file name's stem and extension, ".city.json" whole (in its case), so that a temporary
+// CityJSON file is one for the writers that choose the format by the name.
+std::pair<std::string, std::string> stemAndExtension(const fs::path& target) {
+  const std::string name = target.filename().string();
+  constexpr std::string_view kCityJson = ".city.json";
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (lower.size() > kCityJson.size() && lower.ends_with(kCityJson)) {
+    const size_t cut = name.size() - kCityJson.size();
+    return {name.substr(0, cut), name.substr(cut)};
+  }
+  return {target.stem().string(), target.extension().string()};
+}
 
 const std::vector<std::string>& extensionsOf(OutputFormat format) {
   static const std::vector<std::string> geotiff{".tif", ".tiff"};
@@ -135,13 +151,14 @@ void writeAtomically(const std::string& path, const std::function<void(const std
   std::error_code ec;
   if (fs::is_directory(target, ec)) throw Error(ErrorCode::WriteFailed, "is a folder, not a file", path);
   static std::atomic<unsigned> counter{0};
+  const auto [stem, extension] = stemAndExtension(target);
   std::string name(".");
-  name.append(target.stem().string())
+  name.append(stem)
       .append(".partial-")
       .append(std::to_string(::getpid()))
       .append("-")
       .append(std::to_string(counter++))
-      .append(target.extension().string());
+      .append(extension);
   const fs::path temp = target.parent_path() / name;
   try {
     write(temp.string());

@@ -108,6 +108,23 @@ TEST(OutputFile, AFailedWriteLeavesThePreviousFileAndNoTemporaryFile) {
   EXPECT_EQ(files, 1);
 }
 
+TEST(OutputFile, TheTemporaryFileKeepsTheExtensionTheWritersChooseTheFormatBy) {
+  TempDir dir;
+  std::vector<std::string> temporaries;
+  for (const char* name : {"b.city.json", "B.City.JSON", "b.cityjson", "b.geojson"}) {
+    io::writeAtomically(dir.file(name), [&](const std::string& temp) {
+      temporaries.push_back(fs::path(temp).filename().string());
+      writeText(temp, "x");
+    });
+  }
+  ASSERT_EQ(temporaries.size(), 4u);
+  EXPECT_TRUE(temporaries[0].starts_with(".b.partial-") && temporaries[0].ends_with(".city.json")) << temporaries[0];
+  EXPECT_TRUE(temporaries[1].starts_with(".B.partial-") && temporaries[1].ends_with(".City.JSON")) << temporaries[1];
+  EXPECT_TRUE(temporaries[2].starts_with(".b.partial-") && temporaries[2].ends_with(".cityjson")) << temporaries[2];
+  EXPECT_TRUE(temporaries[3].starts_with(".b.partial-") && temporaries[3].ends_with(".geojson")) << temporaries[3];
+  EXPECT_EQ(readText(dir.file("b.city.json")), "x");
+}
+
 TEST(OutputFile, TheErrorOfAFailedWriteNamesTheRequestedFileNotTheTemporaryOne) {
   TempDir dir;
   const core::Error e = captureError([&] {

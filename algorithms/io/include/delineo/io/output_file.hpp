@@ -36,7 +36,7 @@ bool sameFile(const std::string& a, const std::string& b);
 void checkOutputs(const std::vector<OutputFile>& outputs, const std::vector<std::string>& inputs);
 
 // Writes `path` through a temporary file: `write` receives the temporary path (same folder,
-// same extension) and writes the whole file there; on success it replaces the target (the real
+// same extension, ".city.json" whole) and writes the whole file there; on success it replaces the target (the real
 // file when `path` is a symlink), keeping the target's permissions; on any exception the
 // temporary file is removed, the target is untouched and the exception goes on.
 void writeAtomically(const std::string& path, const std::function<void(const std::string&)>& write);
