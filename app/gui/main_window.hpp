@@ -66,8 +66,17 @@ class MainWindow : public QMainWindow {
   bool openSample();
   bool save();
   bool saveAs(const QString& path);
-  // Exports the accepted buildings; returns the number written or -1 on failure.
-  int exportAccepted(const QString& path);
+  // File → Export accepted buildings to `path`, by its extension: the outlines (GeoJSON,
+  // GeoPackage) at once, the CityJSON blocks in the background (exportCityModel).
+  void exportAccepted(const QString& path);
+  // The accepted outlines as GeoJSON or GeoPackage; returns the number written or -1 on failure.
+  int exportOutlines(const QString& path);
+  // The accepted buildings as CityJSON blocks with the terrain (key "export-city", main_window_export.cpp):
+  // the scene analysis runs first when missing and the heights allow it (kept for the window as
+  // Analyse the scene keeps it), then project::exportBuildings writes the blocks, roof parts and
+  // the analysis's DTM as terrain, as `delineo-cli export --terrain` does. A cancel writes nothing.
+  // Returns the job id, or 0 with a message saying why nothing started.
+  widgets::JobId exportCityModel(const QString& path);
   Document* document() const { return document_.get(); }
   static QString sampleDirectory();
 
@@ -212,6 +221,7 @@ class MainWindow : public QMainWindow {
   void buildingsDetected(int added, int present);  // Detect buildings has added its proposals
   void pendingOutlined(int outlined, int skipped);  // Outline the pending buildings has ended
   void elevationRastersExported(const QStringList& files);  // written into the folder, all of them
+  void cityModelExported(const QString& path, int written);  // the CityJSON file is written
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -309,6 +319,9 @@ class MainWindow : public QMainWindow {
   QString sceneInputsMissing() const;
   bool ensureSceneAnalysis();
   void onSceneJobEnded(widgets::JobId id, widgets::JobOutcome outcome);
+  struct SceneInputs;
+  // An analysis made by an export of `inputs` becomes the window's when it has none and the heights are still those.
+  void adoptSceneAnalysis(project::SceneAnalysisOutcome analysis, const SceneInputs& inputs);
   void addDetectedBuildings();
   void invalidateSceneAnalysis();
   void onSceneLayerToggled(QAction* toggle, bool on);
@@ -319,6 +332,9 @@ class MainWindow : public QMainWindow {
   void refreshGuides();
   std::vector<widgets::OverlayGuide> sceneObjectGuides() const;
   void showInformation(const QString& title, const QString& text);
+
+  // main_window_export.cpp: File → Export accepted buildings.
+  void showExportSummary(const QString& path, const project::ExportSummary& exported, const QString& terrain);
 
   // main_window_rasters.cpp: File → Export elevation rasters.
   void chooseRasterFolder();

@@ -1,6 +1,6 @@
 // MainWindow's project files: opening a project (with autosave recovery and missing images
 // relocated), a stereo pair or the sample, installing the document in the views, saving,
-// autosaving, exporting, the project settings and the recent projects.
+// autosaving, the project settings and the recent projects.
 #include <QAction>
 #include <QFileDialog>
 #include <QFileInfo>
@@ -291,30 +291,6 @@ bool MainWindow::saveAs(const QString& path) {
   refreshTitle();
   statusBar()->showMessage(tr("Saved %1").arg(path), 5000);
   return true;
-}
-
-int MainWindow::exportAccepted(const QString& path) {
-  if (!document_) return -1;
-  try {
-    // The scene analysis's DTM, when it has run, is the CityJSON's terrain.
-    const project::ExportSummary exported = document_->exportAccepted(path, scene_ ? scene_->dtm : cv::Mat());
-    QString text = tr("%n accepted building(s) exported to %1", nullptr, exported.written).arg(path);
-    if (!exported.leftOut.empty()) {
-      text += QStringLiteral(" ") + tr("%n left out: no roof height above the ground.", nullptr,
-                                       static_cast<int>(exported.leftOut.size()));
-    }
-    if (!exported.notes.empty()) {
-      text += QStringLiteral(" ") + (exported.onLocalGround
-                                         ? tr("%n on the ground level: no ground next to them.", nullptr,
-                                              static_cast<int>(exported.notes.size()))
-                                         : tr("The blocks stand on the ground level: no heights."));
-    }
-    statusBar()->showMessage(text, 8000);
-    return exported.written;
-  } catch (const core::Error& e) {
-    showMessage(tr("Cannot export"), errorMessage(e));
-    return -1;
-  }
 }
 
 void MainWindow::autosaveNow() {

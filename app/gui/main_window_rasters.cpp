@@ -138,16 +138,7 @@ widgets::JobId MainWindow::exportElevationRasters(const QString& dir) {
       },
       [this, doc, dir, leftOut, sceneInputs](RasterExport result) {
         if (!doc || doc != document_.get() || result.written.status != core::RunStatus::Completed) return;
-        // The analysis made for the files is the window's too while the heights are the same.
-        const SceneInputs now{document_->dem().data, document_->disparity().data, document_->project().height.gsd};
-        if (result.analysis && !scene_ && now == sceneInputs) {
-          scene_ = std::move(*result.analysis);
-          sceneInputs_ = sceneInputs;
-          refreshRasters();
-          refreshLabelOverlay();
-          refreshGuides();
-          emit sceneAnalysed();
-        }
+        if (result.analysis) adoptSceneAnalysis(std::move(*result.analysis), sceneInputs);
         onElevationRastersWritten(dir, result.written, leftOut);
       },
       QStringLiteral("rasters"));

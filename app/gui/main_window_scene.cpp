@@ -283,6 +283,18 @@ void MainWindow::onSceneJobEnded(widgets::JobId id, widgets::JobOutcome outcome)
   refreshGuides();
 }
 
+// The analysis made for an export is the window's too while the heights are the same.
+void MainWindow::adoptSceneAnalysis(project::SceneAnalysisOutcome analysis, const SceneInputs& inputs) {
+  const SceneInputs now{document_->dem().data, document_->disparity().data, document_->project().height.gsd};
+  if (scene_ || now != inputs) return;
+  scene_ = std::move(analysis);
+  sceneInputs_ = inputs;
+  refreshRasters();
+  refreshLabelOverlay();
+  refreshGuides();
+  emit sceneAnalysed();
+}
+
 // The heights, the disparity or the analysis's parameters changed: the analysis is of other
 // data. It is computed again when one of its layers is shown.
 void MainWindow::invalidateSceneAnalysis() {

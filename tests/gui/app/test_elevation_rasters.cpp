@@ -1,13 +1,15 @@
-// File → Export elevation rasters and View → Exclusion mask in the real main window, on a
-// georeferenced copy of the generated sample project with a vegetation mask: the files written
-// (values and geotransform read back against the window's layers), nothing written when canceled
-// or when the operator keeps the existing files, the action disabled without elevation data; the
-// mask hatched over the left view (pixels of the grabbed view) and disabled without a mask.
-// With DELINEO_SCREENSHOT_DIR set, it saves the mask overlay, the folder dialog, the question
-// before replacing files and the status message there.
+// File → Export elevation rasters, File → Export accepted buildings and View → Exclusion mask in
+// the real main window, on a georeferenced copy of the generated sample project with a vegetation
+// mask: the files written (values and geotransform read back against the window's layers), nothing
+// written when canceled or when the operator keeps the existing files, the action disabled without
+// elevation data; the CityJSON export in the background with the terrain, the same file as
+// `delineo-cli export --terrain` writes; the mask hatched over the left view (pixels of the
+// grabbed view) and disabled without a mask. With DELINEO_SCREENSHOT_DIR set, it saves the mask
+// overlay, the folder dialog, the question before replacing files and the status messages there.
 #include <QAction>
 #include <QApplication>
 #include <QDir>
+#include <QElapsedTimer>
 #include <QFileInfo>
 #include <QHelpEvent>
 #include <QMenu>
@@ -22,6 +24,7 @@
 #include <QTemporaryDir>
 #include <QTest>
 #include <QTimer>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -32,6 +35,7 @@
 #include "delineo/core/nan_mask.hpp"
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
+#include "delineo/project/project.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "document.hpp"
@@ -107,6 +111,36 @@ OverlayChange compareGrabs(const QImage& before, const QImage& after, const widg
           elsewhereSeen ? static_cast<double>(changed) / elsewhereSeen : 1.0};
 }
 
+// The project at `samplePath` with each building of its ground-truth labels accepted: its outline
+// the labels' contour, its roof height the median of the DEM inside it. Saved as `path`.
+void saveWithAcceptedBuildings(const QString& samplePath, const QString& path) {
+  project::Project p = project::loadProject(samplePath.toStdString());
+  const cv::Mat dem = io::readRaster(p.dem).data;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(io::readRaster(p.labels).data == 1, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  for (const auto& contour : contours) {
+    std::vector<cv::Point> simple;
+    cv::approxPolyDP(contour, simple, 1.0, true);
+    if (cv::contourArea(simple) < 100.0) continue;
+    project::Building b;
+    b.id = p.nextBuildingId();
+    for (const cv::Point& v : simple) b.initial.outer.emplace_back(v.x, v.y);
+    b.outline = b.initial;
+    b.status = project::BuildingStatus::Accepted;
+    std::vector<float> inside;
+    const cv::Mat mask = core::rasterize(b.outline, dem.size());
+    for (int y = 0; y < dem.rows; ++y) {
+      for (int x = 0; x < dem.cols; ++x) {
+        if (mask.at<uchar>(y, x) != 0 && std::isfinite(dem.at<float>(y, x))) inside.push_back(dem.at<float>(y, x));
+      }
+    }
+    std::nth_element(inside.begin(), inside.begin() + inside.size() / 2, inside.end());
+    b.roofHeight = inside[inside.size() / 2];
+    p.buildings.push_back(b);
+  }
+  project::saveProject(p, path.toStdString());
+}
+
 }  // namespace
 
 class ElevationRastersTest : public QObject {
@@ -114,6 +148,7 @@ class ElevationRastersTest : public QObject {
  private:
   QTemporaryDir dir_;
   QString projectPath_;  // the georeferenced sample with its vegetation mask
+  QString cityPath_;     // the same with its buildings accepted, never matched nor saved by the window
   cv::Mat mask_;         // its mask as the project reads it (255 = not roof)
   std::unique_ptr<MainWindow> window_;
 
@@ -197,6 +232,8 @@ class ElevationRastersTest : public QObject {
     guitest::isolateSettings(QStringLiteral("DelineoRastersTest"), false);
     QVERIFY(dir_.isValid());
     projectPath_ = makeGeoreferencedProject(guitest::makeSampleProject(dir_));
+    cityPath_ = dir_.filePath(QStringLiteral("geo/city.delineo.json"));
+    saveWithAcceptedBuildings(projectPath_, cityPath_);
     QVERIFY(cv::countNonZero(mask_) > 500);
     window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
@@ -312,6 +349,91 @@ class ElevationRastersTest : public QObject {
     QCOMPARE(namesIn(out), QStringList{QStringLiteral("dem.tif")});  // no temporary left either
     QCOMPARE(contents(QDir(out).filePath(QStringLiteral("dem.tif"))), std::string("previous"));
     QVERIFY(window_->sceneAnalysis() == nullptr);
+  }
+
+  // The CityJSON export starts a job and returns at once; without a prior analysis it runs one
+  // and the file holds its terrain, byte for byte what `delineo-cli export --terrain` writes.
+  void cityModelExportRunsInTheBackgroundWithTheTerrain() {
+    QVERIFY(window_->openProject(cityPath_));
+    QVERIFY(window_->sceneAnalysis() == nullptr);
+    const int accepted = static_cast<int>(doc()->project().buildings.size());
+    QVERIFY(accepted >= 5);
+    const QString out = QDir(freshFolder(QStringLiteral("city"))).filePath(QStringLiteral("buildings.city.json"));
+    QSignalSpy exported(window_.get(), &MainWindow::cityModelExported);
+    int ticks = 0;  // the window's event loop turning while the job works
+    QTimer ticker;
+    connect(&ticker, &QTimer::timeout, [&ticks] { ++ticks; });
+    ticker.start(5);
+    QElapsedTimer clock;
+    clock.start();
+    window_->exportAccepted(out);
+    const qint64 returnedAfter = clock.elapsed();
+    QVERIFY(!QFileInfo::exists(out));
+    QVERIFY(window_->jobs()->activeCount() >= 1);
+    QVERIFY(exported.wait(120000));
+    qInfo("CityJSON export: the action returned after %lld ms, the file came after %lld ms (%d ticks between)",
+          returnedAfter, clock.elapsed(), ticks);
+    QVERIFY(ticks > 0);
+    QVERIFY(QFileInfo::exists(out));
+    QCOMPARE(namesIn(QFileInfo(out).absolutePath()), QStringList{QStringLiteral("buildings.city.json")});
+    QCOMPARE(exported.first().at(1).toInt(), accepted);
+    QVERIFY(window_->sceneAnalysis() != nullptr);  // the analysis made on the way is the window's
+    const QString message = window_->statusBar()->currentMessage();
+    QVERIFY2(message.startsWith(QStringLiteral("%1 accepted buildings exported to %2").arg(accepted).arg(out)) &&
+                 message.contains(QStringLiteral("; terrain: ")) && message.contains(QStringLiteral(" triangles.")),
+             qPrintable(message));
+    const std::string written = contents(out);
+    QVERIFY(written.find("\"TINRelief\"") != std::string::npos);
+
+    // What the command line writes for the same saved project: its heights, the analysis's DTM.
+    const project::Project saved = project::loadProject(cityPath_.toStdString());
+    const cv::Mat image = io::readImage8(saved.left);
+    const cv::Mat disparity = project::readDisparity(saved, image.size());
+    project::CityModelInputs model;
+    model.heights = project::projectHeights(saved, disparity);
+    model.dtm = project::analyseScene(saved, model.heights, image, disparity, nullptr).dtm;
+    const QString reference = dir_.filePath(QStringLiteral("city-reference.city.json"));
+    project::exportBuildings(saved, reference.toStdString(), {project::BuildingStatus::Accepted}, model);
+    QVERIFY(written == contents(reference));
+    shot(window_.get(), QStringLiteral("city-export.png"));
+    shot(window_->statusBar(), QStringLiteral("city-export-status.png"));
+  }
+
+  // A cancel during the analysis, or once the analysis is there during the writing, leaves no
+  // file and no temporary, and the document as it was.
+  void canceledCityModelExportWritesNothing() {
+    const QString out = QDir(freshFolder(QStringLiteral("city-canceled"))).filePath(QStringLiteral("b.city.json"));
+    for (const bool analysed : {false, true}) {
+      if (!analysed) QVERIFY(window_->openProject(cityPath_));
+      QCOMPARE(window_->sceneAnalysis() != nullptr, analysed);
+      QSignalSpy exported(window_.get(), &MainWindow::cityModelExported);
+      const widgets::JobId job = window_->exportCityModel(out);
+      QVERIFY(job != 0);
+      window_->jobs()->cancel(job);
+      QVERIFY(window_->jobs()->waitForIdle(120000));
+      QTest::qWait(100);
+      QCOMPARE(exported.count(), 0);
+      QVERIFY2(namesIn(QFileInfo(out).absolutePath()).isEmpty(), qPrintable(namesIn(QFileInfo(out).absolutePath()).join(' ')));
+      QVERIFY(!doc()->isModified());
+      if (analysed) continue;
+      QVERIFY(window_->sceneAnalysis() == nullptr);
+      QSignalSpy analysedSpy(window_.get(), &MainWindow::sceneAnalysed);
+      QVERIFY(window_->startSceneAnalysis() != 0);
+      QVERIFY(analysedSpy.wait(120000));
+    }
+  }
+
+  // The outlines are still written at once.
+  void geoJsonExportIsWrittenAtOnce() {
+    QVERIFY(window_->openProject(cityPath_));
+    const QString out = QDir(freshFolder(QStringLiteral("outlines"))).filePath(QStringLiteral("b.geojson"));
+    window_->exportAccepted(out);
+    QVERIFY(QFileInfo::exists(out));
+    const auto features = io::readFeatures(out.toStdString(), doc()->pair().geo);
+    QCOMPARE(features.size(), doc()->project().buildings.size());
+    QVERIFY2(window_->statusBar()->currentMessage().startsWith(
+                 QStringLiteral("%1 accepted buildings exported to ").arg(features.size())),
+             qPrintable(window_->statusBar()->currentMessage()));
   }
 
   void maskIsHatchedOverTheLeftView() {

@@ -605,14 +605,17 @@ class MainWindowTest : public QObject {
     QCOMPARE(reopened.buildingsModel()->rowCount(), 1);
 
     const QString exported = dir_.filePath(QStringLiteral("sample/accepted.geojson"));
-    QCOMPARE(reopened.exportAccepted(exported), 1);
+    QCOMPARE(reopened.exportOutlines(exported), 1);
     const auto features = io::readFeatures(exported.toStdString());
     QCOMPARE(features.size(), size_t(1));
     QCOMPARE(std::get<long long>(features[0].attributes.at("id")), static_cast<long long>(buildingId_));
     // The same building as a CityJSON LoD1 block, up to its roof height.
     QVERIFY(std::isfinite(loaded.buildings[0].roofHeight));
     const QString blocks = dir_.filePath(QStringLiteral("sample/accepted.city.json"));
-    QCOMPARE(reopened.exportAccepted(blocks), 1);
+    QSignalSpy cityExported(&reopened, &MainWindow::cityModelExported);
+    reopened.exportAccepted(blocks);  // in the background
+    QVERIFY(cityExported.wait(60000));
+    QCOMPARE(cityExported.first().at(1).toInt(), 1);
     QFile blocksFile(blocks);
     QVERIFY(blocksFile.open(QIODevice::ReadOnly));
     const QByteArray blocksText = blocksFile.readAll();

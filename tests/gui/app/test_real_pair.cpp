@@ -276,7 +276,7 @@ class RealPairTest : public QObject {
     QVERIFY(window_->saveAs(projectPath_));
     ++actions_;
     const QString exported = window_->document()->outputDirectory() + QStringLiteral("/buildings.geojson");
-    QCOMPARE(window_->exportAccepted(exported), 1);
+    QCOMPARE(window_->exportOutlines(exported), 1);
     ++actions_;
     QCOMPARE(QFileInfo(exported).absolutePath(), dir_.filePath(QStringLiteral("project/output")));
     QVERIFY(QFile::exists(dir_.filePath(QStringLiteral("project/output/disparity.tif"))));
