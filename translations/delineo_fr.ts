@@ -1286,13 +1286,6 @@
         <translation>%1 enregistré</translation>
     </message>
     <message numerus="yes">
-        <source>%n accepted building(s) exported to %1</source>
-        <translation>
-            <numerusform>%n bâtiment accepté exporté vers %1</numerusform>
-            <numerusform>%n bâtiments acceptés exportés vers %1</numerusform>
-        </translation>
-    </message>
-    <message numerus="yes">
         <source>%n left out: no roof height above the ground.</source>
         <translation>
             <numerusform>%n laissé de côté : pas de hauteur de toit au-dessus du sol.</numerusform>
@@ -2089,6 +2082,42 @@ Enter the smallest and largest disparity of the pair (x_right = x_left − d) on
         <translation>L’intervalle de disparité n’a pas pu être estimé à partir des images : %1.
 
 Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_gauche − d) dans l’onglet Appariement du panneau Paramètres, puis calculez la disparité (Ctrl+M).</translation>
+    </message>
+    <message>
+        <source>no terrain: no heights</source>
+        <translation>pas de terrain : pas de hauteurs</translation>
+    </message>
+    <message>
+        <source>no terrain: no ground sample distance</source>
+        <translation>pas de terrain : pas de taille du pixel au sol</translation>
+    </message>
+    <message>
+        <source>no terrain</source>
+        <translation>pas de terrain</translation>
+    </message>
+    <message>
+        <source>Writing the CityJSON file</source>
+        <translation>Écriture du fichier CityJSON</translation>
+    </message>
+    <message>
+        <source>terrain: %1 vertices, %2 triangles</source>
+        <translation>terrain : %1 sommets, %2 triangles</translation>
+    </message>
+    <message>
+        <source>%1 accepted building exported to %2</source>
+        <translation>%1 bâtiment accepté exporté vers %2</translation>
+    </message>
+    <message>
+        <source>%1 accepted buildings exported to %2</source>
+        <translation>%1 bâtiments acceptés exportés vers %2</translation>
+    </message>
+    <message>
+        <source>1 roof part</source>
+        <translation>1 partie de toit</translation>
+    </message>
+    <message>
+        <source>%1 roof parts</source>
+        <translation>%1 parties de toit</translation>
     </message>
 </context>
 <context>
