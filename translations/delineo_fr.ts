@@ -2104,12 +2104,12 @@ Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_ga
         <translation>terrain : %1 sommets, %2 triangles</translation>
     </message>
     <message>
-        <source>%1 accepted building exported to %2</source>
-        <translation>%1 bâtiment accepté exporté vers %2</translation>
+        <source>%1 building exported to %2</source>
+        <translation>%1 bâtiment exporté vers %2</translation>
     </message>
     <message>
-        <source>%1 accepted buildings exported to %2</source>
-        <translation>%1 bâtiments acceptés exportés vers %2</translation>
+        <source>%1 buildings exported to %2</source>
+        <translation>%1 bâtiments exportés vers %2</translation>
     </message>
     <message>
         <source>1 roof part</source>

@@ -1,6 +1,7 @@
 // MainWindow's File → Export accepted buildings: the outlines (GeoJSON, GeoPackage) written at
 // once, the CityJSON blocks in a background job that analyses the scene first when there is no
 // analysis (its DTM is the terrain) and writes the file only when it was not canceled.
+#include <QFileInfo>
 #include <QPointer>
 #include <QStatusBar>
 #include <optional>
@@ -123,10 +124,10 @@ widgets::JobId MainWindow::exportCityModel(const QString& path) {
 // (CityJSON), then what was left out and where the blocks stand when it is not their own ground.
 void MainWindow::showExportSummary(const QString& path, const project::ExportSummary& exported,
                                    const QString& terrain) {
-  QString text = (exported.written == 1 ? tr("%1 accepted building exported to %2")
-                                         : tr("%1 accepted buildings exported to %2"))
+  QString text = (exported.written == 1 ? tr("%1 building exported to %2")
+                                         : tr("%1 buildings exported to %2"))
                      .arg(exported.written)
-                     .arg(path);
+                     .arg(QFileInfo(path).fileName());  // the status bar's room: the name, not the folder
   if (exported.parts > 0) {
     text += QStringLiteral("; ") + (exported.parts == 1 ? tr("1 roof part") : tr("%1 roof parts").arg(exported.parts));
   }
