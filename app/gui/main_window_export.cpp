@@ -34,12 +34,12 @@ struct ExportCanceled {};
 // when `progress` is not canceled by then. Returns nullopt when canceled.
 std::optional<project::ExportSummary> writeUnlessCanceled(const project::Project& project, const std::string& path,
                                                           const project::CityModelInputs& model,
-                                                          const core::Progress& progress) {
+                                                          core::Progress& progress) {
   project::ExportSummary summary;
   try {
     io::writeAtomically(path, [&](const std::string& temporary) {
-      summary = project::exportBuildings(project, temporary, {project::BuildingStatus::Accepted}, model);
-      if (progress.canceled()) throw ExportCanceled{};
+      summary = project::exportBuildings(project, temporary, {project::BuildingStatus::Accepted}, model, &progress);
+      if (summary.status == core::RunStatus::Canceled || progress.canceled()) throw ExportCanceled{};
     });
   } catch (const ExportCanceled&) {
     return std::nullopt;
@@ -103,7 +103,7 @@ widgets::JobId MainWindow::exportCityModel(const QString& path) {
         }
         core::Progress::Range range(&p, analysed, 1.0);
         range.setStage(writing);
-        if (auto summary = writeUnlessCanceled(projectCopy, out, model, p)) result.summary = std::move(*summary);
+        if (auto summary = writeUnlessCanceled(projectCopy, out, model, range)) result.summary = std::move(*summary);
         return result;
       },
       [this, doc, path, sceneInputs, noTerrain](CityModelExport result) {

@@ -63,13 +63,17 @@ std::string buildingName(const core::Feature& feature) {
 // `heights` (the 3D view's estimate). Without heights, or without ground next to a building, the
 // block stands on the ground level: `summary.notes` says so.
 std::vector<core::Feature> withGroundHeights(const Project& project, const cv::Mat& heights,
-                                             std::vector<core::Feature> features, ExportSummary& summary) {
+                                             std::vector<core::Feature> features, ExportSummary& summary,
+                                             core::Progress* progress) {
   if (heights.empty()) {
     summary.notes.push_back("no heights: every block stands on the height model's ground level (z = 0)");
     return features;
   }
   summary.onLocalGround = true;
-  for (auto& feature : features) {
+  for (size_t i = 0; i < features.size(); ++i) {
+    core::Feature& feature = features[i];
+    if (core::isCanceled(progress)) return {};
+    core::report(progress, static_cast<double>(i) / static_cast<double>(features.size()));
     if (feature.attributes.count("roof_height_m") == 0) continue;
     const std::optional<double> ground = groundHeightNextTo(project, heights, feature.polygon);
     if (ground) {
@@ -84,9 +88,13 @@ std::vector<core::Feature> withGroundHeights(const Project& project, const cv::M
 // Each feature with a roof height and its roof parts on `heights` (roofParts(), the project's
 // "roof-levels" group): none when its roof has one level, without heights, or with roof levels off.
 std::vector<io::CityJsonBuilding> withRoofParts(const Project& project, const cv::Mat& heights,
-                                                const std::vector<core::Feature>& features) {
+                                                const std::vector<core::Feature>& features,
+                                                core::Progress* progress) {
   std::vector<io::CityJsonBuilding> buildings;
-  for (const auto& feature : features) {
+  for (size_t i = 0; i < features.size(); ++i) {
+    const core::Feature& feature = features[i];
+    if (core::isCanceled(progress)) return {};
+    core::report(progress, static_cast<double>(i) / static_cast<double>(features.size()));
     io::CityJsonBuilding building{feature, {}};
     if (!heights.empty() && feature.attributes.count("roof_height_m") > 0) {
       const std::vector<RoofPart> parts = roofParts(project, heights, feature.polygon);
@@ -101,7 +109,7 @@ std::vector<io::CityJsonBuilding> withRoofParts(const Project& project, const cv
 
 // The CityJSON of `features`: blocks on the ground next to each, the terrain when there is a DTM.
 ExportSummary writeCityModel(const Project& project, const std::string& path, const std::vector<core::Feature>& features,
-                             const io::GeoReference& geo, const CityModelInputs& model) {
+                             const io::GeoReference& geo, const CityModelInputs& model, core::Progress* progress) {
   ExportSummary summary;
   io::CityJsonOptions options;
   options.geo = geo;
@@ -111,8 +119,23 @@ ExportSummary writeCityModel(const Project& project, const std::string& path, co
     model.terrain.validate();
     options.terrain = {model.dtm, model.terrain.resolvedStep(project.height.gsd)};
   }
-  const io::CityJsonSummary blocks =
-      io::writeCityJson(path, withRoofParts(project, model.heights, withGroundHeights(project, model.heights, features, summary)), options);
+  // The grounds take a tenth of the bar, the roof parts the rest; a cancel writes nothing.
+  std::vector<core::Feature> grounded;
+  {
+    core::Progress::Range range(progress, 0.0, 0.1);
+    grounded = withGroundHeights(project, model.heights, features, summary, &range);
+  }
+  std::vector<io::CityJsonBuilding> buildings;
+  if (!core::isCanceled(progress)) {
+    core::Progress::Range range(progress, 0.1, 0.95);
+    buildings = withRoofParts(project, model.heights, grounded, &range);
+  }
+  if (core::isCanceled(progress)) {
+    summary.status = core::RunStatus::Canceled;
+    return summary;
+  }
+  const io::CityJsonSummary blocks = io::writeCityJson(path, buildings, options);
+  core::report(progress, 1.0);
   summary.written = blocks.written;
   summary.parts = blocks.parts;
   summary.leftOut = blocks.leftOut;
@@ -123,11 +146,12 @@ ExportSummary writeCityModel(const Project& project, const std::string& path, co
 
 // Writes `features` (the project's buildings) to `path` in the format its name says.
 ExportSummary writeBuildingFeatures(const Project& project, const std::string& path,
-                                    const std::vector<core::Feature>& features, const CityModelInputs& model = {}) {
+                                    const std::vector<core::Feature>& features, const CityModelInputs& model = {},
+                                    core::Progress* progress = nullptr) {
   const io::GeoReference geo = leftGeoReference(project);
   std::error_code mk;
   fs::create_directories(fs::absolute(path).parent_path(), mk);
-  if (io::isCityJsonPath(path)) return writeCityModel(project, path, features, geo, model);
+  if (io::isCityJsonPath(path)) return writeCityModel(project, path, features, geo, model, progress);
   ExportSummary summary;
   io::writeFeatures(path, features, geo);
   summary.written = static_cast<int>(features.size());
@@ -142,8 +166,9 @@ int TerrainParams::resolvedStep(double gsd) const {
 }
 
 ExportSummary exportBuildings(const Project& project, const std::string& path,
-                              const std::vector<BuildingStatus>& statuses, const CityModelInputs& model) {
-  return writeBuildingFeatures(project, path, buildingFeatures(project, statuses), model);
+                              const std::vector<BuildingStatus>& statuses, const CityModelInputs& model,
+                              core::Progress* progress) {
+  return writeBuildingFeatures(project, path, buildingFeatures(project, statuses), model, progress);
 }
 
 namespace {

@@ -110,7 +110,8 @@ int run(const std::vector<std::string>& args) {
   io::checkOutputs({{out, cityJson ? io::OutputFormat::CityJson : io::OutputFormat::Vector}},
                    {projectPath, proj.left, proj.right, proj.disparity, proj.dem, proj.labels, proj.exclude});
   const project::CityModelInputs model = cityJson ? cityModelOf(proj, opts.has("terrain"), opts) : project::CityModelInputs{};
-  const project::ExportSummary summary = project::exportBuildings(proj, out, statuses, model);
+  const project::ExportSummary summary = project::exportBuildings(proj, out, statuses, model, &cli::commandProgress());
+  cli::throwIfCanceled(cli::commandProgress());
   cli::commandProgress().finish();
   printSummary(summary, out, cityJson);
   return cli::kExitOk;

@@ -1,6 +1,7 @@
 // The CityJSON export of a project: blocks on the ground next to each building (the 3D view's
 // estimate), the terrain from a DTM, the ground level's elevation; heightModel.groundElevation
 // in the project file.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -177,6 +178,40 @@ TEST(CityModelExport, TheTerrainAndTheGroundElevationComeFromTheProject) {
 
   model.terrain.step = 25;
   EXPECT_EQ(project::exportBuildings(p, dir.file("coarse.city.json"), {BuildingStatus::Accepted}, model).terrainVertices, 24 * 8);
+}
+
+// A progress that records what it is told and cancels once it has reached `cancelAt`.
+class RecordingProgress : public core::Progress {
+ public:
+  explicit RecordingProgress(double cancelAt) : cancelAt_(cancelAt) {}
+  void report(double fraction) override {
+    core::Progress::report(fraction);
+    fractions.push_back(fraction);
+    if (fraction >= cancelAt_) cancel();
+  }
+  std::vector<double> fractions;
+
+ private:
+  double cancelAt_;
+};
+
+TEST(CityModelExport, ItsProgressGoesThroughTheBuildingsAndACancelWritesNothing) {
+  TempDir dir;
+  const Project p = slopeProject();
+  project::CityModelInputs model;
+  model.heights = slopeDem(p);
+  RecordingProgress whole(2.0);  // never cancels
+  const auto done = project::exportBuildings(p, dir.file("whole.city.json"), {BuildingStatus::Accepted}, model, &whole);
+  EXPECT_EQ(done.status, core::RunStatus::Completed);
+  EXPECT_EQ(done.written, 2);
+  ASSERT_GE(whole.fractions.size(), 4u);  // each building's ground and roof parts, then the end
+  EXPECT_TRUE(std::is_sorted(whole.fractions.begin(), whole.fractions.end()));
+  EXPECT_EQ(whole.fractions.back(), 1.0);
+
+  RecordingProgress canceling(0.3);  // canceled during the roof parts
+  const auto canceled = project::exportBuildings(p, dir.file("canceled.city.json"), {BuildingStatus::Accepted}, model, &canceling);
+  EXPECT_EQ(canceled.status, core::RunStatus::Canceled);
+  EXPECT_FALSE(fs::exists(dir.file("canceled.city.json")));
 }
 
 TEST(CityModelExport, TheGroundElevationRoundTripsAndIsBounded) {

@@ -341,6 +341,7 @@ struct ExportSummary {
   std::vector<std::string> notes;
   bool onLocalGround = false;        // CityJSON: the blocks stand on the ground next to each building
   int terrainVertices = 0, terrainTriangles = 0;  // CityJSON: the terrain's, 0 without
+  core::RunStatus status = core::RunStatus::Completed;  // Canceled: nothing was written
 };
 
 // The terrain grid of the CityJSON export.
@@ -379,9 +380,11 @@ struct CityModelInputs {
 // levels is written as its parts (roofParts(), the project's "roof-levels" group; CityJSON
 // BuildingParts), each from the building's base to its own height. Throws WriteFailed, and InvalidParameter naming a
 // building whose outline is degenerate or for a bad terrain step.
+// `progress` goes through the buildings' grounds and roof parts (CityJSON); a cancel there returns
+// status Canceled and writes nothing.
 ExportSummary exportBuildings(const Project& project, const std::string& path,
                               const std::vector<BuildingStatus>& statuses = {BuildingStatus::Accepted},
-                              const CityModelInputs& model = {});
+                              const CityModelInputs& model = {}, core::Progress* progress = nullptr);
 
 // ---- the bundled sample (src/pipeline.cpp) ----
 
