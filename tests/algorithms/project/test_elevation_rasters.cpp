@@ -128,7 +128,7 @@ TEST(ElevationRasters, EmptyLayersAreLeftOut) {
   EXPECT_FALSE(io::readRaster(dir.file("dem.tif")).geo.valid());  // no georeference given, none written
   // Objects are a layer even when there are none: an empty collection says "analysed, nothing found".
   ElevationLayers none;
-  none.objects = std::vector<core::Feature>{};
+  none.objects.emplace();
   EXPECT_TRUE(project::writeElevationRasters(dir.dir(), {}, none).objects);
   EXPECT_TRUE(io::readFeatures(dir.file("objects.geojson")).empty());
   EXPECT_TRUE(project::writeElevationRasters(dir.dir(), {}, ElevationLayers{}).files.empty());
