@@ -71,8 +71,7 @@ widgets::JobId MainWindow::exportCityModel(const QString& path) {
   const project::Project& current = document_->project();
   const std::string out = path.toStdString();
   try {
-    io::checkOutputs({{out, io::OutputFormat::CityJson}},
-                     {current.left, current.right, current.disparity, current.dem, current.labels, current.exclude});
+    io::checkOutputs({{out, io::OutputFormat::CityJson}}, project::inputFiles(current));
   } catch (const core::Error& e) {
     showMessage(tr("Cannot export"), errorMessage(e));
     return 0;

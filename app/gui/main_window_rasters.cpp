@@ -96,8 +96,7 @@ widgets::JobId MainWindow::exportElevationRasters(const QString& dir) {
     planned.insert(planned.end(), std::begin(project::kSceneAnalysisLayers), std::end(project::kSceneAnalysisLayers));
   }
   const std::vector<io::OutputFile> files = project::elevationFiles(folder, planned);
-  const std::vector<std::string> inputs{current.left, current.right, current.disparity, current.dem, current.labels,
-                                        current.exclude};
+  const std::vector<std::string> inputs = project::inputFiles(current);
   try {
     io::checkOutputs(files, inputs);
   } catch (const core::Error& e) {

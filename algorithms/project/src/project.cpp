@@ -474,14 +474,17 @@ Project loadProject(const std::string& path) {
   }
 }
 
+std::vector<std::string> inputFiles(const Project& project) {
+  return {project.left, project.right, project.disparity, project.dem, project.labels, project.exclude};
+}
+
 void saveProject(const Project& project, const std::string& path) {
   const fs::path target = fs::absolute(path).lexically_normal();
   std::error_code ec;
   fs::create_directories(target.parent_path(), ec);
   // The output policy: never over an image of the project, never over a read-only file; a
   // symlinked project is saved into the file it names, with that file's permissions.
-  io::checkOutputs({{path, io::OutputFormat::Text}},
-                   {project.left, project.right, project.disparity, project.dem, project.labels, project.exclude});
+  io::checkOutputs({{path, io::OutputFormat::Text}}, inputFiles(project));
   io::writeTextFile(path, toJson(project, target.parent_path().string()).dump(2) + "\n");
 }
 

@@ -297,8 +297,7 @@ RunSummary runPendingSteps(Project& project, const std::string& outputDir, core:
     const std::vector<ElevationLayer> scene(std::begin(kSceneAnalysisLayers), std::end(kSceneAnalysisLayers));
     for (const io::OutputFile& file : elevationFiles(outputDir, scene)) outputs.push_back(file);
   }
-  io::checkOutputs(outputs, {project.left, project.right, project.disparity, project.dem, project.labels,
-                             project.exclude});
+  io::checkOutputs(outputs, inputFiles(project));
   StereoPair pair = readStereoPair(project);
   const bool work = !project.pendingBuildings().empty() || options.detect;
   double matchShare = project.disparity.empty() ? (work ? 0.5 : 1.0) : 0.0;

@@ -107,8 +107,9 @@ int run(const std::vector<std::string>& args) {
   for (const auto& missing : proj.missingFiles()) {
     throw core::Error(core::ErrorCode::FileNotFound, "referenced by the project " + projectPath, missing);
   }
-  io::checkOutputs({{out, cityJson ? io::OutputFormat::CityJson : io::OutputFormat::Vector}},
-                   {projectPath, proj.left, proj.right, proj.disparity, proj.dem, proj.labels, proj.exclude});
+  std::vector<std::string> inputs = project::inputFiles(proj);
+  inputs.push_back(projectPath);
+  io::checkOutputs({{out, cityJson ? io::OutputFormat::CityJson : io::OutputFormat::Vector}}, inputs);
   const project::CityModelInputs model = cityJson ? cityModelOf(proj, opts.has("terrain"), opts) : project::CityModelInputs{};
   const project::ExportSummary summary = project::exportBuildings(proj, out, statuses, model, &cli::commandProgress());
   cli::throwIfCanceled(cli::commandProgress());

@@ -171,6 +171,10 @@ Project loadProject(const std::string& path);
 // a half-written project. Throws WriteFailed.
 void saveProject(const Project& project, const std::string& path);
 
+// The files the project reads (its images, disparity, DEM, labels and mask; empty names
+// included): no output of the project may replace one of them (io::checkOutputs).
+std::vector<std::string> inputFiles(const Project& project);
+
 // Autosave companion of a project file: "<dir>/.<file name>.autosave".
 std::string autosavePath(const std::string& projectPath);
 // True when an autosave exists and is newer than the project file (e.g. after a crash).
