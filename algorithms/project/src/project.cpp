@@ -101,7 +101,8 @@ bool sameBuilding(const Building& a, const Building& b) {
   return a.id == b.id && samePolygon(a.initial, b.initial) && samePolygon(a.outline, b.outline) &&
          a.status == b.status && a.roofInterval == b.roofInterval &&
          sameNumber(a.roofHeight, b.roofHeight) && sameNumber(a.energy, b.energy) &&
-         a.energyTerms == b.energyTerms && a.method == b.method && a.history == b.history;
+         a.energyTerms == b.energyTerms && a.method == b.method && a.sourceId == b.sourceId &&
+         a.history == b.history;
 }
 
 // ---- paths ---------------------------------------------------------------------------------
@@ -286,6 +287,7 @@ json toJson(const Project& project, const std::string& baseDir) {
       jb["energyTerms"] = std::move(terms);
     }
     if (!b.method.empty()) jb["method"] = b.method;
+    if (!b.sourceId.empty()) jb["sourceId"] = b.sourceId;
     json history = json::array();
     for (const auto& h : b.history) {
       history.push_back({{"action", h.action}, {"time", h.time}, {"detail", h.detail}});
@@ -407,6 +409,7 @@ Building buildingFromJson(const json& jb, const std::string& where, const Projec
   }
   b.method = get<std::string>(jb, "method", "", where);
   if (!b.method.empty() && !isOutlineMethod(b.method)) badField(where + "method", methodProblem(b.method));
+  b.sourceId = get<std::string>(jb, "sourceId", "", where);
   const json history = jb.value("history", json::array());
   if (!history.is_array()) badField(where + "history", "must be an array");
   for (const auto& h : history) {
@@ -416,7 +419,7 @@ Building buildingFromJson(const json& jb, const std::string& where, const Projec
                          get<std::string>(h, "detail", "", where + "history.")});
   }
   b.unknownKeys = unknownKeys(jb, {"id", "status", "method", "initial", "outline", "roofInterval", "roofHeight",
-                                   "energy", "energyTerms", "history"});
+                                   "energy", "energyTerms", "sourceId", "history"});
   return b;
 }
 

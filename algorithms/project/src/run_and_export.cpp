@@ -35,6 +35,7 @@ std::vector<core::Feature> buildingFeatures(const Project& project,
     f.attributes["vertices"] = vertices;
     if (std::isfinite(b.roofHeight)) f.attributes["roof_height_m"] = b.roofHeight;
     if (std::isfinite(b.energy)) f.attributes["energy"] = b.energy;
+    if (!b.sourceId.empty()) f.attributes["source_id"] = b.sourceId;
     features.push_back(std::move(f));
   }
   return features;

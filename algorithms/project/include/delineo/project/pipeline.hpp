@@ -227,6 +227,8 @@ struct SceneAnalysisOutcome {
 SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights, const cv::Mat& image,
                                   const cv::Mat& disparity, core::Progress* progress);
 
+// ---- buildings from elsewhere (src/pending_buildings.cpp) ----
+
 // Adds each proposal that is not already a building (kProposalOverlap) as a Pending building:
 // its polygon as the initial polygon, its roof interval (delineation::readFeatureIntervals), a
 // "detected" history entry (`origin` first). Returns the new buildings' ids. A proposal whose
@@ -234,6 +236,41 @@ SceneAnalysisOutcome analyseScene(const Project& project, const cv::Mat& heights
 // line "building ID: ..." appended to `problems` when given.
 std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
                                       const std::string& origin = {}, std::vector<std::string>* problems = nullptr);
+
+// Outlines of another source (a cadastre, OpenStreetMap, another project's or tool's export)
+// brought in as Pending buildings: File → Import outlines, `delineo-cli import`.
+struct ImportOptions {
+  std::string idField;  // attribute whose value becomes each building's sourceId; empty: none
+  std::string source;   // the file's name, for the history entries (importOutlinesFile sets it)
+  std::string origin;   // first word of the history entries ("delineo", "delineo-cli import")
+};
+struct ImportSummary {
+  int read = 0;                    // polygons read (a multipolygon gives one per part)
+  std::vector<int> added;          // ids of the new Pending buildings, in the file's order
+  int alreadyThere = 0;            // covering, or covered by, a building of the project: not added
+  int outsideImage = 0;            // less than kMinImportedArea on the left image: not added
+  int clipped = 0;                 // of the added, cut at the image border
+  std::vector<std::string> problems;  // "polygon 3: no osm_id", a malformed roof interval
+};
+// Least area (px²) of an imported polygon on the left image.
+inline constexpr double kMinImportedArea = 16.0;
+// An imported polygon placed on the left image (`imageSize`): as it is when inside, else its
+// largest part on the image (`clipped`); an empty polygon when less than kMinImportedArea is left.
+struct ImportedPolygon {
+  core::Polygon polygon;
+  bool clipped = false;
+};
+ImportedPolygon placeOnImage(const core::Polygon& polygon, cv::Size imageSize);
+// Adds each of `features` (left-image pixels) placed on the image that is not already a building
+// (kProposalOverlap, as for proposals) as a Pending building: its polygon as the initial polygon,
+// its roof interval when it carries detect's roof_disparity_min/max, its `idField` value as
+// sourceId, an "imported" history entry. Throws InvalidParameter when no feature has `idField`.
+ImportSummary importOutlines(Project& project, const std::vector<core::Feature>& features, cv::Size imageSize,
+                             const ImportOptions& options);
+// importOutlines() of a vector file (GeoJSON, GeoPackage, Shapefile) read with the left image's
+// georeferencing (io::readFeatures: map coordinates in the image's CRS, or pixels without one).
+// Throws like io::readRaster for the left image and io::readFeatures for the file.
+ImportSummary importOutlinesFile(Project& project, const std::string& path, ImportOptions options);
 
 // ---- elevation rasters (src/elevation_rasters.cpp) ----
 

@@ -73,6 +73,9 @@ struct Building {
   // The method that produced the outline (kActivePolygon, kBoxFitting); for a Pending building
   // the one `delineo-cli run` uses. Empty: not chosen (the project's method applies).
   std::string method;
+  // The building's identifier in the layer it was imported from (importOutlines(): a cadastre's
+  // or OpenStreetMap's id), written with its outline so the two can be joined; empty otherwise.
+  std::string sourceId;
   std::vector<HistoryEntry> history;
   // Keys of the building's JSON object this version does not know, written back on save.
   nlohmann::json unknownKeys = nlohmann::json::object();
