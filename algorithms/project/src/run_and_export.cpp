@@ -3,10 +3,12 @@
 // CityJSON blocks (declared in pipeline.hpp).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 
 #include "delineo/core/error.hpp"
+#include "delineo/delineation/roof_interval.hpp"
 #include "delineo/io/cityjson.hpp"
 #include "delineo/io/output_file.hpp"
 #include "delineo/io/raster.hpp"
@@ -173,10 +175,30 @@ ExportSummary exportBuildings(const Project& project, const std::string& path,
 }
 
 namespace {
+// The roof interval proposed for a pending building that has none (suggestRoofInterval()); none
+// without a disparity map or matches. Throws ProcessingFailed when the main level under the
+// polygon is the ground next to it (a building of an imported map the images no longer show, a
+// polygon on the ground): the active polygon would outline a patch of ground.
+std::optional<DisparityInterval> roofIntervalAboveGround(const cv::Mat& disparity, const core::Polygon& polygon) {
+  if (disparity.empty()) return std::nullopt;
+  const delineation::RoofIntervalParams params;
+  const delineation::RoofIntervalProposal proposal = delineation::proposeRoofInterval(disparity, polygon, params);
+  if (!proposal.found) return std::nullopt;
+  if (std::isfinite(proposal.groundLevel) && std::abs(proposal.peak - proposal.groundLevel) < params.minRoofHeight) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "nothing stands above the ground under its polygon (its disparities peak at %.1f px, the ground "
+                  "next to it lies at %.1f px); give it a roof interval to outline it anyway",
+                  proposal.peak, proposal.groundLevel);
+    throw Error(ErrorCode::ProcessingFailed, text);
+  }
+  return DisparityInterval{proposal.low, proposal.high};
+}
+
 // The active polygon on one pending building; nullopt when canceled.
 std::optional<Building> delineatePending(const Project& project, Building b, const StereoPair& pair,
                                          core::Progress* progress, const std::string& origin) {
-  if (!b.roofInterval) b.roofInterval = suggestRoofInterval(pair.disparity, b.initial);
+  if (!b.roofInterval) b.roofInterval = roofIntervalAboveGround(pair.disparity, b.initial);
   DelineationOutcome outcome = delineateBuilding(project, b, pair, progress);
   if (outcome.status == core::RunStatus::Canceled) return std::nullopt;
   b.outline = outcome.outline;

@@ -262,3 +262,36 @@ TEST(Pipeline, APendingBuildingIsOutlinedWithItsMethod) {
   s.project.height = {};
   EXPECT_THROW(project::outlinePendingBuilding(s.project, s.building, s.pair, none, nullptr, "test"), core::Error);
 }
+
+TEST(Pipeline, APendingPolygonOnTheGroundIsNotOutlinedWithoutARoofInterval) {
+  SceneProject s = makeSceneProject();
+  s.pair.disparity = s.scene.disparity;
+  // A 24 x 24 square on the ground: its centre 20 px from anything else and 40 px from the border.
+  cv::Mat ground = s.scene.labels == sim::kLabelGround;
+  cv::erode(ground, ground, cv::Mat(), cv::Point(-1, -1), 20);
+  cv::Point at(-1, -1);
+  for (int y = 40; y < ground.rows - 40 && at.x < 0; y += 4) {
+    for (int x = 40; x < ground.cols - 40; x += 4) {
+      if (ground.at<uchar>(y, x) != 0) {
+        at = {x, y};
+        break;
+      }
+    }
+  }
+  ASSERT_GE(at.x, 0) << "the scene has no open ground";
+  project::Building onGround;
+  onGround.id = 2;
+  onGround.initial.outer = {{at.x - 12.0, at.y - 12.0}, {at.x + 12.0, at.y - 12.0}, {at.x + 12.0, at.y + 12.0},
+                            {at.x - 12.0, at.y + 12.0}};
+  cv::Mat heights;
+  try {
+    project::outlinePendingBuilding(s.project, onGround, s.pair, heights, nullptr, "test");
+    FAIL() << "a polygon on the ground must not be outlined as a building";
+  } catch (const core::Error& e) {
+    EXPECT_EQ(e.code(), core::ErrorCode::ProcessingFailed);
+    EXPECT_NE(e.detail().find("nothing stands above the ground"), std::string::npos) << e.detail();
+  }
+  // The operator's own interval is taken as it is.
+  onGround.roofInterval = project::DisparityInterval{s.scene.disparityMin, s.scene.disparityMin + 4};
+  EXPECT_TRUE(project::outlinePendingBuilding(s.project, onGround, s.pair, heights, nullptr, "test").has_value());
+}
