@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <memory>
 #include <set>
+#include <sstream>
 
 #include <cpl_string.h>
 #include <gdal.h>
@@ -28,12 +30,117 @@ struct FeatureDeleter {
 };
 using FeaturePtr = std::unique_ptr<std::remove_pointer_t<OGRFeatureH>, FeatureDeleter>;
 
-// OGR driver for a file extension, empty when the extension is not one of ours.
+// OGR driver for a file extension we write, empty when the extension is not one of ours.
 std::string driverForExtension(const std::string& path) {
   const std::string ext = detail::lowerExtension(path);
   if (ext == ".geojson" || ext == ".json") return "GeoJSON";
   if (ext == ".gpkg") return "GPKG";
   return {};
+}
+
+// OGR driver for a file extension we read: the written ones and Shapefiles (cadastres).
+std::string readDriverForExtension(const std::string& path) {
+  if (detail::lowerExtension(path) == ".shp") return "ESRI Shapefile";
+  return driverForExtension(path);
+}
+
+struct TransformDeleter {
+  void operator()(OGRCoordinateTransformationH transform) const { OCTDestroyCoordinateTransformation(transform); }
+};
+using TransformPtr = std::unique_ptr<std::remove_pointer_t<OGRCoordinateTransformationH>, TransformDeleter>;
+
+// How a layer's vertices become left-image pixels: from the layer's CRS into the image's when
+// they differ, then through the image's geotransform.
+struct VertexMapping {
+  const GeoReference& geo;
+  TransformPtr toImageCrs;  // null when the vertices are already in the image's CRS (or either has none)
+  std::string failure;      // "cannot be brought from CRS A to the image's CRS B", for errors
+};
+
+std::string crsName(OGRSpatialReferenceH srs) {
+  const char* name = OSRGetName(srs);
+  std::string text = name != nullptr ? name : "unnamed";
+  const char* authority = OSRGetAuthorityName(srs, nullptr);
+  const char* code = OSRGetAuthorityCode(srs, nullptr);
+  if (authority != nullptr && code != nullptr) text += std::string(" (") + authority + ":" + code + ")";
+  return text;
+}
+
+// A copy of `srs` with coordinates x = easting / longitude, y = northing / latitude, as the
+// geotransform and the vector files have them.
+detail::SpatialReferencePtr inGisOrder(OGRSpatialReferenceH srs) {
+  detail::SpatialReferencePtr copy(OSRClone(srs));
+  OSRSetAxisMappingStrategy(copy.get(), OAMS_TRADITIONAL_GIS_ORDER);
+  return copy;
+}
+
+// A CRS that says no more than "none": a local (engineering) one, or GeoPackage's "undefined
+// geographic" srs_id 0, which GDAL gives layers written without CRS ("undefined Cartesian", -1,
+// is local). Vertices in such a layer are taken as they are, as in a layer without CRS.
+bool isUndefinedCrs(OGRSpatialReferenceH srs) {
+  if (OSRIsLocal(srs)) return true;
+  const char* name = OSRGetName(srs);
+  return name != nullptr && std::string(name) == "Undefined geographic SRS" &&
+         OSRGetAuthorityName(srs, nullptr) == nullptr;
+}
+
+VertexMapping layerMapping(OGRLayerH layer, const GeoReference& geo, bool isGeoJson, const std::string& path) {
+  VertexMapping mapping{geo, nullptr, {}};
+  OGRSpatialReferenceH layerSrs = OGR_L_GetSpatialRef(layer);
+  if (!geo.valid() || geo.crsWkt.empty() || layerSrs == nullptr || isUndefinedCrs(layerSrs)) return mapping;
+  detail::SpatialReferencePtr imageSrs(OSRNewSpatialReference(nullptr));
+  if (OSRSetFromUserInput(imageSrs.get(), geo.crsWkt.c_str()) != OGRERR_NONE) {
+    throw Error(ErrorCode::InvalidParameter, "the image's CRS is not valid WKT", path);
+  }
+  OSRSetAxisMappingStrategy(imageSrs.get(), OAMS_TRADITIONAL_GIS_ORDER);
+  const detail::SpatialReferencePtr source = inGisOrder(layerSrs);
+  if (OSRIsSame(source.get(), imageSrs.get())) return mapping;
+
+  mapping.failure = "cannot be brought from CRS " + crsName(source.get()) + " to the image's CRS " +
+                    crsName(imageSrs.get());
+  // GDAL reads a GeoJSON file without a "crs" member as WGS 84 (RFC 7946), pixel files included.
+  if (isGeoJson && OSRIsGeographic(source.get())) {
+    mapping.failure += " (a GeoJSON file without a \"crs\" member is in WGS 84 longitude/latitude)";
+  }
+  detail::ScopedGdalErrors errors;
+  mapping.toImageCrs.reset(OCTNewCoordinateTransformation(source.get(), imageSrs.get()));
+  if (!mapping.toImageCrs) {
+    const char* name = OGR_L_GetName(layer);
+    throw Error(ErrorCode::UnreadableFile, errors.describe(std::string("layer '") + name + "' " + mapping.failure),
+                path);
+  }
+  return mapping;
+}
+
+std::string formatPoint(double x, double y) {
+  std::ostringstream text;
+  text << std::setprecision(12) << "(" << x << ", " << y << ")";
+  return text.str();
+}
+
+// Ring vertices in the image's CRS (or as they are in the file when no change is needed).
+std::vector<cv::Point2d> ringInImageCrs(OGRGeometryH ring, const VertexMapping& mapping, const std::string& where,
+                                        const std::string& path) {
+  const int count = std::max(OGR_G_GetPointCount(ring), 0);
+  std::vector<double> xs(static_cast<size_t>(count)), ys(xs.size());
+  for (int i = 0; i < count; ++i) {
+    xs[i] = OGR_G_GetX(ring, i);
+    ys[i] = OGR_G_GetY(ring, i);
+  }
+  if (mapping.toImageCrs && count > 0) {
+    std::vector<double> xsIn = xs, ysIn = ys;
+    std::vector<int> success(xs.size(), FALSE);
+    OCTTransformEx(mapping.toImageCrs.get(), count, xs.data(), ys.data(), nullptr, success.data());
+    for (int i = 0; i < count; ++i) {
+      if (success[i] && std::isfinite(xs[i]) && std::isfinite(ys[i])) continue;
+      throw Error(ErrorCode::UnreadableFile,
+                  where + " has a vertex " + formatPoint(xsIn[i], ysIn[i]) + " that " + mapping.failure, path);
+    }
+  }
+  std::vector<cv::Point2d> points;
+  points.reserve(xs.size());
+  for (size_t i = 0; i < xs.size(); ++i) points.emplace_back(xs[i], ys[i]);
+  return points;
 }
 
 std::string describeFeature(long long index, GIntBig fid) {
@@ -45,13 +152,13 @@ std::string describeFeature(long long index, GIntBig fid) {
 bool samePoint(const cv::Point2d& a, const cv::Point2d& b) { return a.x == b.x && a.y == b.y; }
 
 // Ring vertices in pixel coordinates, without the closing repeat and consecutive duplicates.
-core::Ring readRing(OGRGeometryH ring, const GeoReference& geo) {
+core::Ring readRing(OGRGeometryH ring, const VertexMapping& mapping, const std::string& where,
+                    const std::string& path) {
   core::Ring result;
-  const int count = OGR_G_GetPointCount(ring);
-  result.reserve(static_cast<size_t>(std::max(count, 0)));
-  for (int i = 0; i < count; ++i) {
-    cv::Point2d point(OGR_G_GetX(ring, i), OGR_G_GetY(ring, i));
-    if (geo.valid()) point = geo.mapToPixel(point);
+  const std::vector<cv::Point2d> points = ringInImageCrs(ring, mapping, where, path);
+  result.reserve(points.size());
+  for (cv::Point2d point : points) {
+    if (mapping.geo.valid()) point = mapping.geo.mapToPixel(point);
     if (!result.empty() && samePoint(result.back(), point)) continue;
     result.push_back(point);
   }
@@ -81,7 +188,7 @@ void requireFiniteRing(const core::Ring& ring, const std::string& where, const s
   }
 }
 
-core::Polygon readPolygon(OGRGeometryH polygon, const GeoReference& geo, const std::string& where,
+core::Polygon readPolygon(OGRGeometryH polygon, const VertexMapping& mapping, const std::string& where,
                           const std::string& path) {
   const int rings = OGR_G_GetGeometryCount(polygon);
   if (OGR_G_IsEmpty(polygon) || rings == 0) {
@@ -96,14 +203,14 @@ core::Polygon readPolygon(OGRGeometryH polygon, const GeoReference& geo, const s
                 path);
   }
   core::Polygon result;
-  result.outer = readRing(OGR_G_GetGeometryRef(polygon, 0), geo);
+  result.outer = readRing(OGR_G_GetGeometryRef(polygon, 0), mapping, where, path);
   requireFiniteRing(result.outer, where, path);
   if (isDegenerate(result.outer)) {
     throw Error(ErrorCode::UnreadableFile,
                 where + " has a degenerate polygon (fewer than 3 distinct vertices or zero area)", path);
   }
   for (int i = 1; i < rings; ++i) {
-    core::Ring hole = readRing(OGR_G_GetGeometryRef(polygon, i), geo);
+    core::Ring hole = readRing(OGR_G_GetGeometryRef(polygon, i), mapping, where, path);
     requireFiniteRing(hole, where, path);
     if (isDegenerate(hole)) {
       throw Error(ErrorCode::UnreadableFile, where + " has a degenerate hole (ring " + std::to_string(i) + ")",
@@ -134,10 +241,9 @@ std::map<std::string, core::AttributeValue> readAttributes(OGRFeatureH feature) 
   return attributes;
 }
 
-}  // namespace
-
-std::vector<core::Feature> readFeatures(const std::string& path, const GeoReference& geo) {
-  detail::ensureGdalRegistered();
+// Opens a vector file read-only. Restricting the driver to the one the extension names gives a
+// precise error ("invalid GeoJSON") instead of a generic one; other extensions may use any OGR driver.
+DatasetPtr openVectorFile(const std::string& path, const detail::ScopedGdalErrors& errors) {
   if (!detail::isVirtualPath(path)) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error(ErrorCode::FileNotFound, "no such file", path);
@@ -145,10 +251,7 @@ std::vector<core::Feature> readFeatures(const std::string& path, const GeoRefere
       throw Error(ErrorCode::UnreadableFile, "is a directory, not a vector file", path);
     }
   }
-  detail::ScopedGdalErrors errors;
-  // Restricting the driver to the one the extension names gives a precise error ("invalid
-  // GeoJSON") instead of a generic one; other extensions may use any OGR driver.
-  const std::string driverName = driverForExtension(path);
+  const std::string driverName = readDriverForExtension(path);
   CPLStringList allowedDrivers;
   if (!driverName.empty()) allowedDrivers.AddString(driverName.c_str());
   DatasetPtr dataset(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR,
@@ -157,13 +260,46 @@ std::vector<core::Feature> readFeatures(const std::string& path, const GeoRefere
     const std::string what = driverName.empty() ? "not a readable vector file" : "not a valid " + driverName + " file";
     throw Error(ErrorCode::UnreadableFile, errors.describe(what), path);
   }
+  return dataset;
+}
+
+// Appends the polygons of one feature (one per part of a MultiPolygon).
+void appendFeature(OGRFeatureH feature, const VertexMapping& mapping, const std::string& where,
+                   const std::string& path, std::vector<core::Feature>& features) {
+  OGRGeometryH geometry = OGR_F_GetGeometryRef(feature);
+  if (geometry == nullptr) throw Error(ErrorCode::UnreadableFile, where + " has no geometry", path);
+  const auto attributes = readAttributes(feature);
+  const OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(geometry));
+  if (type == wkbPolygon) {
+    features.push_back({readPolygon(geometry, mapping, where, path), attributes});
+  } else if (type == wkbMultiPolygon) {
+    const int parts = OGR_G_GetGeometryCount(geometry);
+    if (parts == 0) throw Error(ErrorCode::UnreadableFile, where + " has an empty multipolygon", path);
+    for (int p = 0; p < parts; ++p) {
+      const std::string part = where + " part " + std::to_string(p);
+      features.push_back({readPolygon(OGR_G_GetGeometryRef(geometry, p), mapping, part, path), attributes});
+    }
+  } else {
+    throw Error(ErrorCode::UnsupportedInput,
+                where + " has a " + OGRGeometryTypeToName(type) + " geometry; only polygons are supported", path);
+  }
+}
+
+}  // namespace
+
+std::vector<core::Feature> readFeatures(const std::string& path, const GeoReference& geo) {
+  detail::ensureGdalRegistered();
+  detail::ScopedGdalErrors errors;
+  const DatasetPtr dataset = openVectorFile(path, errors);
   GDALDatasetH ds = dataset.get();
+  const bool isGeoJson = std::string(GDALGetDriverShortName(GDALGetDatasetDriver(ds))) == "GeoJSON";
 
   std::vector<core::Feature> features;
   long long index = 0;
   const int layers = GDALDatasetGetLayerCount(ds);
   for (int l = 0; l < layers; ++l) {
     OGRLayerH layer = GDALDatasetGetLayer(ds, l);
+    const VertexMapping mapping = layerMapping(layer, geo, isGeoJson, path);
     OGR_L_ResetReading(layer);
     while (true) {
       errors.reset();
@@ -174,24 +310,7 @@ std::vector<core::Feature> readFeatures(const std::string& path, const GeoRefere
       }
       const std::string where = describeFeature(index, OGR_F_GetFID(feature.get()));
       ++index;
-      OGRGeometryH geometry = OGR_F_GetGeometryRef(feature.get());
-      if (geometry == nullptr) throw Error(ErrorCode::UnreadableFile, where + " has no geometry", path);
-      const auto attributes = readAttributes(feature.get());
-      const OGRwkbGeometryType type = wkbFlatten(OGR_G_GetGeometryType(geometry));
-      if (type == wkbPolygon) {
-        features.push_back({readPolygon(geometry, geo, where, path), attributes});
-      } else if (type == wkbMultiPolygon) {
-        const int parts = OGR_G_GetGeometryCount(geometry);
-        if (parts == 0) throw Error(ErrorCode::UnreadableFile, where + " has an empty multipolygon", path);
-        for (int p = 0; p < parts; ++p) {
-          const std::string part = where + " part " + std::to_string(p);
-          features.push_back({readPolygon(OGR_G_GetGeometryRef(geometry, p), geo, part, path), attributes});
-        }
-      } else {
-        throw Error(ErrorCode::UnsupportedInput,
-                    where + " has a " + OGRGeometryTypeToName(type) + " geometry; only polygons are supported",
-                    path);
-      }
+      appendFeature(feature.get(), mapping, where, path, features);
     }
   }
   return features;
@@ -240,7 +359,11 @@ void writeFeaturesAt(const std::string& path, const std::vector<core::Feature>& 
   detail::ensureGdalRegistered();
   const std::string driverName = driverForExtension(path);
   if (driverName.empty()) {
-    throw Error(ErrorCode::WriteFailed, "unknown vector format: use .geojson, .json or .gpkg", path);
+    // Shapefiles are read only: the DBF's 10-character field names would cut the attribute names.
+    const std::string what = readDriverForExtension(path).empty()
+                                 ? "unknown vector format"
+                                 : "Shapefiles are read, not written (field names of at most 10 characters)";
+    throw Error(ErrorCode::WriteFailed, what + ": use .geojson, .json or .gpkg", path);
   }
   detail::ScopedGdalErrors errors;
   GDALDriverH driver = GDALGetDriverByName(driverName.c_str());

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -115,6 +116,189 @@ TEST_P(VectorRoundTrip, GeoreferencedThroughGeoTransformAndCrs) {
 INSTANTIATE_TEST_SUITE_P(Formats, VectorRoundTrip, ::testing::Values(".geojson", ".json", ".gpkg"),
                          [](const auto& paramInfo) { return paramInfo.param.substr(1); });
 
+std::string wktOfEpsg(int epsg) {
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
+  OSRImportFromEPSG(srs, epsg);
+  char* wkt = nullptr;
+  OSRExportToWkt(srs, &wkt);
+  std::string text = wkt;
+  CPLFree(wkt);
+  OSRDestroySpatialReference(srs);
+  return text;
+}
+
+// A 0.5 m image over Toulouse in UTM 31N.
+GeoReference toulouseGeo() {
+  GeoReference geo;
+  geo.geoTransform = {374000.0, 0.5, 0.0, 4829000.0, 0.0, -0.5};
+  geo.hasTransform = true;
+  geo.crsWkt = wktOfEpsg(32631);
+  return geo;
+}
+
+// Map coordinates of `ring` (pixels of `geo`) brought into EPSG `epsg` (x = easting / longitude).
+std::vector<cv::Point2d> ringInCrs(const core::Ring& ring, const GeoReference& geo, int epsg) {
+  OGRSpatialReferenceH from = OSRNewSpatialReference(geo.crsWkt.c_str());
+  OGRSpatialReferenceH to = OSRNewSpatialReference(nullptr);
+  OSRImportFromEPSG(to, epsg);
+  OSRSetAxisMappingStrategy(from, OAMS_TRADITIONAL_GIS_ORDER);
+  OSRSetAxisMappingStrategy(to, OAMS_TRADITIONAL_GIS_ORDER);
+  OGRCoordinateTransformationH transform = OCTNewCoordinateTransformation(from, to);
+  std::vector<cv::Point2d> result;
+  for (const auto& pixel : ring) {
+    cv::Point2d point = geo.pixelToMap(pixel);
+    EXPECT_TRUE(OCTTransform(transform, 1, &point.x, &point.y, nullptr));
+    result.push_back(point);
+  }
+  OCTDestroyCoordinateTransformation(transform);
+  OSRDestroySpatialReference(from);
+  OSRDestroySpatialReference(to);
+  return result;
+}
+
+OGRGeometryH ogrRing(const std::vector<cv::Point2d>& points) {
+  OGRGeometryH ring = OGR_G_CreateGeometry(wkbLinearRing);
+  for (const auto& p : points) OGR_G_AddPoint_2D(ring, p.x, p.y);
+  OGR_G_AddPoint_2D(ring, points.front().x, points.front().y);
+  return ring;
+}
+
+// Writes `polygon` (pixels of `geo`) with OGR into a layer in EPSG `epsg`; epsg 0 writes a layer
+// without CRS holding the map coordinates of `geo`.
+void writePolygonInCrs(const std::string& path, const char* driverName, const GeoReference& geo, int epsg,
+                       const core::Polygon& polygon) {
+  const int crs = epsg == 0 ? 32631 : epsg;
+  OGRSpatialReferenceH srs = nullptr;
+  if (epsg != 0) {
+    srs = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(srs, epsg);
+    OSRSetAxisMappingStrategy(srs, OAMS_TRADITIONAL_GIS_ORDER);
+  }
+  GDALAllRegister();
+  GDALDatasetH ds = GDALCreate(GDALGetDriverByName(driverName), path.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
+  ASSERT_NE(ds, nullptr) << path;
+  OGRLayerH layer = GDALDatasetCreateLayer(ds, "outlines", srs, wkbPolygon, nullptr);
+  ASSERT_NE(layer, nullptr) << path;
+  OGRFeatureH feature = OGR_F_Create(OGR_L_GetLayerDefn(layer));
+  OGRGeometryH geometry = OGR_G_CreateGeometry(wkbPolygon);
+  OGR_G_AddGeometryDirectly(geometry, ogrRing(ringInCrs(polygon.outer, geo, crs)));
+  for (const auto& hole : polygon.holes) OGR_G_AddGeometryDirectly(geometry, ogrRing(ringInCrs(hole, geo, crs)));
+  OGR_F_SetGeometryDirectly(feature, geometry);
+  EXPECT_EQ(OGR_L_CreateFeature(layer, feature), OGRERR_NONE);
+  OGR_F_Destroy(feature);
+  GDALClose(ds);
+  if (srs != nullptr) OSRDestroySpatialReference(srs);
+}
+
+struct CrsCase {
+  const char* extension;
+  const char* driver;
+  int epsg;
+};
+
+class VectorInAnotherCrs : public ::testing::TestWithParam<CrsCase> {};
+
+TEST_P(VectorInAnotherCrs, ReadsToTheSamePixelsAsInTheImageCrs) {
+  TempDir dir;
+  const GeoReference geo = toulouseGeo();
+  const core::Polygon courtyard = sampleFeatures()[0].polygon;
+  const std::string path = dir.file("outlines" + std::string(GetParam().extension));
+  writePolygonInCrs(path, GetParam().driver, geo, GetParam().epsg, courtyard);
+  const auto raw = readFeatures(path);
+  ASSERT_EQ(raw.size(), 1u);
+  const double offset = cv::norm(raw[0].polygon.outer[0] - geo.pixelToMap(courtyard.outer[0]));
+  if (GetParam().epsg != 32631) {
+    EXPECT_GT(offset, 1.0) << "the file holds the image's map coordinates";
+  }
+
+  const auto features = readFeatures(path, geo);
+  ASSERT_EQ(features.size(), 1u);
+  expectSameRing(features[0].polygon.outer, courtyard.outer, 1e-3);
+  ASSERT_EQ(features[0].polygon.holes.size(), 1u);
+  expectSameRing(features[0].polygon.holes[0], courtyard.holes[0], 1e-3);
+}
+
+INSTANTIATE_TEST_SUITE_P(Crs, VectorInAnotherCrs,
+                         ::testing::Values(CrsCase{".geojson", "GeoJSON", 4326}, CrsCase{".geojson", "GeoJSON", 2154},
+                                           CrsCase{".gpkg", "GPKG", 4326}, CrsCase{".gpkg", "GPKG", 2154},
+                                           CrsCase{".shp", "ESRI Shapefile", 2154},
+                                           CrsCase{".shp", "ESRI Shapefile", 32631}),
+                         [](const auto& paramInfo) {
+                           return std::string(paramInfo.param.extension + 1) + "_" + std::to_string(paramInfo.param.epsg);
+                         });
+
+TEST(VectorCrs, AnRfc7946FileWithoutCrsMemberIsLongitudeLatitude) {
+  TempDir dir;
+  const GeoReference geo = toulouseGeo();
+  const core::Ring square = {{100, 100}, {300, 100}, {300, 250}, {100, 250}};
+  std::ostringstream text;
+  text << std::setprecision(17)
+       << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[)";
+  const auto lonLat = ringInCrs(square, geo, 4326);
+  for (size_t i = 0; i <= lonLat.size(); ++i) {
+    const cv::Point2d& p = lonLat[i % lonLat.size()];
+    text << (i ? "," : "") << "[" << p.x << "," << p.y << "]";
+  }
+  text << "]]}}]}";
+  const std::string path = dir.file("rfc7946.geojson");
+  writeText(path, text.str());
+  EXPECT_NEAR(lonLat[0].x, 1.43, 0.05);  // Toulouse, longitude first
+  EXPECT_NEAR(lonLat[0].y, 43.6, 0.05);
+  const auto features = readFeatures(path, geo);
+  ASSERT_EQ(features.size(), 1u);
+  expectSameRing(features[0].polygon.outer, square, 1e-3);
+}
+
+TEST(VectorCrs, FilesWithoutCrsOrAnImageWithoutCrsReadAsBefore) {
+  TempDir dir;
+  GeoReference geo = toulouseGeo();
+  const core::Polygon courtyard = sampleFeatures()[0].polygon;
+  // Layers without CRS holding the image's map coordinates: only the geotransform applies.
+  for (const auto& [name, driver] : {std::pair{"plain.shp", "ESRI Shapefile"}, std::pair{"plain.gpkg", "GPKG"}}) {
+    writePolygonInCrs(dir.file(name), driver, geo, 0, courtyard);
+    const auto features = readFeatures(dir.file(name), geo);
+    ASSERT_EQ(features.size(), 1u) << name;
+    expectSameRing(features[0].polygon.outer, courtyard.outer, 1e-6);
+  }
+  // GeoPackages written without a GeoReference: GDAL gives their layer GeoPackage's "undefined
+  // geographic" CRS, which is no CRS either.
+  const std::string pixels = dir.file("pixels.gpkg");
+  writeFeatures(pixels, {sampleFeatures()[1]});
+  const auto pixelFeatures = readFeatures(pixels, geo);
+  ASSERT_EQ(pixelFeatures.size(), 1u);
+  EXPECT_EQ(pixelFeatures[0].polygon.outer[0], geo.mapToPixel(sampleFeatures()[1].polygon.outer[0]));
+
+  // A layer in WGS 84 over an image whose CRS is unknown: coordinates taken as they are.
+  const std::string lonLat = dir.file("wgs84.gpkg");
+  writePolygonInCrs(lonLat, "GPKG", geo, 4326, courtyard);
+  const auto raw = readFeatures(lonLat);
+  geo.crsWkt.clear();
+  geo.geoTransform = {1.4, 1e-6, 0.0, 43.7, 0.0, -1e-6};
+  const auto unknownCrs = readFeatures(lonLat, geo);
+  ASSERT_EQ(raw.size(), 1u);
+  ASSERT_EQ(unknownCrs.size(), 1u);
+  for (size_t i = 0; i < raw[0].polygon.outer.size(); ++i) {
+    const cv::Point2d expected = geo.mapToPixel(raw[0].polygon.outer[i]);
+    EXPECT_EQ(unknownCrs[0].polygon.outer[i], expected) << i;
+  }
+}
+
+TEST(VectorCrs, PixelCoordinatesThatAreNoLongitudeLatitudeAreRefusedNamingTheFeature) {
+  TempDir dir;
+  // Our own files without a GeoReference: pixel coordinates, no "crs" member, so WGS 84 to GDAL.
+  const std::string path = dir.file("pixels.geojson");
+  const auto features = sampleFeatures();
+  writeFeatures(path, features);
+  expectSameFeatures(readFeatures(path), features, 0.0);  // without an image CRS, as they are
+
+  const core::Error error = captureError([&] { readFeatures(path, toulouseGeo()); });
+  EXPECT_EQ(error.code(), ErrorCode::UnreadableFile) << error.what();
+  EXPECT_EQ(error.path(), path);
+  EXPECT_NE(error.detail().find("feature 0"), std::string::npos) << error.what();
+  EXPECT_NE(error.detail().find("cannot be brought from CRS WGS 84"), std::string::npos) << error.what();
+  EXPECT_NE(error.detail().find("UTM zone 31N"), std::string::npos) << error.what();
+}
+
 TEST(VectorIo, MultiPolygonGivesOneFeaturePerPart) {
   TempDir dir;
   const std::string path = dir.file("multi.geojson");
@@ -225,7 +409,9 @@ TEST(VectorIoErrors, WriteFailures) {
     EXPECT_EQ(error.code(), ErrorCode::WriteFailed) << error.what();
     EXPECT_EQ(error.path(), dir.file(name));
   }
-  EXPECT_EQ(captureError([&] { writeFeatures(dir.file("out.shp"), features); }).code(), ErrorCode::WriteFailed);
+  const core::Error shapefile = captureError([&] { writeFeatures(dir.file("out.shp"), features); });
+  EXPECT_EQ(shapefile.code(), ErrorCode::WriteFailed);
+  EXPECT_NE(shapefile.detail().find("use .geojson, .json or .gpkg"), std::string::npos) << shapefile.what();
 }
 
 }  // namespace
