@@ -20,8 +20,8 @@ void printSummary(const project::ImportSummary& summary, const std::string& path
   std::printf("\n");
   if (summary.read > 0 && summary.outsideImage == summary.read) {
     std::fprintf(stderr,
-                 "import: no polygon lies on the left image: are its coordinates the image's (its CRS, or pixels "
-                 "when the image has no georeferencing)?\n");
+                 "import: no polygon lies on the left image: are its coordinates in the CRS the file declares, "
+                 "else the image's (pixels when the image has no georeferencing)?\n");
   }
 }
 
@@ -29,7 +29,9 @@ int run(const std::vector<std::string>& args) {
   cli::Options opts("import",
                     "Adds the polygons of a vector file to a project as pending buildings, then saves it.\n"
                     "Usage: delineo-cli import PROJECT --outlines FILE [options]");
-  opts.required("outlines", "FILE", "polygons to import (.geojson, .gpkg, .shp), in the left image's CRS or pixels")
+  opts.required("outlines", "FILE",
+                "polygons to import (.geojson, .gpkg, .shp): in the CRS the file declares (transformed into the "
+                "left image's), else in the image's CRS, or pixels when the image has no georeferencing")
       .value("id-field", "NAME", "attribute kept as each building's source id (exported as source_id)")
       .flag("no-save", "do not write the project file back (print what would be added)");
   std::vector<std::string> rest;
