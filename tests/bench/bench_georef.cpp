@@ -4,16 +4,22 @@
 // export` write them, and are read back in map coordinates. Prints, per format, the buildings
 // written and the largest distance between a footprint's vertex and the exported one (m); exits 1
 // when a format loses a building or moves a vertex by more than its precision (CityJSON's 1 mm
-// grid). Skips without the data folder.
+// grid). Then the footprints converted by GDAL into WGS 84 (GeoJSON), Web Mercator (Shapefile)
+// and UTM 16N are imported into a project on the image (project::importOutlinesFile): prints the
+// buildings added and the largest distance (px) between an imported vertex and the one read in the
+// image's CRS; exits 1 when a building is not added or a vertex moves by more than the file's
+// precision (GeoJSON may hold 7 decimals of degrees, about 1 cm: 0.05 px here; the others 1e-6 px). Skips without the data folder.
 //
 // bench_georef [--data DIR]
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include <gdal_utils.h>
 #include <nlohmann/json.hpp>
 
 #include "delineo/io/raster.hpp"
@@ -80,6 +86,61 @@ project::Project atlantaProject(const std::string& image, const std::vector<core
   return p;
 }
 
+// `source` written to `target` in `crs` by GDAL's vector translation (ogr2ogr).
+void convertVector(const std::string& source, const std::string& target, const char* crs, const char* format) {
+  GDALDatasetH input = GDALOpenEx(source.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+  if (input == nullptr) throw std::runtime_error("cannot open " + source);
+  const char* argv[] = {"-t_srs", crs, "-f", format, nullptr};
+  GDALVectorTranslateOptions* options = GDALVectorTranslateOptionsNew(const_cast<char**>(argv), nullptr);
+  GDALDatasetH output = GDALVectorTranslate(target.c_str(), nullptr, 1, &input, options, nullptr);
+  GDALVectorTranslateOptionsFree(options);
+  GDALClose(input);
+  if (output == nullptr) throw std::runtime_error("cannot write " + target);
+  GDALClose(output);
+}
+
+// The largest distance (px) from a vertex of `expected` to the nearest vertex of the same
+// building's initial polygon in `imported` (same order; a footprint across the image border is
+// cut there, which adds vertices); infinite when the building counts differ.
+double largestImportError(const std::vector<core::Feature>& expected, const project::Project& imported) {
+  if (imported.buildings.size() != expected.size()) return INFINITY;
+  double largest = 0.0;
+  for (size_t i = 0; i < expected.size(); ++i) {
+    for (const auto& a : expected[i].polygon.outer) {
+      double nearest = INFINITY;
+      for (const auto& b : imported.buildings[i].initial.outer) nearest = std::min(nearest, std::hypot(a.x - b.x, a.y - b.y));
+      largest = std::max(largest, nearest);
+    }
+  }
+  return largest;
+}
+
+// The labels imported in other CRSs land where they lie in the image's: true when every one does.
+bool importsInOtherCrs(const std::string& image, const std::string& labels, const std::vector<core::Feature>& inPixels,
+                       const fs::path& out) {
+  std::printf("\n%-28s %9s %16s\n", "import (CRS, format)", "added", "max error (px)");
+  bool ok = true;
+  const struct {
+    const char* crs;
+    const char* format;
+    const char* name;
+    double precision;  // px
+  } conversions[] = {{"EPSG:4326", "GeoJSON", "wgs84.geojson", 0.05},
+                     {"EPSG:3857", "ESRI Shapefile", "mercator.shp", 1e-6},
+                     {"EPSG:32616", "GPKG", "utm.gpkg", 1e-6}};
+  for (const auto& c : conversions) {
+    const std::string path = (out / c.name).string();
+    convertVector(labels, path, c.crs, c.format);
+    project::Project p;
+    p.left = p.right = image;
+    const size_t added = project::importOutlinesFile(p, path, {}).added.size();
+    const double error = largestImportError(inPixels, p);
+    std::printf("%-12s %-15s %9zu %16.2e\n", c.crs, c.name, added, error);
+    ok = ok && added == inPixels.size() && error <= c.precision;
+  }
+  return ok;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -96,7 +157,8 @@ int main(int argc, char** argv) {
   }
   const io::GeoReference geo = io::readRaster(image).geo;
   const std::vector<core::Feature> truth = io::readFeatures(labels);
-  const project::Project project = atlantaProject(image, io::readFeatures(labels, geo));
+  const std::vector<core::Feature> inPixels = io::readFeatures(labels, geo);
+  const project::Project project = atlantaProject(image, inPixels);
   const fs::path out = fs::temp_directory_path() / "delineo_bench_georef";
   fs::create_directories(out);
 
@@ -117,8 +179,11 @@ int main(int argc, char** argv) {
   std::printf("%-10s %9d %9s %16.2e  %s\n", ".city.json", blocks, "-", error, referenceSystem.c_str());
   ok = ok && blocks == static_cast<int>(truth.size()) && error <= kCityJsonPrecision &&
        referenceSystem.ends_with("/EPSG/0/32616");
+  const bool imports = importsInOtherCrs(image, labels, inPixels, out);
   fs::remove_all(out);
   std::printf("%s\n", ok ? "round trip: every building, every vertex within the format's precision"
                          : "round trip FAILED");
+  std::printf("%s\n", imports ? "imports: every building, where it lies in the image's CRS" : "imports FAILED");
+  ok = ok && imports;
   return ok ? 0 : 1;
 }
