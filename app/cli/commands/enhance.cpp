@@ -33,7 +33,7 @@ int run(const std::vector<std::string>& args) {
   opts.required("dem", "FILE", "DEM: one band of heights in metres (GeoTIFF float32, nodata = no "
                                "height), in the footprints' image geometry")
       .required("footprints", "FILE",
-                "building footprints (GeoJSON/GeoPackage): in the DEM's map coordinates when it "
+                "building footprints (.geojson, .gpkg, .shp): brought into the DEM's CRS when it "
                 "is georeferenced, else in its pixels; holes are courtyards")
       .required("out", "FILE", "enhanced DEM (GeoTIFF float32, the input's georeferencing)")
       .flag("quiet", "no progress on stderr")

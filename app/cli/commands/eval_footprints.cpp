@@ -65,8 +65,8 @@ int run(const std::vector<std::string>& args) {
                     "Matches predicted building outlines to true ones (greedy by IoU) and reports "
                     "IoU, shape error p1 [%], PoLiS, Hausdorff and corner RMS per building and on "
                     "average, with missed truths and false predictions (docs/metrics.md).");
-  opts.required("pred", "FILE", "predicted outlines (GeoJSON or GeoPackage)")
-      .required("truth", "FILE", "true outlines (GeoJSON or GeoPackage)")
+  opts.required("pred", "FILE", "predicted outlines (GeoJSON, GeoPackage or Shapefile)")
+      .required("truth", "FILE", "true outlines (GeoJSON, GeoPackage or Shapefile)")
       .value("raster", "FILE",
              "georeferenced image the outlines belong to: map coordinates are converted to its "
              "pixels, so distances are in pixels (without it, in the files' own units)")

@@ -17,7 +17,7 @@ int run(const std::vector<std::string>& args) {
   cli::Options opts("rough-init",
                     "Makes rough initial polygons (grown bounding rectangles or jittered outlines) "
                     "from reference footprints, keeping their attributes.");
-  opts.required("truth", "FILE", "reference footprints (GeoJSON or GeoPackage)")
+  opts.required("truth", "FILE", "reference footprints (GeoJSON, GeoPackage or Shapefile)")
       .required("out", "FILE", "output polygons")
       .value("grow", "PX", "rectangle mode: grow each bounding rectangle by PX pixels", "8")
       .value("jitter", "PX", "jitter mode: move every vertex by up to PX pixels (0 = off)", "0")
