@@ -93,7 +93,7 @@ cli::Options boxfitOptions() {
       .value("disparity", "FILE", "disparity map of the left image (as `match` writes it), instead of --dem")
       .value("metres-per-pixel", "M", "with --disparity: metres of height per px of disparity", "1")
       .value("ground-disparity", "PX", "with --disparity: disparity of zero height", "0")
-      .value("init", "FILE", "initial polygons (.geojson, .gpkg, .shp; the image's CRS, or pixels without one); may hold many")
+      .value("init", "FILE", "initial polygons (.geojson, .gpkg, .shp; map coordinates over a georeferenced image, else pixels); may hold many")
       .value("roi", "X,Y,W,H", "initial rectangle in left-image pixels (instead of --init)")
       .required("out", "FILE", "output outlines (GeoJSON/GeoPackage) with their attributes")
       .value("boxes", "FILE", "also write the fitted boxes (one polygon each, with building_id)")

@@ -138,7 +138,7 @@ cli::Options delineateOptions() {
   opts.required("left", "FILE", "left (reference) epipolar image")
       .required("right", "FILE", "right epipolar image")
       .value("init", "FILE",
-             "initial polygons (.geojson, .gpkg, .shp; the image's CRS, or pixels without one); may hold many")
+             "initial polygons (.geojson, .gpkg, .shp; map coordinates over a georeferenced image, else pixels); may hold many")
       .value("roi", "X,Y,W,H", "initial rectangle in left-image pixels (instead of --init)")
       .value("roof-disparity", "A:B",
              "roof disparity interval (a feature's roof_disparity_min/max override it)")
