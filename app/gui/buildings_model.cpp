@@ -2,6 +2,7 @@
 
 #include <QBrush>
 #include <QColor>
+#include <algorithm>
 #include <cmath>
 
 #include "document.hpp"
@@ -62,7 +63,8 @@ QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
   if (!index.isValid() || document_ == nullptr || index.row() >= rowCount()) return {};
   const auto& b = document_->project().buildings[static_cast<size_t>(index.row())];
   if (role == kIdRole) return b.id;
-  if (role == Qt::TextAlignmentRole && index.column() != Status && index.column() != Method) {
+  if (role == Qt::TextAlignmentRole && index.column() != Status && index.column() != Method &&
+      index.column() != SourceId) {
     return QVariant::fromValue(Qt::AlignRight | Qt::AlignVCenter);
   }
   if (role == Qt::ForegroundRole && index.column() == Status) {
@@ -89,6 +91,7 @@ QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
     case Energy:
       return std::isfinite(b.energy) ? QVariant(QString::number(b.energy, 'f', 1)) : QVariant(QStringLiteral("–"));
     case Method: return methodText(b);
+    case SourceId: return QString::fromStdString(b.sourceId);
     default: return {};
   }
 }
@@ -115,8 +118,15 @@ QVariant BuildingsModel::headerData(int section, Qt::Orientation orientation, in
     case RoofHeight: return tr("Roof height (m)");
     case Energy: return tr("Energy");
     case Method: return tr("Method");
+    case SourceId: return tr("Source id");
     default: return {};
   }
+}
+
+bool BuildingsModel::hasSourceIds() const {
+  if (document_ == nullptr) return false;
+  const auto& list = document_->project().buildings;
+  return std::any_of(list.begin(), list.end(), [](const project::Building& b) { return !b.sourceId.empty(); });
 }
 
 int BuildingsModel::idAt(int row) const {

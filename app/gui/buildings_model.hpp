@@ -1,6 +1,6 @@
 #pragma once
-// Table of the document's buildings: id, status, vertex count, roof height, energy, and the
-// method that produced the outline.
+// Table of the document's buildings: id, status, vertex count, roof height, energy, the method
+// that produced the outline, and the id of an imported outline in its source.
 #include <QAbstractTableModel>
 
 #include "delineo/project/project.hpp"
@@ -12,7 +12,7 @@ class Document;
 class BuildingsModel : public QAbstractTableModel {
   Q_OBJECT
  public:
-  enum Column { Id, Status, Vertices, RoofHeight, Energy, Method, ColumnCount };
+  enum Column { Id, Status, Vertices, RoofHeight, Energy, Method, SourceId, ColumnCount };
   static constexpr int kIdRole = Qt::UserRole + 1;
 
   explicit BuildingsModel(QObject* parent = nullptr);
@@ -23,6 +23,8 @@ class BuildingsModel : public QAbstractTableModel {
   QVariant data(const QModelIndex& index, int role) const override;
   QVariant headerData(int section, Qt::Orientation orientation, int role) const override;
 
+  // Whether a building has a source id (the view shows the Source id column only then).
+  bool hasSourceIds() const;
   int idAt(int row) const;
   int rowOf(int id) const;  // -1 when absent
   static QString statusText(project::BuildingStatus status);

@@ -30,7 +30,8 @@ class BuildingCommand : public QUndoCommand {
   int mergeKey_;
 };
 
-// Several buildings' states before and after as one step (the buildings Detect buildings adds).
+// Several buildings' states before and after as one step (the buildings Detect buildings and
+// Import outlines add).
 class BuildingsCommand : public QUndoCommand {
  public:
   using States = std::map<int, std::optional<project::Building>>;

@@ -130,15 +130,29 @@ std::vector<int> Document::addProposedBuildings(const std::vector<core::Feature>
                                                 std::vector<std::string>* problems) {
   project::Project after = project_;
   const std::vector<int> ids = project::addProposedBuildings(after, proposals, "delineo", problems);
-  if (ids.empty()) return ids;
+  pushAddedBuildings(after, ids, tr("Detect %n building(s)", nullptr, static_cast<int>(ids.size())));
+  return ids;
+}
+
+void Document::pushAddedBuildings(const project::Project& after, const std::vector<int>& ids, const QString& text) {
+  if (ids.empty()) return;
   BuildingsCommand::States before, added;
   for (int id : ids) {
     before[id] = std::nullopt;
     added[id] = *after.find(id);
   }
-  undo_.push(new BuildingsCommand(this, std::move(before), std::move(added),
-                                  tr("Detect %n building(s)", nullptr, static_cast<int>(ids.size()))));
-  return ids;
+  undo_.push(new BuildingsCommand(this, std::move(before), std::move(added), text));
+}
+
+project::ImportSummary Document::importOutlines(const std::vector<core::Feature>& features,
+                                                const project::ImportOptions& options) {
+  project::Project after = project_;
+  project::ImportOptions withOrigin = options;
+  withOrigin.origin = "delineo";
+  const project::ImportSummary summary = project::importOutlines(after, features, pair_.left.size(), withOrigin);
+  pushAddedBuildings(after, summary.added,
+                     tr("Import %n outline(s)", nullptr, static_cast<int>(summary.added.size())));
+  return summary;
 }
 
 void Document::removeBuilding(int id) {

@@ -71,6 +71,11 @@ class Document : public QObject {
   // malformed roof interval is left out and said in `problems` when given.
   std::vector<int> addProposedBuildings(const std::vector<core::Feature>& proposals,
                                         std::vector<std::string>* problems = nullptr);
+  // Outlines of another source (left-image pixels, as io::readFeatures gives them) added as
+  // Pending buildings (project::importOutlines, origin "delineo") in one undoable step; none when
+  // no outline is added. Throws like project::importOutlines.
+  project::ImportSummary importOutlines(const std::vector<core::Feature>& features,
+                                        const project::ImportOptions& options);
   void setStatus(int id, project::BuildingStatus status);
   void setRoofInterval(int id, project::DisparityInterval interval);
   void setParameters(const std::string& group, const nlohmann::json& values);
@@ -135,6 +140,8 @@ class Document : public QObject {
   void deriveDem();
   void setExtraDirty(bool dirty);
   void pushSettings(const Settings& after, const QString& description);
+  // The buildings `ids` of `after` (a copy of the project they were added to) as one undo step.
+  void pushAddedBuildings(const project::Project& after, const std::vector<int>& ids, const QString& text);
 
   project::Project project_;
   QString path_;

@@ -154,6 +154,15 @@ class MainWindow : public QMainWindow {
   // agrees. Returns the job id, or 0 with a message saying why nothing started.
   widgets::JobId exportElevationRasters(const QString& dir);
 
+  // ---- outlines from elsewhere (main_window_import.cpp) ----
+  // File → Import outlines of `path` (GeoJSON, GeoPackage, Shapefile; map coordinates in the left
+  // image's CRS, or its pixels when it has no georeferencing): the operator chooses the attribute
+  // kept as each building's source id, then the outlines on the left image that are not buildings
+  // yet become pending buildings in one undoable step, and a message says how many and why the
+  // others were left out. Returns the number added; -1 when the file cannot be read or the
+  // operator cancels (a message says why).
+  int importOutlines(const QString& path);
+
   // ---- accessors for tests and the screenshot tour ----
   widgets::ImageView* leftView() const { return leftView_; }
   widgets::ImageView* rightView() const { return rightView_; }
@@ -194,6 +203,12 @@ class MainWindow : public QMainWindow {
   }
   // Answers "replace the existing files?" of an export when not interactive (default: yes).
   void setReplaceFilesPolicy(bool replace) { replaceFiles_ = replace; }
+  // Answers "which attribute is the source id?" of Import outlines when not interactive: given the
+  // attribute names and the preselected one (empty: none), returns the chosen name (empty: none),
+  // or nullopt to cancel. Default: the preselected one.
+  void setIdFieldHandler(std::function<std::optional<QString>(const QStringList& names, const QString& preselected)> handler) {
+    idFieldHandler_ = std::move(handler);
+  }
   // Fills and answers the project settings dialog when not interactive (true = OK).
   void setProjectSettingsHandler(std::function<bool(ProjectSettingsDialog&)> handler) {
     projectSettingsHandler_ = std::move(handler);
@@ -222,6 +237,7 @@ class MainWindow : public QMainWindow {
   void pendingOutlined(int outlined, int skipped);  // Outline the pending buildings has ended
   void elevationRastersExported(const QStringList& files);  // written into the folder, all of them
   void cityModelExported(const QString& path, int written);  // the CityJSON file is written
+  void outlinesImported(int added, int read);  // Import outlines has added `added` of the `read` polygons
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -336,6 +352,12 @@ class MainWindow : public QMainWindow {
   // main_window_export.cpp: File → Export accepted buildings.
   void showExportSummary(const QString& path, const project::ExportSummary& exported, const QString& terrain);
 
+  // main_window_import.cpp: File → Import outlines.
+  void chooseOutlineFile();
+  std::optional<QString> chooseIdField(const std::vector<core::Feature>& features);
+  QString importSummaryText(const QString& file, const project::ImportSummary& summary) const;
+  void showImportSummary(const QString& path, const project::ImportSummary& summary);
+
   // main_window_rasters.cpp: File → Export elevation rasters.
   void chooseRasterFolder();
   project::ElevationLayers shownElevationLayers() const;
@@ -386,6 +408,7 @@ class MainWindow : public QMainWindow {
   QString lastMessage_;
   std::function<QString(const QString&)> relocate_;
   std::function<bool(ProjectSettingsDialog&)> projectSettingsHandler_;
+  std::function<std::optional<QString>(const QStringList&, const QString&)> idFieldHandler_;
   QSpinBox* rangeMin_ = nullptr;
   QSpinBox* rangeMax_ = nullptr;
   QLabel* rangeNote_ = nullptr;

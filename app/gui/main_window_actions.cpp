@@ -101,6 +101,10 @@ void MainWindow::createFileActions() {
                 tr("GeoJSON (*.geojson);;GeoPackage (*.gpkg);;CityJSON 3D blocks (*.city.json *.cityjson)"));
             if (!path.isEmpty()) exportAccepted(path);
           });
+  QAction* importOutlines = makeAction(this, QStringLiteral("actionImportOutlines"), tr("&Import outlines…"));
+  importOutlines->setStatusTip(tr("Add the polygons of a vector file (a cadastre, OpenStreetMap, an export) as pending "
+                                  "buildings, to outline with Building → Outline the pending buildings"));
+  connect(importOutlines, &QAction::triggered, this, &MainWindow::chooseOutlineFile);
   connect(makeAction(this, QStringLiteral("actionExportRasters"), tr("Export e&levation rasters…")),
           &QAction::triggered, this, &MainWindow::chooseRasterFolder);
   connect(makeAction(this, QStringLiteral("actionQuit"), tr("&Quit"), QKeySequence::Quit),
@@ -277,6 +281,7 @@ void MainWindow::createMenus() {
   file->addSeparator();
   file->addAction(action(QStringLiteral("actionSave")));
   file->addAction(action(QStringLiteral("actionSaveAs")));
+  file->addAction(action(QStringLiteral("actionImportOutlines")));
   file->addAction(action(QStringLiteral("actionExport")));
   file->addAction(action(QStringLiteral("actionExportRasters")));
   file->setToolTipsVisible(true);  // why Export elevation rasters is disabled
@@ -373,6 +378,7 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionSave"))->setEnabled(hasDoc);
   action(QStringLiteral("actionSaveAs"))->setEnabled(hasDoc);
   action(QStringLiteral("actionExport"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionImportOutlines"))->setEnabled(hasDoc);
   refreshRasterExportAction();
   action(QStringLiteral("actionMatch"))->setEnabled(hasDoc);
   action(QStringLiteral("actionDelineate"))->setEnabled(b != nullptr);

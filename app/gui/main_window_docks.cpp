@@ -163,7 +163,10 @@ void MainWindow::createBuildingsDock() {
   buildingsTable_->horizontalHeader()->setStretchLastSection(true);
   connect(buildingsTable_->selectionModel(), &QItemSelectionModel::selectionChanged, this,
           &MainWindow::onSelectionFromTable);
+  buildingsTable_->setColumnHidden(BuildingsModel::SourceId, true);
   connect(buildingsModel_, &QAbstractItemModel::modelReset, this, [this] {
+    // The source ids of imported outlines, only when there are some.
+    buildingsTable_->setColumnHidden(BuildingsModel::SourceId, !buildingsModel_->hasSourceIds());
     // Keep the table's selection on the selected building across model resets.
     updatingSelection_ = true;
     const int row = buildingsModel_->rowOf(selectedId_);
