@@ -872,6 +872,10 @@
         <source>Method</source>
         <translation>Méthode</translation>
     </message>
+    <message>
+        <source>Source id</source>
+        <translation>Id. source</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::Document</name>
@@ -944,6 +948,13 @@
         <translation>
             <numerusform>Détecter %n bâtiment</numerusform>
             <numerusform>Détecter %n bâtiments</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>Import %n outline(s)</source>
+        <translation>
+            <numerusform>Importer %n contour</numerusform>
+            <numerusform>Importer %n contours</numerusform>
         </translation>
     </message>
 </context>
@@ -2118,6 +2129,78 @@ Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_ga
     <message>
         <source>%1 roof parts</source>
         <translation>%1 parties de toit</translation>
+    </message>
+    <message>
+        <source>&amp;Import outlines…</source>
+        <translation>&amp;Importer des contours…</translation>
+    </message>
+    <message>
+        <source>Add the polygons of a vector file (a cadastre, OpenStreetMap, an export) as pending buildings, to outline with Building → Outline the pending buildings</source>
+        <translation>Ajouter les polygones d’un fichier vecteur (un cadastre, OpenStreetMap, un export) comme bâtiments en attente, à délimiter avec Bâtiment → Délimiter les bâtiments en attente</translation>
+    </message>
+    <message>
+        <source>Import outlines</source>
+        <translation>Importer des contours</translation>
+    </message>
+    <message>
+        <source>Vector files (*.geojson *.json *.gpkg *.shp);;GeoJSON (*.geojson *.json);;GeoPackage (*.gpkg);;Shapefile (*.shp);;All files (*)</source>
+        <translation>Fichiers vecteur (*.geojson *.json *.gpkg *.shp);;GeoJSON (*.geojson *.json);;GeoPackage (*.gpkg);;Shapefile (*.shp);;Tous les fichiers (*)</translation>
+    </message>
+    <message>
+        <source>Cannot import outlines</source>
+        <translation>Impossible d’importer les contours</translation>
+    </message>
+    <message>
+        <source>(none)</source>
+        <translation>(aucun)</translation>
+    </message>
+    <message>
+        <source>Attribute kept as each building&apos;s source id (exported as source_id):</source>
+        <translation>Attribut gardé comme identifiant source de chaque bâtiment (exporté en source_id) :</translation>
+    </message>
+    <message>
+        <source>%1 of 1 outline of %2 imported as a pending building</source>
+        <translation>Contour de %2 importé comme bâtiment en attente : %1 sur 1</translation>
+    </message>
+    <message>
+        <source>%1 of %2 outlines of %3 imported as pending buildings</source>
+        <translation>Contours de %3 importés comme bâtiments en attente : %1 sur %2</translation>
+    </message>
+    <message>
+        <source>(%1 cut at the image border)</source>
+        <translation>(coupés au bord de l’image : %1)</translation>
+    </message>
+    <message>
+        <source>%1 already in the project</source>
+        <translation>%1 déjà dans le projet</translation>
+    </message>
+    <message>
+        <source>%1 outside the left image</source>
+        <translation>%1 hors de l’image gauche</translation>
+    </message>
+    <message>
+        <source>Outline them with Building → Outline the pending buildings.</source>
+        <translation>Délimitez-les avec Bâtiment → Délimiter les bâtiments en attente.</translation>
+    </message>
+    <message>
+        <source>No outline lies on the left image: are the file&apos;s coordinates in the left image&apos;s coordinate reference system?</source>
+        <translation>Aucun contour ne se trouve sur l’image gauche : les coordonnées du fichier sont-elles dans le système de référence de l’image gauche ?</translation>
+    </message>
+    <message>
+        <source>No outline lies on the left image: it has no georeferencing, so the file&apos;s coordinates are read as its pixels. Are they?</source>
+        <translation>Aucun contour ne se trouve sur l’image gauche : elle n’est pas géoréférencée, les coordonnées du fichier sont donc lues comme ses pixels. En sont-elles ?</translation>
+    </message>
+    <message>
+        <source>and %1 more</source>
+        <translation>et %1 de plus</translation>
+    </message>
+    <message>
+        <source>Problems: %1.</source>
+        <translation>Problèmes : %1.</translation>
+    </message>
+    <message>
+        <source>%1 holds no polygon.</source>
+        <translation>%1 ne contient aucun polygone.</translation>
     </message>
 </context>
 <context>

@@ -9,6 +9,7 @@
 #include <QTableView>
 #include <QTemporaryDir>
 #include <QTest>
+#include <QTranslator>
 #include <QUndoStack>
 
 #include <cmath>
@@ -206,6 +207,16 @@ class ImportOutlinesTest : public QObject {
     QCOMPARE(window_->importOutlines(path), -1);
     QVERIFY2(window_->lastMessage().contains(QStringLiteral("broken.geojson")), qPrintable(window_->lastMessage()));
     QVERIFY(doc()->project().buildings.empty());
+  }
+
+  void frenchStrings() {
+    QTranslator translator;
+    QVERIFY(translator.load(QStringLiteral(":/i18n/delineo_fr.qm")));
+    QCOMPARE(translator.translate("delineo::gui::MainWindow", "&Import outlines…"),
+             QStringLiteral("&Importer des contours…"));
+    QCOMPARE(translator.translate("delineo::gui::Document", "Import %n outline(s)", nullptr, 2),
+             QStringLiteral("Importer %n contours"));  // the plural form; tr() puts the number in
+    QCOMPARE(translator.translate("delineo::gui::BuildingsModel", "Source id"), QStringLiteral("Id. source"));
   }
 
   void cleanupTestCase() { window_.reset(); }
