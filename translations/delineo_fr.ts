@@ -876,6 +876,10 @@
         <source>Source id</source>
         <translation>Id. source</translation>
     </message>
+    <message>
+        <source>Source id: %1</source>
+        <translation>Identifiant source : %1</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::Document</name>

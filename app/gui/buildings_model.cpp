@@ -76,6 +76,8 @@ QVariant BuildingsModel::data(const QModelIndex& index, int role) const {
     }
   }
   if (role == Qt::ToolTipRole && index.column() == Energy) return energyTermsText(b);
+  // The source id of an imported outline on the whole row: its column may be scrolled off.
+  if (role == Qt::ToolTipRole && !b.sourceId.empty()) return tr("Source id: %1").arg(QString::fromStdString(b.sourceId));
   if (role != Qt::DisplayRole) return {};
   switch (index.column()) {
     case Id: return b.id;

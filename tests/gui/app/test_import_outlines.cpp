@@ -117,6 +117,8 @@ class ImportOutlinesTest : public QObject {
     QVERIFY(!table->isColumnHidden(gui::BuildingsModel::SourceId));
     QCOMPARE(table->model()->data(table->model()->index(1, gui::BuildingsModel::SourceId)).toString(),
              QStringLiteral("102"));
+    QCOMPARE(table->model()->data(table->model()->index(1, gui::BuildingsModel::Status), Qt::ToolTipRole).toString(),
+             QStringLiteral("Source id: 102"));
     // One undo removes both, one redo brings them back.
     QCOMPARE(doc()->undoStack()->undoText(), QStringLiteral("Import 2 outline(s)"));
     act("actionUndo")->trigger();
