@@ -2187,10 +2187,6 @@ Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_ga
         <translation>Délimitez-les avec Bâtiment → Délimiter les bâtiments en attente.</translation>
     </message>
     <message>
-        <source>No outline lies on the left image: are the file&apos;s coordinates in the left image&apos;s coordinate reference system?</source>
-        <translation>Aucun contour ne se trouve sur l’image gauche : les coordonnées du fichier sont-elles dans le système de référence de l’image gauche ?</translation>
-    </message>
-    <message>
         <source>No outline lies on the left image: it has no georeferencing, so the file&apos;s coordinates are read as its pixels. Are they?</source>
         <translation>Aucun contour ne se trouve sur l’image gauche : elle n’est pas géoréférencée, les coordonnées du fichier sont donc lues comme ses pixels. En sont-elles ?</translation>
     </message>
@@ -2205,6 +2201,10 @@ Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_ga
     <message>
         <source>%1 holds no polygon.</source>
         <translation>%1 ne contient aucun polygone.</translation>
+    </message>
+    <message>
+        <source>No outline lies on the left image: are the file&apos;s coordinates in the coordinate reference system it declares, or in the left image&apos;s when it declares none?</source>
+        <translation>Aucun contour ne se trouve sur l’image gauche : les coordonnées du fichier sont-elles dans le système de référence qu’il déclare, ou dans celui de l’image gauche s’il n’en déclare aucun ?</translation>
     </message>
 </context>
 <context>

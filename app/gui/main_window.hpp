@@ -155,12 +155,13 @@ class MainWindow : public QMainWindow {
   widgets::JobId exportElevationRasters(const QString& dir);
 
   // ---- outlines from elsewhere (main_window_import.cpp) ----
-  // File → Import outlines of `path` (GeoJSON, GeoPackage, Shapefile; map coordinates in the left
-  // image's CRS, or its pixels when it has no georeferencing): the operator chooses the attribute
-  // kept as each building's source id, then the outlines on the left image that are not buildings
-  // yet become pending buildings in one undoable step, and a message says how many and why the
-  // others were left out. Returns the number added; -1 when the file cannot be read or the
-  // operator cancels (a message says why).
+  // File → Import outlines of `path` (GeoJSON, GeoPackage, Shapefile, read by io::readFeatures
+  // with the left image's georeferencing: in the CRS the file declares, else the image's, or its
+  // pixels when it has no georeferencing): the operator chooses the attribute kept as each
+  // building's source id, then the outlines on the left image that are not buildings yet become
+  // pending buildings in one undoable step, and a message says how many and why the others were
+  // left out. Returns the number added; -1 when the file cannot be read or the operator cancels
+  // (a message says why).
   int importOutlines(const QString& path);
 
   // ---- accessors for tests and the screenshot tour ----

@@ -120,7 +120,8 @@ QString MainWindow::importSummaryText(const QString& file, const project::Import
   if (summary.outsideImage == summary.read) {
     text += QLatin1Char(' ') + (document_->pair().geo.valid()
                                     ? tr("No outline lies on the left image: are the file's coordinates in the "
-                                         "left image's coordinate reference system?")
+                                         "coordinate reference system it declares, or in the left image's when it "
+                                         "declares none?")
                                     : tr("No outline lies on the left image: it has no georeferencing, so the "
                                          "file's coordinates are read as its pixels. Are they?"));
   }

@@ -194,8 +194,8 @@ class ImportOutlinesTest : public QObject {
     io::writeFeatures(pixels.toStdString(), {square(40, 30, 20, 6)});
     QCOMPARE(window_->importOutlines(pixels), 0);
     QVERIFY2(window_->lastMessage().contains(QStringLiteral(
-                 "No outline lies on the left image: are the file's coordinates in the left image's coordinate "
-                 "reference system?")),
+                 "No outline lies on the left image: are the file's coordinates in the coordinate reference "
+                 "system it declares, or in the left image's when it declares none?")),
              qPrintable(window_->lastMessage()));
   }
 
