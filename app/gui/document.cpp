@@ -19,24 +19,11 @@ using project::Building;
 using project::BuildingStatus;
 
 namespace {
-cv::Mat toDisplayGrey(const cv::Mat& grey) {
-  // Stretch the finite range to 0..255 for display; the read-out uses the same scale as the
-  // file for 8-bit images, which is the common case.
-  double lo = 0, hi = 255;
-  cv::Mat finiteMask = grey == grey;  // NaN != NaN
-  cv::minMaxLoc(grey, &lo, &hi, nullptr, nullptr, finiteMask);
-  cv::Mat out;
-  if (lo >= 0 && hi <= 255) {
-    grey.convertTo(out, CV_8U);
-  } else {
-    const double scale = hi > lo ? 255.0 / (hi - lo) : 1.0;
-    grey.convertTo(out, CV_8U, scale, -lo * scale);
-  }
-  return out;
-}
+// The grey image as 8-bit for display (io::stretchTo8Bit: 8-bit values as they are).
+cv::Mat toDisplayGrey(const cv::Mat& grey) { return io::stretchTo8Bit(grey); }
 
 // A BGR 8-bit copy of a colour raster (io::readImage8: the first three bands as R, G, B, deeper
-// values stretched to 0..255) for display; empty for a grey one.
+// values stretched) for display; empty for a grey one.
 cv::Mat toDisplayColour(const std::string& path) {
   cv::Mat image = io::readImage8(path);
   return image.channels() == 3 ? image : cv::Mat();

@@ -1,11 +1,14 @@
 #include "delineo/io/raster.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <cpl_conv.h>
@@ -305,39 +308,64 @@ cv::Mat readGreyFloat(const std::string& path, GeoReference* geo) {
   return raster.data;
 }
 
-cv::Mat readImage8(const std::string& path) {
-  ReadOptions options;
-  options.type = PixelType::Float32;
-  const Raster raster = readRaster(path, options);
-  cv::Mat values;
-  if (raster.data.channels() >= 3) {
-    std::vector<cv::Mat> bands;
-    cv::split(raster.data, bands);
-    const std::vector<cv::Mat> bgr{bands[2], bands[1], bands[0]};  // a fourth band is not read
-    cv::merge(bgr, values);
-  } else {
-    values = raster.data;  // one band (two-band rasters are refused by readRaster)
+namespace {
+// The values at quantiles `low` and `high` of the finite values of every band of `values`
+// (CV_32F), read on at most about a million of them taken at a regular stride.
+std::pair<double, double> finiteQuantiles(const cv::Mat& values, double low, double high) {
+  const cv::Mat flat = values.isContinuous() ? values.reshape(1, 1) : values.clone().reshape(1, 1);
+  const size_t total = flat.total();
+  const size_t stride = std::max<size_t>(1, total / 1000000);
+  std::vector<float> samples;
+  samples.reserve(total / stride + 1);
+  const float* data = flat.ptr<float>();
+  for (size_t i = 0; i < total; i += stride) {
+    if (std::isfinite(data[i])) samples.push_back(data[i]);
   }
+  if (samples.empty()) return {0.0, 0.0};
+  auto at = [&](double q) {
+    const auto k = samples.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(samples.size() - 1));
+    std::nth_element(samples.begin(), k, samples.end());
+    return static_cast<double>(*k);
+  };
+  return {at(low), at(high)};
+}
+}  // namespace
+
+cv::Mat stretchTo8Bit(const cv::Mat& values) {
+  CV_Assert(values.depth() == CV_32F);
   const cv::Mat finiteBands = (values == values);  // NaN != NaN, per band
-  const cv::Mat finite = finiteBands.reshape(1);
   double lo = 0.0, hi = 255.0;
-  cv::minMaxLoc(values.reshape(1), &lo, &hi, nullptr, nullptr, finite);
+  cv::minMaxLoc(values.reshape(1), &lo, &hi, nullptr, nullptr, finiteBands.reshape(1));
   if (lo >= 0.0 && hi <= 255.0) {
     lo = 0.0, hi = 255.0;  // 8-bit values keep their grey levels
-  } else if (!(hi > lo)) {
-    hi = lo + 1.0;
+  } else {
+    std::tie(lo, hi) = finiteQuantiles(values, kStretchLowQuantile, 1.0 - kStretchLowQuantile);
+    if (!(hi > lo)) hi = lo + 1.0;
   }
   cv::Mat finiteAll = finiteBands;
   if (finiteAll.channels() > 1) {
     std::vector<cv::Mat> parts;
     cv::split(finiteAll, parts);
-    finiteAll = parts[0] & parts[1] & parts[2];
+    finiteAll = parts[0];
+    for (size_t b = 1; b < parts.size(); ++b) finiteAll &= parts[b];
   }
   const double scale = 255.0 / (hi - lo);
   cv::Mat out;
-  values.convertTo(out, CV_8U, scale, -lo * scale);
+  values.convertTo(out, CV_8U, scale, -lo * scale);  // saturates outside lo..hi
   out.setTo(cv::Scalar::all(0), finiteAll == 0);
   return out;
+}
+
+cv::Mat readImage8(const std::string& path) {
+  ReadOptions options;
+  options.type = PixelType::Float32;
+  const Raster raster = readRaster(path, options);
+  if (raster.data.channels() < 3) return stretchTo8Bit(raster.data);  // two-band rasters are refused by readRaster
+  std::vector<cv::Mat> bands;
+  cv::split(raster.data, bands);
+  cv::Mat bgr;
+  cv::merge(std::vector<cv::Mat>{bands[2], bands[1], bands[0]}, bgr);  // a fourth band is not read
+  return stretchTo8Bit(bgr);
 }
 
 cv::Mat readMask(const std::string& path, cv::Size expected) {

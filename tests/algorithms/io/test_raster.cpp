@@ -496,3 +496,39 @@ TEST(RasterIoErrors, WriteFailures) {
 
 }  // namespace
 }  // namespace delineo::io
+
+TEST(StretchTo8Bit, EightBitValuesKeepTheirGreyLevels) {
+  cv::Mat values(4, 4, CV_32F);
+  for (int i = 0; i < 16; ++i) values.at<float>(i / 4, i % 4) = static_cast<float>(i * 17);
+  values.at<float>(0, 0) = std::numeric_limits<float>::quiet_NaN();
+  const cv::Mat out = delineo::io::stretchTo8Bit(values);
+  ASSERT_EQ(out.type(), CV_8UC1);
+  EXPECT_EQ(out.at<uchar>(0, 0), 0) << "nodata is black";
+  EXPECT_EQ(out.at<uchar>(3, 3), 255);
+  EXPECT_EQ(out.at<uchar>(1, 2), 6 * 17);
+}
+
+TEST(StretchTo8Bit, AFewHotPixelsOfADeepImageDoNotDarkenTheRest) {
+  // An 11-bit image spread over 100..1100, with 0.1 % of its pixels at 2047 (saturated sensor).
+  cv::Mat values(100, 100, CV_32F);
+  cv::randu(values, 100.0f, 1100.0f);
+  for (int i = 0; i < 10; ++i) values.at<float>(i * 7, i * 9) = 2047.0f;
+  const cv::Mat out = delineo::io::stretchTo8Bit(values);
+  cv::Mat inside = values < 1100.0f;
+  // Within the bulk the stretch spans nearly the whole 8-bit range: the mid value lands mid-grey.
+  EXPECT_NEAR(cv::mean(out, inside)[0], 127.5, 6.0);
+  EXPECT_EQ(out.at<uchar>(0, 0), 255) << "a hot pixel saturates";
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(out, &lo, &hi, nullptr, nullptr, inside);
+  EXPECT_LE(lo, 2);
+  EXPECT_GE(hi, 250);
+}
+
+TEST(StretchTo8Bit, BandsShareOneRangeSoColoursKeepTheirBalance) {
+  cv::Mat values(10, 10, CV_32FC3, cv::Scalar(1000, 2000, 3000));
+  values.at<cv::Vec3f>(0, 0) = cv::Vec3f(500, 500, 500);
+  values.at<cv::Vec3f>(1, 1) = cv::Vec3f(3500, 3500, 3500);
+  const cv::Vec3b pixel = delineo::io::stretchTo8Bit(values).at<cv::Vec3b>(5, 5);
+  EXPECT_LT(pixel[0], pixel[1]);
+  EXPECT_LT(pixel[1], pixel[2]);
+}

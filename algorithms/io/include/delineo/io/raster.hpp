@@ -49,9 +49,16 @@ Raster readRaster(const std::string& path, const ReadOptions& options = {});
 cv::Mat readGreyFloat(const std::string& path, GeoReference* geo = nullptr);
 
 // Reads an image for its colours: CV_8UC3 BGR for a raster of 3 or more bands (the first three
-// read as R, G, B), else CV_8UC1 grey. Deeper or float values are stretched from their finite
-// range to 0..255; nodata becomes 0. Throws like readRaster.
+// read as R, G, B), else CV_8UC1 grey, through stretchTo8Bit(). Throws like readRaster.
 cv::Mat readImage8(const std::string& path);
+
+// Share of the finite values left darker than black, and brighter than white, by stretchTo8Bit().
+inline constexpr double kStretchLowQuantile = 0.005;
+// CV_32F values (any number of bands) as 8-bit for display and radiometry: values within 0..255
+// keep their grey levels; deeper ones (an 11- or 12-bit satellite image) are stretched from the
+// 0.5th to the 99.5th percentile of the finite values of all bands together (the colours keep
+// their balance), so that a few hot pixels do not darken the rest. NaN (nodata) becomes 0.
+cv::Mat stretchTo8Bit(const cv::Mat& values);
 
 // Reads a single-band raster as a mask of the given size: CV_8U, 255 where the value is non-zero
 // and not nodata, 0 elsewhere (exclusion masks, classifications). Throws like readRaster, and
