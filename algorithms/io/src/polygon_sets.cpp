@@ -1,5 +1,7 @@
 #include "delineo/io/polygon_sets.hpp"
 
+#include <algorithm>
+#include <limits>
 #include <memory>
 
 #include <ogr_geometry.h>
@@ -81,6 +83,65 @@ PolygonSet unionOf(const PolygonSet& a, const PolygonSet& b) {
   if (a.empty() && b.empty()) return {};
   if (a.empty()) return setOf(ogrSet(b)->UnionCascaded());
   return setOf(ogrSet(a)->Union(ogrSet(b).get()));
+}
+
+PolygonSet splitAlong(const core::Polygon& polygon, cv::Point2d from, cv::Point2d to) {
+  if (polygon.outer.size() < 3 || cv::norm(to - from) <= 0.0) return {};
+  detail::ScopedGdalErrors quiet;
+  OGRLineString line;
+  line.addPoint(from.x, from.y);
+  line.addPoint(to.x, to.y);
+  const GeometryPtr blade(line.Buffer(kSplitWidth / 2.0, 1));
+  if (!blade) throw core::Error(core::ErrorCode::ProcessingFailed, "a polygon operation failed (GDAL without GEOS?)");
+  PolygonSet pieces = setOf(ogrSet({polygon})->Difference(blade.get()));
+  if (pieces.size() < 2) return {};
+  std::sort(pieces.begin(), pieces.end(), [](const auto& x, const auto& y) { return core::area(x) > core::area(y); });
+  return pieces;
+}
+
+namespace {
+cv::Point2d nearestOnSegment(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
+  const cv::Point2d ab = b - a;
+  const double length2 = ab.dot(ab);
+  const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return a + t * ab;
+}
+
+// `polygon` with each vertex within `reach` of a ring of `onto` moved to the nearest point there.
+core::Polygon snappedOnto(core::Polygon polygon, const core::Polygon& onto, double reach) {
+  std::vector<const core::Ring*> rings{&onto.outer};
+  for (const auto& hole : onto.holes) rings.push_back(&hole);
+  auto snap = [&](cv::Point2d& p) {
+    double best = reach;
+    cv::Point2d to = p;
+    for (const core::Ring* ring : rings) {
+      for (size_t i = 0; i < ring->size(); ++i) {
+        const cv::Point2d q = nearestOnSegment(p, (*ring)[i], (*ring)[(i + 1) % ring->size()]);
+        if (const double d = cv::norm(q - p); d <= best) best = d, to = q;
+      }
+    }
+    p = to;
+  };
+  for (auto& p : polygon.outer) snap(p);
+  for (auto& hole : polygon.holes) {
+    for (auto& p : hole) snap(p);
+  }
+  return polygon;
+}
+
+std::optional<core::Polygon> singlePolygon(const PolygonSet& set) {
+  if (set.size() != 1) return std::nullopt;
+  return set.front();
+}
+}  // namespace
+
+std::optional<core::Polygon> mergedOutline(const core::Polygon& a, const core::Polygon& b, double maxGap) {
+  if (a.outer.size() < 3 || b.outer.size() < 3) return std::nullopt;
+  if (auto merged = singlePolygon(unionOf({a}, {b}))) return merged;
+  if (!(maxGap > 0.0)) return std::nullopt;
+  const core::Polygon bOnA = snappedOnto(b, a, maxGap);
+  if (auto merged = singlePolygon(unionOf({a}, {bOnA}))) return merged;
+  return singlePolygon(unionOf({snappedOnto(a, bOnA, maxGap)}, {bOnA}));
 }
 
 double sharedBorderLength(const core::Polygon& a, const core::Polygon& b, double tolerance) {
