@@ -99,6 +99,8 @@ class MainWindow : public QMainWindow {
   // undoable step per building), so a cancel keeps those done. Returns the job id, or 0 with a
   // message saying why nothing started.
   widgets::JobId outlinePendingBuildings();
+  // Accept (A) and Reject (X) the selected building; with Building → Next after accepting or
+  // rejecting on, the next building to review is selected then (selectNextToReview).
   void acceptSelected();
   void rejectSelected();
   void autosaveNow();
@@ -163,6 +165,16 @@ class MainWindow : public QMainWindow {
   // left out. Returns the number added; -1 when the file cannot be read or the operator cancels
   // (a message says why).
   int importOutlines(const QString& path);
+
+  // ---- reviewing the outlines (main_window_review.cpp) ----
+  // Building → Next / Previous building to review (N, Shift+N; step +1 or -1): from the selected
+  // building, in the buildings list's order and wrapping, the next one whose outline awaits a
+  // decision (automatic or corrected), else the next pending one. It is selected as a click in
+  // the list selects it, and the left view zooms out to frame it when it does not fit at the
+  // current zoom. Returns its id, or -1 with "review complete" in the status bar when none is left.
+  int selectNextToReview(int step);
+  // The status bar's count of the buildings to review, accepted and rejected.
+  QLabel* reviewProgress() const { return reviewProgress_; }
 
   // ---- accessors for tests and the screenshot tour ----
   widgets::ImageView* leftView() const { return leftView_; }
@@ -295,6 +307,7 @@ class MainWindow : public QMainWindow {
   void createFileActions();
   void createToolActions();
   void createBuildingActions();
+  void createReviewActions();
   void createEditActions();
   void createViewActions();
   void createMenus();
@@ -319,6 +332,13 @@ class MainWindow : public QMainWindow {
   void onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description);
   void reopenSelected();
   void removeSelected();
+
+  // main_window_review.cpp: the next building to review, the review's progress.
+  int nextToReview(int step) const;
+  void frameInLeftView(int id);
+  void advanceAfterDecision();
+  QString reviewProgressText() const;
+  void refreshReviewProgress();
 
   // main_window_jobs.cpp: the background jobs (the others are public).
   void startEdgeMap();
@@ -397,6 +417,7 @@ class MainWindow : public QMainWindow {
   QTableView* buildingsTable_ = nullptr;
   BuildingsModel* buildingsModel_ = nullptr;
   QLabel* readout_ = nullptr;
+  QLabel* reviewProgress_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QActionGroup* toolGroup_ = nullptr;
   QTimer autosaveTimer_;

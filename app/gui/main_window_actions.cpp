@@ -46,6 +46,7 @@ void MainWindow::createActions() {
   createFileActions();
   createToolActions();
   createBuildingActions();
+  createReviewActions();
   createEditActions();
   createViewActions();
   createSceneActions();
@@ -123,7 +124,8 @@ void MainWindow::createToolActions() {
     connect(a, &QAction::triggered, this, [this, mode] { leftView_->setInteractionMode(mode); });
     return a;
   };
-  tool(QStringLiteral("actionNavigate"), tr("&Navigate"), QStringLiteral("N"), InteractionMode::Navigate,
+  // V, as the selection tool of drawing programs: N goes to the next building to review.
+  tool(QStringLiteral("actionNavigate"), tr("&Navigate"), QStringLiteral("V"), InteractionMode::Navigate,
        tr("Pan with the mouse, zoom with the wheel, click a building to select it"))->setChecked(true);
   tool(QStringLiteral("actionPickRectangle"), tr("Pick with a &rectangle"), QStringLiteral("B"),
        InteractionMode::PickRectangle, tr("Drag a rectangle around a building"));
@@ -196,6 +198,27 @@ void MainWindow::createBuildingActions() {
   connect(makeAction(this, QStringLiteral("actionCancelJobs"), tr("&Cancel running jobs"),
                      QKeySequence(Qt::Key_Escape)),
           &QAction::triggered, jobs_, &widgets::JobRunner::cancelAll);
+}
+
+// Going through the buildings to review (main_window_review.cpp), and whether a decision on one
+// goes on to the next.
+void MainWindow::createReviewActions() {
+  QAction* next = makeAction(this, QStringLiteral("actionNextToReview"), tr("Ne&xt building to review"),
+                             QKeySequence(QStringLiteral("N")));
+  next->setStatusTip(tr("Select the next building whose outline awaits a decision (automatic or corrected), "
+                        "else the next pending one"));
+  connect(next, &QAction::triggered, this, [this] { selectNextToReview(1); });
+  QAction* previous = makeAction(this, QStringLiteral("actionPreviousToReview"), tr("Pre&vious building to review"),
+                                 QKeySequence(QStringLiteral("Shift+N")));
+  previous->setStatusTip(tr("Select the previous building whose outline awaits a decision (automatic or "
+                            "corrected), else the previous pending one"));
+  connect(previous, &QAction::triggered, this, [this] { selectNextToReview(-1); });
+  QAction* onDecision = makeAction(this, QStringLiteral("actionNextAfterDecision"), tr("Next a&fter accepting or rejecting"));
+  onDecision->setCheckable(true);
+  onDecision->setChecked(QSettings().value(QStringLiteral("review/nextAfterDecision"), true).toBool());
+  onDecision->setStatusTip(tr("After Accept or Reject, select the next building to review"));
+  connect(onDecision, &QAction::toggled, this,
+          [](bool on) { QSettings().setValue(QStringLiteral("review/nextAfterDecision"), on); });
 }
 
 // Undo, redo and the snapping of edited outlines.
@@ -312,6 +335,10 @@ void MainWindow::createMenus() {
   building->addAction(action(QStringLiteral("actionReopen")));
   building->addAction(action(QStringLiteral("actionRemove")));
   building->addSeparator();
+  building->addAction(action(QStringLiteral("actionNextToReview")));
+  building->addAction(action(QStringLiteral("actionPreviousToReview")));
+  building->addAction(action(QStringLiteral("actionNextAfterDecision")));
+  building->addSeparator();
   building->addAction(action(QStringLiteral("actionDetectBuildings")));
   building->addAction(action(QStringLiteral("actionOutlinePending")));
 
@@ -398,6 +425,8 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionReopen"))->setEnabled(
       b != nullptr && (b->status == BuildingStatus::Accepted || b->status == BuildingStatus::Rejected));
   action(QStringLiteral("actionRemove"))->setEnabled(b != nullptr);
+  action(QStringLiteral("actionNextToReview"))->setEnabled(hasDoc);
+  action(QStringLiteral("actionPreviousToReview"))->setEnabled(hasDoc);
   action(QStringLiteral("actionCancelJobs"))->setEnabled(jobs_->activeCount() > 0);
   QUndoStack* stack = hasDoc ? document_->undoStack() : nullptr;
   QAction* undo = action(QStringLiteral("actionUndo"));

@@ -92,10 +92,13 @@ void MainWindow::acceptSelected() {
   const Building* b = document_->project().find(selectedId_);
   if (b == nullptr || !b->hasOutline()) return;
   document_->setStatus(selectedId_, BuildingStatus::Accepted);
+  advanceAfterDecision();
 }
 
 void MainWindow::rejectSelected() {
-  if (document_ && selectedId_ > 0) document_->setStatus(selectedId_, BuildingStatus::Rejected);
+  if (!document_ || document_->project().find(selectedId_) == nullptr) return;
+  document_->setStatus(selectedId_, BuildingStatus::Rejected);
+  advanceAfterDecision();
 }
 
 void MainWindow::reopenSelected() {

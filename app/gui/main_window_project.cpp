@@ -168,6 +168,7 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
   refreshHistogram();
   refresh3D();
   refreshTitle();
+  refreshReviewProgress();
   updateActions();
   emit documentOpened();
   startEdgeMap();
@@ -179,6 +180,8 @@ void MainWindow::installDocument(std::unique_ptr<Document> document) {
 
 // What the views do when the document changes.
 void MainWindow::connectDocument(Document* doc) {
+  connect(doc, &Document::buildingChanged, this, &MainWindow::refreshReviewProgress);
+  connect(doc, &Document::buildingsReset, this, &MainWindow::refreshReviewProgress);
   connect(doc, &Document::buildingChanged, this, [this](int id) {
     if (document_->project().find(id) == nullptr) boxFitProposals_.erase(id);
     refreshOverlays();

@@ -111,6 +111,9 @@ void MainWindow::createViews() {
   auto* progress = new widgets::JobProgressWidget(jobs_);
   progress->setObjectName(QStringLiteral("jobProgress"));
   statusBar()->addPermanentWidget(progress);
+  reviewProgress_ = new QLabel;
+  reviewProgress_->setObjectName(QStringLiteral("reviewProgress"));
+  statusBar()->addPermanentWidget(reviewProgress_);
 }
 
 void MainWindow::refreshRasters() {
