@@ -2206,6 +2206,66 @@ Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_ga
         <source>No outline lies on the left image: are the file&apos;s coordinates in the coordinate reference system it declares, or in the left image&apos;s when it declares none?</source>
         <translation>Aucun contour ne se trouve sur l’image gauche : les coordonnées du fichier sont-elles dans le système de référence qu’il déclare, ou dans celui de l’image gauche s’il n’en déclare aucun ?</translation>
     </message>
+    <message>
+        <source>Ne&amp;xt building to review</source>
+        <translation>Bâtiment à &amp;vérifier suivant</translation>
+    </message>
+    <message>
+        <source>Select the next building whose outline awaits a decision (automatic or corrected), else the next pending one</source>
+        <translation>Sélectionner le bâtiment suivant dont le contour attend une décision (automatique ou corrigé), sinon le suivant en attente</translation>
+    </message>
+    <message>
+        <source>Pre&amp;vious building to review</source>
+        <translation>Bâtiment à vérifier &amp;précédent</translation>
+    </message>
+    <message>
+        <source>Select the previous building whose outline awaits a decision (automatic or corrected), else the previous pending one</source>
+        <translation>Sélectionner le bâtiment précédent dont le contour attend une décision (automatique ou corrigé), sinon le précédent en attente</translation>
+    </message>
+    <message>
+        <source>Next a&amp;fter accepting or rejecting</source>
+        <translation>Suivant a&amp;près acceptation ou rejet</translation>
+    </message>
+    <message>
+        <source>After Accept or Reject, select the next building to review</source>
+        <translation>Après Accepter ou Rejeter, sélectionner le bâtiment suivant à vérifier</translation>
+    </message>
+    <message>
+        <source>Review complete: no building is left to review.</source>
+        <translation>Vérification terminée : il ne reste aucun bâtiment à vérifier.</translation>
+    </message>
+    <message numerus="yes">
+        <source>%n outlined</source>
+        <translation>
+            <numerusform>%n délimité</numerusform>
+            <numerusform>%n délimités</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>%n pending</source>
+        <translation>
+            <numerusform>%n en attente</numerusform>
+            <numerusform>%n en attente</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>To review: %1</source>
+        <translation>À vérifier : %1</translation>
+    </message>
+    <message numerus="yes">
+        <source>%n accepted</source>
+        <translation>
+            <numerusform>%n accepté</numerusform>
+            <numerusform>%n acceptés</numerusform>
+        </translation>
+    </message>
+    <message numerus="yes">
+        <source>%n rejected</source>
+        <translation>
+            <numerusform>%n rejeté</numerusform>
+            <numerusform>%n rejetés</numerusform>
+        </translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::ProjectSettingsDialog</name>
