@@ -49,9 +49,9 @@ inline std::unique_ptr<gui::MainWindow> showMainWindow() {
 }
 
 // Opens in `window` a pair without heights (no disparity, no DEM, no height model) written into
-// `dir`: two copies of one noise image.
-inline bool openPairWithoutHeights(gui::MainWindow& window, const QTemporaryDir& dir) {
-  cv::Mat left(120, 160, CV_8U);
+// `dir`: two copies of one noise image of `size`.
+inline bool openPairWithoutHeights(gui::MainWindow& window, const QTemporaryDir& dir, cv::Size size = {160, 120}) {
+  cv::Mat left(size, CV_8U);
   cv::randu(left, 0, 255);
   const QString l = dir.filePath(QStringLiteral("bare_left.tif"));
   const QString r = dir.filePath(QStringLiteral("bare_right.tif"));

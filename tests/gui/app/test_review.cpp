@@ -14,9 +14,7 @@
 #include <QTranslator>
 #include <QUndoStack>
 
-#include <opencv2/core.hpp>
 
-#include "delineo/io/raster.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "document.hpp"
@@ -64,17 +62,6 @@ class ReviewTest : public QObject {
     return id;
   }
 
-  // A 640 x 480 noise pair without heights.
-  bool openPair() {
-    cv::Mat image(480, 640, CV_8U);
-    cv::randu(image, 0, 255);
-    const QString left = dir_.filePath(QStringLiteral("left.tif"));
-    const QString right = dir_.filePath(QStringLiteral("right.tif"));
-    io::writeGeoTiff(left.toStdString(), image);
-    io::writeGeoTiff(right.toStdString(), image);
-    return window_->openPair(left, right);
-  }
-
   void addBuildings() {
     accepted_ = outlined(rectangle(20, 20, 40, 40));
     doc()->setStatus(accepted_, BuildingStatus::Accepted);
@@ -101,7 +88,7 @@ class ReviewTest : public QObject {
     window_ = guitest::showMainWindow();
     QVERIFY(QTest::qWaitForWindowExposed(window_.get()));
     QVERIFY(window_->reviewProgress()->text().isEmpty());
-    QVERIFY(openPair());
+    QVERIFY(guitest::openPairWithoutHeights(*window_, dir_, {640, 480}));
     QVERIFY(progress().isEmpty());  // no building yet
     addBuildings();
     QCOMPARE(static_cast<int>(doc()->project().buildings.size()), 7);
