@@ -14,7 +14,6 @@
 #include <QTranslator>
 #include <QUndoStack>
 
-
 #include "delineo/project/pipeline.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "document.hpp"
