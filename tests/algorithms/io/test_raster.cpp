@@ -15,6 +15,7 @@
 #include "delineo/core/error.hpp"
 #include "delineo/core/nan_mask.hpp"
 #include "delineo/io/raster.hpp"
+#include "epsg_wkt.hpp"
 #include "temp_dir.hpp"
 
 namespace delineo::io {
@@ -24,17 +25,6 @@ using core::ErrorCode;
 using testing::TempDir;
 
 using testing::captureError;
-
-std::string utm16Wkt() {
-  OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
-  EXPECT_EQ(OSRImportFromEPSG(srs, 32616), OGRERR_NONE);
-  char* wkt = nullptr;
-  OSRExportToWkt(srs, &wkt);
-  std::string result = wkt;
-  CPLFree(wkt);
-  OSRDestroySpatialReference(srs);
-  return result;
-}
 
 cv::Mat randomImage(int rows, int cols, int type, double low, double high, int seed) {
   cv::Mat image(rows, cols, type);
@@ -221,7 +211,7 @@ TEST(RasterIo, GeoTransformAndCrsPreserved) {
   GeoReference geo;
   geo.geoTransform = {741000.5, 0.5, 0.0, 3737000.25, 0.0, -0.5};
   geo.hasTransform = true;
-  geo.crsWkt = utm16Wkt();
+  geo.crsWkt = testing::wktOfEpsg(32616);
   writeFloatGeoTiff(dir.file("geo.tif"), cv::Mat(8, 9, CV_32FC1, cv::Scalar(1.0f)), geo);
   GeoReference readBack;
   readGreyFloat(dir.file("geo.tif"), &readBack);

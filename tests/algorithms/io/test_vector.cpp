@@ -13,6 +13,7 @@
 
 #include "delineo/core/error.hpp"
 #include "delineo/io/vector.hpp"
+#include "epsg_wkt.hpp"
 #include "temp_dir.hpp"
 
 namespace delineo::io {
@@ -20,6 +21,7 @@ namespace {
 
 using core::ErrorCode;
 using testing::TempDir;
+using testing::wktOfEpsg;
 
 using testing::captureError;
 
@@ -115,17 +117,6 @@ TEST_P(VectorRoundTrip, GeoreferencedThroughGeoTransformAndCrs) {
 
 INSTANTIATE_TEST_SUITE_P(Formats, VectorRoundTrip, ::testing::Values(".geojson", ".json", ".gpkg"),
                          [](const auto& paramInfo) { return paramInfo.param.substr(1); });
-
-std::string wktOfEpsg(int epsg) {
-  OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
-  OSRImportFromEPSG(srs, epsg);
-  char* wkt = nullptr;
-  OSRExportToWkt(srs, &wkt);
-  std::string text = wkt;
-  CPLFree(wkt);
-  OSRDestroySpatialReference(srs);
-  return text;
-}
 
 // A 0.5 m image over Toulouse in UTM 31N.
 GeoReference toulouseGeo() {
