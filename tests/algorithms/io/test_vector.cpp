@@ -69,13 +69,7 @@ GeoReference utmGeo() {
   GeoReference geo;
   geo.geoTransform = {741000.0, 0.5, 0.0, 3737000.0, 0.0, -0.5};
   geo.hasTransform = true;
-  OGRSpatialReferenceH srs = OSRNewSpatialReference(nullptr);
-  OSRImportFromEPSG(srs, 32616);
-  char* wkt = nullptr;
-  OSRExportToWkt(srs, &wkt);
-  geo.crsWkt = wkt;
-  CPLFree(wkt);
-  OSRDestroySpatialReference(srs);
+  geo.crsWkt = wktOfEpsg(32616);
   return geo;
 }
 
