@@ -304,90 +304,99 @@ cv::Mat heightsForBases(const Project& project, const cv::Mat& heights, const cv
 }
 }  // namespace
 
-RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress,
-                           const RunOptions& options) {
-  RunSummary summary;
-  // The outputs are checked before any work: never over an input of the project.
-  std::error_code mk;
-  fs::create_directories(outputDir, mk);
+namespace {
+// The files `run` may write, checked before any work: never over an input of the project.
+std::vector<io::OutputFile> runOutputs(const Project& project, const std::string& outputDir, const RunOptions& options) {
   const fs::path out(outputDir);
   std::vector<io::OutputFile> outputs{{(out / "buildings.geojson").string(), io::OutputFormat::Vector},
                                       {(out / "buildings.city.json").string(), io::OutputFormat::CityJson}};
-  if (project.disparity.empty()) {
-    outputs.push_back({(out / "disparity.tif").string(), io::OutputFormat::GeoTiff});
-  }
+  if (project.disparity.empty()) outputs.push_back({(out / "disparity.tif").string(), io::OutputFormat::GeoTiff});
   if (options.detect) {
     const std::vector<ElevationLayer> scene(std::begin(kSceneAnalysisLayers), std::end(kSceneAnalysisLayers));
     for (const io::OutputFile& file : elevationFiles(outputDir, scene)) outputs.push_back(file);
   }
-  io::checkOutputs(outputs, inputFiles(project));
-  StereoPair pair = readStereoPair(project);
-  const bool work = !project.pendingBuildings().empty() || options.detect;
-  double matchShare = project.disparity.empty() ? (work ? 0.5 : 1.0) : 0.0;
-  cv::Mat disparity;
-  if (project.disparity.empty() && !project.disparityRange) {
-    core::Progress::Range range(progress, 0.0, 0.1 * matchShare);
+  return outputs;
+}
+
+// The pair's disparity into `pair.disparity`: the project's map, or the range estimated when the
+// project has none and the map matched over `share` of the progress (written to
+// `outputDir`/disparity.tif and recorded in the project). False when canceled.
+bool ensureDisparity(Project& project, StereoPair& pair, const std::string& outputDir, core::Progress* progress,
+                     double share, RunSummary& summary) {
+  if (!project.disparity.empty()) {
+    pair.disparity = readDisparity(project, pair.left.size());
+    return true;
+  }
+  if (!project.disparityRange) {
+    core::Progress::Range range(progress, 0.0, 0.1 * share);
     const RangeOutcome estimated = estimateDisparityRange(project, pair, &range);
-    if (estimated.status == core::RunStatus::Canceled) {
-      summary.status = core::RunStatus::Canceled;
-      return summary;
-    }
+    if (estimated.status == core::RunStatus::Canceled) return false;
     project.disparityRange = estimated.range;
     summary.rangeEstimated = estimated;
   }
-  if (project.disparity.empty()) {
-    core::Progress::Range range(progress, 0.1 * matchShare, matchShare);
-    range.setStage(core::StageId::DenseMatching);
-    MatchingOutcome matched = computeDisparity(project, pair.left, pair.right, &range);
-    if (matched.status == core::RunStatus::Canceled) {
-      summary.status = core::RunStatus::Canceled;
-      return summary;
-    }
-    const std::string written = (out / "disparity.tif").string();
-    fs::create_directories(outputDir);
-    io::writeFloatGeoTiff(written, matched.disparity, pair.geo);
-    project.disparity = written;
-    disparity = matched.disparity;
-    summary.matched = true;
-  } else {
-    disparity = readDisparity(project, pair.left.size());
-  }
-  pair.disparity = disparity;
-  cv::Mat heights;  // for box-fitting, the scene analysis and the blocks' bases, read when asked for
-  cv::Mat dtm;      // the scene analysis's, the CityJSON's terrain
-  std::vector<int> pending = project.pendingBuildings();
-  if (options.detect) {
-    core::Progress::Range range(progress, matchShare, matchShare + 0.3 * (1.0 - matchShare));
-    heights = projectHeights(project, disparity);
-    if (!detectBuildings(project, heights, disparity, pair.geo, outputDir, &range, summary, dtm)) return summary;
-    pending = project.pendingBuildings();
-    matchShare += 0.3 * (1.0 - matchShare);
-  }
+  core::Progress::Range range(progress, 0.1 * share, share);
+  range.setStage(core::StageId::DenseMatching);
+  MatchingOutcome matched = computeDisparity(project, pair.left, pair.right, &range);
+  if (matched.status == core::RunStatus::Canceled) return false;
+  const std::string written = (fs::path(outputDir) / "disparity.tif").string();
+  fs::create_directories(outputDir);
+  io::writeFloatGeoTiff(written, matched.disparity, pair.geo);
+  project.disparity = written;
+  pair.disparity = matched.disparity;
+  summary.matched = true;
+  return true;
+}
+
+// Every pending building outlined with its method over [begin, 1] of the progress; a building its
+// method cannot outline is skipped with the reason. False when canceled.
+bool outlineEveryPending(Project& project, const StereoPair& pair, cv::Mat& heights, core::Progress* progress,
+                         double begin, RunSummary& summary) {
+  const std::vector<int> pending = project.pendingBuildings();
+  const double n = static_cast<double>(pending.size());
   for (size_t i = 0; i < pending.size(); ++i) {
-    const double begin = matchShare + (1.0 - matchShare) * static_cast<double>(i) / static_cast<double>(pending.size());
-    const double end = matchShare + (1.0 - matchShare) * static_cast<double>(i + 1) / static_cast<double>(pending.size());
-    core::Progress::Range range(progress, begin, end);
+    core::Progress::Range range(progress, begin + (1.0 - begin) * static_cast<double>(i) / n,
+                                begin + (1.0 - begin) * static_cast<double>(i + 1) / n);
     Building& b = *project.find(pending[i]);
     try {
-      const std::optional<Building> outlined =
-          outlinePendingBuilding(project, b, pair, heights, &range, "delineo-cli run");
-      if (!outlined) {
-        summary.status = core::RunStatus::Canceled;
-        return summary;
-      }
+      const std::optional<Building> outlined = outlinePendingBuilding(project, b, pair, heights, &range, "delineo-cli run");
+      if (!outlined) return false;
       if (outlined->method == kBoxFitting) ++summary.boxFitted;
       b = *outlined;
       ++summary.delineated;
     } catch (const Error& e) {
-      if (!core::isInputError(e.code()) || e.code() == ErrorCode::InvalidParameter) {
-        ++summary.skipped;
-        summary.messages.push_back("building " + std::to_string(b.id) + ": " + e.what());
-      } else {
-        throw;
-      }
+      if (core::isInputError(e.code()) && e.code() != ErrorCode::InvalidParameter) throw;
+      ++summary.skipped;
+      summary.messages.push_back("building " + std::to_string(b.id) + ": " + e.what());
     }
   }
-  exportRunOutputs(project, outputDir, {heightsForBases(project, heights, disparity, summary), dtm, {}}, summary);
+  return true;
+}
+}  // namespace
+
+RunSummary runPendingSteps(Project& project, const std::string& outputDir, core::Progress* progress,
+                           const RunOptions& options) {
+  RunSummary summary;
+  std::error_code mk;
+  fs::create_directories(outputDir, mk);
+  io::checkOutputs(runOutputs(project, outputDir, options), inputFiles(project));
+  StereoPair pair = readStereoPair(project);
+  const bool work = !project.pendingBuildings().empty() || options.detect;
+  double done = project.disparity.empty() ? (work ? 0.5 : 1.0) : 0.0;  // share of the progress matching takes
+  auto canceled = [&summary] {
+    summary.status = core::RunStatus::Canceled;
+    return summary;
+  };
+  if (!ensureDisparity(project, pair, outputDir, progress, done, summary)) return canceled();
+  cv::Mat heights;  // for box-fitting, the scene analysis and the blocks' bases, read when asked for
+  cv::Mat dtm;      // the scene analysis's, the CityJSON's terrain
+  if (options.detect) {
+    core::Progress::Range range(progress, done, done + 0.3 * (1.0 - done));
+    heights = projectHeights(project, pair.disparity);
+    if (!detectBuildings(project, heights, pair.disparity, pair.geo, outputDir, &range, summary, dtm)) return summary;
+    done += 0.3 * (1.0 - done);
+  }
+  if (!outlineEveryPending(project, pair, heights, progress, done, summary)) return canceled();
+  exportRunOutputs(project, outputDir, {heightsForBases(project, heights, pair.disparity, summary), dtm, {}}, summary);
   core::report(progress, 1.0);
   return summary;
 }
