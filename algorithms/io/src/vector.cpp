@@ -353,6 +353,30 @@ OGRGeometryH makeRing(const core::Ring& ring, const GeoReference& geo) {
   return result;
 }
 
+// The feature of `definition`'s layer holding `source`'s attributes (those the layer has a field
+// for) and its polygon, in map coordinates through `geo` when it is valid.
+FeaturePtr ogrFeature(OGRFeatureDefnH definition, const core::Feature& source, const GeoReference& geo) {
+  FeaturePtr feature(OGR_F_Create(definition));
+  for (const auto& [name, value] : source.attributes) {
+    const int fieldIndex = OGR_F_GetFieldIndex(feature.get(), name.c_str());
+    if (fieldIndex < 0) continue;
+    if (std::holds_alternative<std::monostate>(value)) {
+      OGR_F_SetFieldNull(feature.get(), fieldIndex);
+    } else if (const auto* integer = std::get_if<long long>(&value)) {
+      OGR_F_SetFieldInteger64(feature.get(), fieldIndex, *integer);
+    } else if (const auto* real = std::get_if<double>(&value)) {
+      OGR_F_SetFieldDouble(feature.get(), fieldIndex, *real);
+    } else {
+      OGR_F_SetFieldString(feature.get(), fieldIndex, std::get<std::string>(value).c_str());
+    }
+  }
+  OGRGeometryH polygon = OGR_G_CreateGeometry(wkbPolygon);
+  OGR_G_AddGeometryDirectly(polygon, makeRing(source.polygon.outer, geo));
+  for (const auto& hole : source.polygon.holes) OGR_G_AddGeometryDirectly(polygon, makeRing(hole, geo));
+  OGR_F_SetGeometryDirectly(feature.get(), polygon);
+  return feature;
+}
+
 // Writes the file at `path` itself; writeFeatures() points it at a temporary file.
 void writeFeaturesAt(const std::string& path, const std::vector<core::Feature>& features,
                      const GeoReference& geo, const std::string& layerName) {
@@ -397,8 +421,7 @@ void writeFeaturesAt(const std::string& path, const std::vector<core::Feature>& 
   OGRLayerH layer = GDALDatasetCreateLayer(ds, layerName.c_str(), srs.get(), wkbPolygon, nullptr);
   if (layer == nullptr) fail("cannot create layer '" + layerName + "'");
 
-  const auto schema = fieldSchema(features);
-  for (const auto& [name, kind] : schema) {
+  for (const auto& [name, kind] : fieldSchema(features)) {
     const OGRFieldType type = kind == FieldKind::Integer ? OFTInteger64 : kind == FieldKind::Real ? OFTReal : OFTString;
     OGRFieldDefnH field = OGR_Fld_Create(name.c_str(), type);
     const OGRErr status = OGR_L_CreateField(layer, field, TRUE);
@@ -410,28 +433,8 @@ void writeFeaturesAt(const std::string& path, const std::vector<core::Feature>& 
   const bool inTransaction = GDALDatasetStartTransaction(ds, FALSE) == OGRERR_NONE;
   OGRFeatureDefnH definition = OGR_L_GetLayerDefn(layer);
   for (size_t i = 0; i < features.size(); ++i) {
-    const core::Feature& source = features[i];
-    FeaturePtr feature(OGR_F_Create(definition));
-    for (const auto& [name, value] : source.attributes) {
-      const int fieldIndex = OGR_F_GetFieldIndex(feature.get(), name.c_str());
-      if (fieldIndex < 0) continue;
-      if (std::holds_alternative<std::monostate>(value)) {
-        OGR_F_SetFieldNull(feature.get(), fieldIndex);
-      } else if (const auto* integer = std::get_if<long long>(&value)) {
-        OGR_F_SetFieldInteger64(feature.get(), fieldIndex, *integer);
-      } else if (const auto* real = std::get_if<double>(&value)) {
-        OGR_F_SetFieldDouble(feature.get(), fieldIndex, *real);
-      } else {
-        OGR_F_SetFieldString(feature.get(), fieldIndex, std::get<std::string>(value).c_str());
-      }
-    }
-    OGRGeometryH polygon = OGR_G_CreateGeometry(wkbPolygon);
-    OGR_G_AddGeometryDirectly(polygon, makeRing(source.polygon.outer, geo));
-    for (const auto& hole : source.polygon.holes) OGR_G_AddGeometryDirectly(polygon, makeRing(hole, geo));
-    OGR_F_SetGeometryDirectly(feature.get(), polygon);
-    if (OGR_L_CreateFeature(layer, feature.get()) != OGRERR_NONE) {
-      fail("cannot write feature " + std::to_string(i));
-    }
+    const FeaturePtr feature = ogrFeature(definition, features[i], geo);
+    if (OGR_L_CreateFeature(layer, feature.get()) != OGRERR_NONE) fail("cannot write feature " + std::to_string(i));
   }
   if (inTransaction && GDALDatasetCommitTransaction(ds) != OGRERR_NONE) fail("cannot commit the features");
   errors.reset();
