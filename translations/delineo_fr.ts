@@ -961,6 +961,14 @@
             <numerusform>Importer %n contours</numerusform>
         </translation>
     </message>
+    <message>
+        <source>Split building %1</source>
+        <translation>Scinder le bâtiment %1</translation>
+    </message>
+    <message>
+        <source>Merge buildings %1 and %2</source>
+        <translation>Fusionner les bâtiments %1 et %2</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::MainWindow</name>
@@ -2265,6 +2273,57 @@ Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_ga
             <numerusform>%n rejeté</numerusform>
             <numerusform>%n rejetés</numerusform>
         </translation>
+    </message>
+    <message>
+        <source>&amp;Split building</source>
+        <translation>S&amp;cinder le bâtiment</translation>
+    </message>
+    <message>
+        <source>Drag a line across the selected building (or click its two ends) to cut it in two</source>
+        <translation>Tracez une ligne à travers le bâtiment sélectionné (ou cliquez sur ses deux extrémités) pour le couper en deux</translation>
+    </message>
+    <message>
+        <source>Click another building to merge it into the selected one; Esc cancels</source>
+        <translation>Cliquez sur un autre bâtiment pour le fusionner avec le bâtiment sélectionné ; Échap annule</translation>
+    </message>
+    <message>
+        <source>Merge b&amp;uildings</source>
+        <translation>Fusionner &amp;les bâtiments</translation>
+    </message>
+    <message>
+        <source>Merge the second of the two buildings selected in the Buildings list into the first</source>
+        <translation>Fusionner le second des deux bâtiments sélectionnés dans la liste des bâtiments avec le premier</translation>
+    </message>
+    <message>
+        <source>Building %1 was not split: %2</source>
+        <translation>Le bâtiment %1 n’a pas été scindé : %2</translation>
+    </message>
+    <message numerus="yes">
+        <source>Building %1 split into %n buildings.</source>
+        <translation>
+            <numerusform>Bâtiment %1 scindé en %n bâtiment.</numerusform>
+            <numerusform>Bâtiment %1 scindé en %n bâtiments.</numerusform>
+        </translation>
+    </message>
+    <message>
+        <source>Click the building to merge into building %1 (Esc: cancel).</source>
+        <translation>Cliquez sur le bâtiment à fusionner avec le bâtiment %1 (Échap : annuler).</translation>
+    </message>
+    <message>
+        <source>Click another building to merge into building %1 (Esc: cancel).</source>
+        <translation>Cliquez sur un autre bâtiment à fusionner avec le bâtiment %1 (Échap : annuler).</translation>
+    </message>
+    <message>
+        <source>Buildings %1 and %2 were not merged: %3</source>
+        <translation>Les bâtiments %1 et %2 n’ont pas été fusionnés : %3</translation>
+    </message>
+    <message>
+        <source>Building %1 merged into building %2.</source>
+        <translation>Bâtiment %1 fusionné avec le bâtiment %2.</translation>
+    </message>
+    <message>
+        <source>Merge &amp;with…</source>
+        <translation>&amp;Fusionner avec…</translation>
     </message>
 </context>
 <context>

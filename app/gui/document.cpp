@@ -117,18 +117,22 @@ std::vector<int> Document::addProposedBuildings(const std::vector<core::Feature>
                                                 std::vector<std::string>* problems) {
   project::Project after = project_;
   const std::vector<int> ids = project::addProposedBuildings(after, proposals, "delineo", problems);
-  pushAddedBuildings(after, ids, tr("Detect %n building(s)", nullptr, static_cast<int>(ids.size())));
+  pushBuildings(after, ids, tr("Detect %n building(s)", nullptr, static_cast<int>(ids.size())));
   return ids;
 }
 
-void Document::pushAddedBuildings(const project::Project& after, const std::vector<int>& ids, const QString& text) {
+void Document::pushBuildings(const project::Project& after, const std::vector<int>& ids, const QString& text) {
   if (ids.empty()) return;
-  BuildingsCommand::States before, added;
+  const auto state = [](const project::Project& p, int id) {
+    const Building* b = p.find(id);
+    return b != nullptr ? std::optional<Building>(*b) : std::nullopt;
+  };
+  BuildingsCommand::States before, changed;
   for (int id : ids) {
-    before[id] = std::nullopt;
-    added[id] = *after.find(id);
+    before[id] = state(project_, id);
+    changed[id] = state(after, id);
   }
-  undo_.push(new BuildingsCommand(this, std::move(before), std::move(added), text));
+  undo_.push(new BuildingsCommand(this, std::move(before), std::move(changed), text));
 }
 
 project::ImportSummary Document::importOutlines(const std::vector<core::Feature>& features,
@@ -137,9 +141,23 @@ project::ImportSummary Document::importOutlines(const std::vector<core::Feature>
   project::ImportOptions withOrigin = options;
   withOrigin.origin = "delineo";
   const project::ImportSummary summary = project::importOutlines(after, features, pair_.left.size(), withOrigin);
-  pushAddedBuildings(after, summary.added,
+  pushBuildings(after, summary.added,
                      tr("Import %n outline(s)", nullptr, static_cast<int>(summary.added.size())));
   return summary;
+}
+
+project::BuildingEdit Document::splitBuilding(int id, cv::Point2d from, cv::Point2d to) {
+  project::Project after = project_;
+  const project::BuildingEdit edit = project::splitBuilding(after, id, from, to, disparity_, "delineo");
+  pushBuildings(after, edit.ids, tr("Split building %1").arg(id));
+  return edit;
+}
+
+project::BuildingEdit Document::mergeBuildings(int id, int other) {
+  project::Project after = project_;
+  const project::BuildingEdit edit = project::mergeBuildings(after, id, other, disparity_, "delineo");
+  if (edit.done()) pushBuildings(after, {id, other}, tr("Merge buildings %1 and %2").arg(id).arg(other));
+  return edit;
 }
 
 void Document::removeBuilding(int id) {

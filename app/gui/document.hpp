@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "delineo/io/raster.hpp"
+#include "delineo/project/building_edits.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/project/project.hpp"
 
@@ -76,6 +77,12 @@ class Document : public QObject {
   // no outline is added. Throws like project::importOutlines.
   project::ImportSummary importOutlines(const std::vector<core::Feature>& features,
                                         const project::ImportOptions& options);
+  // Building `id` cut along the segment from `from` to `to` (left-image pixels) by
+  // project::splitBuilding with the disparity map, in one undoable step; a refusal changes nothing.
+  project::BuildingEdit splitBuilding(int id, cv::Point2d from, cv::Point2d to);
+  // Building `other` merged into building `id` by project::mergeBuildings with the disparity map,
+  // in one undoable step; a refusal changes nothing.
+  project::BuildingEdit mergeBuildings(int id, int other);
   void setStatus(int id, project::BuildingStatus status);
   void setRoofInterval(int id, project::DisparityInterval interval);
   void setParameters(const std::string& group, const nlohmann::json& values);
@@ -140,8 +147,9 @@ class Document : public QObject {
   void deriveDem();
   void setExtraDirty(bool dirty);
   void pushSettings(const Settings& after, const QString& description);
-  // The buildings `ids` of `after` (a copy of the project they were added to) as one undo step.
-  void pushAddedBuildings(const project::Project& after, const std::vector<int>& ids, const QString& text);
+  // The buildings `ids` as they are in `after` (a changed copy of the project; absent there:
+  // removed) as one undo step.
+  void pushBuildings(const project::Project& after, const std::vector<int>& ids, const QString& text);
 
   project::Project project_;
   QString path_;

@@ -40,6 +40,7 @@ class ParameterForm;
 class ColourLegend;
 class Terrain3DView;
 struct OverlayGuide;
+enum class InteractionMode;
 }  // namespace delineo::widgets
 
 namespace delineo::gui {
@@ -306,6 +307,9 @@ class MainWindow : public QMainWindow {
   void createActions();
   void createFileActions();
   void createToolActions();
+  QAction* addTool(const QString& name, const QString& text, const QString& key, widgets::InteractionMode mode,
+                   const QString& tip);
+  void createSplitMergeTools();
   void createBuildingActions();
   void createReviewActions();
   void createEditActions();
@@ -332,6 +336,19 @@ class MainWindow : public QMainWindow {
   void onEditRequested(int id, int ringIndex, const QPolygonF& ring, const QString& description);
   void reopenSelected();
   void removeSelected();
+  // The Buildings list shows `row` alone selected (none for -1); its selected rows' buildings.
+  void selectListRow(int row);
+  void restoreListSelection();
+  std::vector<int> selectedRowIds() const;
+
+  // main_window_split_merge.cpp: Split building, Merge with…, Merge buildings of the list.
+  void onSplitLine(QPointF from, QPointF to);
+  void beginMergeWith();
+  void onMergeClick(int other);
+  void mergeSelectedRows();
+  void mergeInto(int id, int other);
+  void showEditedBuildings(const std::vector<int>& ids);
+  void updateSplitMergeActions(bool hasSelection);
 
   // main_window_review.cpp: the next building to review, the review's progress.
   int nextToReview(int step) const;
@@ -422,6 +439,7 @@ class MainWindow : public QMainWindow {
   QActionGroup* toolGroup_ = nullptr;
   QTimer autosaveTimer_;
   int selectedId_ = -1;
+  std::vector<int> listSelection_;  // the rows selected in the Buildings list with the selected building's
   bool interactive_ = true;
   bool restoreAutosave_ = false;
   bool replaceFiles_ = true;

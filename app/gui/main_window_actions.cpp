@@ -7,6 +7,7 @@
 #include <QMenu>
 #include <QMenuBar>
 #include <QSettings>
+#include <QTableView>
 #include <QToolBar>
 #include <QToolButton>
 #include <QUndoStack>
@@ -112,39 +113,63 @@ void MainWindow::createFileActions() {
           &QAction::triggered, this, &QWidget::close);
 }
 
+// A tool: a checkable action of the tool group that sets the left view's interaction mode.
+QAction* MainWindow::addTool(const QString& name, const QString& text, const QString& key, InteractionMode mode,
+                             const QString& tip) {
+  QAction* a = makeAction(this, name, text, QKeySequence(key));
+  a->setCheckable(true);
+  a->setToolTip(tip);
+  a->setStatusTip(tip);
+  toolGroup_->addAction(a);
+  connect(a, &QAction::triggered, this, [this, mode] { leftView_->setInteractionMode(mode); });
+  return a;
+}
+
 // The left view's interaction modes, one checked at a time.
 void MainWindow::createToolActions() {
   toolGroup_ = new QActionGroup(this);
-  auto tool = [&](const QString& name, const QString& text, const QString& key, InteractionMode mode, const QString& tip) {
-    QAction* a = makeAction(this, name, text, QKeySequence(key));
-    a->setCheckable(true);
-    a->setToolTip(tip);
-    a->setStatusTip(tip);
-    toolGroup_->addAction(a);
-    connect(a, &QAction::triggered, this, [this, mode] { leftView_->setInteractionMode(mode); });
-    return a;
-  };
   // V, as the selection tool of drawing programs: N goes to the next building to review.
-  tool(QStringLiteral("actionNavigate"), tr("&Navigate"), QStringLiteral("V"), InteractionMode::Navigate,
-       tr("Pan with the mouse, zoom with the wheel, click a building to select it"))->setChecked(true);
-  tool(QStringLiteral("actionPickRectangle"), tr("Pick with a &rectangle"), QStringLiteral("B"),
-       InteractionMode::PickRectangle, tr("Drag a rectangle around a building"));
-  tool(QStringLiteral("actionPickPolygon"), tr("Pick with a &polygon"), QStringLiteral("P"),
-       InteractionMode::PickPolygon, tr("Click the corners of a rough polygon; double-click to close"));
-  tool(QStringLiteral("actionPickObject"), tr("Pick an above-ground &object"), QStringLiteral("O"),
-       InteractionMode::PickPoint, tr("Click a building: its above-ground region becomes the initial polygon"));
-  tool(QStringLiteral("actionEdit"), tr("&Edit outline"), QStringLiteral("E"), InteractionMode::EditPolygon,
-       tr("Drag a vertex or an edge of the selected building, Ctrl+drag to select vertices, "
-          "right-click for more; every change can be undone"));
+  addTool(QStringLiteral("actionNavigate"), tr("&Navigate"), QStringLiteral("V"), InteractionMode::Navigate,
+          tr("Pan with the mouse, zoom with the wheel, click a building to select it"))->setChecked(true);
+  addTool(QStringLiteral("actionPickRectangle"), tr("Pick with a &rectangle"), QStringLiteral("B"),
+          InteractionMode::PickRectangle, tr("Drag a rectangle around a building"));
+  addTool(QStringLiteral("actionPickPolygon"), tr("Pick with a &polygon"), QStringLiteral("P"),
+          InteractionMode::PickPolygon, tr("Click the corners of a rough polygon; double-click to close"));
+  addTool(QStringLiteral("actionPickObject"), tr("Pick an above-ground &object"), QStringLiteral("O"),
+          InteractionMode::PickPoint, tr("Click a building: its above-ground region becomes the initial polygon"));
+  addTool(QStringLiteral("actionEdit"), tr("&Edit outline"), QStringLiteral("E"), InteractionMode::EditPolygon,
+          tr("Drag a vertex or an edge of the selected building, Ctrl+drag to select vertices, "
+             "right-click for more; every change can be undone"));
+  createSplitMergeTools();
   connect(leftView_, &ImageView::interactionModeChanged, this, [this](InteractionMode mode) {
     static const std::map<InteractionMode, QString> names = {
         {InteractionMode::Navigate, QStringLiteral("actionNavigate")},
         {InteractionMode::PickRectangle, QStringLiteral("actionPickRectangle")},
         {InteractionMode::PickPolygon, QStringLiteral("actionPickPolygon")},
         {InteractionMode::PickPoint, QStringLiteral("actionPickObject")},
-        {InteractionMode::EditPolygon, QStringLiteral("actionEdit")}};
+        {InteractionMode::EditPolygon, QStringLiteral("actionEdit")},
+        {InteractionMode::PickLine, QStringLiteral("actionSplit")},
+        {InteractionMode::PickOutline, QStringLiteral("actionMergeWith")}};
     if (QAction* a = action(names.at(mode))) a->setChecked(true);
   });
+}
+
+// Split building (S) and Merge with… (M), tools of the left view; Merge buildings, of the
+// Buildings list. What they do is in main_window_split_merge.cpp.
+void MainWindow::createSplitMergeTools() {
+  addTool(QStringLiteral("actionSplit"), tr("&Split building"), QStringLiteral("S"), InteractionMode::PickLine,
+          tr("Drag a line across the selected building (or click its two ends) to cut it in two"));
+  QAction* merge = addTool(QStringLiteral("actionMergeWith"), tr("Merge &with…"), QStringLiteral("M"),
+                           InteractionMode::PickOutline,
+                           tr("Click another building to merge it into the selected one; Esc cancels"));
+  connect(merge, &QAction::triggered, this, &MainWindow::beginMergeWith);
+  connect(leftView_, &ImageView::linePicked, this, &MainWindow::onSplitLine);
+  connect(leftView_, &ImageView::outlinePicked, this, &MainWindow::onMergeClick);
+  QAction* mergeRows = makeAction(this, QStringLiteral("actionMergeSelected"), tr("Merge b&uildings"));
+  mergeRows->setStatusTip(tr("Merge the second of the two buildings selected in the Buildings list into the first"));
+  connect(mergeRows, &QAction::triggered, this, &MainWindow::mergeSelectedRows);
+  buildingsTable_->setContextMenuPolicy(Qt::ActionsContextMenu);
+  buildingsTable_->addAction(mergeRows);
 }
 
 // Processing and the selected building's commands.
@@ -320,7 +345,8 @@ void MainWindow::createMenus() {
   edit->addAction(action(QStringLiteral("actionSnapEdges")));
 
   QMenu* building = menuBar()->addMenu(tr("&Building"));
-  for (const char* name : {"actionNavigate", "actionPickRectangle", "actionPickPolygon", "actionPickObject", "actionEdit"}) {
+  for (const char* name : {"actionNavigate", "actionPickRectangle", "actionPickPolygon", "actionPickObject", "actionEdit",
+                           "actionSplit", "actionMergeWith", "actionMergeSelected"}) {
     building->addAction(action(QString::fromLatin1(name)));
   }
   building->addSeparator();
@@ -425,6 +451,7 @@ void MainWindow::updateActions() {
   action(QStringLiteral("actionReopen"))->setEnabled(
       b != nullptr && (b->status == BuildingStatus::Accepted || b->status == BuildingStatus::Rejected));
   action(QStringLiteral("actionRemove"))->setEnabled(b != nullptr);
+  updateSplitMergeActions(b != nullptr);
   action(QStringLiteral("actionNextToReview"))->setEnabled(hasDoc);
   action(QStringLiteral("actionPreviousToReview"))->setEnabled(hasDoc);
   action(QStringLiteral("actionCancelJobs"))->setEnabled(jobs_->activeCount() > 0);

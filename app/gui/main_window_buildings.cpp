@@ -3,6 +3,7 @@
 #include <QAction>
 #include <QItemSelectionModel>
 #include <QTableView>
+#include <algorithm>
 
 #include "buildings_model.hpp"
 #include "delineo/widgets/image_view.hpp"
@@ -24,9 +25,8 @@ void MainWindow::selectBuilding(int id) {
   updatingSelection_ = true;
   for (ImageView* v : {leftView_, rightView_, disparityView_, demView_}) v->polygons().setSelectedId(id);
   rightShift_ = roofDisparity(id).value_or(document_ ? document_->project().height.groundDisparity : 0.0);
-  const int row = buildingsModel_->rowOf(id);
-  if (row >= 0) buildingsTable_->selectRow(row);
-  else buildingsTable_->clearSelection();
+  selectListRow(buildingsModel_->rowOf(id));
+  listSelection_.clear();
   updatingSelection_ = false;
   if (id > 0) {
     const cv::Rect2d box = core::boundingBox(document_->project().find(id)->currentPolygon().outer);
@@ -45,11 +45,52 @@ void MainWindow::onSelectionFromOverlay(int id) {
   selectBuilding(id);
 }
 
+// A row added to the list's selection (Ctrl+click) leaves the selected building as it is: Merge
+// buildings merges the other one into it.
 void MainWindow::onSelectionFromTable() {
   if (updatingSelection_) return;
-  const auto rows = buildingsTable_->selectionModel()->selectedRows();
-  const int id = rows.isEmpty() ? -1 : buildingsModel_->idAt(rows.first().row());
-  if (id != selectedId_) selectBuilding(id);
+  const std::vector<int> ids = selectedRowIds();
+  const bool kept = std::find(ids.begin(), ids.end(), selectedId_) != ids.end();
+  const int id = kept ? selectedId_ : ids.empty() ? -1 : ids.front();
+  if (id != selectedId_) {
+    selectBuilding(id);
+    return;
+  }
+  listSelection_ = ids;
+  updateActions();
+}
+
+void MainWindow::selectListRow(int row) {
+  if (row < 0) {
+    buildingsTable_->clearSelection();
+    return;
+  }
+  // Not QTableView::selectRow: with extended selection it extends from the last row while Shift
+  // is down (Shift+N).
+  buildingsTable_->selectionModel()->setCurrentIndex(buildingsModel_->index(row, 0),
+                                                     QItemSelectionModel::ClearAndSelect | QItemSelectionModel::Rows);
+}
+
+// After a model reset: the selected building's row, and the rows selected with it that remain.
+void MainWindow::restoreListSelection() {
+  updatingSelection_ = true;
+  selectListRow(buildingsModel_->rowOf(selectedId_));
+  for (int id : listSelection_) {
+    const int row = buildingsModel_->rowOf(id);
+    if (selectedId_ <= 0 || id == selectedId_ || row < 0) continue;
+    buildingsTable_->selectionModel()->select(buildingsModel_->index(row, 0),
+                                              QItemSelectionModel::Select | QItemSelectionModel::Rows);
+  }
+  updatingSelection_ = false;
+}
+
+std::vector<int> MainWindow::selectedRowIds() const {
+  std::vector<int> ids;
+  for (const QModelIndex& row : buildingsTable_->selectionModel()->selectedRows()) {
+    ids.push_back(buildingsModel_->idAt(row.row()));
+  }
+  std::sort(ids.begin(), ids.end(), [this](int a, int b) { return buildingsModel_->rowOf(a) < buildingsModel_->rowOf(b); });
+  return ids;
 }
 
 void MainWindow::onPicked(const core::Polygon& polygon) {

@@ -157,7 +157,8 @@ void MainWindow::createBuildingsDock() {
   buildingsTable_->setObjectName(QStringLiteral("buildingsTable"));
   buildingsTable_->setModel(buildingsModel_);
   buildingsTable_->setSelectionBehavior(QAbstractItemView::SelectRows);
-  buildingsTable_->setSelectionMode(QAbstractItemView::SingleSelection);
+  // Two rows selected (Ctrl+click) can be merged (Merge buildings).
+  buildingsTable_->setSelectionMode(QAbstractItemView::ExtendedSelection);
   buildingsTable_->verticalHeader()->hide();
   buildingsTable_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   buildingsTable_->horizontalHeader()->setStretchLastSection(true);
@@ -167,11 +168,7 @@ void MainWindow::createBuildingsDock() {
   connect(buildingsModel_, &QAbstractItemModel::modelReset, this, [this] {
     // The source ids of imported outlines, only when there are some.
     buildingsTable_->setColumnHidden(BuildingsModel::SourceId, !buildingsModel_->hasSourceIds());
-    // Keep the table's selection on the selected building across model resets.
-    updatingSelection_ = true;
-    const int row = buildingsModel_->rowOf(selectedId_);
-    if (row >= 0) buildingsTable_->selectRow(row);
-    updatingSelection_ = false;
+    restoreListSelection();
   });
   auto* buildingsPage = new QWidget;
   auto* buildingsLayout = new QVBoxLayout(buildingsPage);

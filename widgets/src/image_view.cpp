@@ -413,6 +413,20 @@ void ImageView::paintEvent(QPaintEvent*) {
     painter.setBrush(QColor(255, 220, 0));
     for (const QPointF& p : pickPolygon_) painter.drawEllipse(imageToWidget(p), 3.0, 3.0);
   }
+  if (mode_ == InteractionMode::PickLine && lineStart_) paintLine(painter);
+}
+
+// The line being drawn, dashed over a dark underlay so that it reads on any image.
+void ImageView::paintLine(QPainter& painter) const {
+  const QPointF a = imageToWidget(*lineStart_);
+  const QPointF b = imageToWidget(hoverImage_);
+  painter.setBrush(Qt::NoBrush);
+  painter.setPen(QPen(QColor(0, 0, 0, 160), 3.5));
+  painter.drawLine(a, b);
+  painter.setPen(QPen(QColor(255, 220, 0), 2.0, Qt::DashLine));
+  painter.drawLine(a, b);
+  painter.setBrush(QColor(255, 220, 0));
+  painter.drawEllipse(a, 3.0, 3.0);
 }
 
 void ImageView::resizeEvent(QResizeEvent*) {
@@ -435,6 +449,7 @@ void ImageView::setInteractionMode(InteractionMode mode) {
   mode_ = mode;
   rectDragging_ = false;
   pickPolygon_.clear();
+  lineStart_.reset();
   polygons_->clearVertexSelection();
   restoreModeCursor();
   update();
@@ -444,6 +459,7 @@ void ImageView::setInteractionMode(InteractionMode mode) {
 void ImageView::restoreModeCursor() {
   setCursor(mode_ == InteractionMode::Navigate      ? Qt::OpenHandCursor
             : mode_ == InteractionMode::EditPolygon ? Qt::ArrowCursor
+            : mode_ == InteractionMode::PickOutline ? Qt::PointingHandCursor
                                                     : Qt::CrossCursor);
 }
 
@@ -482,6 +498,8 @@ void ImageView::mousePressEvent(QMouseEvent* event) {
       update();
       break;
     case InteractionMode::PickPoint: break;
+    case InteractionMode::PickLine: pressLine(imagePos); break;
+    case InteractionMode::PickOutline: beginPan(event->position()); break;
     case InteractionMode::EditPolygon:
       if (polygons_->mousePress(event)) return;
       beginPan(event->position());
@@ -507,7 +525,7 @@ void ImageView::mouseMoveEvent(QMouseEvent* event) {
     return;
   }
   if (mode_ == InteractionMode::EditPolygon && polygons_->mouseMove(event)) return;
-  if (mode_ == InteractionMode::PickPolygon && !pickPolygon_.isEmpty()) update();
+  if ((mode_ == InteractionMode::PickPolygon && !pickPolygon_.isEmpty()) || lineStart_) update();
 }
 
 void ImageView::mouseReleaseEvent(QMouseEvent* event) {
@@ -516,9 +534,13 @@ void ImageView::mouseReleaseEvent(QMouseEvent* event) {
     panning_ = false;
     restoreModeCursor();
     // A click without movement on a polygon selects it (Navigate and EditPolygon modes); in
-    // EditPolygon it also drops the vertex selection.
+    // EditPolygon it also drops the vertex selection. PickOutline reports it instead.
     if (event->button() == Qt::LeftButton && !pressMoved_ && !spaceHeld_) {
       const int id = polygons_->polygonAt(event->position());
+      if (mode_ == InteractionMode::PickOutline) {
+        emit outlinePicked(id);
+        return;
+      }
       if (mode_ == InteractionMode::EditPolygon) polygons_->clearVertexSelection();
       if (id >= 0 || mode_ == InteractionMode::Navigate) polygons_->setSelectedId(id);
     }
@@ -534,6 +556,10 @@ void ImageView::mouseReleaseEvent(QMouseEvent* event) {
                               .intersected(QRectF(0, 0, size.width, size.height));
     update();
     if (picked.width() > 0 && picked.height() > 0) emit rectanglePicked(picked);
+    return;
+  }
+  if (mode_ == InteractionMode::PickLine) {
+    releaseLine(widgetToImage(event->position()));
     return;
   }
   if (mode_ == InteractionMode::PickPoint && !pressMoved_) {
@@ -556,6 +582,29 @@ void ImageView::mouseDoubleClickEvent(QMouseEvent* event) {
     return;
   }
   if (mode_ == InteractionMode::EditPolygon) polygons_->mouseDoubleClick(event);
+}
+
+void ImageView::pressLine(QPointF imagePos) {
+  if (lineStart_) {
+    finishLine(imagePos);
+    return;
+  }
+  lineStart_ = imagePos;
+  hoverImage_ = imagePos;
+  update();
+}
+
+void ImageView::releaseLine(QPointF imagePos) {
+  // A click leaves the line following the cursor until the next click; a drag ends it here.
+  if (lineStart_ && pressMoved_) finishLine(imagePos);
+}
+
+void ImageView::finishLine(QPointF end) {
+  const QPointF start = *lineStart_;
+  lineStart_.reset();
+  update();
+  const QPointF span = imageToWidget(end) - imageToWidget(start);
+  if (std::hypot(span.x(), span.y()) >= 3.0) emit linePicked(start, end);
 }
 
 void ImageView::keyPressEvent(QKeyEvent* event) {
@@ -587,10 +636,16 @@ void ImageView::keyPressEvent(QKeyEvent* event) {
       }
       break;
     case Qt::Key_Escape:
-      if (rectDragging_ || !pickPolygon_.isEmpty()) {
+      if (rectDragging_ || !pickPolygon_.isEmpty() || lineStart_) {
         rectDragging_ = false;
         pickPolygon_.clear();
+        lineStart_.reset();
         update();
+        return;
+      }
+      // The choice of an outline is a one-shot mode: Esc leaves it.
+      if (mode_ == InteractionMode::PickOutline) {
+        setInteractionMode(InteractionMode::Navigate);
         return;
       }
       break;
@@ -621,7 +676,7 @@ bool ImageView::wantsKey(const QKeyEvent& event) const {
   if (mode_ == InteractionMode::EditPolygon && polygons_->wantsKey(event)) return true;
   switch (event.key()) {
     case Qt::Key_Escape:
-      return rectDragging_ || !pickPolygon_.isEmpty();
+      return rectDragging_ || !pickPolygon_.isEmpty() || lineStart_ || mode_ == InteractionMode::PickOutline;
     case Qt::Key_Backspace:
       return mode_ == InteractionMode::PickPolygon && !pickPolygon_.isEmpty();
     default:

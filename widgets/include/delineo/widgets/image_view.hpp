@@ -21,6 +21,7 @@
 #include <limits>
 #include <list>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -38,6 +39,8 @@ enum class InteractionMode {
   PickPolygon,    // left-clicks add vertices; double-click or Enter closes → polygonPicked
   PickPoint,      // left-click → pointPicked
   EditPolygon,    // edit the selected polygon of polygons() (see PolygonOverlay)
+  PickLine,       // left-drag a line, or click its two ends → linePicked; Esc drops it
+  PickOutline,    // left-click a polygon of polygons() → outlinePicked; drag pans
 };
 
 // Labels of an overlay drawn hatched: those with `bit` set (0: none) show diagonal stripes of
@@ -133,6 +136,10 @@ class ImageView : public QWidget {
   void rectanglePicked(QRectF imageRect);
   void polygonPicked(QPolygonF imagePolygon);
   void pointPicked(QPointF imagePos);
+  // A line drawn in PickLine mode (image pixels), at least 3 widget px long.
+  void linePicked(QPointF from, QPointF to);
+  // The polygon clicked in PickOutline mode (-1: the click hit none).
+  void outlinePicked(int id);
   void interactionModeChanged(delineo::widgets::InteractionMode mode);
 
  protected:
@@ -179,6 +186,11 @@ class ImageView : public QWidget {
   // True when the view has a use for this key now (a gesture to cancel, a vertex to delete), so
   // it takes precedence over a window shortcut on the same key.
   bool wantsKey(const QKeyEvent& event) const;
+  // PickLine: a press starts the line or, after a click, ends it; a release after a drag ends it.
+  void pressLine(QPointF imagePos);
+  void releaseLine(QPointF imagePos);
+  void finishLine(QPointF end);  // linePicked when long enough; the line is dropped either way
+  void paintLine(QPainter& painter) const;
 
   std::vector<cv::Mat> pyramid_;
   std::vector<cv::Mat> overlayPyramid_;
@@ -211,6 +223,7 @@ class ImageView : public QWidget {
   QPointF rectStartImage_;
   QPointF rectEndImage_;
   QPolygonF pickPolygon_;
+  std::optional<QPointF> lineStart_;  // PickLine: the line being drawn, from here to hoverImage_
   QPointF hoverImage_;
   bool hoverValid_ = false;
   QPointF pressWidget_;
