@@ -6,7 +6,6 @@
 // actions disabled when they cannot apply; the French strings.
 #include <QAction>
 #include <QItemSelectionModel>
-#include <QSignalSpy>
 #include <QStatusBar>
 #include <QTableView>
 #include <QTemporaryDir>
@@ -176,7 +175,6 @@ class SplitMergeTest : public QObject {
     QTest::keyClick(window_->leftView(), Qt::Key_S);
     QCOMPARE(window_->leftView()->interactionMode(), InteractionMode::PickLine);
     QVERIFY(act("actionSplit")->isChecked());
-    QSignalSpy scored(window_.get(), &MainWindow::energyUpdated);
     // The dashed line shows while it is dragged.
     widgets::ImageView* view = window_->leftView();
     QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, at(200, 60));
@@ -199,9 +197,7 @@ class SplitMergeTest : public QObject {
     }
     QVERIFY2(message().contains(QStringLiteral("split into 2")), qPrintable(message()));
     // Like an edited outline, each piece is scored in the background.
-    QTRY_COMPARE_WITH_TIMEOUT(scored.count(), 2, 60000);
-    QVERIFY(std::isfinite(building(wide_)->energy));
-    QVERIFY(std::isfinite(building(piece)->energy));
+    QTRY_VERIFY_WITH_TIMEOUT(std::isfinite(building(wide_)->energy) && std::isfinite(building(piece)->energy), 60000);
     act("actionUndo")->trigger();
     QCOMPARE(count(), 4);
     QVERIFY(building(piece) == nullptr);
@@ -258,6 +254,8 @@ class SplitMergeTest : public QObject {
     QTest::mouseClick(window_->leftView(), Qt::LeftButton, Qt::NoModifier, at(250, 340));
     QCOMPARE(count(), 3);
     QVERIFY(building(right_) == nullptr);
+    QCOMPARE(st(building(left_)->status), st(BuildingStatus::Corrected));
+    QTRY_VERIFY_WITH_TIMEOUT(std::isfinite(building(left_)->energy), 60000);  // scored like an edit
     QCOMPARE(window_->selectedBuilding(), left_);
     QCOMPARE(window_->leftView()->interactionMode(), InteractionMode::Navigate);
     QVERIFY(std::abs(core::area(building(left_)->outline) - 16000.0) < 50.0);

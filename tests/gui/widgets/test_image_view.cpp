@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "delineo/widgets/image_view.hpp"
+#include "delineo/widgets/polygon_overlay.hpp"
 #include "gui_test_support.hpp"
 
 using delineo::widgets::ImageView;
@@ -171,6 +172,63 @@ TEST(ImageView, PickModesEmitImageGeometry) {
   QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(50, 70));
   ASSERT_EQ(pointSpy.count(), 1);
   EXPECT_EQ(pointSpy.at(0).at(0).toPointF(), QPointF(25, 35));
+}
+
+// PickLine: a drag, or a click at each end, gives the line; one shorter than 3 widget px, or one
+// dropped with Esc, gives nothing.
+TEST(ImageView, PickLineGivesTheLineDraggedOrClicked) {
+  ImageView view;
+  view.resize(400, 400);
+  view.setImage(patternImage(200, 200));
+  view.setView(QPointF(100, 100), 2.0);  // image (x, y) ↔ widget (2x, 2y)
+  view.setInteractionMode(delineo::widgets::InteractionMode::PickLine);
+  QSignalSpy lines(&view, &ImageView::linePicked);
+  QTest::mousePress(&view, Qt::LeftButton, {}, QPoint(20, 40));
+  QTest::mouseMove(&view, QPoint(100, 100));
+  QTest::mouseRelease(&view, Qt::LeftButton, {}, QPoint(200, 160));
+  ASSERT_EQ(lines.count(), 1);
+  EXPECT_EQ(lines.at(0).at(0).toPointF(), QPointF(10, 20));
+  EXPECT_EQ(lines.at(0).at(1).toPointF(), QPointF(100, 80));
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(40, 40));
+  QTest::mouseMove(&view, QPoint(120, 60));
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(240, 80));
+  ASSERT_EQ(lines.count(), 2);
+  EXPECT_EQ(lines.at(1).at(0).toPointF(), QPointF(20, 20));
+  EXPECT_EQ(lines.at(1).at(1).toPointF(), QPointF(120, 40));
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(40, 40));
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(41, 41));  // too short: dropped
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(40, 40));
+  QTest::keyClick(&view, Qt::Key_Escape);
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(240, 80));  // begins a new line
+  EXPECT_EQ(lines.count(), 2);
+}
+
+// PickOutline: a click gives the polygon under it (-1 for none), a drag pans, Esc leaves the mode.
+TEST(ImageView, PickOutlineGivesThePolygonClicked) {
+  ImageView view;
+  view.resize(400, 400);
+  view.setImage(patternImage(200, 200));
+  view.setView(QPointF(100, 100), 2.0);
+  delineo::widgets::OverlayPolygon square;
+  square.id = 7;
+  square.polygon.outer = {{10, 10}, {60, 10}, {60, 60}, {10, 60}};
+  view.polygons().setPolygons({square});
+  view.setInteractionMode(delineo::widgets::InteractionMode::PickOutline);
+  QSignalSpy picked(&view, &ImageView::outlinePicked);
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(60, 60));
+  QTest::mouseClick(&view, Qt::LeftButton, {}, QPoint(300, 300));
+  ASSERT_EQ(picked.count(), 2);
+  EXPECT_EQ(picked.at(0).at(0).toInt(), 7);
+  EXPECT_EQ(picked.at(1).at(0).toInt(), -1);
+  EXPECT_EQ(view.polygons().selectedId(), -1);  // it reports, it does not select
+  const QPointF centre = view.viewCenter();
+  QTest::mousePress(&view, Qt::LeftButton, {}, QPoint(200, 200));
+  QTest::mouseMove(&view, QPoint(240, 200));
+  QTest::mouseRelease(&view, Qt::LeftButton, {}, QPoint(240, 200));
+  EXPECT_EQ(picked.count(), 2);
+  EXPECT_NE(view.viewCenter(), centre);
+  QTest::keyClick(&view, Qt::Key_Escape);
+  EXPECT_EQ(view.interactionMode(), delineo::widgets::InteractionMode::Navigate);
 }
 
 TEST(ImageView, FloatRasterWithColourMapAndOverlay) {
