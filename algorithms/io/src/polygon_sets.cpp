@@ -129,19 +129,29 @@ core::Polygon snappedOnto(core::Polygon polygon, const core::Polygon& onto, doub
   return polygon;
 }
 
-std::optional<core::Polygon> singlePolygon(const PolygonSet& set) {
+// The one polygon of `set` without the holes that are no courtyard of `a` or `b` (the pockets a
+// union leaves where two outlines do not quite meet); nullopt when `set` is not one polygon.
+std::optional<core::Polygon> singlePolygon(const PolygonSet& set, const core::Polygon& a, const core::Polygon& b) {
   if (set.size() != 1) return std::nullopt;
-  return set.front();
+  PolygonSet courtyards;
+  for (const core::Polygon* p : {&a, &b}) {
+    for (const auto& hole : p->holes) courtyards.push_back({hole, {}});
+  }
+  core::Polygon merged = set.front();
+  std::erase_if(merged.holes, [&](const core::Ring& hole) {
+    return courtyards.empty() || intersectionOf({core::Polygon{hole, {}}}, courtyards).empty();
+  });
+  return merged;
 }
 }  // namespace
 
 std::optional<core::Polygon> mergedOutline(const core::Polygon& a, const core::Polygon& b, double maxGap) {
   if (a.outer.size() < 3 || b.outer.size() < 3) return std::nullopt;
-  if (auto merged = singlePolygon(unionOf({a}, {b}))) return merged;
+  if (auto merged = singlePolygon(unionOf({a}, {b}), a, b)) return merged;
   if (!(maxGap > 0.0)) return std::nullopt;
   const core::Polygon bOnA = snappedOnto(b, a, maxGap);
-  if (auto merged = singlePolygon(unionOf({a}, {bOnA}))) return merged;
-  return singlePolygon(unionOf({snappedOnto(a, bOnA, maxGap)}, {bOnA}));
+  if (auto merged = singlePolygon(unionOf({a}, {bOnA}), a, b)) return merged;
+  return singlePolygon(unionOf({snappedOnto(a, bOnA, maxGap)}, {bOnA}), a, b);
 }
 
 double sharedBorderLength(const core::Polygon& a, const core::Polygon& b, double tolerance) {

@@ -52,6 +52,23 @@ TEST(MergedOutline, TouchingOrAFewPixelsApartMergeFartherApartDoNot) {
   EXPECT_FALSE(io::mergedOutline(left, rectangle(30, 0, 50, 20), 3.0).has_value());
 }
 
+TEST(MergedOutline, APocketBetweenTheTwoIsFilledAndACourtyardKept) {
+  // A U open to the right, closed by a bar 1 px beyond its arms: the pocket between them is no
+  // courtyard of either.
+  const core::Polygon u{{{0, 0}, {30, 0}, {30, 10}, {10, 10}, {10, 20}, {30, 20}, {30, 30}, {0, 30}}, {}};
+  const auto closed = io::mergedOutline(u, rectangle(31, 0, 40, 30), 3.0);
+  ASSERT_TRUE(closed.has_value());
+  EXPECT_TRUE(closed->holes.empty());
+  EXPECT_NEAR(core::area(*closed), 40.0 * 30.0, 1e-6);
+  // A courtyard of one of them stays.
+  core::Polygon yard = rectangle(0, 0, 20, 20);
+  yard.holes = {{{5, 5}, {5, 15}, {15, 15}, {15, 5}}};
+  const auto kept = io::mergedOutline(yard, rectangle(20, 0, 40, 20), 3.0);
+  ASSERT_TRUE(kept.has_value());
+  EXPECT_EQ(kept->holes.size(), 1u);
+  EXPECT_NEAR(core::area(*kept), 800.0 - 100.0, 1e-6);
+}
+
 TEST(BuildingEdits, AnOutlinedBuildingSplitsIntoCorrectedPieces) {
   project::Project p;
   project::Building b = outlined(3, rectangle(10, 10, 70, 30), 40, 46);

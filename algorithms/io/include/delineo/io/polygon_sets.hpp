@@ -27,8 +27,9 @@ PolygonSet splitAlong(const core::Polygon& polygon, cv::Point2d from, cv::Point2
 
 // `a` and `b` as one polygon: their union when they overlap or touch; when they lie apart by at
 // most `maxGap` px (two outlines on either side of a shared wall), the vertices of each within
-// `maxGap` of the other's border are first moved onto it. nullopt when they stay apart or the
-// union has a part of its own (they are farther apart somewhere).
+// `maxGap` of the other's border are first moved onto it. A hole of the union that is no
+// courtyard of `a` or `b` (a pocket where they do not quite meet) is filled. nullopt when they
+// stay apart or the union has a part of its own (they are farther apart somewhere).
 std::optional<core::Polygon> mergedOutline(const core::Polygon& a, const core::Polygon& b, double maxGap);
 
 // Length (px) of the border of `a` that runs along the border of `b` (within `tolerance` px).
