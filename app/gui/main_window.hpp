@@ -455,7 +455,8 @@ class MainWindow : public QMainWindow {
   QString rangeSource_;  // how the current range was obtained, when estimated since the project was opened
   QWidget* heightModelNotice_ = nullptr;
   QLabel* view3DNotice_ = nullptr;
-  // Outlines whose energy was asked for, so that one that cannot be scored is not asked again.
+  // Outlines whose energy is being asked for or could not be scored, so that they are not asked
+  // again; a scored one leaves it.
   std::map<int, core::Polygon> energyAsked_;
   int awaitingDisparity_ = -1;  // picked while matching ran: delineated when the disparity arrives
   widgets::JobId matchingJob_ = 0;

@@ -279,7 +279,11 @@ widgets::JobId MainWindow::startEnergyUpdate(int id) {
       [this, doc, id](Scored scored) {
         if (!doc || doc != document_.get()) return;
         if (scored.outcome && scored.outcome->status != core::RunStatus::Completed) return;
-        if (scored.outcome) doc->setOutlineEnergy(id, scored.outline, scored.outcome->energy, scored.outcome->terms);
+        if (scored.outcome) {
+          // Scored: asked again should an undo or redo bring this outline back without its energy.
+          energyAsked_.erase(id);
+          doc->setOutlineEnergy(id, scored.outline, scored.outcome->energy, scored.outcome->terms);
+        }
         emit energyUpdated(id);
       },
       QStringLiteral("energy-%1").arg(id));

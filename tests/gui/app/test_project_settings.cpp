@@ -210,9 +210,15 @@ class ProjectSettingsTest : public QObject {
     double sum = 0;
     for (double t : *b->energyTerms) sum += t;
     QVERIFY(std::abs(sum - b->energy) < 1e-6 * std::abs(b->energy) + 1e-6);
+    const double edited = b->energy;
     // Undo brings the old outline's energy back without a new job.
     doc->undoStack()->undo();
     QCOMPARE(doc->project().find(id)->energy, -1.0);
+    // Redo brings the edit back without its energy: it is scored again.
+    doc->undoStack()->redo();
+    QTRY_COMPARE_WITH_TIMEOUT(updated.count(), 2, 60000);
+    QVERIFY(std::isfinite(doc->project().find(id)->energy));
+    QCOMPARE(doc->project().find(id)->energy, edited);
   }
 
   void aPickStartsTheActivePolygonOnceTheDisparityIsThere() {
