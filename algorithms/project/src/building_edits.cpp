@@ -57,6 +57,8 @@ BuildingEdit splitBuilding(Project& project, int id, cv::Point2d from, cv::Point
       piece.history.clear();
     }
     reshape(project, piece, pieces[i], disparity);
+    // The pieces are apart because they differ: each gets the roof interval its own disparities propose.
+    if (const auto own = suggestRoofInterval(disparity, pieces[i])) piece.roofInterval = own;
     piece.addHistory("split", withOrigin(origin, "building " + std::to_string(id) + " cut along " +
                                                      segmentText(from, to) + " into " +
                                                      std::to_string(pieces.size()) + " pieces"));

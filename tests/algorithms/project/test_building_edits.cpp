@@ -80,7 +80,7 @@ TEST(BuildingEdits, AnOutlinedBuildingSplitsIntoCorrectedPieces) {
   ASSERT_EQ(p.buildings.size(), 2u);
   for (const auto& piece : p.buildings) {
     EXPECT_EQ(piece.status, project::BuildingStatus::Corrected);
-    EXPECT_EQ(piece.roofInterval, b.roofInterval);
+    EXPECT_EQ(piece.roofInterval, b.roofInterval) << "no disparity map: the interval stays";
     EXPECT_EQ(piece.sourceId, "B-7");
     EXPECT_TRUE(std::isnan(piece.energy)) << "an edited outline is scored again";
     EXPECT_EQ(piece.history.back().action, "split");
@@ -139,4 +139,26 @@ TEST(BuildingEdits, BuildingsFarApartOrOneWithItselfAreNotMerged) {
   EXPECT_FALSE(project::mergeBuildings(p, 1, 1).done());
   EXPECT_FALSE(project::mergeBuildings(p, 1, 9).done());
   EXPECT_TRUE(p == before);
+}
+
+TEST(BuildingEdits, EachPieceTakesTheRoofIntervalOfItsOwnDisparities) {
+  // Two roofs side by side, at 40 and 50 px over a ground at 10 px, under one outline.
+  cv::Mat disparity(120, 160, CV_32F, cv::Scalar(10.0f));
+  disparity(cv::Rect(30, 30, 40, 60)).setTo(40.0f);
+  disparity(cv::Rect(70, 30, 50, 60)).setTo(50.0f);
+  project::Project p;
+  p.buildings = {outlined(1, rectangle(30, 30, 120, 90), 39, 51)};
+  ASSERT_TRUE(project::splitBuilding(p, 1, {70, 20}, {70, 100}, disparity).done());
+  const project::Building& right = *p.find(1);  // the larger piece keeps the id
+  const project::Building& left = *p.find(2);
+  ASSERT_TRUE(left.roofInterval && right.roofInterval);
+  EXPECT_LE(left.roofInterval->low, 40);
+  EXPECT_GE(left.roofInterval->high, 40);
+  EXPECT_LT(left.roofInterval->high, 45);
+  EXPECT_GT(right.roofInterval->low, 45);
+  EXPECT_GE(right.roofInterval->high, 50);
+  // Without a disparity map the pieces keep the building's interval.
+  p.buildings = {outlined(1, rectangle(30, 30, 120, 90), 39, 51)};
+  ASSERT_TRUE(project::splitBuilding(p, 1, {70, 20}, {70, 100}).done());
+  EXPECT_EQ(p.find(2)->roofInterval, (project::DisparityInterval{39, 51}));
 }

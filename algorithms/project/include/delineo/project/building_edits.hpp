@@ -25,10 +25,11 @@ struct BuildingEdit {
 
 // Cuts building `id` along the segment from `from` to `to` (left-image pixels), which must cross
 // its polygon (outline, else initial polygon) from side to side. The largest piece keeps the id,
-// the others become new buildings with the same roof interval, method and source id. A building
-// with an outline gives Corrected pieces (the piece as outline and initial polygon, roof height
-// read on `disparity` when given, energy unknown); a Pending one gives Pending pieces. Each gets a
-// "split" history entry (`origin` first).
+// the others become new buildings with the same method and source id. Each piece's roof interval
+// is the one its own disparities propose (suggestRoofInterval() on `disparity`; the building's
+// when there is no map or no proposal). A building with an outline gives Corrected pieces (the
+// piece as outline and initial polygon, roof height read on `disparity`, energy unknown); a
+// Pending one gives Pending pieces. Each gets a "split" history entry (`origin` first).
 BuildingEdit splitBuilding(Project& project, int id, cv::Point2d from, cv::Point2d to, const cv::Mat& disparity = {},
                            const std::string& origin = {});
 
