@@ -2325,6 +2325,22 @@ Saisissez la plus petite et la plus grande disparité du couple (x_droite = x_ga
         <source>Merge &amp;with…</source>
         <translation>&amp;Fusionner avec…</translation>
     </message>
+    <message>
+        <source>the line does not cut the building in two: draw it across, from outside to outside</source>
+        <translation>la ligne ne coupe pas le bâtiment en deux : tracez-la en travers, de l’extérieur à l’extérieur</translation>
+    </message>
+    <message>
+        <source>a building cannot be merged with itself</source>
+        <translation>un bâtiment ne peut pas être fusionné avec lui-même</translation>
+    </message>
+    <message>
+        <source>they are more than %1 px apart</source>
+        <translation>ils sont à plus de %1 px l’un de l’autre</translation>
+    </message>
+    <message>
+        <source>the building is no longer there</source>
+        <translation>le bâtiment n’existe plus</translation>
+    </message>
 </context>
 <context>
     <name>delineo::gui::ProjectSettingsDialog</name>

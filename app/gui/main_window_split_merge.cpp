@@ -16,6 +16,20 @@ using widgets::InteractionMode;
 
 namespace {
 constexpr int kMessageMs = 10000;
+
+// Why a split or a merge changed nothing, in the interface's language.
+QString refusalText(const project::BuildingEdit& edit) {
+  switch (edit.why) {
+    case project::EditRefusal::NotCutInTwo:
+      return MainWindow::tr("the line does not cut the building in two: draw it across, from outside to outside");
+    case project::EditRefusal::SameBuilding: return MainWindow::tr("a building cannot be merged with itself");
+    case project::EditRefusal::TooFarApart:
+      return MainWindow::tr("they are more than %1 px apart").arg(static_cast<int>(project::kMergeGap));
+    case project::EditRefusal::NoSuchBuilding: return MainWindow::tr("the building is no longer there");
+    case project::EditRefusal::None: break;
+  }
+  return QString::fromStdString(edit.refusal);
+}
 }  // namespace
 
 void MainWindow::onSplitLine(QPointF from, QPointF to) {
@@ -24,7 +38,7 @@ void MainWindow::onSplitLine(QPointF from, QPointF to) {
   const project::BuildingEdit edit = document_->splitBuilding(id, {from.x(), from.y()}, {to.x(), to.y()});
   if (!edit.done()) {
     statusBar()->showMessage(
-        tr("Building %1 was not split: %2").arg(id).arg(QString::fromStdString(edit.refusal)), kMessageMs);
+        tr("Building %1 was not split: %2").arg(id).arg(refusalText(edit)), kMessageMs);
     return;
   }
   leftView_->setInteractionMode(InteractionMode::Navigate);
@@ -63,7 +77,7 @@ void MainWindow::mergeInto(int id, int other) {
     statusBar()->showMessage(tr("Buildings %1 and %2 were not merged: %3")
                                  .arg(id)
                                  .arg(other)
-                                 .arg(QString::fromStdString(edit.refusal)),
+                                 .arg(refusalText(edit)),
                              kMessageMs);
     return;
   }

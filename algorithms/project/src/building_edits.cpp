@@ -42,12 +42,14 @@ std::string joinedSourceIds(const std::string& a, const std::string& b) {
 BuildingEdit splitBuilding(Project& project, int id, cv::Point2d from, cv::Point2d to, const cv::Mat& disparity,
                            const std::string& origin) {
   Building* building = project.find(id);
-  if (building == nullptr) return {{}, "no building " + std::to_string(id)};
+  if (building == nullptr) return {{}, EditRefusal::NoSuchBuilding, "no building " + std::to_string(id)};
   io::PolygonSet pieces = io::splitAlong(building->currentPolygon(), from, to);
   pieces.erase(std::remove_if(pieces.begin(), pieces.end(),
                               [](const core::Polygon& p) { return core::area(p) < kMinPieceArea; }),
                pieces.end());
-  if (pieces.size() < 2) return {{}, "the line does not cut the building in two: draw it across, from outside to outside"};
+  if (pieces.size() < 2) {
+    return {{}, EditRefusal::NotCutInTwo, "the line does not cut the building in two: draw it across, from outside to outside"};
+  }
   const Building original = *building;
   BuildingEdit edit;
   for (size_t i = 0; i < pieces.size(); ++i) {
@@ -70,14 +72,17 @@ BuildingEdit splitBuilding(Project& project, int id, cv::Point2d from, cv::Point
 }
 
 BuildingEdit mergeBuildings(Project& project, int id, int other, const cv::Mat& disparity, const std::string& origin) {
-  if (id == other) return {{}, "a building cannot be merged with itself"};
+  if (id == other) return {{}, EditRefusal::SameBuilding, "a building cannot be merged with itself"};
   Building* a = project.find(id);
   const Building* b = project.find(other);
-  if (a == nullptr || b == nullptr) return {{}, "no building " + std::to_string(a == nullptr ? id : other)};
+  if (a == nullptr || b == nullptr) {
+    return {{}, EditRefusal::NoSuchBuilding, "no building " + std::to_string(a == nullptr ? id : other)};
+  }
   const auto merged = io::mergedOutline(a->currentPolygon(), b->currentPolygon(), kMergeGap);
   if (!merged) {
-    return {{}, "buildings " + std::to_string(id) + " and " + std::to_string(other) + " are more than " +
-                    std::to_string(static_cast<int>(kMergeGap)) + " px apart"};
+    return {{}, EditRefusal::TooFarApart,
+            "buildings " + std::to_string(id) + " and " + std::to_string(other) + " are more than " +
+                std::to_string(static_cast<int>(kMergeGap)) + " px apart"};
   }
   const bool outlined = a->hasOutline() || b->hasOutline();
   if (outlined && !a->hasOutline()) a->outline = a->initial;  // reshape() keeps the outlined state
@@ -92,7 +97,7 @@ BuildingEdit mergeBuildings(Project& project, int id, int other, const cv::Mat& 
   a->addHistory("merged", withOrigin(origin, "with building " + std::to_string(other)));
   project.buildings.erase(std::find_if(project.buildings.begin(), project.buildings.end(),
                                        [&](const Building& x) { return x.id == other; }));
-  return {{id}, {}};
+  return {{id}, EditRefusal::None, {}};
 }
 
 }  // namespace delineo::project

@@ -100,6 +100,7 @@ TEST(BuildingEdits, APendingBuildingSplitsIntoPendingPiecesAndABadCutChangesNoth
   const project::Project before = p;
   const project::BuildingEdit refused = project::splitBuilding(p, 1, {20, -5}, {20, 20});
   EXPECT_FALSE(refused.done());
+  EXPECT_EQ(refused.why, project::EditRefusal::NotCutInTwo);
   EXPECT_NE(refused.refusal.find("from outside to outside"), std::string::npos);
   EXPECT_TRUE(p == before);
   ASSERT_TRUE(project::splitBuilding(p, 1, {20, -5}, {20, 45}).done());
@@ -135,9 +136,10 @@ TEST(BuildingEdits, BuildingsFarApartOrOneWithItselfAreNotMerged) {
   const project::Project before = p;
   const project::BuildingEdit apart = project::mergeBuildings(p, 1, 2);
   EXPECT_FALSE(apart.done());
+  EXPECT_EQ(apart.why, project::EditRefusal::TooFarApart);
   EXPECT_NE(apart.refusal.find("more than 3 px apart"), std::string::npos) << apart.refusal;
-  EXPECT_FALSE(project::mergeBuildings(p, 1, 1).done());
-  EXPECT_FALSE(project::mergeBuildings(p, 1, 9).done());
+  EXPECT_EQ(project::mergeBuildings(p, 1, 1).why, project::EditRefusal::SameBuilding);
+  EXPECT_EQ(project::mergeBuildings(p, 1, 9).why, project::EditRefusal::NoSuchBuilding);
   EXPECT_TRUE(p == before);
 }
 

@@ -16,10 +16,14 @@ inline constexpr double kMergeGap = 3.0;
 // Least area (px²) of a piece a split keeps.
 inline constexpr double kMinPieceArea = 4.0;
 
+// Why a split or a merge changed nothing (the GUI words it in the interface's language).
+enum class EditRefusal { None, NoSuchBuilding, NotCutInTwo, SameBuilding, TooFarApart };
+
 // What a split or a merge did: the buildings it changed or made, or why it did nothing.
 struct BuildingEdit {
   std::vector<int> ids;  // the buildings after the edit (a split: the first keeps the id); empty: refused
-  std::string refusal;   // why nothing changed
+  EditRefusal why = EditRefusal::None;
+  std::string refusal;   // why nothing changed, in English
   bool done() const { return !ids.empty(); }
 };
 
