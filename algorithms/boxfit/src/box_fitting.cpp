@@ -181,55 +181,56 @@ void keepEssentialBoxes(BoxFitBuilding& building) {
 
 }  // namespace
 
-BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFitRequest& request,
-                      const BoxFitParams& params, core::Progress* progress) {
-  params.validate();
-  checkInputs(heights, image, request);
+namespace {
+// The building inside the operator's initial polygon (`request.init`).
+BoxFitResult fitFromInit(const cv::Mat& heights32, const cv::Mat& image, const BoxFitRequest& request,
+                         const BoxFitParams& params, core::Progress* progress) {
   BoxFitResult result;
   const cv::Size size = image.size();
-  cv::Mat heights32;
-  heights.convertTo(heights32, CV_32F);
-
-  if (!request.init.outer.empty()) {
-    const cv::Rect2d box = core::boundingBox(request.init.outer);
-    const cv::Rect tight(cv::Point(static_cast<int>(std::floor(box.x)), static_cast<int>(std::floor(box.y))),
-                         cv::Point(static_cast<int>(std::ceil(box.x + box.width)), static_cast<int>(std::ceil(box.y + box.height))));
-    const cv::Rect roi = grown(tight, params.roiMargin, size);
-    double groundMedian = 0;
-    // An opening narrower than the building would take its roof for the ground: the window is
-    // at least twice the initial polygon's longer side.
-    const int window = std::max(params.groundWindow, (2 * std::max(tight.width, tight.height)) | 1);
-    const cv::Mat above = aboveGround(heights32, roi, window, &groundMedian);
-    if (above.empty()) {
-      result.message = "no finite height in the DEM around the initial polygon";
-      return result;
-    }
-    core::Polygon local = request.init;
-    local.holes.clear();
-    for (auto& v : local.outer) v -= cv::Point2d(roi.x, roi.y);
-    const cv::Mat initMask = core::rasterize(local, roi.size());
-    double roof = request.roofHeight ? *request.roofHeight : roofLevel(above, initMask, params.minHeight);
-    if (!std::isfinite(roof) || roof < params.minHeight) {
-      result.message = "nothing inside the initial polygon stands " + metres(params.minHeight) + " above the ground";
-      return result;
-    }
-    BoxFitBuilding building;
-    building.diagnostics.groundHeight = groundMedian;
-    std::string why;
-    if (fitOne(above, initMask, roof, image, roi, size, params, progress, building, why, result.status)) {
-      keepEssentialBoxes(building);
-      result.buildings.push_back(std::move(building));
-    } else {
-      result.message = why;
-    }
+  const cv::Rect2d box = core::boundingBox(request.init.outer);
+  const cv::Rect tight(cv::Point(static_cast<int>(std::floor(box.x)), static_cast<int>(std::floor(box.y))),
+                       cv::Point(static_cast<int>(std::ceil(box.x + box.width)), static_cast<int>(std::ceil(box.y + box.height))));
+  const cv::Rect roi = grown(tight, params.roiMargin, size);
+  double groundMedian = 0;
+  // An opening narrower than the building would take its roof for the ground: the window is
+  // at least twice the initial polygon's longer side.
+  const int window = std::max(params.groundWindow, (2 * std::max(tight.width, tight.height)) | 1);
+  const cv::Mat above = aboveGround(heights32, roi, window, &groundMedian);
+  if (above.empty()) {
+    result.message = "no finite height in the DEM around the initial polygon";
     return result;
   }
+  core::Polygon local = request.init;
+  local.holes.clear();
+  for (auto& v : local.outer) v -= cv::Point2d(roi.x, roi.y);
+  const cv::Mat initMask = core::rasterize(local, roi.size());
+  double roof = request.roofHeight ? *request.roofHeight : roofLevel(above, initMask, params.minHeight);
+  if (!std::isfinite(roof) || roof < params.minHeight) {
+    result.message = "nothing inside the initial polygon stands " + metres(params.minHeight) + " above the ground";
+    return result;
+  }
+  BoxFitBuilding building;
+  building.diagnostics.groundHeight = groundMedian;
+  std::string why;
+  if (fitOne(above, initMask, roof, image, roi, size, params, progress, building, why, result.status)) {
+    keepEssentialBoxes(building);
+    result.buildings.push_back(std::move(building));
+  } else {
+    result.message = why;
+  }
+  return result;
+}
 
-  // Whole image: every region higher than min-height, each fitted like an operator's init.
+// Every region of the image higher than min-height, each fitted like an operator's init; without
+// an operator's word that a building is there, a region none of whose boxes follows straight edges
+// (a tree crown, a heap) is not one.
+BoxFitResult fitWholeImage(const cv::Mat& heights32, const cv::Mat& image, const BoxFitParams& params,
+                           core::Progress* progress) {
+  BoxFitResult result;
+  const cv::Size size = image.size();
   core::setStage(progress, core::StageId::BoxFitSegment);
-  const cv::Rect all(0, 0, size.width, size.height);
   double groundMedian = 0;
-  const cv::Mat above = aboveGround(heights32, all, params.groundWindow, &groundMedian);
+  const cv::Mat above = aboveGround(heights32, cv::Rect(0, 0, size.width, size.height), params.groundWindow, &groundMedian);
   if (above.empty()) {
     result.message = "the DEM has no finite height";
     return result;
@@ -240,7 +241,7 @@ BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFit
                      " above the ground";
     return result;
   }
-  for (size_t i = 0; i < regions.size(); ++i) {
+  for (size_t i = 0; i < regions.size() && result.status != core::RunStatus::Canceled; ++i) {
     if (core::isCanceled(progress)) {
       result.status = core::RunStatus::Canceled;
       break;
@@ -253,23 +254,32 @@ BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFit
     BoxFitBuilding building;
     building.diagnostics.groundHeight = groundMedian;
     std::string why;
-    if (fitOne(above(roi), initMask, roof, image, roi, size, params, progress ? &range : nullptr, building, why,
-               result.status)) {
-      // Without an operator's word that a building is there, a region none of whose boxes
-      // follows straight edges (a tree crown, a heap) is not one.
-      const bool straight = std::any_of(building.boxes.begin(), building.boxes.end(),
-                                        [&](const Box& b) { return b.energy <= params.maxEnergy; });
-      if (straight) {
-        keepEssentialBoxes(building);
-        result.buildings.push_back(std::move(building));
-      }
+    if (!fitOne(above(roi), initMask, roof, image, roi, size, params, progress ? &range : nullptr, building, why,
+                result.status)) {
+      continue;
     }
-    if (result.status == core::RunStatus::Canceled) break;
+    const bool straight = std::any_of(building.boxes.begin(), building.boxes.end(),
+                                      [&](const Box& b) { return b.energy <= params.maxEnergy; });
+    if (straight) {
+      keepEssentialBoxes(building);
+      result.buildings.push_back(std::move(building));
+    }
   }
   if (result.buildings.empty() && result.status == core::RunStatus::Completed) {
     result.message = std::to_string(regions.size()) + " raised region(s) but no building fitted";
   }
   return result;
+}
+}  // namespace
+
+BoxFitResult fitBoxes(const cv::Mat& heights, const cv::Mat& image, const BoxFitRequest& request,
+                      const BoxFitParams& params, core::Progress* progress) {
+  params.validate();
+  checkInputs(heights, image, request);
+  cv::Mat heights32;
+  heights.convertTo(heights32, CV_32F);
+  if (!request.init.outer.empty()) return fitFromInit(heights32, image, request, params, progress);
+  return fitWholeImage(heights32, image, params, progress);
 }
 
 cv::Mat heightsFromDisparity(const cv::Mat& disparity, double groundDisparity, double metresPerPixel) {
