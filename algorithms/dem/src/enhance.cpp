@@ -179,6 +179,26 @@ cv::Mat thickParts(const cv::Mat& mask, int size) {
 // of the ground around the footprint; a footprint whose roof does not stand clear of its ground
 // is left as it is. Paints its free roof pixels into `roofAround` (for the outer band) and
 // returns the bounding box of the footprint's pixels afterwards.
+// The 8-connected components of `mask` (CV_8U) that have a pixel in `seeds`, as a mask.
+cv::Mat componentsTouching(const cv::Mat& mask, const cv::Mat& seeds) {
+  cv::Mat components;
+  const int n = cv::connectedComponents(mask, components, 8, CV_32S);
+  std::vector<uchar> touches(static_cast<size_t>(n), 0);
+  for (int y = 0; y < mask.rows; ++y) {
+    for (int x = 0; x < mask.cols; ++x) {
+      const int c = components.at<int>(y, x);
+      if (c > 0 && seeds.at<uchar>(y, x) != 0) touches[static_cast<size_t>(c)] = 1;
+    }
+  }
+  cv::Mat out(mask.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < mask.rows; ++y) {
+    for (int x = 0; x < mask.cols; ++x) {
+      if (touches[static_cast<size_t>(components.at<int>(y, x))] != 0) out.at<uchar>(y, x) = 255;
+    }
+  }
+  return out;
+}
+
 cv::Rect reconcileFootprint(const cv::Mat& dem, cv::Mat& labels, int label, cv::Rect box,
                             const EnhanceParams& params, FootprintEnhancement& info,
                             cv::Mat& roofAround) {
@@ -216,50 +236,15 @@ cv::Rect reconcileFootprint(const cv::Mat& dem, cv::Mat& labels, int label, cv::
   // Ground inside: thick parts anywhere, and any ground in the wall band that reaches the ground
   // outside (the matcher fattens roofs outwards, so ground seen inside the outline is ground).
   cv::Mat removed = thickParts(inside & groundLike, size);
-  {
-    cv::Mat parts;
-    const int m = cv::connectedComponents(groundLike & (free | (inside & (depth <= params.wallBand))),
-                                          parts, 8, CV_32S);
-    std::vector<uchar> outside(static_cast<size_t>(m), 0);
-    for (int y = 0; y < roi.height; ++y) {
-      for (int x = 0; x < roi.width; ++x) {
-        if (free.at<uchar>(y, x) != 0) outside[static_cast<size_t>(parts.at<int>(y, x))] = 1;
-      }
-    }
-    for (int y = 0; y < roi.height; ++y) {
-      for (int x = 0; x < roi.width; ++x) {
-        const int c = parts.at<int>(y, x);
-        if (c > 0 && outside[static_cast<size_t>(c)] != 0 && inside.at<uchar>(y, x) != 0) {
-          removed.at<uchar>(y, x) = 255;
-        }
-      }
-    }
-  }
+  removed |= inside & componentsTouching(groundLike & (free | (inside & (depth <= params.wallBand))), free);
   // Roof outside the outline joins when its thick part touches the footprint.
-  const cv::Mat candidates = thickParts(free & roofLike & (away <= params.outlineReach), size);
-  cv::Mat components;
-  const int n = cv::connectedComponents(candidates, components, 8, CV_32S);
-  std::vector<uchar> touches(static_cast<size_t>(n), 0);
   cv::Mat near;
   cv::dilate(inside & ~removed, near, cv::Mat::ones(3, 3, CV_8U));
-  for (int y = 0; y < roi.height; ++y) {
-    for (int x = 0; x < roi.width; ++x) {
-      const int c = components.at<int>(y, x);
-      if (c > 0 && near.at<uchar>(y, x) != 0) touches[static_cast<size_t>(c)] = 1;
-    }
-  }
-  for (int y = 0; y < roi.height; ++y) {
-    for (int x = 0; x < roi.width; ++x) {
-      int& l = own.at<int>(y, x);
-      if (removed.at<uchar>(y, x) != 0) {
-        l = 0;
-        ++info.removedPixels;
-      } else if (touches[static_cast<size_t>(components.at<int>(y, x))] != 0) {
-        l = label;
-        ++info.addedPixels;
-      }
-    }
-  }
+  const cv::Mat joined = componentsTouching(thickParts(free & roofLike & (away <= params.outlineReach), size), near);
+  info.removedPixels += cv::countNonZero(removed);
+  info.addedPixels += cv::countNonZero(joined & ~removed);
+  own.setTo(0, removed);
+  own.setTo(label, joined & ~removed);
   const cv::Mat after = own == label;
   if (cv::countNonZero(after) == 0) return box;  // never happens: the roof core is roof-like
   return cv::boundingRect(after) + roi.tl();
