@@ -65,13 +65,16 @@ void expectSameFeatures(const std::vector<core::Feature>& actual, const std::vec
   }
 }
 
-GeoReference utmGeo() {
+// North-up 0.5 m pixels from the top-left corner (x0, y0) in EPSG `epsg`.
+GeoReference halfMetreGeo(double x0, double y0, int epsg) {
   GeoReference geo;
-  geo.geoTransform = {741000.0, 0.5, 0.0, 3737000.0, 0.0, -0.5};
+  geo.geoTransform = {x0, 0.5, 0.0, y0, 0.0, -0.5};
   geo.hasTransform = true;
-  geo.crsWkt = wktOfEpsg(32616);
+  geo.crsWkt = wktOfEpsg(epsg);
   return geo;
 }
+
+GeoReference utmGeo() { return halfMetreGeo(741000.0, 3737000.0, 32616); }
 
 class VectorRoundTrip : public ::testing::TestWithParam<std::string> {};
 
@@ -113,13 +116,7 @@ INSTANTIATE_TEST_SUITE_P(Formats, VectorRoundTrip, ::testing::Values(".geojson",
                          [](const auto& paramInfo) { return paramInfo.param.substr(1); });
 
 // A 0.5 m image over Toulouse in UTM 31N.
-GeoReference toulouseGeo() {
-  GeoReference geo;
-  geo.geoTransform = {374000.0, 0.5, 0.0, 4829000.0, 0.0, -0.5};
-  geo.hasTransform = true;
-  geo.crsWkt = wktOfEpsg(32631);
-  return geo;
-}
+GeoReference toulouseGeo() { return halfMetreGeo(374000.0, 4829000.0, 32631); }
 
 // Map coordinates of `ring` (pixels of `geo`) brought into EPSG `epsg` (x = easting / longitude).
 std::vector<cv::Point2d> ringInCrs(const core::Ring& ring, const GeoReference& geo, int epsg) {
