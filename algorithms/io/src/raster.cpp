@@ -299,6 +299,16 @@ Raster readRaster(const std::string& path, const ReadOptions& options) {
   return raster;
 }
 
+RasterInfo readRasterInfo(const std::string& path) {
+  detail::ensureGdalRegistered();
+  requireFileOnDisk(path);
+  detail::ScopedGdalErrors errors;
+  DatasetPtr dataset(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR, nullptr, nullptr, nullptr));
+  if (!dataset) throw Error(ErrorCode::UnreadableFile, errors.describe("not a readable raster"), path);
+  const RasterShape shape = checkedShape(dataset.get(), path);
+  return {cv::Size(shape.width, shape.height), shape.bands, georeferenceOf(dataset.get())};
+}
+
 cv::Mat readGreyFloat(const std::string& path, GeoReference* geo) {
   ReadOptions options;
   options.type = PixelType::Float32;

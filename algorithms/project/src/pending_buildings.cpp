@@ -195,10 +195,10 @@ ImportSummary importOutlines(Project& project, const std::vector<core::Feature>&
 
 ImportSummary importOutlinesFile(Project& project, const std::string& path, ImportOptions options) {
   if (project.left.empty()) throw Error(ErrorCode::InvalidParameter, "the project has no left image");
-  const io::Raster left = io::readRaster(project.left);
+  const io::RasterInfo left = io::readRasterInfo(project.left);
   const std::vector<core::Feature> features = io::readFeatures(path, left.geo);
   if (options.source.empty()) options.source = std::filesystem::path(path).filename().string();
-  return importOutlines(project, features, left.data.size(), options);
+  return importOutlines(project, features, left.size, options);
 }
 
 }  // namespace delineo::project

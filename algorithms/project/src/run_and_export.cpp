@@ -50,7 +50,7 @@ io::GeoReference leftGeoReference(const Project& project) {
   std::error_code ec;
   if (project.left.empty() || !fs::exists(project.left, ec)) return {};
   try {
-    return io::readRaster(project.left).geo;
+    return io::readRasterInfo(project.left).geo;
   } catch (const Error&) {
     return {};
   }

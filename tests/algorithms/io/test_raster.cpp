@@ -522,3 +522,20 @@ TEST(StretchTo8Bit, BandsShareOneRangeSoColoursKeepTheirBalance) {
   EXPECT_LT(pixel[0], pixel[1]);
   EXPECT_LT(pixel[1], pixel[2]);
 }
+
+TEST(ReadRasterInfo, TheHeaderGivesWhatReadRasterGivesWithoutThePixels) {
+  delineo::io::testing::TempDir dir;
+  delineo::io::GeoReference geo;
+  geo.geoTransform = {500000.0, 0.5, 0.0, 4000000.0, 0.0, -0.5};
+  geo.hasTransform = true;
+  geo.crsWkt = delineo::io::testing::wktOfEpsg(32631);
+  const std::string path = dir.file("rgb.tif");
+  delineo::io::writeGeoTiff(path, cv::Mat(30, 40, CV_8UC3, cv::Scalar(1, 2, 3)), geo);
+  const delineo::io::RasterInfo info = delineo::io::readRasterInfo(path);
+  const delineo::io::Raster raster = delineo::io::readRaster(path);
+  EXPECT_EQ(info.size, raster.data.size());
+  EXPECT_EQ(info.bands, 3);
+  EXPECT_EQ(info.geo.geoTransform, raster.geo.geoTransform);
+  EXPECT_EQ(info.geo.crsWkt, raster.geo.crsWkt);
+  EXPECT_THROW(delineo::io::readRasterInfo(dir.file("missing.tif")), delineo::core::Error);
+}

@@ -45,6 +45,15 @@ struct ReadOptions {
 // or 64-bit types, 2 bands, a declared size above ReadOptions::maxBytes).
 Raster readRaster(const std::string& path, const ReadOptions& options = {});
 
+// What a raster's header says, without reading its pixels: its size, bands and georeferencing.
+// Throws like readRaster for a file it would refuse by its header.
+struct RasterInfo {
+  cv::Size size;
+  int bands = 0;
+  GeoReference geo;
+};
+RasterInfo readRasterInfo(const std::string& path);
+
 // Reads a raster as a single-band float32 image ready for matching (grey, NaN for nodata).
 cv::Mat readGreyFloat(const std::string& path, GeoReference* geo = nullptr);
 
