@@ -141,8 +141,7 @@ project::ImportSummary Document::importOutlines(const std::vector<core::Feature>
   project::ImportOptions withOrigin = options;
   withOrigin.origin = "delineo";
   const project::ImportSummary summary = project::importOutlines(after, features, pair_.left.size(), withOrigin);
-  pushBuildings(after, summary.added,
-                     tr("Import %n outline(s)", nullptr, static_cast<int>(summary.added.size())));
+  pushBuildings(after, summary.added, tr("Import %n outline(s)", nullptr, static_cast<int>(summary.added.size())));
   return summary;
 }
 

@@ -6,14 +6,13 @@
 
 #include "delineo/io/polygon_sets.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "history_detail.hpp"
 
 namespace delineo::project {
 
-namespace {
-std::string withOrigin(const std::string& origin, const std::string& text) {
-  return origin.empty() ? text : origin + ": " + text;
-}
+using detail::withOrigin;
 
+namespace {
 // The building on `polygon` as an operator's edit leaves it: its outline when it had one (status
 // Corrected, energy unknown, roof height read on `disparity`), else its initial polygon (Pending).
 void reshape(const Project& project, Building& b, const core::Polygon& polygon, const cv::Mat& disparity) {

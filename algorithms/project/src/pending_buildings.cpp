@@ -16,8 +16,11 @@
 #include "delineo/io/raster.hpp"
 #include "delineo/io/vector.hpp"
 #include "delineo/project/pipeline.hpp"
+#include "history_detail.hpp"
 
 namespace delineo::project {
+
+using detail::withOrigin;
 
 using core::Error;
 using core::ErrorCode;
@@ -77,9 +80,6 @@ Building pendingBuilding(const Project& project, const core::Feature& feature, c
   return b;
 }
 
-std::string withOrigin(const std::string& origin, const std::string& text) {
-  return origin.empty() ? text : origin + ": " + text;
-}
 }  // namespace
 
 std::vector<int> addProposedBuildings(Project& project, const std::vector<core::Feature>& proposals,
