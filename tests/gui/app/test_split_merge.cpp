@@ -17,7 +17,6 @@
 #include <opencv2/core.hpp>
 
 #include "buildings_model.hpp"
-#include "delineo/io/raster.hpp"
 #include "delineo/project/pipeline.hpp"
 #include "delineo/widgets/image_view.hpp"
 #include "document.hpp"
@@ -86,14 +85,9 @@ class SplitMergeTest : public QObject {
 
   // A 640 x 480 noise pair with the disparity of roofDisparity().
   bool openPair() {
-    cv::Mat image(480, 640, CV_8U);
-    cv::randu(image, 0, 255);
-    const QString left = dir_.filePath(QStringLiteral("left.tif"));
-    const QString right = dir_.filePath(QStringLiteral("right.tif"));
-    io::writeGeoTiff(left.toStdString(), image);
-    io::writeGeoTiff(right.toStdString(), image);
-    if (!window_->openPair(left, right)) return false;
-    doc()->setDisparity(roofDisparity(image.size()));
+    const cv::Size size(640, 480);
+    if (!guitest::openPairWithoutHeights(*window_, dir_, size)) return false;
+    doc()->setDisparity(roofDisparity(size));
     return true;
   }
 
