@@ -119,7 +119,13 @@ std::optional<std::string> attributeText(const core::Feature& feature, const std
   }
   return std::nullopt;  // null
 }
-}  // namespace
+
+// An imported polygon placed on the left image (`imageSize`): as it is when inside, else its
+// largest part on the image (`clipped`); an empty polygon when less than kMinImportedArea is left.
+struct ImportedPolygon {
+  core::Polygon polygon;
+  bool clipped = false;
+};
 
 ImportedPolygon placeOnImage(const core::Polygon& polygon, cv::Size imageSize) {
   ImportedPolygon placed;
@@ -143,6 +149,8 @@ ImportedPolygon placeOnImage(const core::Polygon& polygon, cv::Size imageSize) {
   if (core::area(placed.polygon) < kMinImportedArea) placed.polygon = {};
   return placed;
 }
+
+}  // namespace
 
 ImportSummary importOutlines(Project& project, const std::vector<core::Feature>& features, cv::Size imageSize,
                              const ImportOptions& options) {

@@ -254,22 +254,16 @@ struct ImportSummary {
 };
 // Least area (px²) of an imported polygon on the left image.
 inline constexpr double kMinImportedArea = 16.0;
-// An imported polygon placed on the left image (`imageSize`): as it is when inside, else its
-// largest part on the image (`clipped`); an empty polygon when less than kMinImportedArea is left.
-struct ImportedPolygon {
-  core::Polygon polygon;
-  bool clipped = false;
-};
-ImportedPolygon placeOnImage(const core::Polygon& polygon, cv::Size imageSize);
-// Adds each of `features` (left-image pixels) placed on the image that is not already a building
-// (kProposalOverlap, as for proposals) as a Pending building: its polygon as the initial polygon,
-// its roof interval when it carries detect's roof_disparity_min/max, its `idField` value as
-// sourceId, an "imported" history entry. Throws InvalidParameter when no feature has `idField`.
+// Adds each of `features` (left-image pixels) that lies on the image (one across its border cut
+// there, its largest part kept; less than kMinImportedArea left: outside) and is not already a
+// building (kProposalOverlap, as for proposals) as a Pending building: its polygon as the initial
+// polygon, its roof interval when it carries detect's roof_disparity_min/max, its `idField` value
+// as sourceId, an "imported" history entry. Throws InvalidParameter when no feature has `idField`.
 ImportSummary importOutlines(Project& project, const std::vector<core::Feature>& features, cv::Size imageSize,
                              const ImportOptions& options);
 // importOutlines() of a vector file (GeoJSON, GeoPackage, Shapefile) read with the left image's
-// georeferencing (io::readFeatures: map coordinates in the image's CRS, or pixels without one).
-// Throws like io::readRaster for the left image and io::readFeatures for the file.
+// georeferencing (io::readFeatures: map coordinates brought into the image's CRS, or pixels
+// without one). Throws like io::readRasterInfo for the left image and io::readFeatures for the file.
 ImportSummary importOutlinesFile(Project& project, const std::string& path, ImportOptions options);
 
 // ---- elevation rasters (src/elevation_rasters.cpp) ----
